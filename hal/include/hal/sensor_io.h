@@ -1,0 +1,33 @@
+// Sources and sinks the localization loop uses. A backend (sim, socketcan, serial) implements
+// them; the firmware sees only these interfaces. All calls are non-blocking: poll() returns
+// false when nothing is pending.
+#pragma once
+
+#include "hal/msg/health.h"
+#include "hal/msg/laser_scan.h"
+#include "hal/msg/odometry.h"
+#include "hal/msg/pose_estimate.h"
+
+namespace hal {
+
+class LaserScanSource {
+ public:
+  virtual ~LaserScanSource() = default;
+  // Copies the next complete scan into *out; false if none is pending.
+  virtual bool poll(LaserScan* out) = 0;
+};
+
+class OdometrySource {
+ public:
+  virtual ~OdometrySource() = default;
+  virtual bool poll(Odometry* out) = 0;
+};
+
+class PoseSink {
+ public:
+  virtual ~PoseSink() = default;
+  virtual void publish(const PoseEstimate& estimate) = 0;
+  virtual void publish_health(const Health& health) = 0;
+};
+
+}  // namespace hal

@@ -1,0 +1,54 @@
+// BenchJson: collects named figures and writes the flat JSON object scripts/bench.sh expects
+// (build/bench/NAME.json), keeping insertion order; also echoes each figure to stdout.
+#pragma once
+
+#include <cmath>
+#include <cstdio>
+#include <fstream>
+#include <string>
+#include <utility>
+#include <vector>
+
+namespace sim {
+
+class BenchJson {
+ public:
+  void add(const std::string& key, double value) {
+    char buf[64];
+    if (!std::isfinite(value)) {
+      std::snprintf(buf, sizeof(buf), "null");
+    } else {
+      std::snprintf(buf, sizeof(buf), "%.6g", value);
+    }
+    put(key, buf);
+  }
+  void add_int(const std::string& key, long long value) { put(key, std::to_string(value)); }
+  void add_bool(const std::string& key, bool value) { put(key, value ? "true" : "false"); }
+  void add_string(const std::string& key, const std::string& value) { put(key, "\"" + value + "\""); }
+
+  bool write(const std::string& path) const {
+    std::ofstream out(path);
+    if (!out) {
+      std::fprintf(stderr, "bench: cannot write %s\n", path.c_str());
+      return false;
+    }
+    out << "{\n";
+    for (size_t i = 0; i < items_.size(); ++i) {
+      out << "  \"" << items_[i].first << "\": " << items_[i].second << (i + 1 < items_.size() ? ",\n" : "\n");
+    }
+    out << "}\n";
+    return static_cast<bool>(out);
+  }
+
+ private:
+  void put(const std::string& key, const std::string& json) {
+    std::printf("  %-36s %s\n", key.c_str(), json.c_str());
+    for (auto& kv : items_) {
+      if (kv.first == key) { kv.second = json; return; }
+    }
+    items_.emplace_back(key, json);
+  }
+  std::vector<std::pair<std::string, std::string>> items_;
+};
+
+}  // namespace sim

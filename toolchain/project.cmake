@@ -1,0 +1,71 @@
+# Project-wide options and the one place where firmware/hal compile flags live.
+option(MMLFW_BUILD_HOST_TOOLS "Build sim/ host tools (off for cross builds)" ON)
+option(MMLFW_BUILD_BENCHMARKS "Build benchmarks (Google Benchmark / harness)" ON)
+set(MMLFW_SANITIZE "" CACHE STRING "Sanitizers: '', 'address' (ASan+UBSan) or 'thread'")
+
+# Eigen is header-only; for cross builds the host copy under /usr/include/eigen3 is the same.
+find_path(EIGEN3_INCLUDE_DIR NAMES Eigen/Core PATHS /usr/include/eigen3 NO_CMAKE_FIND_ROOT_PATH)
+if(NOT EIGEN3_INCLUDE_DIR)
+  message(FATAL_ERROR "Eigen3 not found (install libeigen3-dev: scripts/setup.sh)")
+endif()
+add_library(eigen3 INTERFACE)
+target_include_directories(eigen3 SYSTEM INTERFACE ${EIGEN3_INCLUDE_DIR})
+# Eigen must never touch the heap in firmware: fixed-size types only, checked at run time too.
+target_compile_definitions(eigen3 INTERFACE EIGEN_NO_MALLOC EIGEN_DONT_PARALLELIZE)
+
+# Reproducibility across x86-64 and aarch64: no FMA contraction (GCC contracts by default on
+# aarch64, which changes float results), no fast-math anywhere.
+add_compile_options(-ffp-contract=off)
+
+if(MMLFW_SANITIZE STREQUAL "address")
+  add_compile_options(-fsanitize=address,undefined -fno-omit-frame-pointer -fno-sanitize-recover=undefined)
+  add_link_options(-fsanitize=address,undefined)
+elseif(MMLFW_SANITIZE STREQUAL "thread")
+  add_compile_options(-fsanitize=thread -fno-omit-frame-pointer)
+  add_link_options(-fsanitize=thread)
+endif()
+
+# Embedded rules for firmware/ and hal/ targets (DEVELOPERS.md): no exceptions, no RTTI, warnings
+# are errors. Tests and sim/ are ordinary C++20 and do not call this.
+function(mmlfw_embedded_target tgt)
+  target_compile_options(${tgt} PRIVATE
+    -fno-exceptions -fno-rtti -Wall -Wextra -Wshadow -Werror -Wno-psabi)
+  target_link_libraries(${tgt} PUBLIC eigen3)
+  set_property(GLOBAL APPEND PROPERTY MMLFW_EMBEDDED_LIBS ${tgt})
+endfunction()
+
+# GoogleTest: built from Debian's source package so that cross builds get a matching library.
+if(NOT TARGET gtest)
+  set(INSTALL_GTEST OFF CACHE BOOL "" FORCE)
+  set(BUILD_GMOCK OFF CACHE BOOL "" FORCE)
+  add_subdirectory(/usr/src/googletest ${CMAKE_BINARY_DIR}/_googletest EXCLUDE_FROM_ALL)
+endif()
+
+# mmlfw_add_test(NAME SOURCES... LIBS ...): a gtest binary registered with CTest. Tests sit
+# beside the code they test (Cartographer style); the fault handler is made fatal by test_main.
+function(mmlfw_add_test name)
+  cmake_parse_arguments(T "" "" "SOURCES;LIBS;LABELS" ${ARGN})
+  add_executable(${name} ${T_SOURCES})
+  target_link_libraries(${name} PRIVATE ${T_LIBS} mmlfw_test_main gtest)
+  add_test(NAME ${name} COMMAND ${name})
+  if(T_LABELS)
+    set_tests_properties(${name} PROPERTIES LABELS "${T_LABELS}")
+  endif()
+  if(DEFINED ENV{MMLFW_DATA_DIR})
+    set_tests_properties(${name} PROPERTIES ENVIRONMENT "MMLFW_DATA_DIR=$ENV{MMLFW_DATA_DIR}")
+  else()
+    set_tests_properties(${name} PROPERTIES ENVIRONMENT "MMLFW_DATA_DIR=${CMAKE_SOURCE_DIR}/../shared/data")
+  endif()
+endfunction()
+
+# mmlfw_add_benchmark(NAME SOURCES... LIBS ...): host benchmark executable bench_NAME in
+# build/<preset>/bench/, run by scripts/bench.sh NAME with the JSON output path as argv[1].
+function(mmlfw_add_benchmark name)
+  cmake_parse_arguments(B "" "" "SOURCES;LIBS" ${ARGN})
+  if(NOT MMLFW_BUILD_BENCHMARKS)
+    return()
+  endif()
+  add_executable(bench_${name} ${B_SOURCES})
+  target_link_libraries(bench_${name} PRIVATE ${B_LIBS} sim_common)
+  set_target_properties(bench_${name} PROPERTIES RUNTIME_OUTPUT_DIRECTORY ${CMAKE_BINARY_DIR}/bench)
+endfunction()
