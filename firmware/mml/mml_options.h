@@ -1,0 +1,92 @@
+// MmlOptions: every knob of MML (dissertation Ch. 5, Tables 5.1–5.4) in one plain struct, validated
+// once at start-up (Cartographer style). Defaults are the thesis's values "chosen once for all
+// scenarios" (Sec. 5.7): σ²_trans,max = 30 cm², σ²_rot,max = 50 deg², δ_r = 0.8, ξ_r² = 8,
+// ξ_med = 10, τ_tr = 10, k = 4, δ_l = 0.01, Δ_u = 0.07, Ω_thres0 = 0.7, τ_up = 10.
+#pragma once
+
+#include <cstddef>
+#include <cstdint>
+
+#include "firmware/base/status.h"
+
+namespace fw {
+namespace mml {
+
+// Compile-time capacities (fixed storage; the options may use less).
+constexpr std::size_t kMaxHypotheses = 4096;   // hypotheses per step handed to the interpreter
+constexpr std::size_t kMaxClusters = 512;      // clusters per step
+constexpr std::size_t kMaxMedianWindow = 64;   // τ_m
+constexpr std::size_t kMaxThresholdWindow = 64;  // τ_tr
+constexpr std::size_t kMaxUnknownWindow = 64;  // τ_up
+
+struct MmlOptions {
+  // --- Hypothesis filter (Eq. 5.3): max rotation about x (roll) and y (pitch) of a 3-D frame
+  // transform; a flipped 2-D triangle frame has roll = π and is discarded.
+  float filter_max_roll_rad = 0.5f;
+  float filter_max_pitch_rad = 0.5f;
+
+  // --- Hierarchical K-means clustering (Sec. 5.3.1).
+  float sigma2_trans_max_m2 = 0.0030f;   // 30 cm²
+  float sigma2_rot_max_deg2 = 50.0f;     // 50 deg²
+  std::uint32_t kmeans_iterations = 8;   // Lloyd iterations per 2-means split
+
+  // --- Rating (Eq. 5.4–5.6). Σα = 1.
+  float alpha[4] = {0.4f, 0.1f, 0.1f, 0.4f};
+  bool stretch_quality = true;  // Eq. 5.5: f(w4) = (w4 − Ω_thres)/(1 − Ω_thres)
+
+  // --- Localization constraints (Eq. 5.17) and soft rule (Eq. 5.22).
+  float delta_r = 0.8f;         // r(C) > δ_r
+  float xi_r2 = 8.0f;           // d²(r_h, R_h) < ξ_r² (χ² quantile, 3 dof)
+  float xi_med = 10.0f;         // σ_med < ξ_med
+  std::uint32_t tau_m = 10;     // window of d² values for the median test (Eq. 5.15–5.16)
+  std::uint32_t med_min_samples = 5;  // d² samples needed before σ_med is trusted
+  bool soft_rule = true;        // Eq. 5.22
+  std::uint32_t soft_max_blind_steps = 3;  // steps without any hypothesis tolerated in soft mode
+
+  // Covariances for Eq. 5.9–5.13: odometry noise per step (P_r) and a floor added to cluster
+  // covariances (P_prev, P_h) — a one-hypothesis cluster has zero spread but is not exact.
+  float odom_sigma_trans_per_m = 0.10f;    // σ_t = a·|Δt| + floor
+  float odom_sigma_rot_per_rad = 0.10f;    // σ_θ = b·|Δθ| + c·|Δt| + floor
+  float odom_sigma_rot_per_m = 0.05f;
+  float odom_sigma_trans_floor_m = 0.02f;
+  float odom_sigma_rot_floor_rad = 0.02f;
+  float hyp_sigma_trans_floor_m = 0.10f;
+  float hyp_sigma_rot_floor_rad = 0.035f;  // ≈ 2°
+
+  // --- Matching threshold adaptation (Sec. 5.3.3, Eq. 5.18–5.21).
+  bool bollinger = true;
+  float omega_thres0 = 0.7f;
+  std::uint32_t tau_tr = 10;
+  float bollinger_k = 4.0f;
+  float bollinger_delta_l = 0.01f;
+  float bollinger_delta_u = 0.07f;
+  float omega_thres_min = 0.30f;   // never ask pRANSAM for less than this
+  float omega_thres_max = 0.95f;
+
+  // --- Unknown regions (Sec. 5.6, Eq. 5.37).
+  bool detect_unknown = true;
+  std::uint32_t tau_up = 10;
+  float outside_map_contact = 0.35f;   // Ω' below ⇒ outside-map
+  float contact_distance_m = 0.15f;    // "contact" = a map point within this distance
+
+  // --- Local map (Sec. 5.4–5.5).
+  std::uint32_t local_map_fragments = 0;   // keep only the last m fragments (0 = all that fit)
+  bool reduce_observations = false;        // Eq. 5.28–5.30: keep information-rich observations
+  float reduction_min_jump = 2.0f;         // Δ(|C(t)|)
+  bool correct_local_map = false;          // Eq. 5.23–5.27 / App. D
+  std::uint32_t correction_iterations = 20;
+  float correction_step = 0.05f;
+  std::uint32_t min_local_map_points = 150;  // no matching below (status searching)
+
+  // --- Matching (pRANSAM collect-all).
+  bool precomputed_table = true;
+  std::uint32_t matching_iterations = 30000;
+  std::uint32_t max_local_map_points = 1500;  // subsampled for matching
+  std::uint32_t max_hypotheses = 2048;        // ≤ kMaxHypotheses
+  std::uint64_t seed = 1;
+
+  Status validate() const;
+};
+
+}  // namespace mml
+}  // namespace fw
