@@ -1,0 +1,96 @@
+// CARMEN laser-log reader and writer (host tool). Reads the record types present in the Radish /
+// Freiburg benchmark logs (../shared/data/README.md): FLASER, RLASER, ROBOTLASER1, RAWLASER1..4,
+// ODOM, PARAM, NEFF (counted only), '#' comments; other message names (SYNC, TRUEPOS, GPS…) are
+// counted in `other_records` and otherwise ignored. Plain text or gzip (zlib; detected by magic).
+//
+// Strict by default: a malformed line (wrong field count for the beam count it declares, non-numeric
+// or non-finite number, negative range, truncated line) makes read_carmen_log return false with an
+// error "path:line: problem". With skip_bad_lines the line is dropped, counted in bad_lines and its
+// message kept in bad_line_messages (first 100). A missing file or corrupt gzip stream is always an
+// error.
+//
+// Scan geometry: ROBOTLASER1 / RAWLASER carry start angle, resolution and maximum range. FLASER /
+// RLASER carry none, so it follows from the beam count n (README): n even → spacing π/n from -π/2
+// (180 → 1°, 360 → 0.5°), n odd → spacing π/(n-1) from -π/2 to +π/2 inclusive (181, 361). Their
+// max_range is the PARAM robot_front_laser_max / robot_rear_laser_max when the log has it, else the
+// largest reading of that record type in the log (the loggers store "no return" as the sensor
+// maximum: 81.83 m intel, 81.91 m fr079, 50.0 m aces).
+#pragma once
+
+#include <cstddef>
+#include <cstdint>
+#include <string>
+#include <utility>
+#include <vector>
+
+#include "firmware/base/se2.h"
+#include "hal/msg/laser_scan.h"
+
+namespace sim {
+
+struct CarmenScan {
+  size_t line = 0;   // 1-based line number in the file
+  size_t index = 0;  // 0-based among scan records (= flaser_index of *.corrected-poses.txt)
+  std::string type;  // "FLASER", "RLASER", "ROBOTLASER1", "RAWLASER1".."RAWLASER4"
+  double ipc_timestamp = 0, logger_timestamp = 0;
+  float angle_min = 0, angle_increment = 0, max_range = 0;
+  std::vector<float> ranges;
+  fw::Se2d pose;  // FLASER/RLASER: first triple; ROBOTLASER1: laser pose; RAWLASER: zero
+  fw::Se2d odom;  // FLASER/RLASER: odom triple; ROBOTLASER1: robot pose; RAWLASER: zero
+};
+
+struct CarmenOdom {
+  size_t line = 0;
+  fw::Se2d pose;
+  double tv = 0, rv = 0, ipc_timestamp = 0, logger_timestamp = 0;
+};
+
+struct CarmenLog {
+  std::string path;
+  std::vector<CarmenScan> scans;
+  std::vector<CarmenOdom> odom;
+  std::vector<std::pair<std::string, std::string>> params;
+  size_t bad_lines = 0;
+  std::vector<std::string> bad_line_messages;
+  // Additional counters (beyond interfaces.md §1).
+  size_t lines = 0;          // lines read
+  size_t comment_lines = 0;  // lines starting with '#'
+  size_t neff_records = 0;   // NEFF lines (corrected logs)
+  size_t other_records = 0;  // well-formed lines of message types not listed above
+  size_t count(const std::string& type) const;  // scan records of that type ("FLASER", …)
+};
+
+struct CarmenReadOptions {
+  bool skip_bad_lines = false;
+  size_t max_scans = 0;  // 0 = all; reading stops after this many scan records
+};
+
+// Reads a CARMEN log (plain or .gz). On failure returns false and sets *error to "path:line: …"
+// (or "path: …" for file-level problems); *out then holds what was read before the error.
+bool read_carmen_log(const std::string& path, const CarmenReadOptions& options, CarmenLog* out,
+                     std::string* error);
+
+// Parses a whole log already in memory (same rules; `name` is used in messages).
+bool parse_carmen_log(const std::string& name, const char* data, size_t size, const CarmenReadOptions& options,
+                      CarmenLog* out, std::string* error);
+
+// Converts to the HAL message. Readings at/above max_range are "no return" (range_max = max_range),
+// range_min = 0.01 m (the logs' resolution; 0 means "no reading" on SICK). Beams beyond
+// hal::LaserScan::kMaxBeams are dropped (none of the logs in ../shared/data exceed 361). scan_id = index.
+hal::LaserScan to_laser_scan(const CarmenScan& scan, uint64_t timestamp_ns);
+
+// Writer for replay tools: FLASER and ODOM lines in the classic format (ranges with 3 decimals,
+// poses with 6, timestamps with 6 decimals), "#" header, PARAMs first. Records are written in
+// timestamp-agnostic file order: all scans and odometry merged by line number (so a log read and
+// written keeps its order). Returns false with a message naming the path on I/O failure.
+struct CarmenWriteOptions {
+  bool gzip = false;        // also implied by a path ending in ".gz"
+  std::string hostname = "nohost";
+};
+bool write_carmen_log(const std::string& path, const CarmenLog& log, const CarmenWriteOptions& options,
+                      std::string* error);
+
+// Reads a whole file (plain or gzip, detected by the 1f 8b magic) into memory.
+bool read_file_maybe_gz(const std::string& path, std::string* data, std::string* error);
+
+}  // namespace sim

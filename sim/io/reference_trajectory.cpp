@@ -1,0 +1,189 @@
+#include "sim/io/reference_trajectory.h"
+
+#include <algorithm>
+#include <charconv>
+#include <cmath>
+#include <cstring>
+#include <limits>
+#include <string_view>
+
+namespace sim {
+namespace {
+
+constexpr double kRad2Deg = 180.0 / 3.14159265358979323846;
+
+bool parse_double(std::string_view tok, double* v) {
+  const char* b = tok.data();
+  const char* e = b + tok.size();
+  if (b != e && *b == '+') ++b;
+  if (b == e) return false;
+  auto r = std::from_chars(b, e, *v);
+  return r.ec == std::errc() && r.ptr == e && std::isfinite(*v);
+}
+
+fw::Se2d chain(const fw::Se2d& c, const fw::Se2d& o_anchor, const fw::Se2d& o_i) {
+  return c.compose(o_anchor.between(o_i));
+}
+
+fw::Se2d blend(const fw::Se2d& a, const fw::Se2d& b, double w) {
+  return fw::Se2d((1 - w) * a.x + w * b.x, (1 - w) * a.y + w * b.y,
+                  fw::wrap_angle(a.theta + w * fw::wrap_angle(b.theta - a.theta)));
+}
+
+// Corrected poses usable with this log (index in range), in index order.
+std::vector<const CorrectedPose*> usable(const CarmenLog& raw, const std::vector<CorrectedPose>& corrected) {
+  std::vector<const CorrectedPose*> u;
+  for (const auto& c : corrected) {
+    if (c.flaser_index < raw.scans.size()) u.push_back(&c);
+  }
+  std::stable_sort(u.begin(), u.end(),
+                   [](const CorrectedPose* a, const CorrectedPose* b) { return a->flaser_index < b->flaser_index; });
+  return u;
+}
+
+}  // namespace
+
+bool read_corrected_poses(const std::string& path, std::vector<CorrectedPose>* out, std::string* error) {
+  out->clear();
+  std::string data;
+  if (!read_file_maybe_gz(path, &data, error)) return false;
+  const char* p = data.data();
+  const char* end = p + data.size();
+  size_t line_no = 0;
+  std::vector<std::string_view> tok;
+  while (p < end) {
+    const char* eol = static_cast<const char*>(memchr(p, '\n', static_cast<size_t>(end - p)));
+    if (!eol) eol = end;
+    ++line_no;
+    const char* q = p;
+    p = eol + 1;
+    tok.clear();
+    while (q < eol) {
+      while (q < eol && (*q == ' ' || *q == '\t' || *q == '\r')) ++q;
+      if (q == eol) break;
+      const char* b = q;
+      while (q < eol && !(*q == ' ' || *q == '\t' || *q == '\r')) ++q;
+      tok.emplace_back(b, static_cast<size_t>(q - b));
+    }
+    if (tok.empty() || tok[0][0] == '#') continue;
+    const std::string where = path + ":" + std::to_string(line_no) + ": ";
+    if (tok.size() != 6) {
+      *error = where + "expected 6 fields (flaser_index ipc_timestamp logger_timestamp x y theta), found " +
+               std::to_string(tok.size());
+      return false;
+    }
+    CorrectedPose c;
+    unsigned long long idx = 0;
+    auto r = std::from_chars(tok[0].data(), tok[0].data() + tok[0].size(), idx);
+    if (r.ec != std::errc() || r.ptr != tok[0].data() + tok[0].size()) {
+      *error = where + "flaser_index is not a non-negative integer: '" + std::string(tok[0].substr(0, 40)) + "'";
+      return false;
+    }
+    c.flaser_index = static_cast<size_t>(idx);
+    double v[5];
+    static const char* kNames[5] = {"ipc_timestamp", "logger_timestamp", "x", "y", "theta"};
+    for (int i = 0; i < 5; ++i) {
+      if (!parse_double(tok[static_cast<size_t>(i) + 1], &v[i])) {
+        *error = where + kNames[i] + " is not a finite number: '" +
+                 std::string(tok[static_cast<size_t>(i) + 1].substr(0, 40)) + "'";
+        return false;
+      }
+    }
+    if (!out->empty() && c.flaser_index <= out->back().flaser_index) {
+      *error = where + "flaser_index " + std::to_string(c.flaser_index) + " does not increase (previous " +
+               std::to_string(out->back().flaser_index) + ")";
+      return false;
+    }
+    c.ipc_timestamp = v[0];
+    c.logger_timestamp = v[1];
+    c.pose = fw::Se2d(v[2], v[3], v[4]);
+    out->push_back(c);
+  }
+  return true;
+}
+
+std::vector<ReferencePose> reference_with_bounds(const CarmenLog& raw, const std::vector<CorrectedPose>& corrected) {
+  const auto u = usable(raw, corrected);
+  std::vector<ReferencePose> out;
+  if (u.empty()) return out;
+  const size_t n = raw.scans.size();
+  out.resize(n);
+  const double inf = std::numeric_limits<double>::infinity();
+  auto odo = [&](size_t i) -> const fw::Se2d& { return raw.scans[i].odom; };
+  // Before the first corrected pose: backward chain only.
+  for (size_t i = 0; i < u.front()->flaser_index; ++i) {
+    out[i].pose = chain(u.front()->pose, odo(u.front()->flaser_index), odo(i));
+    out[i].bound = inf;
+  }
+  for (size_t k = 0; k < u.size(); ++k) {
+    const size_t a = u[k]->flaser_index;
+    out[a].pose = u[k]->pose;
+    out[a].exact = true;
+    if (k + 1 == u.size()) {
+      for (size_t i = a + 1; i < n; ++i) {
+        out[i].pose = chain(u[k]->pose, odo(a), odo(i));
+        out[i].bound = inf;
+      }
+      break;
+    }
+    const size_t b = u[k + 1]->flaser_index;
+    const fw::Se2d closure = chain(u[k]->pose, odo(a), odo(b)).between(u[k + 1]->pose);
+    const double r = std::hypot(closure.x, closure.y);
+    const double dd = static_cast<double>(b - a);
+    for (size_t i = a + 1; i < b; ++i) {
+      const double w = static_cast<double>(i - a) / dd;
+      const fw::Se2d f = chain(u[k]->pose, odo(a), odo(i));
+      const fw::Se2d bb = chain(u[k + 1]->pose, odo(b), odo(i));
+      out[i].pose = blend(f, bb, w);
+      out[i].bound = 2.0 * w * (1.0 - w) * r;
+    }
+  }
+  return out;
+}
+
+std::vector<fw::Se2d> reference_at_every_scan(const CarmenLog& raw, const std::vector<CorrectedPose>& corrected) {
+  std::vector<fw::Se2d> out;
+  for (const auto& r : reference_with_bounds(raw, corrected)) out.push_back(r.pose);
+  return out;
+}
+
+ReferenceGapStats reference_gap_stats(const CarmenLog& raw, const std::vector<CorrectedPose>& corrected) {
+  const auto u = usable(raw, corrected);
+  ReferenceGapStats s;
+  for (size_t k = 0; k + 1 < u.size(); ++k) {
+    const size_t a = u[k]->flaser_index, b = u[k + 1]->flaser_index;
+    const fw::Se2d closure = chain(u[k]->pose, raw.scans[a].odom, raw.scans[b].odom).between(u[k + 1]->pose);
+    const double r = std::hypot(closure.x, closure.y);
+    const double rd = std::abs(closure.theta) * kRad2Deg;
+    ++s.gaps;
+    s.mean_gap_scans += static_cast<double>(b - a);
+    s.max_gap_scans = std::max(s.max_gap_scans, static_cast<double>(b - a));
+    s.mean_closure_m += r;
+    s.max_closure_m = std::max(s.max_closure_m, r);
+    s.mean_closure_deg += rd;
+    s.max_closure_deg = std::max(s.max_closure_deg, rd);
+  }
+  if (s.gaps > 0) {
+    s.mean_gap_scans /= static_cast<double>(s.gaps);
+    s.mean_closure_m /= static_cast<double>(s.gaps);
+    s.mean_closure_deg /= static_cast<double>(s.gaps);
+  }
+  return s;
+}
+
+Trajectory odometry_trajectory(const CarmenLog& raw) {
+  Trajectory t;
+  t.reserve(raw.scans.size());
+  for (const auto& s : raw.scans) t.push_back({s.ipc_timestamp, s.odom});
+  return t;
+}
+
+Trajectory make_trajectory(const CarmenLog& raw, const std::vector<fw::Se2d>& poses) {
+  Trajectory t;
+  const size_t n = std::min(raw.scans.size(), poses.size());
+  t.reserve(n);
+  for (size_t i = 0; i < n; ++i) t.push_back({raw.scans[i].ipc_timestamp, poses[i]});
+  return t;
+}
+
+}  // namespace sim
