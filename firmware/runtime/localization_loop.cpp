@@ -1,0 +1,200 @@
+#include "firmware/runtime/localization_loop.h"
+
+#include <cmath>
+#include <cstdarg>
+
+#include "firmware/runtime/odometry_interpolation.h"
+
+namespace fw {
+
+Status LocalizationLoopOptions::validate() const {
+  if (max_odom_gap_ns == 0) {
+    return Status::error(Errc::kInvalidArgument, "LocalizationLoopOptions.max_odom_gap_ns must be > 0");
+  }
+  return Status::ok();
+}
+
+Status LocalizationLoop::init(hal::Hal& hal, Localizer& localizer, const LocalizationLoopOptions& options) {
+  if (hal.clock == nullptr || hal.laser == nullptr || hal.odometry == nullptr || hal.pose_sink == nullptr) {
+    return Status::error(Errc::kInvalidArgument, "LocalizationLoop::init: HAL lacks %s",
+                         hal.clock == nullptr   ? "clock"
+                         : hal.laser == nullptr ? "laser source"
+                         : hal.odometry == nullptr ? "odometry source"
+                                                   : "pose sink");
+  }
+  FW_RETURN_IF_ERROR(options.validate());
+  hal_ = &hal;
+  localizer_ = &localizer;
+  options_ = options;
+  perf_clock_ = options.perf_clock != nullptr ? options.perf_clock : hal.clock;
+  odom_.clear();
+  has_pending_ = false;
+  stepped_ = false;
+  counters_ = LoopCounters();
+  health_ = hal::Health();
+  estimate_ = hal::PoseEstimate();
+  return Status::ok();
+}
+
+void LocalizationLoop::reset() {
+  odom_.clear();
+  has_pending_ = false;
+  stepped_ = false;
+  if (localizer_ != nullptr) localizer_->reset();
+}
+
+void LocalizationLoop::log(hal::LogLevel level, const char* fmt, ...) {
+  if (hal_ == nullptr || hal_->log == nullptr) return;
+  va_list args;
+  va_start(args, fmt);
+  hal_->log->vlog(level, fmt, args);
+  va_end(args);
+}
+
+void LocalizationLoop::drain_odometry() {
+  hal::Odometry o;
+  while (hal_->odometry->poll(&o)) {
+    ++counters_.odom_received;
+    if (!odometry_is_finite(o)) {
+      ++counters_.odom_rejected;
+      log(hal::LogLevel::kWarning, "odometry t=%llu ns rejected: non-finite value",
+          static_cast<unsigned long long>(o.timestamp_ns));
+      continue;
+    }
+    if (!odom_.empty()) {
+      const hal::Odometry& newest = odom_.newest();
+      if (o.timestamp_ns < newest.timestamp_ns) {
+        ++counters_.odom_rejected;
+        log(hal::LogLevel::kWarning, "odometry t=%llu ns rejected: older than previous sample t=%llu ns",
+            static_cast<unsigned long long>(o.timestamp_ns), static_cast<unsigned long long>(newest.timestamp_ns));
+        continue;
+      }
+      if (o.timestamp_ns == newest.timestamp_ns) {  // duplicate time: the later message wins
+        odom_[odom_.size() - 1] = o;
+        continue;
+      }
+    }
+    odom_.push_overwrite(o);  // the history is a window: the oldest sample falls out
+  }
+}
+
+bool LocalizationLoop::validate_scan(const hal::LaserScan& scan) {
+  const bool ok = scan.beam_count > 0 && scan.beam_count <= hal::LaserScan::kMaxBeams &&
+                  std::isfinite(scan.angle_min) && std::isfinite(scan.angle_increment) &&
+                  std::isfinite(scan.range_max) && scan.range_max > 0.0f;
+  if (!ok) {
+    ++counters_.scans_malformed;
+    log(hal::LogLevel::kWarning, "scan %u dropped: malformed header (beam_count %u, range_max %g)", scan.scan_id,
+        scan.beam_count, static_cast<double>(scan.range_max));
+  }
+  return ok;
+}
+
+LocalizationLoop::Pairing LocalizationLoop::pair(std::uint64_t now, hal::Odometry* out) {
+  const std::uint64_t t = pending_.timestamp_ns;
+  const std::uint64_t waited = now > t ? now - t : 0;
+  if (odom_.empty()) {
+    if (waited < options_.odom_wait_ns) return Pairing::kWait;
+    ++counters_.scans_unpaired;
+    ++health_.timeouts;
+    log(hal::LogLevel::kWarning, "scan %u dropped: no odometry", pending_.scan_id);
+    return Pairing::kDropped;
+  }
+  const hal::Odometry& oldest = odom_[0];
+  const hal::Odometry& newest = odom_.newest();
+  if (t > newest.timestamp_ns) {
+    if (waited < options_.odom_wait_ns) return Pairing::kWait;
+    ++health_.timeouts;
+    if (t - newest.timestamp_ns > options_.max_odom_gap_ns) {
+      ++counters_.scans_unpaired;
+      log(hal::LogLevel::kWarning, "scan %u dropped: newest odometry is %llu ms older", pending_.scan_id,
+          static_cast<unsigned long long>((t - newest.timestamp_ns) / 1000000));
+      return Pairing::kDropped;
+    }
+    *out = newest;
+    out->timestamp_ns = t;
+    ++counters_.scans_held;
+    return Pairing::kPaired;
+  }
+  if (t < oldest.timestamp_ns) {
+    if (oldest.timestamp_ns - t > options_.max_odom_gap_ns) {
+      ++counters_.scans_unpaired;
+      log(hal::LogLevel::kWarning, "scan %u dropped: older than all odometry kept", pending_.scan_id);
+      return Pairing::kDropped;
+    }
+    *out = oldest;
+    out->timestamp_ns = t;
+    ++counters_.scans_held;
+    return Pairing::kPaired;
+  }
+  // Bracketing pair: the history is sorted by time; search from the newest end (scans are recent).
+  std::size_t i = odom_.size() - 1;
+  while (i > 0 && odom_[i - 1].timestamp_ns > t) --i;
+  // Now odom_[i-1].t ≤ t ≤ odom_[i].t, or i == 0 and t == oldest.t.
+  const hal::Odometry& a = i > 0 ? odom_[i - 1] : odom_[0];
+  const hal::Odometry& b = odom_[i];
+  if (!interpolate_odometry(a, b, t, out).is_ok()) {
+    raise_fault(Fault::kLogicError);  // the search above guarantees the bracket
+    return Pairing::kDropped;
+  }
+  ++counters_.scans_interpolated;
+  return Pairing::kPaired;
+}
+
+Status LocalizationLoop::spin_once() {
+  if (hal_ == nullptr) return Status::error(Errc::kNotInitialized, "LocalizationLoop::spin_once before init");
+  stepped_ = false;
+  const std::uint64_t now = hal_->clock->now_ns();
+  const std::uint64_t t_start = perf_clock_->now_ns();
+  {
+    PerfScope scope(perf_poll_, *perf_clock_);
+    drain_odometry();
+    while (!has_pending_ && hal_->laser->poll(&pending_)) {
+      ++counters_.scans_received;
+      has_pending_ = validate_scan(pending_);
+      if (!has_pending_) ++health_.dropped_scans;
+    }
+  }
+  if (!has_pending_) return Status::ok();
+
+  Pairing pairing;
+  {
+    PerfScope scope(perf_pair_, *perf_clock_);
+    pairing = pair(now, &paired_odom_);
+  }
+  if (pairing == Pairing::kWait) return Status::ok();
+  has_pending_ = false;
+  if (pairing == Pairing::kDropped) {
+    ++health_.dropped_scans;
+    return Status::ok();
+  }
+
+  Status status;
+  {
+    const std::uint64_t t0 = perf_clock_->now_ns();
+    status = localizer_->step(pending_, paired_odom_, &estimate_);
+    last_step_ns_ = perf_clock_->now_ns() - t0;
+    perf_step_.add_ns(last_step_ns_);
+    if (options_.step_deadline_ns != 0 && last_step_ns_ > options_.step_deadline_ns) ++health_.deadline_misses;
+  }
+  if (!status.is_ok()) {
+    ++counters_.step_errors;
+    estimate_.timestamp_ns = pending_.timestamp_ns;
+    estimate_.scan_id = pending_.scan_id;
+    estimate_.status = hal::LocalizationStatus::kFault;
+    log(hal::LogLevel::kError, "scan %u: %s step failed: %s", pending_.scan_id, localizer_->name(), status.message());
+  }
+  {
+    PerfScope scope(perf_publish_, *perf_clock_);
+    ++health_.scans_processed;
+    health_.timestamp_ns = now;
+    health_.fault_bits = fault_bits();
+    hal_->pose_sink->publish(estimate_);
+    hal_->pose_sink->publish_health(health_);
+  }
+  stepped_ = true;
+  perf_total_.add_ns(perf_clock_->now_ns() - t_start);
+  return status;
+}
+
+}  // namespace fw

@@ -1,0 +1,112 @@
+// LocalizationLoop: the firmware's main cycle over the HAL. Each spin_once() drains pending
+// odometry into a short history, takes the next scan, pairs it with the odometry pose interpolated
+// to the scan's timestamp (odometry_interpolation.h), runs Localizer::step and publishes the
+// PoseEstimate and a Health frame. Every stage is timed by a PerfCounter. Nothing is allocated:
+// the odometry history is a fixed ring and the pending scan a member.
+//
+// Pairing policy (bad luck is a counter, not a crash):
+//  - odometry samples that are not finite or go back in time are rejected (odom_rejected);
+//  - a scan with a malformed header (beam_count 0 or > kMaxBeams, non-finite angles) is dropped;
+//  - a scan newer than the newest odometry waits for odometry up to `odom_wait_ns` of clock time,
+//    then is paired with the newest odometry held constant if that is at most `max_odom_gap_ns`
+//    older (a timeout), else dropped;
+//  - a scan older than the oldest kept odometry is paired with it when within `max_odom_gap_ns`,
+//    else dropped.
+#pragma once
+
+#include <cstdint>
+
+#include "firmware/base/perf_counter.h"
+#include "firmware/base/ring_buffer.h"
+#include "firmware/base/status.h"
+#include "firmware/runtime/localizer.h"
+#include "hal/hal.h"
+
+namespace fw {
+
+struct LocalizationLoopOptions {
+  std::uint64_t odom_wait_ns = 200'000'000;     // how long a scan may wait for bracketing odometry
+  std::uint64_t max_odom_gap_ns = 500'000'000;  // largest gap bridged by holding an odometry sample
+  std::uint64_t step_deadline_ns = 0;           // Localizer::step longer than this counts a miss (0 = off)
+  // Clock for the perf counters. The simulator steps hal.clock (deterministic time domain) and
+  // measures with a real monotonic clock here; nullptr = hal.clock.
+  const hal::Clock* perf_clock = nullptr;
+
+  Status validate() const;
+};
+
+// Loop-level counters beyond what hal::Health carries.
+struct LoopCounters {
+  std::uint64_t odom_received = 0;
+  std::uint64_t odom_rejected = 0;   // non-finite or out of order
+  std::uint64_t scans_received = 0;
+  std::uint64_t scans_malformed = 0;
+  std::uint64_t scans_unpaired = 0;  // no odometry within max_odom_gap_ns
+  std::uint64_t scans_interpolated = 0;
+  std::uint64_t scans_held = 0;      // paired with a held (not bracketing) odometry sample
+  std::uint64_t step_errors = 0;
+};
+
+class LocalizationLoop {
+ public:
+  static constexpr std::size_t kOdomHistory = 128;
+
+  LocalizationLoop() = default;
+  LocalizationLoop(const LocalizationLoop&) = delete;
+  LocalizationLoop& operator=(const LocalizationLoop&) = delete;
+
+  // hal.clock, hal.laser, hal.odometry and hal.pose_sink are required; hal.log is optional.
+  Status init(hal::Hal& hal, Localizer& localizer, const LocalizationLoopOptions& options = {});
+  // One cycle; returns the localizer's error if its step failed (the estimate is then published
+  // with status `fault`). Use stepped() to know whether an estimate was produced.
+  Status spin_once();
+  // Forgets odometry history, the pending scan and the localizer state (kidnapping / restart).
+  void reset();
+
+  bool stepped() const { return stepped_; }
+  // True while a scan waits for odometry.
+  bool scan_pending() const { return has_pending_; }
+  const hal::PoseEstimate& last_estimate() const { return estimate_; }
+  // Odometry paired with the last processed scan.
+  const hal::Odometry& last_odometry() const { return paired_odom_; }
+  const hal::Health& health() const { return health_; }
+  const LoopCounters& counters() const { return counters_; }
+
+  const PerfCounter& perf_poll() const { return perf_poll_; }
+  const PerfCounter& perf_pair() const { return perf_pair_; }
+  const PerfCounter& perf_step() const { return perf_step_; }
+  const PerfCounter& perf_publish() const { return perf_publish_; }
+  const PerfCounter& perf_total() const { return perf_total_; }
+  // Time of the last Localizer::step in ns of the perf clock.
+  std::uint64_t last_step_ns() const { return last_step_ns_; }
+
+ private:
+  enum class Pairing { kWait, kPaired, kDropped };
+  void drain_odometry();
+  bool validate_scan(const hal::LaserScan& scan);
+  Pairing pair(std::uint64_t now, hal::Odometry* out);
+  void log(hal::LogLevel level, const char* fmt, ...) __attribute__((format(printf, 3, 4)));
+
+  hal::Hal* hal_ = nullptr;
+  Localizer* localizer_ = nullptr;
+  LocalizationLoopOptions options_;
+  const hal::Clock* perf_clock_ = nullptr;
+
+  RingBuffer<hal::Odometry, kOdomHistory> odom_;
+  hal::LaserScan pending_;
+  bool has_pending_ = false;
+  bool stepped_ = false;
+  hal::Odometry paired_odom_;
+  hal::PoseEstimate estimate_;
+  hal::Health health_;
+  LoopCounters counters_;
+  std::uint64_t last_step_ns_ = 0;
+
+  PerfCounter perf_poll_{"loop.poll"};
+  PerfCounter perf_pair_{"loop.pair"};
+  PerfCounter perf_step_{"loop.step"};
+  PerfCounter perf_publish_{"loop.publish"};
+  PerfCounter perf_total_{"loop.total"};
+};
+
+}  // namespace fw
