@@ -1,0 +1,83 @@
+#include "hal_can/can_node.h"
+
+namespace hal_can {
+namespace {
+std::uint16_t sat16(std::uint64_t v) { return v > 0xFFFF ? 0xFFFF : static_cast<std::uint16_t>(v); }
+}  // namespace
+
+void CanNode::init(hal::CanBus* bus, const hal::Clock* clock, bool fd) {
+  bus_ = bus;
+  clock_ = clock;
+  fd_ = fd;
+  start_ns_ = clock_ ? clock_->now_ns() : 0;
+}
+
+int CanNode::pump() {
+  if (!bus_) return 0;
+  int n = 0;
+  hal::CanFrame f;
+  while (n < kMaxFramesPerPump && bus_->receive(&f)) {
+    ++n;
+    switch (decoder_.feed(f)) {
+      case Decoded::kScan:
+        // Keep the newest scans: a late localizer should see the present, not the past.
+        if (scans_.push_overwrite(decoder_.scan())) ++scans_overflowed_;
+        break;
+      case Decoded::kOdometry:
+        if (odoms_.push_overwrite(decoder_.odometry())) ++odom_overflowed_;
+        break;
+      default:
+        break;
+    }
+  }
+  return n;
+}
+
+bool CanNode::Laser::poll(hal::LaserScan* out) {
+  node_->pump();
+  return node_->scans_.pop(out);
+}
+
+bool CanNode::Odom::poll(hal::Odometry* out) {
+  node_->pump();
+  return node_->odoms_.pop(out);
+}
+
+void CanNode::send_frames(const hal::CanFrame* frames, std::size_t n) {
+  for (std::size_t i = 0; i < n; ++i) {
+    if (!bus_ || !bus_->send(frames[i])) ++tx_failed_;
+  }
+}
+
+void CanNode::Sink::publish(const hal::PoseEstimate& estimate) {
+  std::size_t n = 0;
+  if (encode_pose(estimate, node_->pose_tag_++, node_->fd_, node_->tx_, kMaxParts, &n).is_ok()) {
+    node_->send_frames(node_->tx_, n);
+    ++node_->poses_sent_;
+  }
+}
+
+void CanNode::Sink::publish_health(const hal::Health& h) {
+  const DecoderStats& d = node_->decoder_.stats();
+  const hal::CanBusStats* b = node_->bus_ ? &node_->bus_->stats() : nullptr;
+  HealthRecord r;
+  const std::uint64_t now = node_->clock_ ? node_->clock_->now_ns() : 0;
+  r.uptime_ms = static_cast<std::uint32_t>((now - node_->start_ns_) / 1000000);
+  r.crc_errors = sat16(std::uint64_t{h.crc_errors} + d.crc_errors);
+  r.lost_segments = sat16(std::uint64_t{h.lost_segments} + d.lost_segments + d.duplicate_segments);
+  r.dropped_scans = sat16(std::uint64_t{h.dropped_scans} + d.scans_dropped + node_->scans_overflowed_);
+  r.timeouts = sat16(std::uint64_t{h.timeouts} + d.timeouts);
+  r.deadline_misses = sat16(h.deadline_misses);
+  r.bus_off = sat16(std::uint64_t{h.bus_off_count} + (b ? b->bus_off : 0));
+  r.scans_processed = h.scans_processed;
+  r.rx_dropped = sat16(b ? b->rx_dropped : 0);
+  r.error_frames = sat16(b ? b->error_frames : 0);
+  r.fault_bits = h.fault_bits;
+  r.state = h.fault_bits ? 2 : ((r.crc_errors || r.lost_segments || r.dropped_scans || r.bus_off) ? 1 : 0);
+  std::size_t n = 0;
+  if (encode_health(r, node_->health_tag_++, node_->fd_, node_->tx_, kMaxParts, &n).is_ok()) {
+    node_->send_frames(node_->tx_, n);
+  }
+}
+
+}  // namespace hal_can

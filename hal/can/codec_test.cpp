@@ -1,0 +1,345 @@
+#include "hal_can/codec.h"
+
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <cstring>
+#include <deque>
+#include <random>
+#include <vector>
+
+#include "hal_can/can_node.h"
+
+namespace hal_can {
+namespace {
+
+hal::LaserScan make_scan(std::uint32_t id, std::uint32_t beams) {
+  hal::LaserScan s;
+  s.scan_id = id;
+  s.beam_count = beams;
+  s.timestamp_ns = 1234567890123000ull + id * 13333000ull;
+  s.angle_min = -1.5707963f;
+  s.angle_increment = 0.017453292f;
+  s.range_min = 0.0f;
+  s.range_max = 81.91f;
+  for (std::uint32_t i = 0; i < beams; ++i) s.ranges[i] = 0.5f + 0.037f * static_cast<float>((i * 7 + id) % 300);
+  s.ranges[beams / 2] = 81.91f;             // max reading: "no return"
+  s.ranges[beams / 3] = std::nanf("");      // NaN: "no return"
+  return s;
+}
+
+std::vector<hal::CanFrame> encode(const hal::LaserScan& s, bool fd) {
+  std::vector<hal::CanFrame> f(kMaxScanFrames);
+  std::size_t n = 0;
+  EncodeOptions o;
+  o.fd = fd;
+  EXPECT_TRUE(encode_scan(s, o, f.data(), f.size(), &n).is_ok());
+  f.resize(n);
+  return f;
+}
+
+void expect_scan_eq(const hal::LaserScan& in, const hal::LaserScan& out) {
+  EXPECT_EQ(out.scan_id, in.scan_id);
+  EXPECT_EQ(out.beam_count, in.beam_count);
+  EXPECT_EQ(out.timestamp_ns, in.timestamp_ns);
+  EXPECT_NEAR(out.angle_min, in.angle_min, 1e-6);
+  EXPECT_NEAR(out.angle_increment, in.angle_increment, 1e-7);
+  EXPECT_NEAR(out.range_max, in.range_max, 0.01);
+  for (std::uint32_t i = 0; i < in.beam_count; ++i) {
+    if (std::isfinite(in.ranges[i]) && in.ranges[i] < in.range_max) {
+      EXPECT_NEAR(out.ranges[i], in.ranges[i], 0.0011) << i;
+    } else {
+      EXPECT_EQ(out.ranges[i], out.range_max) << i;
+    }
+  }
+}
+
+TEST(Crc32, CheckValue) {
+  const char* s = "123456789";
+  EXPECT_EQ(crc32(reinterpret_cast<const std::uint8_t*>(s), 9), 0xCBF43926u);
+}
+
+TEST(FdLength, ValidLengths) {
+  EXPECT_EQ(fd_length_for(8), 8);
+  EXPECT_EQ(fd_length_for(9), 12);
+  EXPECT_EQ(fd_length_for(29), 32);
+  EXPECT_EQ(fd_length_for(36), 48);
+  EXPECT_EQ(fd_length_for(64), 64);
+}
+
+TEST(ScanCodec, RoundTripClassicAndFd) {
+  for (bool fd : {false, true}) {
+    for (std::uint32_t beams : {1u, 3u, 180u, 181u, 361u, 1081u}) {
+      hal::LaserScan s = make_scan(17, beams);
+      auto frames = encode(s, fd);
+      ASSERT_EQ(frames.size(), scan_frame_count(beams, fd));
+      for (const auto& f : frames) {
+        EXPECT_LE(f.len, fd ? 64 : 8);
+        if (!fd) EXPECT_FALSE(f.fd);
+      }
+      Decoder d;
+      int scans = 0;
+      for (const auto& f : frames) scans += d.feed(f) == Decoded::kScan;
+      ASSERT_EQ(scans, 1) << "fd=" << fd << " beams=" << beams;
+      expect_scan_eq(s, d.scan());
+      EXPECT_EQ(d.stats().scans_ok, 1u);
+      EXPECT_EQ(d.stats().scans_dropped, 0u);
+    }
+  }
+  // FD is what makes 75 Hz scans cheap: 180 beams = 65 classic frames vs 8 FD frames.
+  EXPECT_EQ(scan_frame_count(180, false), 65u);
+  EXPECT_EQ(scan_frame_count(180, true), 8u);
+}
+
+TEST(ScanCodec, RejectsBadInput) {
+  hal::LaserScan s = make_scan(1, 180);
+  std::vector<hal::CanFrame> f(kMaxScanFrames);
+  std::size_t n = 0;
+  s.beam_count = 0;
+  EXPECT_FALSE(encode_scan(s, {}, f.data(), f.size(), &n).is_ok());
+  s.beam_count = 180;
+  EXPECT_FALSE(encode_scan(s, {}, f.data(), 10, &n).is_ok());  // buffer too small
+  s.range_max = std::nanf("");
+  fw::Status st = encode_scan(s, {}, f.data(), f.size(), &n);
+  EXPECT_FALSE(st.is_ok());
+  EXPECT_NE(std::strstr(st.message(), "scan 1"), nullptr) << st.message();
+}
+
+TEST(ScanCodec, CorruptSegmentIsCrcError) {
+  hal::LaserScan s = make_scan(5, 180);
+  auto frames = encode(s, false);
+  frames[10].data[3] ^= 0x40;
+  Decoder d;
+  for (const auto& f : frames) EXPECT_NE(d.feed(f), Decoded::kScan);
+  EXPECT_EQ(d.stats().crc_errors, 1u);
+  EXPECT_EQ(d.stats().scans_dropped, 1u);
+  // The next scan is fine again.
+  for (const auto& f : encode(make_scan(6, 180), false)) d.feed(f);
+  EXPECT_EQ(d.stats().scans_ok, 1u);
+}
+
+TEST(ScanCodec, MissingDuplicateOutOfOrderDropTheScan) {
+  Decoder d;
+  auto a = encode(make_scan(1, 180), true);
+  a.erase(a.begin() + 3);  // missing segment
+  auto b = encode(make_scan(2, 180), true);
+  b.insert(b.begin() + 3, b[3]);  // duplicated segment
+  auto c = encode(make_scan(3, 180), true);
+  std::swap(c[2], c[3]);  // out of order
+  auto e = encode(make_scan(4, 180), true);
+  for (auto* v : {&a, &b, &c, &e})
+    for (const auto& f : *v) d.feed(f);
+  EXPECT_EQ(d.stats().scans_ok, 1u);
+  EXPECT_EQ(d.stats().scans_dropped, 3u);
+  EXPECT_EQ(d.stats().duplicate_segments, 1u);
+  EXPECT_GE(d.stats().lost_segments, 2u);
+  EXPECT_EQ(d.scan().scan_id, 4u);
+}
+
+TEST(ScanCodec, MissingStartOrEndIsCounted) {
+  Decoder d;
+  auto a = encode(make_scan(1, 180), false);
+  a.erase(a.begin());  // start part 0 lost → the whole start record is broken
+  auto b = encode(make_scan(2, 180), false);
+  b.pop_back();  // END lost → dropped when the next START arrives
+  auto c = encode(make_scan(3, 180), false);
+  for (auto* v : {&a, &b, &c})
+    for (const auto& f : *v) d.feed(f);
+  EXPECT_EQ(d.stats().scans_ok, 1u);
+  EXPECT_EQ(d.stats().scans_dropped, 2u);
+  EXPECT_GE(d.stats().broken_records, 1u);
+}
+
+TEST(ScanCodec, TimeoutDropsStalledTransfer) {
+  Decoder::Options o;
+  o.scan_timeout_ns = 100'000'000;
+  Decoder d(o);
+  auto a = encode(make_scan(1, 180), false);
+  for (std::size_t i = 0; i < 20; ++i) {
+    a[i].timestamp_ns = 1'000'000'000;
+    d.feed(a[i]);
+  }
+  d.check_timeout(1'200'000'000);
+  EXPECT_EQ(d.stats().timeouts, 1u);
+  EXPECT_EQ(d.stats().scans_dropped, 1u);
+}
+
+TEST(ScanCodec, RandomGarbageNeverCrashesAndNeverDeliversWrongScans) {
+  std::mt19937 rng(42);
+  Decoder d;
+  std::uint32_t delivered = 0;
+  for (int round = 0; round < 200; ++round) {
+    auto frames = encode(make_scan(static_cast<std::uint32_t>(round), 180), round % 2 == 0);
+    const int mode = round % 4;
+    if (mode == 1) {  // flip random bits in one frame
+      auto& f = frames[rng() % frames.size()];
+      f.data[rng() % (f.len ? f.len : 1)] ^= static_cast<std::uint8_t>(1u << (rng() % 8));
+    } else if (mode == 2) {  // truncate a frame
+      frames[rng() % frames.size()].len = static_cast<std::uint8_t>(rng() % 3);
+    } else if (mode == 3) {  // inject a random frame
+      hal::CanFrame g;
+      g.id = 0x100 + rng() % 0x40;
+      g.len = 8;
+      for (int i = 0; i < 8; ++i) g.data[i] = static_cast<std::uint8_t>(rng());
+      frames.insert(frames.begin() + static_cast<long>(rng() % frames.size()), g);
+    }
+    for (const auto& f : frames) {
+      if (d.feed(f) == Decoded::kScan) {
+        ++delivered;
+        // A delivered scan must be exactly the scan that was sent.
+        expect_scan_eq(make_scan(d.scan().scan_id, 180), d.scan());
+      }
+    }
+  }
+  EXPECT_GE(delivered, 50u);  // every untouched scan (mode 0) at least
+  EXPECT_EQ(delivered + d.stats().scans_dropped, 200u);
+}
+
+TEST(RecordCodec, OdometryPoseHealthRoundTrip) {
+  for (bool fd : {false, true}) {
+    Decoder d;
+    hal::CanFrame f[kMaxParts];
+    std::size_t n = 0;
+    hal::Odometry o;
+    o.timestamp_ns = 2691287460000000ull;  // 2691 s (u48 µs: monotonic sender clock)
+    o.x = -12.345f;
+    o.y = 101.5f;
+    o.theta = -3.1f;
+    o.v = 0.5f;
+    o.omega = -0.25f;
+    ASSERT_TRUE(encode_odometry(o, 9, fd, f, kMaxParts, &n).is_ok());
+    EXPECT_EQ(n, fd ? 1u : kOdomParts);
+    Decoded last = Decoded::kNothing;
+    for (std::size_t i = 0; i < n; ++i) last = d.feed(f[i]);
+    ASSERT_EQ(last, Decoded::kOdometry);
+    EXPECT_NEAR(d.odometry().x, o.x, 1e-3);
+    EXPECT_NEAR(d.odometry().y, o.y, 1e-3);
+    EXPECT_NEAR(d.odometry().theta, o.theta, 1e-6);
+    EXPECT_NEAR(d.odometry().v, o.v, 1e-3);
+    EXPECT_EQ(d.odometry().timestamp_ns, o.timestamp_ns);
+
+    hal::PoseEstimate p;
+    p.timestamp_ns = 42'000'000;
+    p.scan_id = 77;
+    p.x = 3.25f;
+    p.y = -4.5f;
+    p.theta = 1.0f;
+    p.cov[0] = 0.01f;
+    p.cov[4] = 0.04f;
+    p.cov[8] = 0.0001f;
+    p.status = hal::LocalizationStatus::kLocalized;
+    p.mode = hal::LocalizationMode::kTracking;
+    p.hypothesis_count = 300;
+    p.cluster_count = 2;
+    p.rating = 0.5f;
+    ASSERT_TRUE(encode_pose(p, 3, fd, f, kMaxParts, &n).is_ok());
+    for (std::size_t i = 0; i < n; ++i) last = d.feed(f[i]);
+    ASSERT_EQ(last, Decoded::kPose);
+    EXPECT_EQ(d.pose().scan_id, 77u);
+    EXPECT_EQ(d.pose().status, hal::LocalizationStatus::kLocalized);
+    EXPECT_EQ(d.pose().mode, hal::LocalizationMode::kTracking);
+    EXPECT_NEAR(d.pose().x, 3.25, 1e-3);
+    EXPECT_NEAR(d.pose().y, -4.5, 1e-3);
+    EXPECT_NEAR(d.pose().cov[4], 0.04, 1e-4);
+    EXPECT_EQ(d.pose().hypothesis_count, 300);
+    EXPECT_EQ(d.pose().timestamp_ns, 42'000'000u);
+
+    HealthRecord h;
+    h.uptime_ms = 123456;
+    h.crc_errors = 3;
+    h.lost_segments = 7;
+    h.bus_off = 1;
+    h.error_frames = 5;
+    h.scans_processed = 1000;
+    h.fault_bits = 0x10;
+    h.state = 2;
+    ASSERT_TRUE(encode_health(h, 1, fd, f, kMaxParts, &n).is_ok());
+    for (std::size_t i = 0; i < n; ++i) last = d.feed(f[i]);
+    ASSERT_EQ(last, Decoded::kHealth);
+    EXPECT_EQ(d.health().uptime_ms, 123456u);
+    EXPECT_EQ(d.health().lost_segments, 7);
+    EXPECT_EQ(d.health().error_frames, 5);
+    EXPECT_EQ(d.health().fault_bits, 0x10u);
+    EXPECT_EQ(d.health().scans_processed, 1000u);
+  }
+}
+
+TEST(RecordCodec, PartsOfDifferentRecordsAreNotMixed) {
+  Decoder d;
+  hal::CanFrame a[kMaxParts], b[kMaxParts];
+  std::size_t n = 0;
+  hal::Odometry o1, o2;
+  o1.x = 1;
+  o2.x = 2;
+  ASSERT_TRUE(encode_odometry(o1, 1, false, a, kMaxParts, &n).is_ok());
+  ASSERT_TRUE(encode_odometry(o2, 2, false, b, kMaxParts, &n).is_ok());
+  // Parts 0,1 of record 1 then parts 2,3 of record 2: nothing must come out.
+  EXPECT_EQ(d.feed(a[0]), Decoded::kNothing);
+  EXPECT_EQ(d.feed(a[1]), Decoded::kNothing);
+  EXPECT_EQ(d.feed(b[2]), Decoded::kNothing);
+  EXPECT_EQ(d.feed(b[3]), Decoded::kNothing);
+  EXPECT_GE(d.stats().broken_records, 1u);
+  // Bad status byte in a pose is malformed, not a pose.
+  hal::PoseEstimate p;
+  ASSERT_TRUE(encode_pose(p, 1, true, a, kMaxParts, &n).is_ok());
+  a[0].data[1 + 2] = 9;
+  EXPECT_EQ(d.feed(a[0]), Decoded::kNothing);
+  EXPECT_EQ(d.stats().malformed, 1u);
+}
+
+// A loopback bus: what one side sends, the other receives (unit test of CanNode only; the real
+// bus is tested over vcan in tests/hil).
+class LoopbackBus final : public hal::CanBus {
+ public:
+  bool receive(hal::CanFrame* out) override {
+    if (rx.empty()) return false;
+    *out = rx.front();
+    rx.pop_front();
+    ++stats_.rx_frames;
+    return true;
+  }
+  bool send(const hal::CanFrame& f) override {
+    tx.push_back(f);
+    ++stats_.tx_frames;
+    return true;
+  }
+  const hal::CanBusStats& stats() const override { return stats_; }
+  std::deque<hal::CanFrame> rx;
+  std::vector<hal::CanFrame> tx;
+  hal::CanBusStats stats_;
+};
+
+TEST(CanNode, DeliversScansAndOdometryAndEncodesPoses) {
+  static LoopbackBus bus;
+  static CanNode node;
+  node.init(&bus, nullptr, true);
+  for (const auto& f : encode(make_scan(8, 180), true)) bus.rx.push_back(f);
+  hal::CanFrame f[kMaxParts];
+  std::size_t n = 0;
+  hal::Odometry o;
+  o.x = 5;
+  ASSERT_TRUE(encode_odometry(o, 0, false, f, kMaxParts, &n).is_ok());
+  for (std::size_t i = 0; i < n; ++i) bus.rx.push_back(f[i]);
+  static hal::LaserScan s;
+  ASSERT_TRUE(node.laser().poll(&s));
+  EXPECT_EQ(s.scan_id, 8u);
+  hal::Odometry got;
+  ASSERT_TRUE(node.odometry().poll(&got));
+  EXPECT_NEAR(got.x, 5.0, 1e-3);
+  EXPECT_FALSE(node.laser().poll(&s));
+
+  hal::PoseEstimate p;
+  p.scan_id = 8;
+  node.pose_sink().publish(p);
+  hal::Health h;
+  h.deadline_misses = 2;
+  node.pose_sink().publish_health(h);
+  ASSERT_EQ(bus.tx.size(), 2u);  // one FD frame each
+  Decoder d;
+  EXPECT_EQ(d.feed(bus.tx[0]), Decoded::kPose);
+  EXPECT_EQ(d.feed(bus.tx[1]), Decoded::kHealth);
+  EXPECT_EQ(d.health().deadline_misses, 2);
+}
+
+}  // namespace
+}  // namespace hal_can

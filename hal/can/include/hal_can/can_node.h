@@ -1,0 +1,82 @@
+// CanNode: the firmware side of the CAN message set over any hal::CanBus (SocketCAN on the robot,
+// an in-memory bus in tests). Decodes scans and odometry into fixed rings and encodes pose and
+// health frames. Exposes the HAL source/sink interfaces the localization loop uses.
+#pragma once
+
+#include <cstdint>
+
+#include "firmware/base/ring_buffer.h"
+#include "hal/can_bus.h"
+#include "hal/clock.h"
+#include "hal/sensor_io.h"
+#include "hal_can/codec.h"
+
+namespace hal_can {
+
+class CanNode {
+ public:
+  static constexpr std::size_t kScanQueue = 4;
+  static constexpr std::size_t kOdomQueue = 256;
+  static constexpr int kMaxFramesPerPump = 4096;
+
+  CanNode() : laser_(this), odom_(this), sink_(this) {}
+  CanNode(const CanNode&) = delete;
+  CanNode& operator=(const CanNode&) = delete;
+
+  // `fd`: send pose/health as CAN FD frames (the bus must support FD).
+  void init(hal::CanBus* bus, const hal::Clock* clock, bool fd);
+
+  // Drains pending frames (bounded) into the decoder; returns frames read.
+  int pump();
+
+  hal::LaserScanSource& laser() { return laser_; }
+  hal::OdometrySource& odometry() { return odom_; }
+  hal::PoseSink& pose_sink() { return sink_; }
+
+  const DecoderStats& decoder_stats() const { return decoder_.stats(); }
+  std::uint32_t scans_overflowed() const { return scans_overflowed_; }
+  std::uint32_t odometry_overflowed() const { return odom_overflowed_; }
+  std::uint32_t tx_failed() const { return tx_failed_; }
+  std::uint32_t poses_sent() const { return poses_sent_; }
+
+ private:
+  class Laser final : public hal::LaserScanSource {
+   public:
+    explicit Laser(CanNode* n) : node_(n) {}
+    bool poll(hal::LaserScan* out) override;
+   private:
+    CanNode* node_;
+  };
+  class Odom final : public hal::OdometrySource {
+   public:
+    explicit Odom(CanNode* n) : node_(n) {}
+    bool poll(hal::Odometry* out) override;
+   private:
+    CanNode* node_;
+  };
+  class Sink final : public hal::PoseSink {
+   public:
+    explicit Sink(CanNode* n) : node_(n) {}
+    void publish(const hal::PoseEstimate& estimate) override;
+    void publish_health(const hal::Health& health) override;
+   private:
+    CanNode* node_;
+  };
+  void send_frames(const hal::CanFrame* frames, std::size_t n);
+
+  hal::CanBus* bus_ = nullptr;
+  const hal::Clock* clock_ = nullptr;
+  bool fd_ = false;
+  std::uint64_t start_ns_ = 0;
+  Decoder decoder_;
+  fw::RingBuffer<hal::LaserScan, kScanQueue> scans_;
+  fw::RingBuffer<hal::Odometry, kOdomQueue> odoms_;
+  std::uint32_t scans_overflowed_ = 0, odom_overflowed_ = 0, tx_failed_ = 0, poses_sent_ = 0;
+  std::uint8_t pose_tag_ = 0, health_tag_ = 0;
+  hal::CanFrame tx_[kMaxParts];
+  Laser laser_;
+  Odom odom_;
+  Sink sink_;
+};
+
+}  // namespace hal_can

@@ -1,0 +1,128 @@
+// Encoders (message → frames into a caller array) and the decoder (frames → messages with
+// counters). Corrupt, missing, duplicated or out-of-order input drops the affected scan/record and
+// is counted; it never crashes and never allocates.
+#pragma once
+
+#include <cstddef>
+#include <cstdint>
+
+#include "firmware/base/status.h"
+#include "hal/can_bus.h"
+#include "hal/msg/health.h"
+#include "hal/msg/laser_scan.h"
+#include "hal/msg/odometry.h"
+#include "hal/msg/pose_estimate.h"
+#include "hal_can/protocol.h"
+
+namespace hal_can {
+
+// Worst case frames for one scan on classic CAN: 4 start parts + 361 segments + end.
+constexpr std::size_t kMaxScanFrames =
+    kScanStartParts + (hal::LaserScan::kMaxBeams + kClassicRangesPerSegment - 1) / kClassicRangesPerSegment + 1;
+
+struct EncodeOptions {
+  bool fd = false;              // CAN FD frames (fewer, larger) instead of classic
+  std::uint32_t range_unit_um = 0;  // metres per range LSB in µm; 0 = choose (1 mm, or 10 mm if range_max > 65 m)
+};
+
+// Health as it travels on the bus: the firmware's counters plus the bus statistics.
+struct HealthRecord {
+  std::uint32_t uptime_ms = 0;
+  std::uint8_t state = 0;  // 0 ok, 1 degraded (counters rising), 2 fault (fault_bits != 0)
+  std::uint16_t crc_errors = 0, lost_segments = 0, dropped_scans = 0;
+  std::uint16_t timeouts = 0, deadline_misses = 0, bus_off = 0;
+  std::uint32_t scans_processed = 0;
+  std::uint16_t rx_dropped = 0, error_frames = 0;
+  std::uint32_t fault_bits = 0;
+};
+
+// Number of frames a scan takes. Classic: 4 + ceil(n/3) + 1; FD: 1 + ceil(n/31) + 1.
+std::size_t scan_frame_count(std::uint32_t beam_count, bool fd);
+
+// Each encoder writes frames into out[0..capacity) and sets *count. `tag` is the sequence byte
+// the sender increments per record (scans use scan_id).
+fw::Status encode_scan(const hal::LaserScan& scan, const EncodeOptions& opt, hal::CanFrame* out,
+                       std::size_t capacity, std::size_t* count);
+fw::Status encode_odometry(const hal::Odometry& odom, std::uint8_t tag, bool fd, hal::CanFrame* out,
+                           std::size_t capacity, std::size_t* count);
+fw::Status encode_pose(const hal::PoseEstimate& pose, std::uint8_t tag, bool fd, hal::CanFrame* out,
+                       std::size_t capacity, std::size_t* count);
+fw::Status encode_health(const HealthRecord& health, std::uint8_t tag, bool fd, hal::CanFrame* out,
+                         std::size_t capacity, std::size_t* count);
+
+struct DecoderStats {
+  std::uint32_t frames = 0;
+  std::uint32_t unknown_ids = 0;       // frames with an ID outside the message set (ignored)
+  std::uint32_t malformed = 0;         // wrong length / impossible field values
+  std::uint32_t scans_ok = 0;
+  std::uint32_t scans_dropped = 0;     // every scan that started but was not delivered
+  std::uint32_t crc_errors = 0;        // scan CRC-32 mismatch at SCAN_END
+  std::uint32_t lost_segments = 0;     // segments missing (gaps, missing start/end)
+  std::uint32_t duplicate_segments = 0;
+  std::uint32_t out_of_order_segments = 0;
+  std::uint32_t orphan_segments = 0;   // data segments with no transfer in progress
+  std::uint32_t timeouts = 0;          // transfer not finished within the timeout
+  std::uint32_t broken_records = 0;    // record parts missing / out of order / wrong tag
+  std::uint32_t odometry_ok = 0, poses_ok = 0, health_ok = 0;
+};
+
+enum class Decoded : std::uint8_t { kNothing, kScan, kOdometry, kPose, kHealth };
+
+class Decoder {
+ public:
+  struct Options {
+    std::uint64_t scan_timeout_ns = 500'000'000;  // START..END must fit (frame timestamps)
+  };
+  Decoder() = default;
+  explicit Decoder(const Options& o) : options_(o) {}
+
+  // Feeds one frame. When it completes a message, returns its kind; the message is then in
+  // scan() / odometry() / pose() / health() until the next completion of that kind.
+  Decoded feed(const hal::CanFrame& frame);
+
+  const hal::LaserScan& scan() const { return scan_; }
+  const hal::Odometry& odometry() const { return odom_; }
+  const hal::PoseEstimate& pose() const { return pose_; }
+  const HealthRecord& health() const { return health_; }
+  std::uint64_t pose_time_us() const { return pose_time_us_; }
+  const DecoderStats& stats() const { return stats_; }
+  // Abandons an unfinished transfer older than the timeout (call when the bus is quiet).
+  void check_timeout(std::uint64_t now_ns);
+
+ private:
+  struct Record {
+    bool active = false;
+    std::uint8_t tag = 0, next = 0;
+    std::uint8_t bytes[kMaxRecordBytes] = {};
+  };
+  // Returns true when the record of `parts` parts is complete in rec->bytes.
+  bool feed_part(Record* rec, std::size_t parts, std::size_t part, const hal::CanFrame& f);
+  bool feed_fd_record(Record* rec, std::size_t parts, const hal::CanFrame& f);
+  void start_scan(const std::uint8_t* payload, std::uint64_t t_ns);
+  void scan_segment(const hal::CanFrame& f, bool fd);
+  bool scan_end(const hal::CanFrame& f);
+  void drop_scan(std::uint32_t missing_segments);
+
+  Options options_;
+  DecoderStats stats_;
+  Record odom_rec_, start_rec_, pose_rec_, health_rec_;
+
+  // Scan transfer in progress.
+  bool scan_active_ = false;
+  bool scan_broken_ = false;
+  bool scan_fd_ = false;
+  std::uint64_t scan_started_ns_ = 0;
+  std::uint32_t expected_segment_ = 0;
+  std::uint32_t beams_received_ = 0;
+  std::uint32_t range_unit_um_ = 1000;
+  std::uint32_t scan_crc_ = 0;
+  hal::LaserScan scan_work_;
+
+  hal::LaserScan scan_;
+  hal::Odometry odom_;
+  hal::PoseEstimate pose_;
+  std::uint64_t pose_time_us_ = 0;
+  HealthRecord health_;
+};
+
+}  // namespace hal_can

@@ -1,0 +1,71 @@
+// The mmlfw CAN message set (documented frame by frame in hal/can/mmlfw.dbc and hal/can/README.md).
+// Pure encode/decode: no sockets, no <linux/can.h>; frames are hal::CanFrame.
+//
+// Records (odometry, scan start, pose, health) are fixed little-endian payloads cut into 7-byte
+// parts. On classic CAN part k travels at ID base+k as [tag][7 payload bytes]; on CAN FD the whole
+// record travels in one frame at ID base|0x400 as [tag][payload], padded to an FD length. The tag
+// is a per-record-type sequence number that ties the parts of one record together; fields never
+// straddle a part boundary so the DBC can describe every classic part.
+//
+// A laser scan is a segmented transfer: SCAN_START record, SCAN_DATA segments
+// [u16 header: segment index (bits 0..11) | scan_id & 0xF (bits 12..15)][u16 ranges...]
+// (3 ranges per classic frame, 31 per FD frame), then SCAN_END [scan_id u16][segments u16][crc32]
+// where the CRC-32 (IEEE 802.3) covers the 28-byte start payload followed by all range bytes.
+#pragma once
+
+#include <cstddef>
+#include <cstdint>
+
+namespace hal_can {
+
+constexpr std::uint32_t kFdIdFlag = 0x400;  // FD variant of a record / data frame: base | 0x400
+
+// Base identifiers (11-bit). Lower ID wins arbitration: odometry first, health last.
+constexpr std::uint32_t kOdomId = 0x100;       // 4 parts 0x100..0x103; FD 0x500
+constexpr std::uint32_t kScanStartId = 0x110;  // 4 parts 0x110..0x113; FD 0x510
+constexpr std::uint32_t kScanDataId = 0x118;   // classic; FD 0x518
+constexpr std::uint32_t kScanEndId = 0x119;    // 8 bytes on both buses
+constexpr std::uint32_t kPoseId = 0x120;       // 5 parts 0x120..0x124; FD 0x520
+constexpr std::uint32_t kHealthId = 0x130;     // 5 parts 0x130..0x134; FD 0x530
+
+constexpr std::size_t kPartBytes = 7;
+constexpr std::size_t kOdomParts = 4, kScanStartParts = 4, kPoseParts = 5, kHealthParts = 5;
+constexpr std::size_t kMaxParts = 5;
+constexpr std::size_t kMaxRecordBytes = kMaxParts * kPartBytes;  // 35
+
+constexpr std::size_t kClassicRangesPerSegment = 3;
+constexpr std::size_t kFdRangesPerSegment = 31;
+constexpr std::uint32_t kMaxSegments = 4096;  // 12-bit segment index
+constexpr std::uint16_t kNoReturn = 0xFFFF;   // range code: no return / not representable
+
+// Smallest valid CAN FD data length >= n (0..8, 12, 16, 20, 24, 32, 48, 64).
+std::uint8_t fd_length_for(std::size_t n);
+
+// Little-endian field access (payloads are byte arrays; no alignment assumptions).
+inline void put_u16(std::uint8_t* p, std::uint16_t v) { p[0] = v & 0xFF; p[1] = (v >> 8) & 0xFF; }
+inline void put_u32(std::uint8_t* p, std::uint32_t v) {
+  for (int i = 0; i < 4; ++i) p[i] = (v >> (8 * i)) & 0xFF;
+}
+inline void put_u48(std::uint8_t* p, std::uint64_t v) {
+  for (int i = 0; i < 6; ++i) p[i] = (v >> (8 * i)) & 0xFF;
+}
+inline std::uint16_t get_u16(const std::uint8_t* p) { return static_cast<std::uint16_t>(p[0] | (p[1] << 8)); }
+inline std::uint32_t get_u32(const std::uint8_t* p) {
+  return static_cast<std::uint32_t>(p[0]) | (static_cast<std::uint32_t>(p[1]) << 8) |
+         (static_cast<std::uint32_t>(p[2]) << 16) | (static_cast<std::uint32_t>(p[3]) << 24);
+}
+inline std::uint64_t get_u48(const std::uint8_t* p) {
+  std::uint64_t v = 0;
+  for (int i = 5; i >= 0; --i) v = (v << 8) | p[i];
+  return v;
+}
+
+// CRC-32 (IEEE 802.3, reflected, init/xorout 0xFFFFFFFF; same as zlib's crc32).
+std::uint32_t crc32_update(std::uint32_t crc, const std::uint8_t* data, std::size_t len);
+inline std::uint32_t crc32_begin() { return 0xFFFFFFFFu; }
+inline std::uint32_t crc32_end(std::uint32_t crc) { return crc ^ 0xFFFFFFFFu; }
+inline std::uint32_t crc32(const std::uint8_t* data, std::size_t len) {
+  return crc32_end(crc32_update(crc32_begin(), data, len));
+}
+
+}  // namespace hal_can
