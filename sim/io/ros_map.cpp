@@ -1,0 +1,442 @@
+#include "sim/io/ros_map.h"
+
+#include <cerrno>
+#include <charconv>
+#include <cmath>
+#include <cstdio>
+#include <cstdlib>
+#include <cstring>
+#include <filesystem>
+#include <fstream>
+#include <map>
+#include <sstream>
+
+namespace sim {
+namespace {
+
+bool fail(std::string* error, const std::string& msg) {
+  if (error != nullptr) *error = msg;
+  return false;
+}
+
+std::string trim(const std::string& s) {
+  std::size_t b = 0, e = s.size();
+  while (b < e && std::isspace(static_cast<unsigned char>(s[b]))) ++b;
+  while (e > b && std::isspace(static_cast<unsigned char>(s[e - 1]))) --e;
+  return s.substr(b, e - b);
+}
+
+std::string unquote(const std::string& s) {
+  if (s.size() >= 2 && ((s.front() == '"' && s.back() == '"') || (s.front() == '\'' && s.back() == '\''))) {
+    return s.substr(1, s.size() - 2);
+  }
+  return s;
+}
+
+bool parse_double(const std::string& text, double* out) {
+  const std::string t = trim(text);
+  if (t.empty()) return false;
+  char* end = nullptr;
+  errno = 0;
+  const double v = std::strtod(t.c_str(), &end);
+  if (errno != 0 || end != t.c_str() + t.size()) return false;
+  *out = v;
+  return true;
+}
+
+// Shortest representation that reads back to the same double (bit-exact YAML round trip).
+std::string format_double(double v) {
+  char buf[64];
+  auto r = std::to_chars(buf, buf + sizeof(buf), v);
+  std::string s(buf, r.ptr);
+  // Keep it recognisably a float for YAML readers ("1" -> "1.0").
+  if (s.find_first_of(".eEn") == std::string::npos) s += ".0";
+  return s;
+}
+
+bool read_whole_file(const std::string& path, std::string* data, std::string* error) {
+  std::ifstream in(path, std::ios::binary);
+  if (!in) return fail(error, path + ": cannot open: " + std::strerror(errno));
+  std::ostringstream ss;
+  ss << in.rdbuf();
+  if (in.bad()) return fail(error, path + ": read error");
+  *data = ss.str();
+  return true;
+}
+
+// PGM header tokenizer: whitespace and '#' comments between tokens.
+struct PgmCursor {
+  const std::string& d;
+  std::size_t pos = 0;
+  void skip_space_and_comments() {
+    while (pos < d.size()) {
+      if (d[pos] == '#') {
+        while (pos < d.size() && d[pos] != '\n' && d[pos] != '\r') ++pos;
+      } else if (std::isspace(static_cast<unsigned char>(d[pos]))) {
+        ++pos;
+      } else {
+        break;
+      }
+    }
+  }
+  // Reads an unsigned decimal; false at end of data or on a non-digit.
+  bool read_uint(long long* v) {
+    skip_space_and_comments();
+    if (pos >= d.size() || !std::isdigit(static_cast<unsigned char>(d[pos]))) return false;
+    long long x = 0;
+    while (pos < d.size() && std::isdigit(static_cast<unsigned char>(d[pos]))) {
+      x = x * 10 + (d[pos] - '0');
+      if (x > (1LL << 40)) return false;
+      ++pos;
+    }
+    *v = x;
+    return true;
+  }
+};
+
+std::string resolve_image_path(const std::string& yaml_path, const std::string& image) {
+  std::filesystem::path p(image);
+  if (p.is_absolute()) return image;
+  return (std::filesystem::path(yaml_path).parent_path() / p).string();
+}
+
+}  // namespace
+
+bool read_pgm(const std::string& path, RosMap* out, std::string* error) {
+  std::string d;
+  if (!read_whole_file(path, &d, error)) return false;
+  if (d.size() < 2 || d[0] != 'P' || (d[1] != '2' && d[1] != '5')) {
+    return fail(error, path + ": bad magic (expected PGM 'P2' or 'P5')");
+  }
+  const bool ascii = d[1] == '2';
+  PgmCursor c{d, 2};
+  long long w = 0, h = 0, maxval = 0;
+  if (!c.read_uint(&w)) return fail(error, path + ": PGM header: missing or invalid width");
+  if (!c.read_uint(&h)) return fail(error, path + ": PGM header: missing or invalid height");
+  if (!c.read_uint(&maxval)) return fail(error, path + ": PGM header: missing or invalid maxval");
+  if (w <= 0 || h <= 0 || w > 100000 || h > 100000) {
+    return fail(error, path + ": PGM header: size " + std::to_string(w) + "x" + std::to_string(h) +
+                           " out of range (1..100000)");
+  }
+  if (maxval < 1 || maxval > 255) {
+    return fail(error, path + ": PGM header: maxval " + std::to_string(maxval) +
+                           " not supported (8-bit PGM only, 1..255)");
+  }
+  const std::size_t n = static_cast<std::size_t>(w) * static_cast<std::size_t>(h);
+  std::vector<std::uint8_t> pixels(n);
+  if (ascii) {
+    for (std::size_t i = 0; i < n; ++i) {
+      long long v = 0;
+      if (!c.read_uint(&v)) {
+        return fail(error, path + ": truncated or malformed P2 data: pixel " + std::to_string(i) + " of " +
+                               std::to_string(n) + " missing");
+      }
+      if (v > maxval) {
+        return fail(error, path + ": pixel " + std::to_string(i) + " value " + std::to_string(v) + " exceeds maxval " +
+                               std::to_string(maxval));
+      }
+      pixels[i] = static_cast<std::uint8_t>(v);
+    }
+  } else {
+    // Exactly one whitespace byte separates maxval from the raster.
+    if (c.pos >= d.size() || !std::isspace(static_cast<unsigned char>(d[c.pos]))) {
+      return fail(error, path + ": PGM header: no whitespace after maxval");
+    }
+    ++c.pos;
+    if (d.size() - c.pos < n) {
+      return fail(error, path + ": truncated P5 data: " + std::to_string(d.size() - c.pos) + " of " +
+                             std::to_string(n) + " pixel bytes");
+    }
+    std::memcpy(pixels.data(), d.data() + c.pos, n);
+    for (std::size_t i = 0; i < n; ++i) {
+      if (pixels[i] > maxval) {
+        return fail(error, path + ": pixel " + std::to_string(i) + " value " + std::to_string(pixels[i]) +
+                               " exceeds maxval " + std::to_string(maxval));
+      }
+    }
+  }
+  out->width = static_cast<int>(w);
+  out->height = static_cast<int>(h);
+  out->maxval = static_cast<int>(maxval);
+  out->pgm_ascii = ascii;
+  out->pixels = std::move(pixels);
+  return true;
+}
+
+bool write_pgm(const std::string& path, const RosMap& map, std::string* error) {
+  if (map.width <= 0 || map.height <= 0 ||
+      map.pixels.size() != static_cast<std::size_t>(map.width) * static_cast<std::size_t>(map.height)) {
+    return fail(error, path + ": cannot write PGM: pixel buffer does not match " + std::to_string(map.width) + "x" +
+                           std::to_string(map.height));
+  }
+  if (map.maxval < 1 || map.maxval > 255) return fail(error, path + ": cannot write PGM: maxval out of 1..255");
+  std::ofstream o(path, std::ios::binary | std::ios::trunc);
+  if (!o) return fail(error, path + ": cannot create: " + std::strerror(errno));
+  o << (map.pgm_ascii ? "P2" : "P5") << "\n" << map.width << " " << map.height << "\n" << map.maxval << "\n";
+  if (map.pgm_ascii) {
+    for (int y = 0; y < map.height; ++y) {
+      for (int x = 0; x < map.width; ++x) {
+        o << static_cast<int>(map.pixels[static_cast<std::size_t>(y) * map.width + x]);
+        o << ((x + 1 == map.width || (x + 1) % 16 == 0) ? '\n' : ' ');
+      }
+    }
+  } else {
+    o.write(reinterpret_cast<const char*>(map.pixels.data()), static_cast<std::streamsize>(map.pixels.size()));
+  }
+  o.close();
+  if (!o) return fail(error, path + ": write failed");
+  return true;
+}
+
+bool validate_ros_map(const RosMap& m, const std::string& name, std::string* error) {
+  if (m.image.empty()) return fail(error, name + ": field 'image': empty");
+  if (!std::isfinite(m.resolution) || !(m.resolution > 0.0)) {
+    return fail(error, name + ": field 'resolution': must be a positive number (got " + format_double(m.resolution) + ")");
+  }
+  for (int i = 0; i < 3; ++i) {
+    if (!std::isfinite(m.origin[i])) return fail(error, name + ": field 'origin': component " + std::to_string(i) + " not finite");
+  }
+  if (!(m.occupied_thresh >= 0.0 && m.occupied_thresh <= 1.0)) {
+    return fail(error, name + ": field 'occupied_thresh': must be in [0, 1] (got " + format_double(m.occupied_thresh) + ")");
+  }
+  if (!(m.free_thresh >= 0.0 && m.free_thresh <= 1.0)) {
+    return fail(error, name + ": field 'free_thresh': must be in [0, 1] (got " + format_double(m.free_thresh) + ")");
+  }
+  if (!(m.free_thresh < m.occupied_thresh)) {
+    return fail(error, name + ": fields 'free_thresh' (" + format_double(m.free_thresh) +
+                           ") must be below 'occupied_thresh' (" + format_double(m.occupied_thresh) + ")");
+  }
+  if (m.mode != "trinary" && m.mode != "scale" && m.mode != "raw") {
+    return fail(error, name + ": field 'mode': '" + m.mode + "' is not trinary, scale or raw");
+  }
+  if (m.width <= 0 || m.height <= 0 ||
+      m.pixels.size() != static_cast<std::size_t>(m.width) * static_cast<std::size_t>(m.height)) {
+    return fail(error, name + ": image: pixel buffer does not match " + std::to_string(m.width) + "x" +
+                           std::to_string(m.height));
+  }
+  return true;
+}
+
+bool read_ros_map(const std::string& yaml_path, RosMap* out, std::string* error) {
+  std::string text;
+  if (!read_whole_file(yaml_path, &text, error)) return false;
+  std::map<std::string, std::string> kv;
+  std::istringstream in(text);
+  std::string line;
+  int line_no = 0;
+  while (std::getline(in, line)) {
+    ++line_no;
+    // Strip comments outside quotes.
+    bool in_q = false;
+    char q = 0;
+    for (std::size_t i = 0; i < line.size(); ++i) {
+      const char ch = line[i];
+      if (in_q) {
+        if (ch == q) in_q = false;
+      } else if (ch == '"' || ch == '\'') {
+        in_q = true;
+        q = ch;
+      } else if (ch == '#') {
+        line.resize(i);
+        break;
+      }
+    }
+    const std::string t = trim(line);
+    if (t.empty() || t == "---") continue;
+    const std::size_t colon = t.find(':');
+    if (colon == std::string::npos) {
+      return fail(error, yaml_path + ":" + std::to_string(line_no) + ": expected 'key: value', got '" + t + "'");
+    }
+    const std::string key = trim(t.substr(0, colon));
+    const std::string value = trim(t.substr(colon + 1));
+    if (kv.count(key) != 0) return fail(error, yaml_path + ":" + std::to_string(line_no) + ": duplicate field '" + key + "'");
+    kv[key] = value;
+  }
+  RosMap m;
+  m.yaml_path = yaml_path;
+  for (const char* key : {"image", "resolution", "origin", "negate", "occupied_thresh", "free_thresh"}) {
+    if (kv.count(key) == 0) return fail(error, yaml_path + ": missing field '" + std::string(key) + "'");
+  }
+  m.image = unquote(kv["image"]);
+  if (m.image.empty()) return fail(error, yaml_path + ": field 'image': empty");
+  if (!parse_double(kv["resolution"], &m.resolution)) {
+    return fail(error, yaml_path + ": field 'resolution': not a number: '" + kv["resolution"] + "'");
+  }
+  {
+    std::string o = kv["origin"];
+    if (o.size() < 2 || o.front() != '[' || o.back() != ']') {
+      return fail(error, yaml_path + ": field 'origin': expected [x, y, yaw], got '" + o + "'");
+    }
+    o = o.substr(1, o.size() - 2);
+    std::vector<std::string> parts;
+    std::size_t start = 0;
+    while (true) {
+      const std::size_t comma = o.find(',', start);
+      parts.push_back(o.substr(start, comma == std::string::npos ? std::string::npos : comma - start));
+      if (comma == std::string::npos) break;
+      start = comma + 1;
+    }
+    if (parts.size() != 3) {
+      return fail(error, yaml_path + ": field 'origin': expected 3 numbers [x, y, yaw], got " +
+                             std::to_string(parts.size()));
+    }
+    for (int i = 0; i < 3; ++i) {
+      if (!parse_double(parts[i], &m.origin[i])) {
+        return fail(error, yaml_path + ": field 'origin': component " + std::to_string(i) + " not a number: '" +
+                               trim(parts[i]) + "'");
+      }
+    }
+  }
+  {
+    const std::string n = kv["negate"];
+    if (n == "0" || n == "false" || n == "False") {
+      m.negate = false;
+    } else if (n == "1" || n == "true" || n == "True") {
+      m.negate = true;
+    } else {
+      return fail(error, yaml_path + ": field 'negate': expected 0/1/true/false, got '" + n + "'");
+    }
+  }
+  if (!parse_double(kv["occupied_thresh"], &m.occupied_thresh)) {
+    return fail(error, yaml_path + ": field 'occupied_thresh': not a number: '" + kv["occupied_thresh"] + "'");
+  }
+  if (!parse_double(kv["free_thresh"], &m.free_thresh)) {
+    return fail(error, yaml_path + ": field 'free_thresh': not a number: '" + kv["free_thresh"] + "'");
+  }
+  if (kv.count("mode") != 0) m.mode = unquote(kv["mode"]);
+  // Validate fields before touching the image, so the message is about the YAML.
+  m.width = 1;
+  m.height = 1;
+  m.pixels.assign(1, 0);
+  if (!validate_ros_map(m, yaml_path, error)) return false;
+  const std::string image_path = resolve_image_path(yaml_path, m.image);
+  if (!std::filesystem::exists(image_path)) {
+    return fail(error, yaml_path + ": field 'image': file '" + image_path + "' does not exist");
+  }
+  if (!read_pgm(image_path, &m, error)) return false;
+  *out = std::move(m);
+  return true;
+}
+
+bool write_ros_map(const std::string& yaml_path, const RosMap& map, std::string* error) {
+  RosMap m = map;
+  if (m.image.empty()) m.image = std::filesystem::path(yaml_path).stem().string() + ".pgm";
+  if (!validate_ros_map(m, yaml_path, error)) return false;
+  if (!write_pgm(resolve_image_path(yaml_path, m.image), m, error)) return false;
+  std::ofstream o(yaml_path, std::ios::trunc);
+  if (!o) return fail(error, yaml_path + ": cannot create: " + std::strerror(errno));
+  o << "image: " << m.image << "\n"
+    << "resolution: " << format_double(m.resolution) << "\n"
+    << "origin: [" << format_double(m.origin[0]) << ", " << format_double(m.origin[1]) << ", "
+    << format_double(m.origin[2]) << "]\n"
+    << "negate: " << (m.negate ? 1 : 0) << "\n"
+    << "occupied_thresh: " << format_double(m.occupied_thresh) << "\n"
+    << "free_thresh: " << format_double(m.free_thresh) << "\n"
+    << "mode: " << m.mode << "\n";
+  o.close();
+  if (!o) return fail(error, yaml_path + ": write failed");
+  return true;
+}
+
+bool ros_map_to_grid(const RosMap& m, OccupancyGrid* out, std::string* error) {
+  const std::string name = m.yaml_path.empty() ? std::string("map") : m.yaml_path;
+  if (!validate_ros_map(m, name, error)) return false;
+  if (m.origin[2] != 0.0) {
+    return fail(error, name + ": field 'origin': yaw " + format_double(m.origin[2]) +
+                           " is not supported (grids are axis-aligned; rotate the image instead)");
+  }
+  OccupancyGrid g;
+  g.geometry.resolution = static_cast<float>(m.resolution);
+  g.geometry.origin_x = static_cast<float>(m.origin[0]);
+  g.geometry.origin_y = static_cast<float>(m.origin[1]);
+  g.geometry.width = static_cast<std::uint32_t>(m.width);
+  g.geometry.height = static_cast<std::uint32_t>(m.height);
+  g.cells.assign(g.geometry.cell_count(), 255);
+  const double maxval = m.maxval;
+  for (int row = 0; row < m.height; ++row) {
+    const int gy = m.height - 1 - row;  // PGM top row = highest y
+    for (int x = 0; x < m.width; ++x) {
+      const int raw = m.pixels[static_cast<std::size_t>(row) * m.width + x];
+      const int v = m.negate ? m.maxval - raw : raw;
+      std::uint8_t cell = 255;
+      if (m.mode == "raw") {
+        if (v <= 100) {
+          cell = static_cast<std::uint8_t>(v);
+        } else if (v == 255) {
+          cell = 255;
+        } else {
+          return fail(error, name + ": mode raw: pixel (" + std::to_string(x) + ", " + std::to_string(row) +
+                                 ") value " + std::to_string(v) + " is neither 0..100 nor 255");
+        }
+      } else {
+        const double p = (maxval - v) / maxval;  // darker = more likely occupied
+        if (p > m.occupied_thresh) {
+          cell = 100;
+        } else if (p < m.free_thresh) {
+          cell = 0;
+        } else if (m.mode == "trinary") {
+          cell = 255;
+        } else {
+          const double ratio = (p - m.free_thresh) / (m.occupied_thresh - m.free_thresh);
+          cell = static_cast<std::uint8_t>(std::lround(1.0 + 98.0 * ratio));
+        }
+      }
+      g.cells[g.geometry.index(x, gy)] = cell;
+    }
+  }
+  *out = std::move(g);
+  return true;
+}
+
+RosMap grid_to_ros_map(const OccupancyGrid& grid, const std::string& image_name) {
+  RosMap m;
+  m.image = image_name;
+  m.resolution = grid.geometry.resolution;
+  m.origin[0] = grid.geometry.origin_x;
+  m.origin[1] = grid.geometry.origin_y;
+  m.origin[2] = 0.0;
+  m.negate = false;
+  m.occupied_thresh = 0.65;
+  m.free_thresh = 0.196;
+  m.mode = "trinary";
+  m.width = static_cast<int>(grid.geometry.width);
+  m.height = static_cast<int>(grid.geometry.height);
+  m.pixels.assign(grid.geometry.cell_count(), 205);
+  for (int gy = 0; gy < m.height; ++gy) {
+    const int row = m.height - 1 - gy;
+    for (int x = 0; x < m.width; ++x) {
+      const std::uint8_t c = grid.cells[grid.geometry.index(x, gy)];
+      std::uint8_t px = 205;  // unknown (map_saver convention)
+      if (c == 255) {
+        px = 205;
+      } else if (c >= 65) {
+        px = 0;
+      } else if (c <= 19) {
+        px = 254;
+      }
+      m.pixels[static_cast<std::size_t>(row) * m.width + x] = px;
+    }
+  }
+  return m;
+}
+
+std::vector<fw::Point2f> occupied_points(const OccupancyGrid& grid) {
+  std::vector<fw::Point2f> pts;
+  for (std::uint32_t y = 0; y < grid.geometry.height; ++y) {
+    for (std::uint32_t x = 0; x < grid.geometry.width; ++x) {
+      if (grid.cells[grid.geometry.index(static_cast<std::int32_t>(x), static_cast<std::int32_t>(y))] == 100) {
+        pts.push_back(grid.geometry.cell_center(static_cast<std::int32_t>(x), static_cast<std::int32_t>(y)));
+      }
+    }
+  }
+  return pts;
+}
+
+bool ros_map_occupied_points(const RosMap& map, std::vector<fw::Point2f>* out, std::string* error) {
+  OccupancyGrid g;
+  if (!ros_map_to_grid(map, &g, error)) return false;
+  *out = occupied_points(g);
+  return true;
+}
+
+}  // namespace sim

@@ -1,0 +1,364 @@
+// Compiled map image: host writer + firmware loader together (the loader is firmware code; its
+// tests live here because they need the host writer).
+#include <gtest/gtest.h>
+#include <unistd.h>
+#include <zlib.h>
+
+#include <cmath>
+#include <cstring>
+#include <filesystem>
+#include <limits>
+
+#include "firmware/base/arena.h"
+#include "firmware/base/memory_report.h"
+#include "firmware/base/rng.h"
+#include "firmware/map/crc32.h"
+#include "firmware/map/map_image.h"
+#include "firmware/map/map_image_file.h"
+#include "sim/map/map_image_writer.h"
+
+namespace sim {
+namespace {
+
+// A 40x30 grid at 0.1 m: border walls, an inner wall with a door, one unknown blob.
+OccupancyGrid test_grid() {
+  OccupancyGrid g;
+  g.geometry.resolution = 0.1f;
+  g.geometry.origin_x = -2.0f;
+  g.geometry.origin_y = 1.0f;
+  g.geometry.width = 40;
+  g.geometry.height = 30;
+  g.cells.assign(g.geometry.cell_count(), fw::kCellFree);
+  for (int y = 0; y < 30; ++y) {
+    for (int x = 0; x < 40; ++x) {
+      const bool border = x == 0 || y == 0 || x == 39 || y == 29;
+      const bool inner = x == 20 && (y < 12 || y > 16);
+      if (border || inner) g.cells[g.geometry.index(x, y)] = fw::kCellOccupied;
+      if (x > 30 && x < 35 && y > 20 && y < 25) g.cells[g.geometry.index(x, y)] = fw::kCellUnknown;
+    }
+  }
+  return g;
+}
+
+std::vector<std::uint8_t> image_of(const OccupancyGrid& g) {
+  MapImageWriter w;
+  std::string err;
+  EXPECT_TRUE(w.set_grid(g, &err)) << err;
+  return w.bytes();
+}
+
+struct Loaded {
+  fw::StartupArena arena;
+  fw::GlobalMap map;
+  fw::Status status;
+};
+
+void load(const std::vector<std::uint8_t>& bytes, Loaded* out) {
+  ASSERT_TRUE(out->arena.init_mapped(bytes.size() + 4096, false, "test").is_ok());
+  out->status = fw::load_map_image(bytes.data(), bytes.size(), out->arena, &out->map, "test.mmap");
+}
+
+std::uint32_t rd32(const std::vector<std::uint8_t>& b, std::size_t at) {
+  return b[at] | (b[at + 1] << 8) | (b[at + 2] << 16) | (static_cast<std::uint32_t>(b[at + 3]) << 24);
+}
+void wr32(std::vector<std::uint8_t>* b, std::size_t at, std::uint32_t v) {
+  for (int i = 0; i < 4; ++i) (*b)[at + i] = static_cast<std::uint8_t>(v >> (8 * i));
+}
+// Recomputes every section CRC and the image CRC (to make a structurally "honest" corrupt image).
+void refresh_crcs(std::vector<std::uint8_t>* b) {
+  const std::uint32_t n = rd32(*b, 12);
+  for (std::uint32_t i = 0; i < n; ++i) {
+    const std::size_t e = 32 + 32 * i;
+    const std::size_t off = rd32(*b, e + 8), size = rd32(*b, e + 16);
+    if (off > b->size() || size > b->size() - off) continue;  // deliberately out of bounds
+    wr32(b, e + 24, static_cast<std::uint32_t>(::crc32(0, b->data() + off, static_cast<uInt>(size))));
+  }
+  wr32(b, 28, 0);
+  wr32(b, 28, static_cast<std::uint32_t>(::crc32(0, b->data(), static_cast<uInt>(b->size()))));
+}
+std::size_t section_entry(const std::vector<std::uint8_t>& b, fw::MapSectionType t) {
+  const std::uint32_t n = rd32(b, 12);
+  for (std::uint32_t i = 0; i < n; ++i) {
+    if (rd32(b, 32 + 32 * i) == static_cast<std::uint32_t>(t)) return 32 + 32 * i;
+  }
+  return 0;
+}
+
+TEST(MapImageTest, FirmwareCrcMatchesZlib) {
+  fw::RandomStream rng(7, 0);
+  std::vector<std::uint8_t> buf(100000);
+  for (auto& x : buf) x = static_cast<std::uint8_t>(rng.next_u32());
+  for (std::size_t len : {0u, 1u, 3u, 1000u, 99999u, 100000u}) {
+    EXPECT_EQ(fw::crc32(buf.data(), len), static_cast<std::uint32_t>(::crc32(0, buf.data(), static_cast<uInt>(len))));
+  }
+}
+
+TEST(MapImageTest, LoadsWhatTheWriterWrote) {
+  fw::MemoryReport::instance().clear();
+  const OccupancyGrid g = test_grid();
+  const std::vector<std::uint8_t> bytes = image_of(g);
+  Loaded l;
+  load(bytes, &l);
+  ASSERT_TRUE(l.status.is_ok()) << l.status.message();
+  const fw::GlobalMap& m = l.map;
+  EXPECT_EQ(m.geometry.width, 40u);
+  EXPECT_EQ(m.geometry.height, 30u);
+  EXPECT_EQ(m.geometry.resolution, 0.1f);
+  EXPECT_EQ(m.geometry.origin_x, -2.0f);
+  EXPECT_EQ(m.geometry.origin_y, 1.0f);
+  std::size_t occ = 0;
+  for (std::size_t i = 0; i < g.cells.size(); ++i) {
+    EXPECT_EQ(m.occupancy[i], g.cells[i]);
+    occ += g.cells[i] == fw::kCellOccupied;
+  }
+  EXPECT_EQ(m.num_points, occ);
+  // Distance field against brute force, exact (same float ops: sqrt(integer) * res).
+  float maxd = 0.0f;
+  for (int y = 0; y < 30; ++y) {
+    for (int x = 0; x < 40; ++x) {
+      int best = std::numeric_limits<int>::max();
+      for (int yy = 0; yy < 30; ++yy)
+        for (int xx = 0; xx < 40; ++xx)
+          if (g.cells[g.geometry.index(xx, yy)] == fw::kCellOccupied)
+            best = std::min(best, (x - xx) * (x - xx) + (y - yy) * (y - yy));
+      const float expect = std::sqrt(static_cast<float>(best)) * 0.1f;
+      ASSERT_EQ(m.distance_m[g.geometry.index(x, y)], expect) << x << "," << y;
+      maxd = std::max(maxd, expect);
+    }
+  }
+  EXPECT_EQ(m.max_distance_m, maxd);
+  // Points are the occupied cell centres and lie in occupied cells.
+  for (std::uint32_t i = 0; i < m.num_points; ++i) {
+    std::int32_t cx, cy;
+    ASSERT_TRUE(m.geometry.world_to_cell(m.points[i].x(), m.points[i].y(), &cx, &cy));
+    EXPECT_EQ(m.cell(cx, cy), fw::kCellOccupied);
+  }
+  EXPECT_NEAR(m.points[0].x(), -1.95f, 1e-6f);
+  EXPECT_NEAR(m.points[0].y(), 1.05f, 1e-6f);
+  EXPECT_EQ(m.distance_at(-1.95f, 1.05f, -1.0f), 0.0f);
+  EXPECT_EQ(m.distance_at(100.0f, 0.0f, -1.0f), -1.0f);
+  // Registered with the memory report.
+  EXPECT_EQ(fw::MemoryReport::instance().module_bytes("map"),
+            g.cells.size() * (1 + sizeof(float)) + m.num_points * sizeof(fw::Point2f));
+  fw::MemoryReport::instance().clear();
+}
+
+TEST(MapImageTest, ExtraSectionsAreFoundAndCovered) {
+  MapImageWriter w;
+  std::string err;
+  ASSERT_TRUE(w.set_grid(test_grid(), &err)) << err;
+  const std::vector<std::uint8_t> table = {1, 2, 3, 4, 5};
+  ASSERT_TRUE(w.add_section(fw::MapSectionType::kRelationTable2D, table, 3, &err)) << err;
+  EXPECT_FALSE(w.add_section(fw::MapSectionType::kOccupancy, {1}, 1, &err));
+  std::vector<std::uint8_t> bytes = w.bytes();
+  EXPECT_TRUE(fw::verify_map_image(bytes.data(), bytes.size()).is_ok());
+  std::size_t len = 0;
+  std::uint32_t ver = 0;
+  const std::uint8_t* p = fw::find_section(bytes.data(), bytes.size(), fw::MapSectionType::kRelationTable2D, &len, &ver);
+  ASSERT_NE(p, nullptr);
+  EXPECT_EQ(len, 5u);
+  EXPECT_EQ(ver, 3u);
+  EXPECT_EQ(std::memcmp(p, table.data(), 5), 0);
+  EXPECT_EQ(static_cast<std::size_t>(p - bytes.data()) % fw::kMapSectionAlignment, 0u);
+  EXPECT_EQ(fw::find_section(bytes.data(), bytes.size(), fw::MapSectionType::kRelationTable3D, &len), nullptr);
+  Loaded l;
+  load(bytes, &l);
+  EXPECT_TRUE(l.status.is_ok()) << l.status.message();
+  // A flipped byte inside the extra section is caught by its CRC.
+  bytes[static_cast<std::size_t>(p - bytes.data()) + 2] ^= 0x10;
+  const fw::Status st = fw::verify_map_image(bytes.data(), bytes.size(), "x.mmap");
+  ASSERT_FALSE(st.is_ok());
+  EXPECT_NE(std::strstr(st.message(), "relation table 2D section CRC mismatch"), nullptr) << st.message();
+}
+
+void expect_rejected(const std::vector<std::uint8_t>& bytes, const char* what) {
+  Loaded l;
+  load(bytes, &l);
+  ASSERT_FALSE(l.status.is_ok()) << "accepted: expected '" << what << "'";
+  EXPECT_NE(std::strstr(l.status.message(), "test.mmap"), nullptr) << l.status.message();
+  EXPECT_NE(std::strstr(l.status.message(), what), nullptr) << "'" << l.status.message() << "' lacks '" << what << "'";
+  EXPECT_EQ(l.arena.used(), 0u) << "a rejected image must not consume arena memory";
+}
+
+TEST(MapImageTest, FlippedByteAnywhereIsRejected) {
+  const std::vector<std::uint8_t> good = image_of(test_grid());
+  // Every byte position (step 7 for speed) with a single bit flip must be rejected.
+  for (std::size_t i = 0; i < good.size(); i += 7) {
+    std::vector<std::uint8_t> b = good;
+    b[i] ^= 0x04;
+    Loaded l;
+    load(b, &l);
+    EXPECT_FALSE(l.status.is_ok()) << "flip at byte " << i << " accepted";
+  }
+  std::vector<std::uint8_t> b = good;
+  const std::size_t occ_entry = section_entry(b, fw::MapSectionType::kOccupancy);
+  b[rd32(b, occ_entry + 8) + 5] ^= 1;
+  expect_rejected(b, "occupancy section CRC mismatch");
+  b = good;
+  b[good.size() - 1] ^= 0x80;  // inside the last section (points)
+  expect_rejected(b, "CRC mismatch");
+  b = good;
+  b[25] ^= 0;                   // unchanged control
+  Loaded ok;
+  load(b, &ok);
+  EXPECT_TRUE(ok.status.is_ok());
+  b[20] ^= 1;  // total size high bytes
+  expect_rejected(b, "bytes");
+}
+
+TEST(MapImageTest, TruncatedAndPaddedFilesAreRejected) {
+  const std::vector<std::uint8_t> good = image_of(test_grid());
+  for (std::size_t keep : {std::size_t{0}, std::size_t{10}, std::size_t{31}, std::size_t{32}, std::size_t{100},
+                           good.size() / 2, good.size() - 1}) {
+    std::vector<std::uint8_t> b(good.begin(), good.begin() + static_cast<std::ptrdiff_t>(keep));
+    if (keep == 0) b.push_back(0);  // empty buffers: give the loader one byte
+    expect_rejected(b, keep < 32 ? "truncated" : "truncated or padded");
+  }
+  std::vector<std::uint8_t> b = good;
+  b.push_back(0);
+  expect_rejected(b, "truncated or padded");
+}
+
+TEST(MapImageTest, WrongMagicAndVersionAreRejected) {
+  const std::vector<std::uint8_t> good = image_of(test_grid());
+  std::vector<std::uint8_t> b = good;
+  b[0] = 'X';
+  expect_rejected(b, "bad magic");
+  b = good;
+  wr32(&b, 8, 2);
+  refresh_crcs(&b);
+  expect_rejected(b, "format version 2");
+  b = good;
+  wr32(&b, section_entry(b, fw::MapSectionType::kDistanceField) + 4, 9);
+  refresh_crcs(&b);
+  expect_rejected(b, "distance field section version 9");
+}
+
+TEST(MapImageTest, SectionSizeLiesAreRejectedEvenWithValidCrcs) {
+  const OccupancyGrid g = test_grid();
+  const std::vector<std::uint8_t> good = image_of(g);
+  // Section claims to run past the end of the image.
+  std::vector<std::uint8_t> b = good;
+  std::size_t e = section_entry(b, fw::MapSectionType::kOccupancy);
+  wr32(&b, e + 16, static_cast<std::uint32_t>(good.size()));
+  refresh_crcs(&b);
+  expect_rejected(b, "outside the image");
+  // Occupancy section shorter than the geometry says (shrunk by one byte, CRCs honest).
+  b = good;
+  wr32(&b, e + 16, rd32(b, e + 16) - 1);
+  refresh_crcs(&b);
+  expect_rejected(b, "occupancy section is 1199 bytes");
+  // Geometry lies about the width.
+  b = good;
+  const std::size_t geo = rd32(b, section_entry(b, fw::MapSectionType::kGeometry) + 8);
+  wr32(&b, geo + 12, 41);
+  refresh_crcs(&b);
+  expect_rejected(b, "geometry 41x30");
+  // Geometry lies about the point count.
+  b = good;
+  wr32(&b, geo + 20, rd32(b, geo + 20) + 1);
+  refresh_crcs(&b);
+  expect_rejected(b, "occupied points section");
+  // Overlapping sections.
+  b = good;
+  const std::size_t e_dist = section_entry(b, fw::MapSectionType::kDistanceField);
+  wr32(&b, e_dist + 8, rd32(b, e + 8));
+  refresh_crcs(&b);
+  expect_rejected(b, "overlap");
+  // Section table count beyond the file.
+  b = good;
+  wr32(&b, 12, 65);
+  refresh_crcs(&b);
+  expect_rejected(b, "65 sections");
+  // Missing required section (type renamed).
+  b = good;
+  wr32(&b, section_entry(b, fw::MapSectionType::kOccupiedPoints), static_cast<std::uint32_t>(fw::MapSectionType::kUser));
+  refresh_crcs(&b);
+  expect_rejected(b, "missing occupied points section");
+}
+
+TEST(MapImageTest, BadFloatsAndInconsistentContentsAreRejected) {
+  const std::vector<std::uint8_t> good = image_of(test_grid());
+  const std::size_t dist = rd32(good, section_entry(good, fw::MapSectionType::kDistanceField) + 8);
+  const std::size_t pts = rd32(good, section_entry(good, fw::MapSectionType::kOccupiedPoints) + 8);
+  const std::size_t occ = rd32(good, section_entry(good, fw::MapSectionType::kOccupancy) + 8);
+  const std::size_t geo = rd32(good, section_entry(good, fw::MapSectionType::kGeometry) + 8);
+  auto put_f = [](std::vector<std::uint8_t>* b, std::size_t at, float f) {
+    std::uint32_t u;
+    std::memcpy(&u, &f, 4);
+    wr32(b, at, u);
+  };
+  std::vector<std::uint8_t> b = good;
+  put_f(&b, dist + 4 * 45, std::numeric_limits<float>::quiet_NaN());
+  refresh_crcs(&b);
+  expect_rejected(b, "NaN");
+  b = good;
+  put_f(&b, dist + 4 * 45, -1.0f);
+  refresh_crcs(&b);
+  expect_rejected(b, "negative");
+  b = good;
+  put_f(&b, dist + 4 * 45, 0.0f);  // cell 45 is free: distance 0 is a lie
+  refresh_crcs(&b);
+  expect_rejected(b, "not occupied");
+  b = good;
+  put_f(&b, pts, std::numeric_limits<float>::infinity());
+  refresh_crcs(&b);
+  expect_rejected(b, "occupied point 0");
+  b = good;
+  put_f(&b, pts, -1.0f);  // point 0 moved into a free cell
+  put_f(&b, pts + 4, 2.0f);
+  refresh_crcs(&b);
+  expect_rejected(b, "not inside an occupied cell");
+  b = good;
+  b[occ + 45] = 150;
+  refresh_crcs(&b);
+  expect_rejected(b, "invalid value 150");
+  b = good;
+  put_f(&b, geo, std::numeric_limits<float>::quiet_NaN());
+  refresh_crcs(&b);
+  expect_rejected(b, "resolution");
+  b = good;
+  put_f(&b, geo, -0.1f);
+  refresh_crcs(&b);
+  expect_rejected(b, "resolution");
+  b = good;
+  put_f(&b, geo + 24, 99.0f);
+  refresh_crcs(&b);
+  expect_rejected(b, "max distance");
+}
+
+TEST(MapImageTest, ArenaTooSmallIsAnErrorNotACrash) {
+  const std::vector<std::uint8_t> bytes = image_of(test_grid());
+  fw::StartupArena arena;
+  ASSERT_TRUE(arena.init_mapped(1000, false, "small").is_ok());
+  fw::GlobalMap m;
+  const fw::Status st = fw::load_map_image(bytes.data(), bytes.size(), arena, &m, "x.mmap");
+  ASSERT_FALSE(st.is_ok());
+  EXPECT_EQ(st.code(), fw::Errc::kCapacityExceeded);
+}
+
+TEST(MapImageTest, WriterRejectsEmptyMapsAndFileRoundTrip) {
+  OccupancyGrid g = test_grid();
+  for (auto& c : g.cells) c = fw::kCellFree;
+  MapImageWriter w;
+  std::string err;
+  EXPECT_FALSE(w.set_grid(g, &err));
+  EXPECT_NE(err.find("no occupied cells"), std::string::npos) << err;
+
+  const std::string path = (std::filesystem::temp_directory_path() / ("map_image_test_" + std::to_string(::getpid()) + ".mmap")).string();
+  ASSERT_TRUE(w.set_grid(test_grid(), &err)) << err;
+  ASSERT_TRUE(w.write(path, &err)) << err;
+  fw::StartupArena arena;
+  ASSERT_TRUE(arena.init_mapped(1 << 20, false, "t").is_ok());
+  fw::GlobalMap m;
+  fw::Status st = fw::load_map_image_file(path.c_str(), arena, &m);
+  EXPECT_TRUE(st.is_ok()) << st.message();
+  EXPECT_EQ(m.geometry.width, 40u);
+  std::filesystem::remove(path);
+  st = fw::load_map_image_file(path.c_str(), arena, &m);
+  ASSERT_FALSE(st.is_ok());
+  EXPECT_NE(std::strstr(st.message(), path.c_str()), nullptr) << st.message();
+}
+
+}  // namespace
+}  // namespace sim
