@@ -135,7 +135,7 @@ std::vector<ReferencePose> reference_with_bounds(const CarmenLog& raw, const std
       const fw::Se2d f = chain(u[k]->pose, odo(a), odo(i));
       const fw::Se2d bb = chain(u[k + 1]->pose, odo(b), odo(i));
       out[i].pose = blend(f, bb, w);
-      out[i].bound = 2.0 * w * (1.0 - w) * r;
+      out[i].bound = ((1.0 - w) * std::sqrt(w) + w * std::sqrt(1.0 - w)) * r;
     }
   }
   return out;

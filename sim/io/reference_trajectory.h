@@ -14,12 +14,15 @@
 //
 // Error bound. Let ε(n) bound the odometry pose error accumulated over n scans (monotone) and e_C
 // the error of the corrected poses. F_i is off by at most e_C + ε(d), B_i by e_C + ε(D-d) (d = i-i_k,
-// D = i_{k+1}-i_k), so |R_i - truth| ≤ e_C + (1-w)ε(d) + wε(D-d) ≤ e_C + ε(D/2) for linear ε —
-// i.e. the drift over at most HALF the gap (a constant odometry bias cancels to first order in the
-// blend). The closure residual r_k = |F_{i_{k+1}} ⊖ C_{k+1}| (reported per gap by
-// reference_gap_stats) is an observable estimate of ε(D); the per-scan bound estimate returned in
-// ReferencePose::bound is 2w(1-w)·|r_k| (≤ |r_k|/2), plus nothing for e_C (unknown; GMapping maps are
-// typically consistent to a few cm). One-sided extrapolation at the ends has no such bound.
+// D = i_{k+1}-i_k), so |R_i - truth| ≤ e_C + (1-w)ε(d) + wε(D-d). For linear drift this is
+// e_C + 2w(1-w)ε(D) ≤ e_C + ε(D)/2, i.e. the drift over at most HALF the gap (a constant odometry
+// bias even cancels to first order in the blend); for random-walk drift (ε(n) ∝ √n) it is
+// e_C + ((1-w)√w + w√(1-w))ε(D) ≤ e_C + 0.71ε(D). The closure residual r_k = |F_{i_{k+1}} ⊖ C_{k+1}|
+// (per gap: reference_gap_stats) is the observable estimate of ε(D) (it also contains the corrected
+// poses' own relative error). ReferencePose::bound = ((1-w)√w + w√(1-w))·r_k, which covers linear,
+// convex and √n growth; e_C is not included (unknown; GMapping maps of these logs are consistent to a
+// few cm — see the relations figures in sim/io/data_test.cpp). One-sided extrapolation before the
+// first / after the last corrected pose has no bound (inf).
 #pragma once
 
 #include <cstddef>
