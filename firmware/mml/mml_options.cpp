@@ -75,6 +75,18 @@ Status MmlOptions::validate() const {
   FW_RETURN_IF_ERROR(check_range("correction_iterations", correction_iterations, 0, 10000));
   FW_RETURN_IF_ERROR(check_range("correction_step", correction_step, 0.0, 1.0));
   FW_RETURN_IF_ERROR(check_range("min_local_map_points", min_local_map_points, 3, 1000000));
+  FW_RETURN_IF_ERROR(check_range("table_triples", static_cast<double>(table_triples), 1, 1e9));
+  FW_RETURN_IF_ERROR(check_range("table_extent_m", table_extent_m, 0.5, 1000.0));
+  if (reduce_observations) {
+    return Status::error(Errc::kUnsupported,
+                         "MmlOptions.reduce_observations: local map reduction (Eq. 5.28-5.30) is not implemented in "
+                         "this build");
+  }
+  if (correct_local_map) {
+    return Status::error(Errc::kUnsupported,
+                         "MmlOptions.correct_local_map: gradient-descent local map correction (Eq. 5.23-5.27) "
+                         "is not implemented in this build");
+  }
   FW_RETURN_IF_ERROR(check_range("matching_iterations", matching_iterations, 1, 100000000));
   FW_RETURN_IF_ERROR(check_range("max_local_map_points", max_local_map_points, 3, 1000000));
   FW_RETURN_IF_ERROR(check_range("max_hypotheses", max_hypotheses, 1, kMaxHypotheses));

@@ -80,6 +80,8 @@ struct MmlOptions {
 
   // --- Matching (pRANSAM collect-all).
   bool precomputed_table = true;
+  std::uint64_t table_triples = 2000000;  // h of Sec. 5.5.2 when the table is filled at start-up
+  float table_extent_m = 12.0f;           // relation table extent (longest triangle side)
   std::uint32_t matching_iterations = 30000;
   std::uint32_t max_local_map_points = 1500;  // subsampled for matching
   std::uint32_t max_hypotheses = 2048;        // ≤ kMaxHypotheses

@@ -1,0 +1,59 @@
+#include "firmware/mcl/mcl_localizer.h"
+
+#include <cmath>
+
+namespace fw {
+namespace mcl {
+
+Status MclLocalizer::init(const MclOptions& options, const MapView& map, WorkerPool* pool) {
+  FW_RETURN_IF_ERROR(mcl_.init(options, map, pool));
+  reset();
+  return Status::ok();
+}
+
+void MclLocalizer::reset() {
+  have_odom_ = false;
+  tracking_ = false;
+  need_uniform_ = true;
+  last_ = MclStepResult();
+}
+
+Status MclLocalizer::start_tracking(const Se2f& pose, const Eigen::Matrix3f& cov, const hal::Odometry& odom) {
+  FW_RETURN_IF_ERROR(mcl_.init_gaussian(pose, cov));
+  need_uniform_ = false;
+  tracking_ = true;
+  prev_odom_ = Se2f(odom.x, odom.y, odom.theta);
+  have_odom_ = true;
+  return Status::ok();
+}
+
+Status MclLocalizer::step(const hal::LaserScan& scan, const hal::Odometry& odom, hal::PoseEstimate* out) {
+  if (out == nullptr) return Status::error(Errc::kInvalidArgument, "MclLocalizer: null output");
+  if (!std::isfinite(odom.x) || !std::isfinite(odom.y) || !std::isfinite(odom.theta)) {
+    return Status::error(Errc::kInvalidArgument, "MclLocalizer: non-finite odometry at scan %u", scan.scan_id);
+  }
+  if (need_uniform_) {
+    FW_RETURN_IF_ERROR(mcl_.init_uniform());
+    need_uniform_ = false;
+    have_odom_ = false;
+  }
+  const Se2f cur(odom.x, odom.y, odom.theta);
+  const Se2f delta = have_odom_ ? prev_odom_.between(cur) : Se2f();
+  FW_RETURN_IF_ERROR(mcl_.step(scan, delta, have_odom_, &last_));
+  prev_odom_ = cur;
+  have_odom_ = true;
+  *out = hal::PoseEstimate();
+  out->timestamp_ns = scan.timestamp_ns;
+  out->scan_id = scan.scan_id;
+  out->x = last_.pose.x;
+  out->y = last_.pose.y;
+  out->theta = last_.pose.theta;
+  for (int r = 0; r < 3; ++r)
+    for (int c = 0; c < 3; ++c) out->cov[r * 3 + c] = last_.cov(r, c);
+  out->mode = tracking_ ? hal::LocalizationMode::kTracking : hal::LocalizationMode::kGlobal;
+  out->status = (last_.localized || tracking_) ? hal::LocalizationStatus::kLocalized : hal::LocalizationStatus::kSearching;
+  return Status::ok();
+}
+
+}  // namespace mcl
+}  // namespace fw

@@ -1,0 +1,228 @@
+#include "firmware/mml/mml_localizer.h"
+
+#include <cmath>
+
+#include "firmware/pransam/relation_table_io.h"
+
+namespace fw {
+namespace mml {
+
+Status MmlLocalizerConfig::validate() const {
+  FW_RETURN_IF_ERROR(mml.validate());
+  FW_RETURN_IF_ERROR(rbsm.validate());
+  FW_RETURN_IF_ERROR(local_map.validate());
+  FW_RETURN_IF_ERROR(front_end.validate());
+  if (mml.max_local_map_points > matcher.max_scene_points) {
+    return Status::error(Errc::kInvalidArgument,
+                         "MmlLocalizerConfig: mml.max_local_map_points %u > matcher.max_scene_points %u",
+                         mml.max_local_map_points, matcher.max_scene_points);
+  }
+  if (mml.max_hypotheses > matcher.collect_capacity) {
+    return Status::error(Errc::kInvalidArgument, "MmlLocalizerConfig: mml.max_hypotheses %u > matcher.collect_capacity %u",
+                         mml.max_hypotheses, matcher.collect_capacity);
+  }
+  return Status::ok();
+}
+
+MmlLocalizerConfig default_mml_config() {
+  MmlLocalizerConfig c;
+  c.local_map.fragment_length_m = 2.0f;
+  c.local_map.keep_last = 0;
+  c.local_map.point_capacity = 16384;
+  c.front_end.scan.max_range = 8.0f;
+  c.rbsm.max_range = 8.0f;
+  c.matcher.num_workers = 2;
+  c.matcher.max_scene_points = 2048;
+  c.matcher.collect_capacity = 2048;
+  c.match.collect_all = true;
+  c.match.fuzzy = true;
+  c.match.extrapolate = true;
+  return c;
+}
+
+Status MmlLocalizer::init(const MmlLocalizerConfig& config, const GlobalMap& map, const std::uint8_t* table_section,
+                          std::size_t table_len, StartupArena& arena, WorkerPool* pool) {
+  FW_RETURN_IF_ERROR(config.validate());
+  if (!map.valid() || map.points == nullptr || map.num_points < 3) {
+    return Status::error(Errc::kInvalidArgument, "MmlLocalizer: global map is empty (%u occupied points)", map.num_points);
+  }
+  config_ = config;
+  map_ = map;
+  FW_RETURN_IF_ERROR(interp_.init(config.mml));
+  FW_RETURN_IF_ERROR(rbsm_.init(config.rbsm, arena, pool));
+  FW_RETURN_IF_ERROR(local_map_.init(config.local_map, arena));
+  FW_RETURN_IF_ERROR(front_end_.init(config.front_end, &rbsm_, &local_map_));
+  pransam::MatcherOptions mo = config.matcher;
+  const bool have_section = config.mml.precomputed_table && table_section != nullptr && table_len > 0;
+  mo.allocate_model_table = !have_section;
+  FW_RETURN_IF_ERROR(matcher_.init(mo, arena, pool));
+  FW_RETURN_IF_ERROR(matcher_.set_model(map.points, map.num_points, "global map"));
+  if (config.mml.precomputed_table) {
+    if (have_section) {
+      pransam::RelationTableSection sec;
+      FW_RETURN_IF_ERROR(pransam::parse_relation_table_section(table_section, table_len, 2,
+                                                               reinterpret_cast<const float*>(map.points),
+                                                               map.num_points, &sec, "map image relation table"));
+      FW_RETURN_IF_ERROR(matcher_.use_precomputed_table(sec.slots, sec.extent, "map image relation table"));
+    } else {
+      // No offline table in the image: fill R_B once at start-up (Theorem 2, h triples).
+      FW_RETURN_IF_ERROR(matcher_.fill_model_table(config.mml.seed ^ 0x5eedull, config.mml.table_triples,
+                                                   config.mml.table_extent_m, config.match.min_height_ratio));
+      const pransam::RelationTable& t = matcher_.model_table();
+      FW_RETURN_IF_ERROR(matcher_.use_precomputed_table(t.data(), config.mml.table_extent_m, "start-up relation table"));
+    }
+  }
+  scene_capacity_ = config.mml.max_local_map_points;
+  Result<Point2f*> sp = arena.allocate_array<Point2f>(scene_capacity_, "mml local map points");
+  if (!sp) return sp.status();
+  scene_ = *sp;
+  Result<Hypothesis*> hp = arena.allocate_array<Hypothesis>(kMaxHypotheses, "mml hypotheses");
+  if (!hp) return hp.status();
+  hyps_ = *hp;
+  FW_RETURN_IF_ERROR(MemoryReport::instance().add({"mml", "interpreter", sizeof(Interpreter), kMaxHypotheses, nullptr}));
+  FW_RETURN_IF_ERROR(MemoryReport::instance().add({"mml", "observations", sizeof(observations_), kMaxUnknownWindow, nullptr}));
+  initialized_ = true;
+  reset();
+  return Status::ok();
+}
+
+void MmlLocalizer::reset() {
+  front_end_.reset();
+  interp_.reset();
+  observations_.clear();
+  last_ = InterpretResult();
+  have_odom_ = false;
+  have_h_ = false;
+  num_scene_ = 0;
+  steps_ = 0;
+}
+
+Status MmlLocalizer::gather_local_map() {
+  const std::size_t total = local_map_.total_points();
+  const std::size_t stride = total > scene_capacity_ ? (total + scene_capacity_ - 1) / scene_capacity_ : 1;
+  num_scene_ = 0;
+  std::size_t k = 0;
+  for (std::size_t f = 0; f < local_map_.num_fragments(); ++f) {
+    const FragmentView v = local_map_.fragment(f);
+    for (std::size_t i = 0; i < v.size(); ++i, ++k) {
+      if (k % stride != 0 || num_scene_ >= scene_capacity_) continue;
+      scene_[num_scene_++] = v.frame.transform_point(v[i]);
+    }
+  }
+  return Status::ok();
+}
+
+// Eq. 5.37: mean contact fraction of the last τ_up observations under H_best.
+float MmlLocalizer::unknown_contact(const Se2f& h) const {
+  if (observations_.empty()) return 1.0f;
+  double sum = 0.0;
+  std::size_t used = 0;
+  const float eps = config_.mml.contact_distance_m;
+  for (std::size_t o = 0; o < observations_.size(); ++o) {
+    const Observation& ob = observations_[o];
+    if (ob.n == 0) continue;
+    std::uint32_t hit = 0;
+    for (std::uint32_t i = 0; i < ob.n; ++i) {
+      const Point2f p = h.transform_point(ob.pts[i]);
+      if (map_.distance_at(p.x(), p.y(), 1e9f) < eps) ++hit;
+    }
+    sum += static_cast<double>(hit) / ob.n;
+    ++used;
+  }
+  return used > 0 ? static_cast<float>(sum / used) : 1.0f;
+}
+
+Status MmlLocalizer::step(const hal::LaserScan& scan, const hal::Odometry& odom, hal::PoseEstimate* out) {
+  if (!initialized_) return Status::error(Errc::kNotInitialized, "MmlLocalizer: step() before init()");
+  if (out == nullptr) return Status::error(Errc::kInvalidArgument, "MmlLocalizer: null output");
+  if (!std::isfinite(odom.x) || !std::isfinite(odom.y) || !std::isfinite(odom.theta)) {
+    return Status::error(Errc::kInvalidArgument, "MmlLocalizer: non-finite odometry at scan %u", scan.scan_id);
+  }
+  // (1) RBSM: scan → local map.
+  Se2f local_pose;
+  FW_RETURN_IF_ERROR(front_end_.step(scan, odom, &local_pose));
+  ++steps_;
+
+  // Remember a subsample of this observation (local frame) for Eq. 5.37.
+  {
+    ScanPointsResult sr;
+    ScanPointsOptions so = config_.front_end.scan;
+    if (scan_to_points(scan, so, scan_pts_, hal::LaserScan::kMaxBeams, &sr).is_ok() && sr.count > 0) {
+      Observation ob;
+      const std::size_t stride = (sr.count + kUnknownPointsPerObservation - 1) / kUnknownPointsPerObservation;
+      for (std::size_t i = 0; i < sr.count && ob.n < kUnknownPointsPerObservation; i += stride) {
+        ob.pts[ob.n++] = local_pose.transform_point(scan_pts_[i]);
+      }
+      if (observations_.size() >= config_.mml.tau_up) { Observation d; observations_.pop(&d); }
+      observations_.push_overwrite(ob);
+    }
+  }
+
+  *out = hal::PoseEstimate();
+  out->timestamp_ns = scan.timestamp_ns;
+  out->scan_id = scan.scan_id;
+  out->mode = hal::LocalizationMode::kGlobal;
+
+  FW_RETURN_IF_ERROR(gather_local_map());
+  if (local_map_.total_points() < config_.mml.min_local_map_points || num_scene_ < 3) {
+    out->status = hal::LocalizationStatus::kSearching;
+    return Status::ok();
+  }
+
+  // (2) pRANSAM collect-all against the global map at the adaptive threshold.
+  pransam::MatchParams mp = config_.match;
+  mp.collect_all = true;
+  mp.max_iterations = config_.mml.matching_iterations;
+  mp.omega_thres = interp_.omega_thres();
+  mp.seed = config_.mml.seed * 1000003ull + steps_;
+  pransam::MatchResult<2> mr;
+  const Status ms = matcher_.match(scene_, num_scene_, mp, &mr);
+  std::size_t nh = 0;
+  if (ms.is_ok()) {
+    Se2f best_h;
+    float best_q = -1.0f;
+    for (std::size_t i = 0; i < mr.num_hypotheses && nh < config_.mml.max_hypotheses; ++i) {
+      const Se2f h = pransam::to_se2(mr.hypotheses[i]);
+      const Se2f robot = h.compose(local_pose);
+      Hypothesis& o = hyps_[nh++];
+      o.x = robot.x;
+      o.y = robot.y;
+      o.theta = robot.theta;
+      o.quality = mr.hypotheses[i].quality;
+      o.roll = 0.0f;  // flipped 2-D frames are already rejected inside pRANSAM (Eq. 5.3)
+      o.pitch = 0.0f;
+      if (o.quality > best_q) { best_q = o.quality; best_h = h; }
+    }
+    if (best_q >= 0.0f) { last_h_ = best_h; have_h_ = true; }
+  }
+  // A failed match (e.g. all triples of a degenerate local map rejected) is "no hypotheses".
+
+  // (3) Interpretation.
+  InterpretInput in;
+  in.hypotheses = hyps_;
+  in.count = nh;
+  in.have_odom_delta = have_odom_;
+  in.odom_delta = have_odom_ ? prev_odom_.between(local_pose) : Se2f();
+  prev_odom_ = local_pose;
+  have_odom_ = true;
+  FW_RETURN_IF_ERROR(interp_.interpret(in, &last_));
+  if (have_h_) {
+    interp_.report_unknown(unknown_contact(last_h_), static_cast<std::uint32_t>(observations_.size()), &last_);
+  }
+
+  out->status = last_.status;
+  if (last_.have_pose) {
+    out->x = last_.pose.x;
+    out->y = last_.pose.y;
+    out->theta = last_.pose.theta;
+    for (int r = 0; r < 3; ++r)
+      for (int c = 0; c < 3; ++c) out->cov[r * 3 + c] = last_.cov(r, c);
+  }
+  out->hypothesis_count = static_cast<std::uint16_t>(last_.hypotheses_valid > 65535 ? 65535 : last_.hypotheses_valid);
+  out->cluster_count = static_cast<std::uint16_t>(last_.cluster_count > 65535 ? 65535 : last_.cluster_count);
+  out->rating = last_.best_rating;
+  return Status::ok();
+}
+
+}  // namespace mml
+}  // namespace fw
