@@ -1,0 +1,311 @@
+#include "firmware/rbsm/endpoint_grid.h"
+
+#include <cmath>
+#include <cstring>
+
+namespace fw {
+
+Status EndpointGridOptions::validate() const {
+  if (!(resolution > 0.0f) || !std::isfinite(resolution)) {
+    return Status::error(Errc::kInvalidArgument, "endpoint grid: resolution %g m must be positive",
+                         static_cast<double>(resolution));
+  }
+  if (size_log2 < 4 || size_log2 > 13) {
+    return Status::error(Errc::kInvalidArgument, "endpoint grid: size_log2 %u outside [4, 13]", size_log2);
+  }
+  if (subcell_log2 > 3) {
+    return Status::error(Errc::kInvalidArgument, "endpoint grid: subcell_log2 %u outside [0, 3]", subcell_log2);
+  }
+  if (size_log2 + subcell_log2 > 15) {
+    return Status::error(Errc::kInvalidArgument, "endpoint grid: lookup side 2^%u sub-cells too large (max 2^15)",
+                         size_log2 + subcell_log2);
+  }
+  // ξ > 1.5 cells would need neighbours beyond the 3×3 block (see header).
+  if (!(xi_cells > 0.0f) || xi_cells > 1.5f) {
+    return Status::error(Errc::kInvalidArgument, "endpoint grid: xi %g cells outside (0, 1.5]",
+                         static_cast<double>(xi_cells));
+  }
+  if (!(recenter_fraction > 0.0f) || recenter_fraction > 0.45f) {
+    return Status::error(Errc::kInvalidArgument, "endpoint grid: recenter_fraction %g outside (0, 0.45]",
+                         static_cast<double>(recenter_fraction));
+  }
+  return Status::ok();
+}
+
+std::size_t EndpointGrid::required_bytes(const EndpointGridOptions& o) {
+  const std::size_t side = std::size_t{1} << o.size_log2;
+  const std::size_t sub = side << o.subcell_log2;
+  return side * side + sub * sub + 128;
+}
+
+Status EndpointGrid::init(const EndpointGridOptions& options, StartupArena& arena) {
+  FW_RETURN_IF_ERROR(options.validate());
+  options_ = options;
+  side_ = 1u << options.size_log2;
+  cell_mask_ = side_ - 1;
+  k_ = 1u << options.subcell_log2;
+  sub_shift_ = options.size_log2 + options.subcell_log2;
+  sub_mask_ = (1u << sub_shift_) - 1;
+  const std::size_t cells = static_cast<std::size_t>(side_) * side_;
+  const std::size_t subs = static_cast<std::size_t>(sub_mask_ + 1) * (sub_mask_ + 1);
+  Result<void*> occ = arena.allocate(cells, 64, "rbsm endpoint grid");
+  if (!occ) return occ.status();
+  Result<void*> lut = arena.allocate(subs, 64, "rbsm likelihood lookup");
+  if (!lut) return lut.status();
+  occupancy_ = static_cast<std::uint8_t*>(*occ);
+  lookup_ = static_cast<std::uint8_t*>(*lut);
+  std::memset(occupancy_, 0, cells);
+  std::memset(lookup_, 0, subs);
+  // Eq. 2.9 in cells: δ = exp(−d²) for d ≤ ξ, else 0; quantised to 1/255.
+  const float xi2 = options.xi_cells * options.xi_cells;
+  for (int dy = -1; dy <= 1; ++dy) {
+    for (int dx = -1; dx <= 1; ++dx) {
+      const int n = (dy + 1) * 3 + (dx + 1);
+      for (std::uint32_t b = 0; b < k_; ++b) {
+        for (std::uint32_t a = 0; a < k_; ++a) {
+          const float ux = (static_cast<float>(a) + 0.5f) / static_cast<float>(k_) - 0.5f;
+          const float uy = (static_cast<float>(b) + 0.5f) / static_cast<float>(k_) - 0.5f;
+          const float ddx = static_cast<float>(dx) - ux, ddy = static_cast<float>(dy) - uy;
+          const float d2 = ddx * ddx + ddy * ddy;
+          float v = 0.0f;
+          if (d2 <= xi2 * (1.0f + 1e-6f)) v = std::exp(-d2) * static_cast<float>(kLikelihoodMax);
+          table_[n][b * k_ + a] = static_cast<std::uint8_t>(std::lround(v));
+        }
+      }
+    }
+  }
+  centered_ = false;
+  occupied_count_ = 0;
+  dirty_x0_ = dirty_y0_ = 0;
+  dirty_x1_ = dirty_y1_ = -1;
+  return Status::ok();
+}
+
+void EndpointGrid::world_to_cell(float x, float y, std::int32_t* gx, std::int32_t* gy) const {
+  *gx = static_cast<std::int32_t>(std::floor(x / options_.resolution));
+  *gy = static_cast<std::int32_t>(std::floor(y / options_.resolution));
+}
+
+void EndpointGrid::clear_cell(std::int32_t gx, std::int32_t gy) {
+  std::uint8_t& c = occupancy_[cell_index(gx, gy)];
+  if (c) --occupied_count_;
+  c = 0;
+  for (std::uint32_t b = 0; b < k_; ++b) {
+    const std::uint32_t sy = static_cast<std::uint32_t>(gy) * k_ + b;
+    std::uint8_t* row = lookup_ + (static_cast<std::size_t>(sy & sub_mask_) << sub_shift_);
+    for (std::uint32_t a = 0; a < k_; ++a) row[(static_cast<std::uint32_t>(gx) * k_ + a) & sub_mask_] = 0;
+  }
+}
+
+void EndpointGrid::clear() {
+  if (!initialized()) return;
+  const std::int64_t w = static_cast<std::int64_t>(dirty_x1_) - dirty_x0_ + 1;
+  const std::int64_t h = static_cast<std::int64_t>(dirty_y1_) - dirty_y0_ + 1;
+  if (w > 0 && h > 0) {
+    if (w * h * 2 >= static_cast<std::int64_t>(side_) * side_) {
+      std::memset(occupancy_, 0, static_cast<std::size_t>(side_) * side_);
+      std::memset(lookup_, 0, static_cast<std::size_t>(sub_mask_ + 1) * (sub_mask_ + 1));
+    } else {
+      // The lookup of the dirty box's 1-cell border was raised too.
+      for (std::int32_t gy = dirty_y0_ - 1; gy <= dirty_y1_ + 1; ++gy) {
+        for (std::int32_t gx = dirty_x0_ - 1; gx <= dirty_x1_ + 1; ++gx) {
+          if (in_window(gx, gy)) clear_cell(gx, gy);
+        }
+      }
+    }
+  }
+  occupied_count_ = 0;
+  dirty_x0_ = dirty_y0_ = 0;
+  dirty_x1_ = dirty_y1_ = -1;
+}
+
+void EndpointGrid::center_on(float x, float y) {
+  std::int32_t gx, gy;
+  world_to_cell(x, y, &gx, &gy);
+  const std::int32_t half = static_cast<std::int32_t>(side_ / 2);
+  if (!centered_) {
+    origin_cx_ = gx - half;
+    origin_cy_ = gy - half;
+    centered_ = true;
+    return;
+  }
+  move_window(gx - half, gy - half);
+}
+
+bool EndpointGrid::follow(float x, float y) {
+  if (!centered_) {
+    center_on(x, y);
+    return true;
+  }
+  std::int32_t gx, gy;
+  world_to_cell(x, y, &gx, &gy);
+  const std::int32_t half = static_cast<std::int32_t>(side_ / 2);
+  const std::int32_t limit = static_cast<std::int32_t>(options_.recenter_fraction * static_cast<float>(side_));
+  const std::int32_t ox = gx - (origin_cx_ + half), oy = gy - (origin_cy_ + half);
+  if (ox > limit || ox < -limit || oy > limit || oy < -limit) {
+    move_window(gx - half, gy - half);
+    return true;
+  }
+  return false;
+}
+
+void EndpointGrid::move_window(std::int32_t nox, std::int32_t noy) {
+  const std::int32_t s = static_cast<std::int32_t>(side_);
+  const std::int32_t dx = nox - origin_cx_, dy = noy - origin_cy_;
+  if (dx == 0 && dy == 0) return;
+  if (dx >= s || dx <= -s || dy >= s || dy <= -s) {
+    std::memset(occupancy_, 0, static_cast<std::size_t>(side_) * side_);
+    std::memset(lookup_, 0, static_cast<std::size_t>(sub_mask_ + 1) * (sub_mask_ + 1));
+    occupied_count_ = 0;
+    origin_cx_ = nox;
+    origin_cy_ = noy;
+    return;
+  }
+  // Global columns of the old window that are not in the new one: clear their storage columns.
+  const std::int32_t cx0 = dx > 0 ? origin_cx_ : nox + s, cx1 = dx > 0 ? nox : origin_cx_ + s;  // [cx0, cx1)
+  for (std::int32_t gx = cx0; gx < cx1; ++gx) {
+    for (std::int32_t gy = origin_cy_; gy < origin_cy_ + s; ++gy) clear_cell(gx, gy);
+  }
+  const std::int32_t cy0 = dy > 0 ? origin_cy_ : noy + s, cy1 = dy > 0 ? noy : origin_cy_ + s;
+  for (std::int32_t gy = cy0; gy < cy1; ++gy) {
+    for (std::int32_t gx = origin_cx_; gx < origin_cx_ + s; ++gx) clear_cell(gx, gy);
+  }
+  origin_cx_ = nox;
+  origin_cy_ = noy;
+  // Cells on the new border may have been raised by neighbours that just left: recompute them.
+  for (std::int32_t i = 0; i < s; ++i) {
+    refresh(nox + i, noy);
+    refresh(nox + i, noy + s - 1);
+    refresh(nox, noy + i);
+    refresh(nox + s - 1, noy + i);
+  }
+}
+
+void EndpointGrid::refresh(std::int32_t gx, std::int32_t gy) {
+  bool occ[9];
+  for (int dy = -1; dy <= 1; ++dy) {
+    for (int dx = -1; dx <= 1; ++dx) occ[(dy + 1) * 3 + (dx + 1)] = occupied_cell(gx + dx, gy + dy);
+  }
+  for (std::uint32_t b = 0; b < k_; ++b) {
+    const std::uint32_t sy = static_cast<std::uint32_t>(gy) * k_ + b;
+    std::uint8_t* row = lookup_ + (static_cast<std::size_t>(sy & sub_mask_) << sub_shift_);
+    for (std::uint32_t a = 0; a < k_; ++a) {
+      std::uint8_t v = 0;
+      for (int n = 0; n < 9; ++n) {
+        if (occ[n] && table_[n][b * k_ + a] > v) v = table_[n][b * k_ + a];
+      }
+      row[(static_cast<std::uint32_t>(gx) * k_ + a) & sub_mask_] = v;
+    }
+  }
+}
+
+void EndpointGrid::splat(std::int32_t gx, std::int32_t gy) {
+  for (int dy = -1; dy <= 1; ++dy) {
+    for (int dx = -1; dx <= 1; ++dx) {
+      // The cell at (gx, gy) − d sees the occupied cell as its neighbour d.
+      const std::int32_t cx = gx - dx, cy = gy - dy;
+      if (!in_window(cx, cy)) continue;
+      const std::uint8_t* t = table_[(dy + 1) * 3 + (dx + 1)];
+      for (std::uint32_t b = 0; b < k_; ++b) {
+        const std::uint32_t sy = static_cast<std::uint32_t>(cy) * k_ + b;
+        std::uint8_t* row = lookup_ + (static_cast<std::size_t>(sy & sub_mask_) << sub_shift_);
+        for (std::uint32_t a = 0; a < k_; ++a) {
+          std::uint8_t& v = row[(static_cast<std::uint32_t>(cx) * k_ + a) & sub_mask_];
+          if (t[b * k_ + a] > v) v = t[b * k_ + a];
+        }
+      }
+    }
+  }
+}
+
+bool EndpointGrid::insert(float x, float y, float* cx, float* cy) {
+  if (!initialized() || !std::isfinite(x) || !std::isfinite(y)) return false;
+  if (!centered_) center_on(x, y);
+  std::int32_t gx, gy;
+  world_to_cell(x, y, &gx, &gy);
+  if (!in_window(gx, gy)) return false;
+  std::uint8_t& c = occupancy_[cell_index(gx, gy)];
+  if (c) return false;
+  c = 1;
+  ++occupied_count_;
+  if (dirty_x1_ < dirty_x0_) {
+    dirty_x0_ = dirty_x1_ = gx;
+    dirty_y0_ = dirty_y1_ = gy;
+  } else {
+    if (gx < dirty_x0_) dirty_x0_ = gx;
+    if (gx > dirty_x1_) dirty_x1_ = gx;
+    if (gy < dirty_y0_) dirty_y0_ = gy;
+    if (gy > dirty_y1_) dirty_y1_ = gy;
+  }
+  splat(gx, gy);
+  if (cx) *cx = (static_cast<float>(gx) + 0.5f) * options_.resolution;
+  if (cy) *cy = (static_cast<float>(gy) + 0.5f) * options_.resolution;
+  return true;
+}
+
+bool EndpointGrid::occupied(float x, float y) const {
+  if (!initialized() || !std::isfinite(x) || !std::isfinite(y)) return false;
+  std::int32_t gx, gy;
+  world_to_cell(x, y, &gx, &gy);
+  return occupied_cell(gx, gy);
+}
+
+std::uint8_t EndpointGrid::likelihood(float x, float y) const {
+  if (!initialized() || !std::isfinite(x) || !std::isfinite(y)) return 0;
+  const LookupView v = lookup_view();
+  const float fx = (x - v.origin_x) * v.inv_subcell, fy = (y - v.origin_y) * v.inv_subcell;
+  if (!(fx >= 0.0f && fx < v.extent && fy >= 0.0f && fy < v.extent)) return 0;
+  const std::uint32_t sx = static_cast<std::uint32_t>(static_cast<std::int32_t>(fx) + v.origin_sx) & v.mask;
+  const std::uint32_t sy = static_cast<std::uint32_t>(static_cast<std::int32_t>(fy) + v.origin_sy) & v.mask;
+  return v.values[(static_cast<std::size_t>(sy) << v.shift) | sx];
+}
+
+EndpointGrid::LookupView EndpointGrid::lookup_view() const {
+  LookupView v;
+  v.values = lookup_;
+  v.origin_x = static_cast<float>(origin_cx_) * options_.resolution;
+  v.origin_y = static_cast<float>(origin_cy_) * options_.resolution;
+  v.inv_subcell = static_cast<float>(k_) / options_.resolution;
+  v.extent = static_cast<float>(side_ * k_);
+  v.origin_sx = origin_cx_ * static_cast<std::int32_t>(k_);
+  v.origin_sy = origin_cy_ * static_cast<std::int32_t>(k_);
+  v.mask = sub_mask_;
+  v.shift = sub_shift_;
+  return v;
+}
+
+bool EndpointGrid::nearest_occupied(float x, float y, float max_dist_m, float* nx, float* ny, float* dist2_m) const {
+  if (!initialized() || !std::isfinite(x) || !std::isfinite(y)) return false;
+  std::int32_t gx, gy;
+  world_to_cell(x, y, &gx, &gy);
+  const float res = options_.resolution;
+  const std::int32_t rmax = static_cast<std::int32_t>(std::ceil(max_dist_m / res)) + 1;
+  float best = max_dist_m * max_dist_m;
+  bool found = false;
+  for (std::int32_t r = 0; r <= rmax; ++r) {
+    // Every cell of ring r is at least (r − 1) cells from the query point.
+    const float ring_min = static_cast<float>(r > 0 ? r - 1 : 0) * res;
+    if (ring_min * ring_min > best) break;
+    for (std::int32_t j = -r; j <= r; ++j) {
+      const std::int32_t step = (j == -r || j == r || r == 0) ? 1 : 2 * r;  // ring cells only
+      for (std::int32_t i = -r; i <= r; i += step) {
+        const std::int32_t cx = gx + i, cy = gy + j;
+        if (!occupied_cell(cx, cy)) continue;
+        const float mx = (static_cast<float>(cx) + 0.5f) * res, my = (static_cast<float>(cy) + 0.5f) * res;
+        const float d2 = (mx - x) * (mx - x) + (my - y) * (my - y);
+        if (d2 <= best) {
+          if (!found || d2 < best) {
+            best = d2;
+            *nx = mx;
+            *ny = my;
+          }
+          found = true;
+        }
+      }
+    }
+  }
+  if (found && dist2_m) *dist2_m = best;
+  return found;
+}
+
+}  // namespace fw

@@ -1,0 +1,85 @@
+#include "firmware/rbsm/endpoint_grid.h"
+
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <vector>
+
+namespace {
+
+struct GridFixture : ::testing::Test {
+  std::vector<unsigned char> block;
+  fw::StartupArena arena;
+  fw::EndpointGrid grid;
+  void make(const fw::EndpointGridOptions& o) {
+    block.assign(fw::EndpointGrid::required_bytes(o) + 256, 0);
+    ASSERT_TRUE(arena.init(block.data(), block.size(), "test").is_ok());
+    ASSERT_TRUE(grid.init(o, arena).is_ok());
+  }
+};
+
+TEST_F(GridFixture, LikelihoodFollowsEq29) {
+  fw::EndpointGridOptions o;
+  o.size_log2 = 6;
+  make(o);
+  grid.center_on(0, 0);
+  float cx, cy;
+  ASSERT_TRUE(grid.insert(0.01f, 0.02f, &cx, &cy));
+  EXPECT_NEAR(cx, 0.025f, 1e-6f);
+  EXPECT_NEAR(cy, 0.025f, 1e-6f);
+  EXPECT_FALSE(grid.insert(0.03f, 0.04f));  // same cell
+  EXPECT_EQ(grid.occupied_count(), 1u);
+  // Sub-cell centre 1/8 cell from the cell centre: d² = 2·(1/8)² → 255·exp(−1/32).
+  EXPECT_NEAR(grid.likelihood(0.02f, 0.02f), 255.0 * std::exp(-2.0 / 64), 1.0);
+  // One cell to the right, first sub-cell: d = (5/8, 1/8) cells.
+  EXPECT_NEAR(grid.likelihood(0.051f, 0.026f), 255.0 * std::exp(-(25.0 + 1.0) / 64), 1.0);
+  // Two cells away: beyond ξ = √2.
+  EXPECT_EQ(grid.likelihood(0.125f, 0.025f), 0);
+  float nx, ny, d2;
+  ASSERT_TRUE(grid.nearest_occupied(0.2f, 0.03f, 0.3f, &nx, &ny, &d2));
+  EXPECT_NEAR(nx, 0.025f, 1e-6f);
+  EXPECT_NEAR(d2, 0.175f * 0.175f + 0.005f * 0.005f, 1e-5f);
+  EXPECT_FALSE(grid.nearest_occupied(0.5f, 0.0f, 0.3f, &nx, &ny, &d2));
+  grid.clear();
+  EXPECT_EQ(grid.occupied_count(), 0u);
+  EXPECT_EQ(grid.likelihood(0.02f, 0.02f), 0);
+  EXPECT_EQ(grid.likelihood(0.051f, 0.026f), 0);
+}
+
+TEST_F(GridFixture, ScrollingDropsCellsThatLeaveTheWindow) {
+  fw::EndpointGridOptions o;
+  o.size_log2 = 6;  // 64 cells = 3.2 m
+  make(o);
+  grid.center_on(0, 0);
+  ASSERT_TRUE(grid.insert(-1.0f, 0.0f));
+  ASSERT_TRUE(grid.insert(1.0f, 0.0f));
+  EXPECT_FALSE(grid.insert(5.0f, 0.0f));  // outside the window
+  EXPECT_FALSE(grid.follow(0.5f, 0.0f));  // within the re-centre margin
+  EXPECT_TRUE(grid.follow(2.0f, 0.0f));   // moves: window [0.4, 3.6)
+  EXPECT_FALSE(grid.occupied(-1.0f, 0.0f));
+  EXPECT_EQ(grid.likelihood(-1.0f, 0.0f), 0);
+  EXPECT_TRUE(grid.occupied(1.0f, 0.0f));
+  EXPECT_GT(grid.likelihood(1.026f, 0.026f), 200);
+  EXPECT_EQ(grid.occupied_count(), 1u);
+  // The storage of the dropped cell is reused by the new area without ghosts.
+  EXPECT_FALSE(grid.occupied(-1.0f + 3.2f, 0.0f));
+  EXPECT_EQ(grid.likelihood(-1.0f + 3.2f, 0.0f), 0);
+  ASSERT_TRUE(grid.insert(3.0f, 0.1f));
+  EXPECT_GT(grid.likelihood(3.026f, 0.126f), 200);
+}
+
+TEST(EndpointGridOptionsTest, RejectsBadValues) {
+  fw::EndpointGridOptions o;
+  o.resolution = 0;
+  EXPECT_EQ(o.validate().code(), fw::Errc::kInvalidArgument);
+  o = {};
+  o.xi_cells = 2.0f;
+  EXPECT_NE(std::string(o.validate().message()).find("xi"), std::string::npos);
+  o = {};
+  o.size_log2 = 20;
+  EXPECT_FALSE(o.validate().is_ok());
+  o = {};
+  EXPECT_TRUE(o.validate().is_ok());
+}
+
+}  // namespace

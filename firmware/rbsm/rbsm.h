@@ -1,0 +1,130 @@
+// RBSM — resampling-based scan matching (dissertation Ch. 2, Alg. 1; SPEC §1).
+//
+// Per match: the particle set is moved by the motion (Alg. 1 l. 2–4), then repeatedly every
+// particle is re-sampled from N(x_j, Σ) (l. 10), weighted by the bounded nearest-neighbour
+// end-point likelihood w_j ∝ Σ_i δ_ij (Eq. 2.8–2.10), optionally improved by a deterministic
+// hill-climbing step (l. 12), and the set is resampled ∝ w (low-variance resampling, l. 16–19),
+// until M_eff = 1/Σ w_j² ≥ Δ·M (l. 7, 20) or the iteration cap; Σ ← δ·Σ each round (l. 21). The
+// best particle over all rounds is x̂_t (Eq. 2.7); integrate() adds its points to the map (Eq. 2.5–2.6).
+//
+// Fast without changing what is computed: the bounded NN likelihood is a lookup (EndpointGrid),
+// particles are structure-of-arrays, sin/cos are per particle, the weighting loop runs beams outer
+// and particles inner (all particles of a beam hit the same few cache lines), weights are integer
+// sums (exact, order-independent). Determinism: particles are split into kPartitions fixed
+// partitions, each with its own fw::RandomStream; workers of the optional fw::WorkerPool take whole
+// partitions, so 1 or N workers give bit-identical results. All storage comes from the arena at
+// init; match() and integrate() allocate nothing.
+#pragma once
+
+#include <cstddef>
+#include <cstdint>
+
+#include "firmware/base/arena.h"
+#include "firmware/base/rng.h"
+#include "firmware/base/se2.h"
+#include "firmware/base/status.h"
+#include "firmware/base/worker_pool.h"
+#include "firmware/rbsm/endpoint_grid.h"
+#include "firmware/rbsm/scan_matcher.h"
+#include "hal/msg/laser_scan.h"
+
+namespace fw {
+
+struct RbsmOptions {
+  static constexpr std::uint32_t kMaxParticles = 8192;
+  static constexpr std::uint32_t kMaxPoints = hal::LaserScan::kMaxBeams;
+  // Fixed work/RNG partitions: independent of the worker count, so results are too.
+  static constexpr std::uint32_t kPartitions = 8;
+
+  std::uint32_t num_particles = 1000;  // M (thesis: 1000)
+  float sigma_xy2_cells2 = 4.0f;       // Σ0: σ_xx² = σ_yy² in cells² (Eq. 2.11)
+  float sigma_psi2_deg2 = 3.0f;        // Σ0: σ_ψψ² in deg²
+  float accept_ratio = 0.8f;           // Δ: stop when M_eff ≥ Δ·M (Alg. 1 l. 7)
+  float shrink = 0.5f;                 // δ: Σ ← δ·Σ per round (Alg. 1 l. 21), 0 < δ < 1
+  std::uint32_t max_iterations = 20;   // cap on resampling rounds
+  std::uint32_t min_points = 10;       // fewer valid points → status, no match
+  float max_range = 0.0f;              // ignore points farther than this (m); 0 = keep all
+  bool hill_climbing = false;          // Alg. 1 l. 12 (deterministic local correction)
+  std::uint32_t hill_climb_steps = 3;
+  // Noisy-sensor weighting (Eq. 2.12–2.16): w ∝ Σ exp(−hᵀC⁻¹h) instead of Eq. 2.9.
+  bool mahalanobis = false;
+  float range_sigma = 0.01f;           // m, sensor range noise (P_p)
+  float bearing_sigma_deg = 0.1f;      // deg, sensor bearing noise (P_p)
+  float map_point_sigma_cells = 0.29f; // map point std (P_q), ≈ cell/√12
+  std::uint64_t seed = 1;
+  EndpointGridOptions grid;
+
+  Status validate() const;
+};
+
+class Rbsm final : public ScanMatcher {
+ public:
+  static std::size_t required_arena_bytes(const RbsmOptions& options);
+
+  // Validates the options once, carves storage from the arena. `pool` (optional) splits the
+  // sampling/weighting over its workers; results do not depend on it.
+  Status init(const RbsmOptions& options, StartupArena& arena, WorkerPool* pool = nullptr);
+  const RbsmOptions& options() const { return options_; }
+
+  const char* name() const override { return "rbsm"; }
+  void reset() override;
+  Status match(const Point2f* points, std::size_t count, const Se2f& initial_guess, ScanMatchResult* out) override;
+  Status integrate(const Point2f* points, std::size_t count, const Se2f& pose, Point2f* new_cells = nullptr,
+                   std::size_t capacity = 0, std::size_t* num_new = nullptr) override;
+
+  // Next match starts with all particles at its initial guess (pairwise experiments); otherwise
+  // the particle set of the previous match is moved by (last estimate ⊖ initial guess).
+  void forget_tracking() { tracking_ = false; }
+  void set_worker_pool(WorkerPool* pool) { pool_ = pool; }
+
+  const EndpointGrid& grid() const { return grid_; }
+  EndpointGrid& grid() { return grid_; }
+  std::uint32_t num_particles() const { return options_.num_particles; }
+  Se2f particle(std::uint32_t i) const { return Se2f(x_[i], y_[i], psi_[i]); }
+  // Score (Σ δ, in units of 1/255) of one pose against the current map, for tests and tools.
+  std::uint32_t score_pose(const Se2f& pose) const;
+
+ private:
+  struct Job;
+  static void job_entry(void* context, int worker, int num_workers);
+  void run_partition(std::uint32_t partition, float sig_xy, float sig_psi);
+  void weigh_block(std::uint32_t begin, std::uint32_t end);
+  std::uint32_t weigh_single(float x, float y, float c, float s) const;
+  std::uint32_t weigh_mahalanobis(float x, float y, float psi, float c, float s) const;
+  void hill_climb(std::uint32_t j, float step_xy, float step_psi);
+  void resample(std::uint64_t total);
+
+  RbsmOptions options_;
+  EndpointGrid grid_;
+  WorkerPool* pool_ = nullptr;
+  bool initialized_ = false;
+
+  // Particle set χ (structure of arrays) and the sampled set of the current round.
+  float* x_ = nullptr;
+  float* y_ = nullptr;
+  float* psi_ = nullptr;
+  float* sx_ = nullptr;
+  float* sy_ = nullptr;
+  float* spsi_ = nullptr;
+  float* cos_ = nullptr;
+  float* sin_ = nullptr;
+  std::uint32_t* w_ = nullptr;
+
+  // Points of the scan being matched (sensor frame), with per-point covariance for Eq. 2.14.
+  std::uint32_t num_points_ = 0;
+  float px_[RbsmOptions::kMaxPoints] = {};
+  float py_[RbsmOptions::kMaxPoints] = {};
+  float pcov_[RbsmOptions::kMaxPoints][3] = {};  // P_p (xx, xy, yy) in the sensor frame
+  EndpointGrid::LookupView view_{};
+  float cur_sig_xy_ = 0.0f, cur_sig_psi_ = 0.0f;  // current Σ (m, rad) for Eq. 2.14's P_B
+
+  RandomStream streams_[RbsmOptions::kPartitions];
+  RandomStream resample_stream_;
+  std::uint32_t part_best_w_[RbsmOptions::kPartitions] = {};
+  std::uint32_t part_best_j_[RbsmOptions::kPartitions] = {};
+
+  bool tracking_ = false;
+  Se2f last_estimate_;
+};
+
+}  // namespace fw

@@ -1,0 +1,242 @@
+#include "firmware/rbsm/rbsm.h"
+
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <memory>
+#include <vector>
+
+#include "firmware/icp/trimmed_icp.h"
+#include "firmware/rbsm/synthetic_world_test_util.h"
+#include "tests/alloc_counter.h"
+
+namespace {
+
+using rbsm_test::Segment;
+constexpr float kDeg = 0.017453292519943295f;
+
+// A matcher with its own arena (tests only: the block comes from the test's heap at set-up).
+struct RbsmHarness {
+  std::vector<unsigned char> block;
+  fw::StartupArena arena;
+  std::unique_ptr<fw::Rbsm> rbsm = std::make_unique<fw::Rbsm>();
+  fw::Status init(const fw::RbsmOptions& o, fw::WorkerPool* pool = nullptr) {
+    block.assign(fw::Rbsm::required_arena_bytes(o) + 4096, 0);
+    fw::Status st = arena.init(block.data(), block.size(), "rbsm test");
+    if (!st) return st;
+    return rbsm->init(o, arena, pool);
+  }
+};
+struct IcpHarness {
+  std::vector<unsigned char> block;
+  fw::StartupArena arena;
+  std::unique_ptr<fw::TrimmedIcp> icp = std::make_unique<fw::TrimmedIcp>();
+  fw::Status init(const fw::TrimmedIcpOptions& o) {
+    block.assign(fw::TrimmedIcp::required_arena_bytes(o) + 4096, 0);
+    fw::Status st = arena.init(block.data(), block.size(), "icp test");
+    if (!st) return st;
+    return icp->init(o, arena);
+  }
+};
+
+fw::RbsmOptions small_options() {
+  fw::RbsmOptions o;
+  // 2 cm cells (thesis: 1–5 cm): the end-point model is exact only up to the cell size.
+  o.grid.resolution = 0.02f;
+  o.grid.size_log2 = 10;  // 20 m window is plenty for the toy worlds
+  o.seed = 7;
+  return o;
+}
+
+struct Case {
+  const char* name;
+  std::vector<Segment> world;
+  fw::Se2f reference, truth, guess;
+};
+
+std::vector<Case> cases() {
+  return {
+      {"corridor", rbsm_test::corridor_world(), fw::Se2f(-2, 0, 0), fw::Se2f(-1.6f, 0.1f, 4 * kDeg),
+       fw::Se2f(-1.55f, 0.04f, 2 * kDeg)},
+      {"l_corner", rbsm_test::l_corner_world(), fw::Se2f(0, 0, 0), fw::Se2f(0.5f, -0.1f, 10 * kDeg),
+       fw::Se2f(0.44f, -0.04f, 12.5f * kDeg)},
+      {"room", rbsm_test::room_world(), fw::Se2f(-1, -1, 0.3f), fw::Se2f(-0.7f, -0.9f, 0.3f - 8 * kDeg),
+       fw::Se2f(-0.64f, -0.97f, 0.3f - 5.5f * kDeg)},
+  };
+}
+
+void expect_close(const fw::Se2f& got, const fw::Se2f& want, float tol_m, float tol_rad, const char* what) {
+  EXPECT_NEAR(got.x, want.x, tol_m) << what;
+  EXPECT_NEAR(got.y, want.y, tol_m) << what;
+  EXPECT_NEAR(fw::wrap_angle(got.theta - want.theta), 0.0f, tol_rad) << what;
+}
+
+TEST(RbsmTest, RecoversKnownDisplacementInSyntheticWorlds) {
+  for (const Case& c : cases()) {
+    RbsmHarness h;
+    ASSERT_TRUE(h.init(small_options()).is_ok());
+    const auto ref = rbsm_test::cast_scan(c.world, c.reference);
+    const auto cur = rbsm_test::cast_scan(c.world, c.truth);
+    ASSERT_TRUE(h.rbsm->integrate(ref.data(), ref.size(), c.reference).is_ok());
+    fw::ScanMatchResult r;
+    ASSERT_TRUE(h.rbsm->match(cur.data(), cur.size(), c.guess, &r).is_ok()) << c.name;
+    EXPECT_FALSE(r.map_was_empty);
+    EXPECT_GE(r.iterations, 1u);
+    // The start error is 4–7 cm and 2.5°: RBSM must land within a cell and half a degree.
+    expect_close(r.pose, c.truth, 0.02f, 0.5f * kDeg, c.name);
+    EXPECT_GT(r.score, 0.5f) << c.name;
+    // The matched pose explains the scan better than the guess.
+    EXPECT_GT(h.rbsm->score_pose(r.pose), h.rbsm->score_pose(c.guess)) << c.name;
+  }
+}
+
+TEST(RbsmTest, OptionalHillClimbingAndMahalanobisAlsoRecover) {
+  const Case c = cases()[2];
+  for (int variant = 0; variant < 2; ++variant) {
+    fw::RbsmOptions o = small_options();
+    o.num_particles = 300;
+    if (variant == 0) o.hill_climbing = true; else o.mahalanobis = true;
+    RbsmHarness h;
+    ASSERT_TRUE(h.init(o).is_ok());
+    const auto ref = rbsm_test::cast_scan(c.world, c.reference);
+    const auto cur = rbsm_test::cast_scan(c.world, c.truth);
+    ASSERT_TRUE(h.rbsm->integrate(ref.data(), ref.size(), c.reference).is_ok());
+    fw::ScanMatchResult r;
+    ASSERT_TRUE(h.rbsm->match(cur.data(), cur.size(), c.guess, &r).is_ok());
+    expect_close(r.pose, c.truth, 0.03f, 0.8f * kDeg, variant == 0 ? "hill climbing" : "mahalanobis");
+  }
+}
+
+TEST(TrimmedIcpTest, RecoversKnownDisplacementInSyntheticWorlds) {
+  for (const Case& c : cases()) {
+    IcpHarness h;
+    fw::TrimmedIcpOptions o;
+    o.grid.resolution = 0.02f;
+    o.grid.size_log2 = 10;
+    ASSERT_TRUE(h.init(o).is_ok());
+    const auto ref = rbsm_test::cast_scan(c.world, c.reference);
+    const auto cur = rbsm_test::cast_scan(c.world, c.truth);
+    ASSERT_TRUE(h.icp->integrate(ref.data(), ref.size(), c.reference).is_ok());
+    fw::ScanMatchResult r;
+    ASSERT_TRUE(h.icp->match(cur.data(), cur.size(), c.guess, &r).is_ok()) << c.name;
+    // Looser than RBSM: point-to-point ICP on the sparse corridor map is off by ~1.2° (a baseline).
+    expect_close(r.pose, c.truth, 0.03f, 1.5f * kDeg, c.name);
+    EXPECT_GE(r.iterations, 2u);
+  }
+}
+
+// Same seed ⇒ identical trajectory, also when the particles are split over 2 workers.
+std::vector<fw::Se2f> run_sequence(fw::WorkerPool* pool, std::uint64_t seed) {
+  fw::RbsmOptions o = small_options();
+  o.seed = seed;
+  RbsmHarness h;
+  EXPECT_TRUE(h.init(o, pool).is_ok());
+  const auto world = rbsm_test::room_world();
+  std::vector<fw::Se2f> out;
+  fw::Se2f est(-1, -1, 0);
+  fw::Se2f truth = est;
+  const fw::Se2f step(0.15f, 0.02f, 3 * kDeg);
+  const fw::Se2f odom_bias(0.17f, 0.0f, 2 * kDeg);
+  auto pts = rbsm_test::cast_scan(world, truth);
+  EXPECT_TRUE(h.rbsm->integrate(pts.data(), pts.size(), est).is_ok());
+  for (int k = 0; k < 8; ++k) {
+    truth = truth.compose(step);
+    pts = rbsm_test::cast_scan(world, truth);
+    fw::ScanMatchResult r;
+    EXPECT_TRUE(h.rbsm->match(pts.data(), pts.size(), est.compose(odom_bias), &r).is_ok());
+    est = r.pose;
+    EXPECT_TRUE(h.rbsm->integrate(pts.data(), pts.size(), est).is_ok());
+    out.push_back(est);
+  }
+  // Tracking through 8 steps with a biased odometry stays on the true path.
+  expect_close(est, truth, 0.05f, 1.0f * kDeg, "tracked end pose");
+  return out;
+}
+
+TEST(RbsmTest, GoldenTraceIsIdenticalForSameSeedAndAcrossWorkerCounts) {
+  const auto a = run_sequence(nullptr, 11);
+  const auto b = run_sequence(nullptr, 11);
+  fw::WorkerPool pool;
+  fw::WorkerPoolOptions po;
+  po.num_workers = 2;
+  po.pin = false;
+  ASSERT_TRUE(pool.start(po).is_ok());
+  const auto c = run_sequence(&pool, 11);
+  pool.stop();
+  const auto d = run_sequence(nullptr, 12);
+  ASSERT_EQ(a.size(), c.size());
+  bool differs_with_seed = false;
+  for (size_t i = 0; i < a.size(); ++i) {
+    EXPECT_EQ(a[i].x, b[i].x);
+    EXPECT_EQ(a[i].theta, b[i].theta);
+    EXPECT_EQ(a[i].x, c[i].x) << "1 vs 2 workers at step " << i;
+    EXPECT_EQ(a[i].y, c[i].y) << "1 vs 2 workers at step " << i;
+    EXPECT_EQ(a[i].theta, c[i].theta) << "1 vs 2 workers at step " << i;
+    if (a[i].x != d[i].x || a[i].theta != d[i].theta) differs_with_seed = true;
+  }
+  EXPECT_TRUE(differs_with_seed) << "a different seed must change the samples";
+}
+
+TEST(RbsmTest, MalformedInputIsAStatus) {
+  RbsmHarness h;
+  ASSERT_TRUE(h.init(small_options()).is_ok());
+  fw::ScanMatchResult r;
+  // Empty scan.
+  fw::Status st = h.rbsm->match(nullptr, 0, fw::Se2f(), &r);
+  EXPECT_EQ(st.code(), fw::Errc::kInvalidArgument);
+  EXPECT_NE(std::string(st.message()).find("valid points"), std::string::npos) << st.message();
+  // All-NaN scan.
+  std::vector<fw::Point2f> nan_pts(181, fw::Point2f(NAN, 1.0f));
+  st = h.rbsm->match(nan_pts.data(), nan_pts.size(), fw::Se2f(), &r);
+  EXPECT_EQ(st.code(), fw::Errc::kInvalidArgument);
+  EXPECT_NE(std::string(st.message()).find("0 valid points of 181"), std::string::npos) << st.message();
+  // Null pointer with a count, too many points, non-finite guess.
+  EXPECT_FALSE(h.rbsm->match(nullptr, 5, fw::Se2f(), &r).is_ok());
+  std::vector<fw::Point2f> many(2000, fw::Point2f(1, 1));
+  EXPECT_FALSE(h.rbsm->match(many.data(), many.size(), fw::Se2f(), &r).is_ok());
+  const auto pts = rbsm_test::cast_scan(rbsm_test::room_world(), fw::Se2f());
+  EXPECT_FALSE(h.rbsm->match(pts.data(), pts.size(), fw::Se2f(NAN, 0, 0), &r).is_ok());
+  EXPECT_FALSE(h.rbsm->integrate(pts.data(), pts.size(), fw::Se2f(0, INFINITY, 0)).is_ok());
+  // Some NaN points among good ones are dropped, not fatal; empty map ⇒ pose = guess.
+  std::vector<fw::Point2f> mixed = pts;
+  mixed[3] = fw::Point2f(NAN, NAN);
+  ASSERT_TRUE(h.rbsm->match(mixed.data(), mixed.size(), fw::Se2f(1, 2, 0.5f), &r).is_ok());
+  EXPECT_TRUE(r.map_was_empty);
+  EXPECT_EQ(r.used_points, pts.size() - 1);
+  EXPECT_EQ(r.pose.x, 1.0f);
+  // Options are validated once, at init.
+  fw::RbsmOptions bad = small_options();
+  bad.num_particles = 100000;
+  RbsmHarness h2;
+  EXPECT_NE(std::string(h2.init(bad).message()).find("num_particles"), std::string::npos);
+  bad = small_options();
+  bad.shrink = 1.5f;
+  EXPECT_FALSE(h2.init(bad).is_ok());
+  bad = small_options();
+  bad.accept_ratio = 0.0f;
+  EXPECT_FALSE(h2.init(bad).is_ok());
+}
+
+TEST(RbsmTest, MatchAndIntegrateAllocateNothing) {
+  if (!mmlfw_test::AllocCounter::available()) GTEST_SKIP() << "allocation counter unavailable under sanitizers";
+  RbsmHarness h;
+  ASSERT_TRUE(h.init(small_options()).is_ok());
+  IcpHarness hi;
+  fw::TrimmedIcpOptions io;
+  io.grid.size_log2 = 9;
+  ASSERT_TRUE(hi.init(io).is_ok());
+  const auto world = rbsm_test::room_world();
+  const auto a = rbsm_test::cast_scan(world, fw::Se2f(-1, -1, 0));
+  const auto b = rbsm_test::cast_scan(world, fw::Se2f(-0.9f, -1, 0.05f));
+  fw::ScanMatchResult r;
+  mmlfw_test::AllocCounter::begin();
+  fw::Status s1 = h.rbsm->integrate(a.data(), a.size(), fw::Se2f(-1, -1, 0));
+  fw::Status s2 = h.rbsm->match(b.data(), b.size(), fw::Se2f(-0.92f, -1, 0.03f), &r);
+  fw::Status s3 = hi.icp->integrate(a.data(), a.size(), fw::Se2f(-1, -1, 0));
+  fw::Status s4 = hi.icp->match(b.data(), b.size(), fw::Se2f(-0.92f, -1, 0.03f), &r);
+  const long n = mmlfw_test::AllocCounter::end();
+  EXPECT_TRUE(s1.is_ok() && s2.is_ok() && s3.is_ok() && s4.is_ok());
+  EXPECT_EQ(n, 0);
+}
+
+}  // namespace
