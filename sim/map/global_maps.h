@@ -1,0 +1,40 @@
+// The global maps of the real datasets (../shared/data), built by ray casting the SLAM-corrected
+// logs (sim/map/occupancy_builder.h) and cached as ROS maps + compiled map images:
+//   <cache>/<dataset>.yaml, .pgm, .png (picture), .mmap (firmware image), .build.txt (parameters)
+// <cache> = $MMLFW_MAP_DIR, else <source dir>/build/maps. Default resolutions: 0.05 m for the
+// office buildings (intel, fr079, aces, fr-clinic), 0.10 m for mit-killian (a ~250 m campus loop).
+#pragma once
+
+#include <string>
+#include <vector>
+
+#include "sim/io/ros_map.h"
+#include "sim/map/occupancy_builder.h"
+
+namespace sim {
+
+// Datasets with a global map: intel, fr079, aces, mit-killian, fr-clinic.
+const std::vector<std::string>& global_map_datasets();
+double default_map_resolution(const std::string& dataset);
+// Builder options used for a dataset (resolution filled in by the caller).
+OccupancyBuildOptions global_map_options(const std::string& dataset, double resolution);
+// Human-readable provenance: which log and poses the map comes from, and its caveats.
+std::string global_map_source(const std::string& dataset);
+
+// Builds the map from the dataset's corrected log (fr-clinic: raw log, see global_map_source).
+bool build_global_map(const std::string& dataset, double resolution, RosMap* out, std::string* error,
+                      OccupancyBuildStats* stats = nullptr);
+
+std::string map_cache_dir();
+std::string global_map_yaml_path(const std::string& dataset, const std::string& dir = map_cache_dir());
+std::string global_map_image_path(const std::string& dataset, const std::string& dir = map_cache_dir());
+
+// Builds (if the cache is missing or was built with other parameters) and writes <dir>/<dataset>.*
+// (yaml, pgm, png, mmap, build.txt); then reads the cached map. resolution ≤ 0: the default.
+bool ensure_global_map(const std::string& dataset, double resolution, const std::string& dir, RosMap* out,
+                       std::string* error, bool* rebuilt = nullptr);
+
+// Writes a PNG of a ROS map's image (grey levels as in the PGM).
+bool write_map_png(const std::string& path, const RosMap& map, std::string* error);
+
+}  // namespace sim
