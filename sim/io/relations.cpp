@@ -187,6 +187,69 @@ RelationsMetric evaluate_relations(const std::vector<Relation>& relations, const
   return m;
 }
 
+bool read_trajectory(const std::string& path, Trajectory* out, std::string* error) {
+  out->clear();
+  std::string data;
+  if (!read_file_maybe_gz(path, &data, error)) return false;
+  const char* p = data.data();
+  const char* end = p + data.size();
+  size_t line_no = 0;
+  std::vector<std::string_view> tok;
+  auto sep = [](char c) { return c == ' ' || c == '\t' || c == '\r' || c == ','; };
+  while (p < end) {
+    const char* eol = static_cast<const char*>(memchr(p, '\n', static_cast<size_t>(end - p)));
+    if (!eol) eol = end;
+    ++line_no;
+    const char* q = p;
+    p = eol + 1;
+    tok.clear();
+    while (q < eol) {
+      while (q < eol && sep(*q)) ++q;
+      if (q == eol) break;
+      const char* b = q;
+      while (q < eol && !sep(*q)) ++q;
+      tok.emplace_back(b, static_cast<size_t>(q - b));
+    }
+    if (tok.empty() || tok[0][0] == '#') continue;
+    const std::string where = path + ":" + std::to_string(line_no) + ": ";
+    if (tok.size() != 4) {
+      *error = where + "expected 4 fields (t x y theta), found " + std::to_string(tok.size());
+      return false;
+    }
+    double v[4];
+    static const char* kNames[4] = {"t", "x", "y", "theta"};
+    for (int i = 0; i < 4; ++i) {
+      if (!parse_double(tok[static_cast<size_t>(i)], &v[i])) {
+        *error = where + kNames[i] + " is not a finite number: '" + std::string(tok[static_cast<size_t>(i)].substr(0, 40)) + "'";
+        return false;
+      }
+    }
+    out->push_back({v[0], fw::Se2d(v[1], v[2], v[3])});
+  }
+  return true;
+}
+
+bool write_trajectory(const std::string& path, const Trajectory& traj, std::string* error) {
+  FILE* f = std::fopen(path.c_str(), "w");
+  if (!f) {
+    *error = path + ": cannot open for writing";
+    return false;
+  }
+  std::fprintf(f, "# t x y theta\n");
+  for (const auto& tp : traj) {
+    char a[64], b[64], c[64];
+    *std::to_chars(a, a + 63, tp.pose.x).ptr = 0;
+    *std::to_chars(b, b + 63, tp.pose.y).ptr = 0;
+    *std::to_chars(c, c + 63, tp.pose.theta).ptr = 0;
+    std::fprintf(f, "%.6f %s %s %s\n", tp.t, a, b, c);
+  }
+  if (std::fclose(f) != 0) {
+    *error = path + ": write error";
+    return false;
+  }
+  return true;
+}
+
 std::string to_string(const RelationsMetric& m) {
   char buf[400];
   std::snprintf(buf, sizeof(buf),

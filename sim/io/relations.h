@@ -59,4 +59,11 @@ std::vector<RelationError> relation_errors(const std::vector<Relation>& relation
 
 std::string to_string(const RelationsMetric& m);
 
+// Plain trajectory files for tools: one "t x y theta" per line (blanks or commas between fields,
+// '#' comments). Errors name "path:line". The writer prints t with 6 decimals (like the logs' ipc
+// timestamps, so relation lookups with the default tolerance still match) and poses shortest
+// round-trip.
+bool read_trajectory(const std::string& path, Trajectory* out, std::string* error);
+bool write_trajectory(const std::string& path, const Trajectory& traj, std::string* error);
+
 }  // namespace sim

@@ -132,6 +132,26 @@ TEST(Relations, LookupToleratesUnsortedAndDuplicateTimestamps) {
   EXPECT_TRUE(std::isnan(errs[2].trans));  // no pose at t=4
 }
 
+TEST(Relations, TrajectoryFileRoundTripAndErrors) {
+  Trajectory traj = {{976052857.33753, fw::Se2d(1.0 / 3, -2, 0.1)}, {976052858.5, fw::Se2d(4, 5, -3.1)}};
+  const std::string p = temp_path("traj.txt");
+  std::string err;
+  ASSERT_TRUE(write_trajectory(p, traj, &err)) << err;
+  Trajectory back;
+  ASSERT_TRUE(read_trajectory(p, &back, &err)) << err;
+  ASSERT_EQ(back.size(), 2u);
+  EXPECT_NEAR(back[0].t, traj[0].t, 1e-6);
+  EXPECT_EQ(back[0].pose.x, traj[0].pose.x);
+  EXPECT_EQ(back[1].pose.theta, traj[1].pose.theta);
+  write_text(p, "1,2,3,4\n5 6 7\n");
+  EXPECT_FALSE(read_trajectory(p, &back, &err));
+  EXPECT_NE(err.find(p + ":2: expected 4 fields"), std::string::npos) << err;
+  write_text(p, "1 2 3 inf\n");
+  EXPECT_FALSE(read_trajectory(p, &back, &err));
+  EXPECT_NE(err.find(p + ":1: theta is not a finite number"), std::string::npos) << err;
+  std::remove(p.c_str());
+}
+
 TEST(ReferenceTrajectory, BlendRecoversTruthUnderLinearDrift) {
   // Truth: a curved path. Odometry: the truth increments with a constant scale/heading bias (linear
   // drift). Corrected poses (in a different frame) every 10th scan. The blend removes the first-order
