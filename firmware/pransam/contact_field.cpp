@@ -1,0 +1,120 @@
+#include "firmware/pransam/contact_field.h"
+
+#include <cmath>
+
+#include "firmware/base/memory_report.h"
+
+namespace fw::pransam {
+
+template <int D>
+Status ContactField<D>::init(const ContactFieldOptions& options, StartupArena& arena) {
+  if (!(options.resolution > 0.0f) || !(options.eps_hard > 0.0f) || !(options.eps_soft > options.eps_hard)) {
+    return Status::error(Errc::kInvalidArgument,
+                         "pransam contact field: need resolution > 0 and 0 < eps_hard < eps_soft (got %g, %g, %g)",
+                         static_cast<double>(options.resolution), static_cast<double>(options.eps_hard),
+                         static_cast<double>(options.eps_soft));
+  }
+  if (options.max_cells == 0 || options.max_axis < 2) {
+    return Status::error(Errc::kInvalidArgument, "pransam contact field: max_cells/max_axis must be positive");
+  }
+  options_ = options;
+  Result<std::uint8_t*> c = arena.allocate_array<std::uint8_t>(options.max_cells, "pransam contact field");
+  if (!c) return c.status();
+  cells_ = *c;
+  Result<float*> d = arena.allocate_array<float>(options.max_cells, "pransam distance field");
+  if (!d) return d.status();
+  dist2_ = *d;
+  const std::size_t n = options.max_axis;
+  Result<int*> v = arena.allocate_array<int>(n, "pransam edt v");
+  Result<float*> z = arena.allocate_array<float>(n + 1, "pransam edt z");
+  Result<float*> f = arena.allocate_array<float>(n, "pransam edt f");
+  Result<float*> dd = arena.allocate_array<float>(n, "pransam edt d");
+  if (!v) return v.status();
+  if (!z) return z.status();
+  if (!f) return f.status();
+  if (!dd) return dd.status();
+  scratch_ = EdtScratch{*v, *z, *f, *dd, n};
+  return MemoryReport::instance().add({D == 2 ? "pransam2d" : "pransam3d", "contact+distance field",
+                                       options.max_cells * 5 + n * 16, options.max_cells, nullptr});
+}
+
+template <int D>
+Status ContactField<D>::build(const Point<D>* points, std::size_t n, const char* name) {
+  if (cells_ == nullptr) return Status::error(Errc::kNotInitialized, "%s: contact field not initialised", name);
+  if (n == 0) return Status::error(Errc::kInvalidArgument, "%s: empty point set", name);
+  Point<D> lo = points[0], hi = points[0];
+  for (std::size_t i = 0; i < n; ++i) {
+    if (!points[i].allFinite()) {
+      return Status::error(Errc::kInvalidArgument, "%s: point %zu is not finite", name, i);
+    }
+    lo = lo.cwiseMin(points[i]);
+    hi = hi.cwiseMax(points[i]);
+  }
+  const float res = options_.resolution;
+  const float margin = options_.eps_soft + 2.0f * res;
+  std::size_t total = 1;
+  std::size_t dims[D];
+  for (int a = 0; a < D; ++a) {
+    const double span = static_cast<double>(hi(a) - lo(a)) + 2.0 * margin;
+    const double cells = std::ceil(span / res) + 1.0;
+    if (cells > static_cast<double>(options_.max_axis)) {
+      return Status::error(Errc::kCapacityExceeded, "%s: contact field axis %d needs %.0f cells > max_axis %u", name,
+                           a, cells, options_.max_axis);
+    }
+    dims[a] = static_cast<std::size_t>(cells);
+    total *= dims[a];
+  }
+  if (total > options_.max_cells) {
+    return Status::error(Errc::kCapacityExceeded, "%s: contact field needs %zu cells > capacity %zu", name, total,
+                         options_.max_cells);
+  }
+  origin_ = lo - Point<D>::Constant(margin);
+  inv_res_ = 1.0f / res;
+  for (int a = 0; a < D; ++a) {
+    dims_[a] = dims[a];
+    dims_f_[a] = static_cast<float>(dims[a]);
+  }
+  total_ = total;
+  for (std::size_t i = 0; i < total; ++i) dist2_[i] = kEdtInf;
+  for (std::size_t i = 0; i < n; ++i) {
+    std::size_t idx = 0;
+    for (int a = 0; a < D; ++a) {
+      const std::size_t c = static_cast<std::size_t>((points[i](a) - origin_(a)) * inv_res_);
+      idx = idx * dims_[a] + c;
+    }
+    dist2_[idx] = 0.0f;
+  }
+  squared_edt<D>(dist2_, dims, scratch_);
+  const float eh = options_.eps_hard, es = options_.eps_soft;
+  for (std::size_t i = 0; i < total; ++i) {
+    const float dm = std::sqrt(dist2_[i]) * res;
+    std::uint8_t c;
+    if (dm < eh) {
+      c = 255;  // Eq. 4.31
+    } else if (dm < es) {
+      float f = std::floor(255.0f * (es - dm) / (es - eh));  // Eq. 4.33
+      if (f > 254.0f) f = 254.0f;
+      c = static_cast<std::uint8_t>(f);
+    } else {
+      c = 0;
+    }
+    cells_[i] = c;
+  }
+  return Status::ok();
+}
+
+template <int D>
+float ContactField<D>::distance(const Point<D>& p) const {
+  std::size_t idx = 0;
+  for (int a = 0; a < D; ++a) {
+    const float f = (p(a) - origin_(a)) * inv_res_;
+    if (!(f >= 0.0f && f < dims_f_[a])) return INFINITY;
+    idx = idx * dims_[a] + static_cast<std::size_t>(f);
+  }
+  return std::sqrt(dist2_[idx]) * options_.resolution;
+}
+
+template class ContactField<2>;
+template class ContactField<3>;
+
+}  // namespace fw::pransam

@@ -1,0 +1,496 @@
+#include "firmware/pransam/matcher.h"
+
+#include <cmath>
+
+#include "firmware/base/memory_report.h"
+
+namespace fw::pransam {
+
+namespace {
+constexpr std::uint64_t kSceneOrderStream = 0x5CE7E0000ull;  // stream of the scene visiting order
+constexpr std::uint64_t kFillStream = 0xF111ull;               // offline R_B fill
+constexpr std::size_t kMaxTouched = 1u << 18;                  // touched-slot list per table
+
+template <int D>
+const char* module_name() { return D == 2 ? "pransam2d" : "pransam3d"; }
+
+// Contact value → contribution to Ω: hard (Eq. 4.31) counts only 255, fuzzy (Eq. 4.33) is linear.
+struct ContactLut {
+  float hard[256];
+  float fuzzy[256];
+  ContactLut() {
+    for (int c = 0; c < 256; ++c) {
+      hard[c] = c == 255 ? 1.0f : 0.0f;
+      fuzzy[c] = c == 255 ? 1.0f : static_cast<float>(c) / 255.0f;
+    }
+  }
+};
+const ContactLut kLut;
+
+template <int D>
+bool all_finite(const Point<D>* p, std::size_t n, std::size_t* bad) {
+  for (std::size_t i = 0; i < n; ++i) {
+    if (!p[i].allFinite()) { *bad = i; return false; }
+  }
+  return true;
+}
+}  // namespace
+
+template <int D>
+Status Matcher<D>::init(const MatcherOptions& options, StartupArena& arena, WorkerPool* pool) {
+  if (options.num_workers < 1 || options.num_workers > kMaxLogicalWorkers) {
+    return Status::error(Errc::kInvalidArgument, "pransam options: num_workers %d outside [1, %d]",
+                         options.num_workers, kMaxLogicalWorkers);
+  }
+  if (options.max_scene_points < 3 || options.max_model_points < 3 || options.max_batch < 1 ||
+      options.collect_capacity < 1) {
+    return Status::error(Errc::kInvalidArgument,
+                         "pransam options: max_scene_points/max_model_points must be >= 3, max_batch and "
+                         "collect_capacity >= 1");
+  }
+  options_ = options;
+  pool_ = pool;
+  FW_RETURN_IF_ERROR(table_a_.allocate(arena, D == 2 ? "R_A (2d)" : "R_A (3d)"));
+  if (options.allocate_model_table) FW_RETURN_IF_ERROR(table_b_.allocate(arena, D == 2 ? "R_B (2d)" : "R_B (3d)"));
+  FW_RETURN_IF_ERROR(field_.init(options.field, arena));
+  FW_RETURN_IF_ERROR(index_a_.init(options.max_scene_points, options.max_index_cells, arena, "scene index"));
+  FW_RETURN_IF_ERROR(index_b_.init(options.max_model_points, options.max_index_cells, arena, "model index"));
+  Result<std::uint32_t*> order = arena.allocate_array<std::uint32_t>(options.max_scene_points, "pransam order");
+  if (!order) return order.status();
+  scene_order_ = *order;
+  Result<std::uint32_t*> ta = arena.allocate_array<std::uint32_t>(kMaxTouched, "pransam touched A");
+  Result<std::uint32_t*> tb = arena.allocate_array<std::uint32_t>(kMaxTouched, "pransam touched B");
+  if (!ta) return ta.status();
+  if (!tb) return tb.status();
+  touched_[0] = *ta;
+  touched_[1] = *tb;
+  Result<WorkerState*> ws = arena.allocate_array<WorkerState>(static_cast<std::size_t>(options.num_workers),
+                                                              "pransam workers");
+  if (!ws) return ws.status();
+  workers_ = *ws;
+  for (int w = 0; w < options.num_workers; ++w) {
+    Result<InsertRecord*> ins = arena.allocate_array<InsertRecord>(options.max_batch, "pransam inserts");
+    Result<Hypothesis<D>*> col = arena.allocate_array<Hypothesis<D>>(options.collect_capacity, "pransam collected");
+    if (!ins) return ins.status();
+    if (!col) return col.status();
+    workers_[w].inserts = *ins;
+    workers_[w].collected = *col;
+  }
+  Result<Hypothesis<D>*> merged = arena.allocate_array<Hypothesis<D>>(options.collect_capacity, "pransam merged");
+  if (!merged) return merged.status();
+  merged_ = *merged;
+  const std::size_t per_worker = sizeof(WorkerState) + options.max_batch * sizeof(InsertRecord) +
+                                 options.collect_capacity * sizeof(Hypothesis<D>);
+  FW_RETURN_IF_ERROR(MemoryReport::instance().add(
+      {module_name<D>(), "workers+hypotheses",
+       per_worker * static_cast<std::size_t>(options.num_workers) + options.collect_capacity * sizeof(Hypothesis<D>) +
+           2 * kMaxTouched * 4 + options.max_scene_points * 4,
+       options.collect_capacity, nullptr}));
+  initialized_ = true;
+  return Status::ok();
+}
+
+template <int D>
+Status Matcher<D>::set_model(const Point<D>* points, std::size_t n, const char* name) {
+  if (!initialized_) return Status::error(Errc::kNotInitialized, "pransam: set_model('%s') before init", name);
+  model_ = nullptr;
+  model_n_ = 0;
+  precomputed_ = false;
+  if (points == nullptr || n < 3) {
+    return Status::error(Errc::kInvalidArgument, "pransam model '%s': %zu points (need >= 3)", name,
+                         points == nullptr ? std::size_t(0) : n);
+  }
+  if (n > options_.max_model_points) {
+    return Status::error(Errc::kCapacityExceeded, "pransam model '%s': %zu points > capacity %u", name, n,
+                         options_.max_model_points);
+  }
+  std::size_t bad = 0;
+  if (!all_finite<D>(points, n, &bad)) {
+    return Status::error(Errc::kInvalidArgument, "pransam model '%s': point %zu is not finite", name, bad);
+  }
+  FW_RETURN_IF_ERROR(field_.build(points, n, name));
+  model_min_ = points[0];
+  model_max_ = points[0];
+  for (std::size_t i = 1; i < n; ++i) {
+    model_min_ = model_min_.cwiseMin(points[i]);
+    model_max_ = model_max_.cwiseMax(points[i]);
+  }
+  model_ = points;
+  model_n_ = static_cast<std::uint32_t>(n);
+  model_index_extent_ = -1.0f;
+  if (table_b_.valid()) table_b_.clear();
+  touched_n_[1] = 0;
+  touched_overflow_[1] = false;
+  return Status::ok();
+}
+
+template <int D>
+Status Matcher<D>::use_precomputed_table(const Triple* slots, float extent, const char* name) {
+  if (model_ == nullptr) return Status::error(Errc::kNotInitialized, "%s: set_model() first", name);
+  if (slots == nullptr || !(extent > 0.0f) || !std::isfinite(extent)) {
+    return Status::error(Errc::kInvalidArgument, "%s: no slots or extent %g not positive", name,
+                         static_cast<double>(extent));
+  }
+  // Every stored index must address the model set (a corrupt section must not read out of bounds).
+  std::size_t filled = 0;
+  for (std::size_t s = 0; s < kNumSlots; ++s) {
+    if (slots[s].empty()) continue;
+    for (int k = 0; k < 3; ++k) {
+      if (slots[s].v[k] >= model_n_) {
+        return Status::error(Errc::kCorruptData, "%s: slot %zu refers to point %u but the model has %u points", name,
+                             s, slots[s].v[k], model_n_);
+      }
+    }
+    ++filled;
+  }
+  if (filled == 0) return Status::error(Errc::kInvalidArgument, "%s: table is empty", name);
+  if (slots == table_b_.data()) {
+    table_b_.set_extent(extent);
+    model_table_ = &table_b_;
+  } else {
+    precomp_table_.attach_read_only(slots, extent);
+    model_table_ = &precomp_table_;
+  }
+  precomputed_ = true;
+  return Status::ok();
+}
+
+template <int D>
+Status Matcher<D>::fill_model_table(std::uint64_t seed, std::uint64_t triples, float extent, float min_height_ratio) {
+  if (model_ == nullptr) return Status::error(Errc::kNotInitialized, "pransam fill: set_model() first");
+  if (!table_b_.valid()) {
+    return Status::error(Errc::kNotInitialized, "pransam fill: R_B not allocated (allocate_model_table = false)");
+  }
+  if (!(extent > 0.0f) || triples == 0) {
+    return Status::error(Errc::kInvalidArgument, "pransam fill: extent %g and triples %llu must be positive",
+                         static_cast<double>(extent), static_cast<unsigned long long>(triples));
+  }
+  FW_RETURN_IF_ERROR(index_b_.build(model_, model_n_, extent, "model index"));
+  model_index_extent_ = extent;
+  precomputed_ = false;
+  table_b_.clear();
+  table_b_.set_extent(extent);
+  touched_overflow_[1] = true;  // an online match afterwards must clear the whole table
+  const TripleFilter filter{extent, min_height_ratio, 0.0f};
+  RandomStream rng(seed, kFillStream);
+  std::uint64_t keyed = 0, draws = 0;
+  const std::uint64_t max_draws = triples * 200 + 100000;
+  while (keyed < triples && draws < max_draws) {
+    ++draws;
+    Triple t;
+    if (!index_b_.draw(rng, &t)) continue;
+    std::uint32_t slot;
+    if (key_triple<D>(model_, filter, &t, &slot) != KeyResult::kOk) continue;
+    table_b_.insert(slot, t);
+    ++keyed;
+  }
+  if (keyed < triples) {
+    return Status::error(Errc::kNumerical, "pransam fill: only %llu of %llu triples keyable after %llu draws",
+                         static_cast<unsigned long long>(keyed), static_cast<unsigned long long>(triples),
+                         static_cast<unsigned long long>(draws));
+  }
+  return Status::ok();
+}
+
+template <int D>
+float Matcher<D>::rate(const Hypothesis<D>& h, float bound, std::uint32_t start, bool* complete,
+                       std::uint64_t* checks) const {
+  const float* lut = params_.fuzzy ? kLut.fuzzy : kLut.hard;
+  const std::uint32_t n = scene_n_;
+  const std::uint32_t kmin = params_.min_extrapolation_points;
+  const bool extrapolate = params_.extrapolate && bound > 0.0f;
+  float sum = 0.0f;
+  std::uint32_t k = 0;
+  std::uint32_t idx = start;
+  for (; k < n;) {
+    const Point<D> p = h.rotation * scene_[scene_order_[idx]] + h.translation;
+    sum += lut[field_.contact(p)];
+    ++k;
+    if (++idx == n) idx = 0;
+    // Eq. 4.8: Ω⁺(k) = mean + 1.96 / (2√k); give up once it cannot beat the bound.
+    if (extrapolate && (k & 7u) == 0 && k >= kmin && k < n) {
+      const float kf = static_cast<float>(k);
+      if (sum / kf + 0.98f / std::sqrt(kf) < bound) {
+        *checks += k;
+        *complete = false;
+        return sum / kf;
+      }
+    }
+  }
+  *checks += n;
+  *complete = true;
+  return sum / static_cast<float>(n);
+}
+
+template <int D>
+void Matcher<D>::run_worker(int w) {
+  WorkerState& st = workers_[w];
+  st.num_inserts = 0;
+  st.num_collected = 0;
+  st.reached = false;
+  st.best_valid = false;
+  const bool from_a = precomputed_ || w < tau_;
+  const PointIndex<D>& idx = from_a ? index_a_ : index_b_;
+  const RelationTable& other = from_a ? *model_table_ : table_a_;
+  const bool collect = params_.collect_all;
+  const float thres = params_.omega_thres;
+  float bound = collect ? thres : round_bound_;
+  for (std::uint32_t it = 0; it < st.batch; ++it) {
+    ++st.stats.iterations;
+    Triple t;
+    if (!idx.draw(st.rng, &t)) { ++st.stats.failed_draws; continue; }
+    std::uint32_t slot;
+    const KeyResult kr = key_triple<D>(idx.points(), filter_, &t, &slot);
+    if (kr != KeyResult::kOk) {
+      if (kr == KeyResult::kCollinear) ++st.stats.rejected_collinear; else ++st.stats.rejected_size;
+      continue;
+    }
+    ++st.stats.keyed;
+    if (!precomputed_) st.inserts[st.num_inserts++] = InsertRecord{slot, t};
+    const Triple o = other.at(slot);  // the other table as of the round start (Eq. 4.4)
+    if (o.empty()) continue;
+    ++st.stats.collisions;
+    const Triple& ta = from_a ? t : o;
+    const Triple& tb = from_a ? o : t;
+    TriangleFrame<D> fa, fb;
+    if (!triangle_frame<D>(scene_[ta.v[0]], scene_[ta.v[1]], scene_[ta.v[2]], &fa) ||
+        !triangle_frame<D>(model_[tb.v[0]], model_[tb.v[1]], model_[tb.v[2]], &fb)) {
+      continue;
+    }
+    Hypothesis<D> h;
+    if (!make_hypothesis<D>(fa, fb, &h)) { ++st.stats.flipped; continue; }  // Eq. 5.3
+    h.iteration = static_cast<std::uint32_t>(st.first_iteration + it);
+    h.worker = static_cast<std::uint16_t>(w);
+    ++st.stats.evaluated;
+    bool complete = false;
+    const float q = rate(h, bound, st.rng.uniform_index(scene_n_), &complete, &st.stats.point_checks);
+    if (!complete) { ++st.stats.extrapolation_cut; continue; }
+    h.quality = q;
+    if (!st.best_valid || q > st.best.quality) {
+      st.best = h;
+      st.best_valid = true;
+    }
+    if (!collect && q > bound) bound = q;
+    if (q >= thres) {
+      if (collect) {
+        if (st.num_collected < options_.collect_capacity) st.collected[st.num_collected++] = h; else ++st.dropped;
+      } else {
+        st.reached = true;
+        break;  // stop criterion Ω ≥ Ω_thres
+      }
+    }
+  }
+}
+
+template <int D>
+void Matcher<D>::round_job(void* ctx, int pool_index, int pool_size) {
+  Matcher* m = static_cast<Matcher*>(ctx);
+  for (int w = pool_index; w < m->num_workers_; w += pool_size) m->run_worker(w);
+}
+
+template <int D>
+void Matcher<D>::apply_job(void* ctx, int pool_index, int pool_size) {
+  Matcher* m = static_cast<Matcher*>(ctx);
+  for (int table = 0; table < 2; ++table) {
+    if (table % pool_size != pool_index) continue;
+    RelationTable& rt = table == 0 ? m->table_a_ : m->table_b_;
+    const int w0 = table == 0 ? 0 : m->tau_;
+    const int w1 = table == 0 ? m->tau_ : m->num_workers_;
+    for (int w = w0; w < w1; ++w) {  // worker order: later workers overwrite earlier ones
+      const WorkerState& st = m->workers_[w];
+      for (std::uint32_t i = 0; i < st.num_inserts; ++i) {
+        const std::uint32_t slot = st.inserts[i].slot;
+        if (!rt.insert(slot, st.inserts[i].triple)) {
+          if (m->touched_n_[table] < kMaxTouched) m->touched_[table][m->touched_n_[table]++] = slot;
+          else m->touched_overflow_[table] = true;
+        }
+      }
+    }
+  }
+}
+
+template <int D>
+void Matcher<D>::reset_online_table(int table) {
+  RelationTable& rt = table == 0 ? table_a_ : table_b_;
+  if (!rt.valid()) return;
+  if (touched_overflow_[table]) rt.clear(); else rt.clear_slots(touched_[table], touched_n_[table]);
+  touched_n_[table] = 0;
+  touched_overflow_[table] = false;
+}
+
+template <int D>
+Status Matcher<D>::match(const Point<D>* scene, std::size_t n, const MatchParams& params, MatchResult<D>* out) {
+  if (out == nullptr) return Status::error(Errc::kInvalidArgument, "pransam match: no result object");
+  *out = MatchResult<D>{};
+  if (!initialized_) return Status::error(Errc::kNotInitialized, "pransam match: matcher not initialised");
+  if (model_ == nullptr) return Status::error(Errc::kNotInitialized, "pransam match: no model set (set_model)");
+  if (scene == nullptr || n < 3) {
+    return Status::error(Errc::kInvalidArgument, "pransam scene: %zu points (need >= 3)",
+                         scene == nullptr ? std::size_t(0) : n);
+  }
+  if (n > options_.max_scene_points) {
+    return Status::error(Errc::kCapacityExceeded, "pransam scene: %zu points > capacity %u", n,
+                         options_.max_scene_points);
+  }
+  std::size_t bad = 0;
+  if (!all_finite<D>(scene, n, &bad)) {
+    return Status::error(Errc::kInvalidArgument, "pransam scene: point %zu is not finite", bad);
+  }
+  if (!(params.omega_thres >= 0.0f && params.omega_thres <= 1.0f) || params.max_iterations == 0 ||
+      params.first_batch == 0) {
+    return Status::error(Errc::kInvalidArgument,
+                         "pransam params: omega_thres %g outside [0,1], or max_iterations/first_batch zero",
+                         static_cast<double>(params.omega_thres));
+  }
+  const int T = options_.num_workers;
+  int tau = params.tau < 0 ? T / 2 : params.tau;
+  if (!precomputed_) {
+    if (!table_b_.valid()) {
+      return Status::error(Errc::kNotInitialized, "pransam match: no precomputed table and R_B not allocated");
+    }
+    if (T < 2 || tau < 1 || tau > T - 1) {
+      return Status::error(Errc::kInvalidArgument,
+                           "pransam params: online matching needs T >= 2 and 1 <= tau <= T-1 (T %d, tau %d)", T, tau);
+    }
+  }
+  Point<D> lo = scene[0], hi = scene[0];
+  for (std::size_t i = 1; i < n; ++i) {
+    lo = lo.cwiseMin(scene[i]);
+    hi = hi.cwiseMax(scene[i]);
+  }
+  float extent;
+  if (precomputed_) {
+    extent = model_table_->extent();
+  } else if (params.extent > 0.0f) {
+    extent = params.extent;
+  } else {
+    // Sides longer than the smaller set's diameter can never correspond.
+    extent = (hi - lo).norm();
+    const float db = (model_max_ - model_min_).norm();
+    if (db < extent) extent = db;
+    if (params.max_extent > 0.0f && params.max_extent < extent) extent = params.max_extent;
+    extent *= 1.001f;
+  }
+  if (!(extent > 0.0f)) return Status::error(Errc::kInvalidArgument, "pransam scene: all points coincide");
+  scene_ = scene;
+  scene_n_ = static_cast<std::uint32_t>(n);
+  params_ = params;
+  num_workers_ = T;
+  tau_ = precomputed_ ? T : tau;
+  filter_ = TripleFilter{extent, params.min_height_ratio, 0.0f};
+  FW_RETURN_IF_ERROR(index_a_.build(scene, scene_n_, extent, "scene"));
+  if (!precomputed_) {
+    reset_online_table(0);
+    reset_online_table(1);
+    table_a_.set_extent(extent);
+    table_b_.set_extent(extent);
+    if (model_index_extent_ != extent) {
+      FW_RETURN_IF_ERROR(index_b_.build(model_, model_n_, extent, "model index"));
+      model_index_extent_ = extent;
+    }
+    model_table_ = &table_b_;
+  }
+  // A has to contain at least one keyable triple, otherwise no hypothesis can ever exist.
+  {
+    bool any = false;
+    const TripleFilter& f = filter_;
+    for (std::uint32_t i = 0; i < scene_n_ && !any; ++i) {
+      for (std::uint32_t j = i + 1; j < scene_n_ && !any; j += 1 + scene_n_ / 64) {
+        for (std::uint32_t k = j + 1; k < scene_n_ && !any; k += 1 + scene_n_ / 64) {
+          Triple t;
+          t.v[0] = i; t.v[1] = j; t.v[2] = k;
+          std::uint32_t slot;
+          any = key_triple<D>(scene, f, &t, &slot) == KeyResult::kOk;
+        }
+      }
+      if (scene_n_ > 64) i += scene_n_ / 64;
+    }
+    if (!any) {
+      return Status::error(Errc::kInvalidArgument,
+                           "pransam scene: no usable triple (%zu points all collinear, coincident or wider than the "
+                           "table extent %.2f m)", n, static_cast<double>(extent));
+    }
+  }
+  // Random visiting order of A for the extrapolation (Eq. 4.8): Fisher–Yates from the seed.
+  {
+    RandomStream rng(params.seed, kSceneOrderStream);
+    for (std::uint32_t i = 0; i < scene_n_; ++i) scene_order_[i] = i;
+    for (std::uint32_t i = scene_n_ - 1; i > 0; --i) {
+      const std::uint32_t j = rng.uniform_index(i + 1);
+      const std::uint32_t tmp = scene_order_[i];
+      scene_order_[i] = scene_order_[j];
+      scene_order_[j] = tmp;
+    }
+  }
+  for (int w = 0; w < T; ++w) {
+    workers_[w].rng.reseed(params.seed, static_cast<std::uint64_t>(w));
+    workers_[w].stats = MatchStats{};
+    workers_[w].dropped = 0;
+  }
+  round_bound_ = 0.0f;
+  std::uint64_t done = 0;
+  std::uint32_t batch = params.first_batch < options_.max_batch ? params.first_batch : options_.max_batch;
+  std::size_t merged_n = 0;
+  std::size_t dropped = 0;
+  bool reached = false;
+  std::uint32_t rounds = 0;
+  while (done < params.max_iterations && !reached) {
+    const std::uint64_t remaining = params.max_iterations - done;
+    const std::uint64_t round_total = remaining < static_cast<std::uint64_t>(batch) * static_cast<std::uint64_t>(T)
+                                          ? remaining
+                                          : static_cast<std::uint64_t>(batch) * static_cast<std::uint64_t>(T);
+    for (int w = 0; w < T; ++w) {
+      std::size_t b, e;
+      WorkerPool::partition(static_cast<std::size_t>(round_total), w, T, &b, &e);
+      workers_[w].batch = static_cast<std::uint32_t>(e - b);
+      workers_[w].first_iteration = done + b;
+    }
+    if (pool_ != nullptr && pool_->running()) pool_->run(&Matcher::round_job, this); else round_job(this, 0, 1);
+    if (!precomputed_) {
+      if (pool_ != nullptr && pool_->running()) pool_->run(&Matcher::apply_job, this); else apply_job(this, 0, 1);
+    }
+    // Merge in worker order.
+    for (int w = 0; w < T; ++w) {
+      const WorkerState& st = workers_[w];
+      if (st.best_valid && (!out->best_valid || st.best.quality > out->best.quality)) {
+        out->best = st.best;
+        out->best_valid = true;
+      }
+      for (std::uint32_t i = 0; i < st.num_collected; ++i) {
+        if (merged_n < options_.collect_capacity) merged_[merged_n++] = st.collected[i]; else ++dropped;
+      }
+      reached = reached || st.reached;
+    }
+    if (out->best_valid) round_bound_ = out->best.quality;
+    done += round_total;
+    ++rounds;
+    if (batch < options_.max_batch) batch = batch * 2 < options_.max_batch ? batch * 2 : options_.max_batch;
+  }
+  MatchStats& s = out->stats;
+  for (int w = 0; w < T; ++w) {
+    const MatchStats& ws = workers_[w].stats;
+    s.iterations += ws.iterations;
+    s.keyed += ws.keyed;
+    s.rejected_collinear += ws.rejected_collinear;
+    s.rejected_size += ws.rejected_size;
+    s.failed_draws += ws.failed_draws;
+    s.collisions += ws.collisions;
+    s.flipped += ws.flipped;
+    s.evaluated += ws.evaluated;
+    s.extrapolation_cut += ws.extrapolation_cut;
+    s.point_checks += ws.point_checks;
+    dropped += workers_[w].dropped;
+  }
+  s.rounds = rounds;
+  s.stop = reached ? StopReason::kThreshold : StopReason::kMaxIterations;
+  out->hypotheses = merged_;
+  out->num_hypotheses = merged_n;
+  out->dropped = dropped;
+  out->found = out->best_valid && out->best.quality >= params.omega_thres;
+  return Status::ok();
+}
+
+template class Matcher<2>;
+template class Matcher<3>;
+
+}  // namespace fw::pransam

@@ -1,0 +1,184 @@
+// pRANSAM (Ch. 4): parallel random sample matching of a scene set A (scan / local map) to a model
+// set B (global map) without an initial guess, in 2-D and 3-D (same code, D = 2 or 3).
+//
+// Reproducible parallelism (our organisation of Fig. 4.3): T logical workers run in ROUNDS on the
+// fw::WorkerPool (any pool size; logical worker w runs on pool worker w mod P, in order). In a
+// round each worker draws a batch of triples with its own RandomStream(seed, w), keys them, checks
+// the OTHER table as it was at the start of the round (a collision, Eq. 4.4), turns collisions into
+// hypotheses and rates them against B's contact field; its own inserts are buffered. After the
+// barrier the buffered inserts are applied in worker order (overwrite on clash), hypotheses are
+// merged in worker order, and the stop test runs. Hence the same seed and T give the same
+// hypotheses whatever the pool size or scheduling. Workers 0..τ−1 fill R_A, the others R_B;
+// τ = T/2 by default (Theorem 1).
+//
+// Precomputed mode (Sec. 5.5.2, Theorem 2): R_B comes filled (offline, map image section) and all T
+// workers draw from A. Because R_B never changes at run time, an entry written to R_A could never
+// produce a later collision, so in this mode workers only probe R_B (R_A is not written).
+//
+// Quality Ω (Eq. 4.7) uses hard (Eq. 4.31) or fuzzy (Eq. 4.33) contact from the ContactField, with
+// the extrapolation shortcut (Eq. 4.8): points of A are visited in a random order and a hypothesis
+// is dropped as soon as the 95 % upper bound mean + 1.96/(2√k) falls below the bound to beat
+// (Ω_best in stop mode, Ω_thres in collect-all mode).
+//
+// Memory: everything is taken from a StartupArena in init() (two tables of kNumSlots·12 bytes, the
+// contact field, indices, per-worker buffers) and registered with MemoryReport (module "pransam").
+#pragma once
+
+#include <cstddef>
+#include <cstdint>
+
+#include "firmware/base/arena.h"
+#include "firmware/base/rng.h"
+#include "firmware/base/status.h"
+#include "firmware/base/worker_pool.h"
+#include "firmware/pransam/contact_field.h"
+#include "firmware/pransam/hypothesis.h"
+#include "firmware/pransam/point_index.h"
+#include "firmware/pransam/relation_table.h"
+
+namespace fw::pransam {
+
+constexpr int kMaxLogicalWorkers = 16;
+
+struct MatcherOptions {
+  int num_workers = 2;                   // T (logical workers; ≥ pool size is fine)
+  std::uint32_t max_scene_points = 4096; // |A| capacity
+  std::uint32_t max_model_points = 131072;  // |B| capacity
+  std::uint32_t max_index_cells = 65536;    // PointIndex grid capacity per set
+  ContactFieldOptions field;
+  bool allocate_model_table = true;      // false: only precomputed R_B will be used (saves 6 MB)
+  std::uint32_t max_batch = 1024;        // iterations per worker per round (upper bound)
+  std::uint32_t collect_capacity = 4096; // collect-all buffer (merged), per-worker buffers the same
+};
+
+enum class StopReason : std::uint8_t { kThreshold, kMaxIterations };
+
+struct MatchParams {
+  std::uint64_t seed = 1;
+  std::uint32_t max_iterations = 100000;  // I_max: total triples drawn over all workers
+  float omega_thres = 0.8f;               // Ω_thres
+  bool fuzzy = true;                      // Eq. 4.33 instead of Eq. 4.31
+  bool extrapolate = true;                // Eq. 4.8
+  bool collect_all = false;               // MML mode: run I_max and return all Ω ≥ Ω_thres
+  int tau = -1;                           // workers filling R_A (online); −1 = T/2 (Theorem 1)
+  float extent = 0.0f;                    // online table extent; 0 = min(diam A, diam B, max_extent)
+  float max_extent = 12.0f;
+  float min_height_ratio = 0.1f;          // collinear rejection
+  std::uint32_t first_batch = 64;         // round batch starts here and doubles up to max_batch
+  std::uint32_t min_extrapolation_points = 12;
+};
+
+struct MatchStats {
+  std::uint64_t iterations = 0;       // triples drawn (all workers)
+  std::uint64_t keyed = 0;            // triples that passed the filter and were keyed
+  std::uint64_t rejected_collinear = 0, rejected_size = 0, failed_draws = 0;
+  std::uint64_t collisions = 0;       // Eq. 4.4 hits
+  std::uint64_t flipped = 0;          // Eq. 5.3 rejections (2-D)
+  std::uint64_t evaluated = 0;        // hypotheses rated
+  std::uint64_t extrapolation_cut = 0;  // rated but dropped early (Eq. 4.8)
+  std::uint64_t point_checks = 0;     // contact look-ups
+  std::uint32_t rounds = 0;
+  StopReason stop = StopReason::kMaxIterations;
+};
+
+template <int D>
+struct MatchResult {
+  bool found = false;             // a hypothesis with Ω ≥ Ω_thres exists
+  Hypothesis<D> best;             // highest Ω seen (valid if best_valid)
+  bool best_valid = false;
+  const Hypothesis<D>* hypotheses = nullptr;  // collect-all: all Ω ≥ Ω_thres in merge order
+  std::size_t num_hypotheses = 0;
+  std::size_t dropped = 0;        // collect-all hypotheses lost to the bounded buffer
+  MatchStats stats;
+};
+
+template <int D>
+class Matcher {
+ public:
+  Matcher() = default;
+  Matcher(const Matcher&) = delete;
+  Matcher& operator=(const Matcher&) = delete;
+
+  // Allocates everything. `pool` may be null (inline, one thread) and must outlive the matcher.
+  Status init(const MatcherOptions& options, StartupArena& arena, WorkerPool* pool);
+
+  // Sets the model set B (non-owning). Builds the contact field and the sampler index and clears
+  // the online R_B. Drops any precomputed table.
+  Status set_model(const Point<D>* points, std::size_t n, const char* name = "model");
+  // Uses a precomputed R_B over the model set last given to set_model (see relation_table_io.h).
+  Status use_precomputed_table(const Triple* slots, float extent, const char* name = "precomputed table");
+  bool has_precomputed_table() const { return precomputed_; }
+
+  // Offline fill of R_B (Theorem 2): draws from B until `triples` have been keyed, using the
+  // table extent `extent`. Leaves the table in R_B for serialisation (model_table()).
+  Status fill_model_table(std::uint64_t seed, std::uint64_t triples, float extent, float min_height_ratio);
+  const RelationTable& model_table() const { return table_b_; }
+  const RelationTable& scene_table() const { return table_a_; }
+
+  // Matches A (non-owning, finite points) to B. Errors: not initialised, no model, |A| < 3,
+  // NaN/inf point, capacity, all triples of A rejected (collinear or too large).
+  Status match(const Point<D>* scene, std::size_t n, const MatchParams& params, MatchResult<D>* out);
+
+  const MatcherOptions& options() const { return options_; }
+  const ContactField<D>& field() const { return field_; }
+
+ private:
+  struct InsertRecord {
+    std::uint32_t slot;
+    Triple triple;
+  };
+  struct alignas(64) WorkerState {
+    RandomStream rng;
+    InsertRecord* inserts = nullptr;
+    std::uint32_t num_inserts = 0;
+    Hypothesis<D>* collected = nullptr;
+    std::uint32_t num_collected = 0;
+    std::uint64_t dropped = 0;
+    Hypothesis<D> best;
+    bool best_valid = false;
+    bool reached = false;
+    std::uint32_t batch = 0;
+    std::uint64_t first_iteration = 0;
+    MatchStats stats;
+  };
+
+  static void round_job(void* ctx, int pool_index, int pool_size);
+  static void apply_job(void* ctx, int pool_index, int pool_size);
+  void run_worker(int w);
+  void reset_online_table(int table);
+  float rate(const Hypothesis<D>& h, float bound, std::uint32_t start, bool* complete, std::uint64_t* checks) const;
+
+  MatcherOptions options_;
+  WorkerPool* pool_ = nullptr;
+  bool initialized_ = false;
+  RelationTable table_a_, table_b_;
+  RelationTable precomp_table_;          // read-only view of a precomputed R_B
+  const RelationTable* model_table_ = &table_b_;
+  bool precomputed_ = false;
+  std::uint32_t* touched_[2] = {nullptr, nullptr};  // slots filled during the last match
+  std::size_t touched_n_[2] = {0, 0};
+  bool touched_overflow_[2] = {false, false};
+  float model_index_extent_ = -1.0f;
+  ContactField<D> field_;
+  PointIndex<D> index_a_, index_b_;
+  const Point<D>* model_ = nullptr;
+  std::uint32_t model_n_ = 0;
+  Point<D> model_min_, model_max_;
+  std::uint32_t* scene_order_ = nullptr;
+  WorkerState* workers_ = nullptr;
+  Hypothesis<D>* merged_ = nullptr;
+
+  // Per-match state read by the workers.
+  const Point<D>* scene_ = nullptr;
+  std::uint32_t scene_n_ = 0;
+  MatchParams params_;
+  TripleFilter filter_;
+  int num_workers_ = 0;
+  int tau_ = 0;
+  float round_bound_ = 0.0f;  // Ω_best as of the round start (stop mode)
+};
+
+extern template class Matcher<2>;
+extern template class Matcher<3>;
+
+}  // namespace fw::pransam
