@@ -95,6 +95,8 @@ void MmlLocalizer::reset() {
   have_h_ = false;
   num_scene_ = 0;
   steps_ = 0;
+  no_match_steps_ = 0;
+  last_out_ = hal::PoseEstimate();
 }
 
 Status MmlLocalizer::gather_local_map() {
@@ -140,7 +142,16 @@ Status MmlLocalizer::step(const hal::LaserScan& scan, const hal::Odometry& odom,
   }
   // (1) RBSM: scan → local map.
   Se2f local_pose;
-  FW_RETURN_IF_ERROR(front_end_.step(scan, odom, &local_pose));
+  const Status fs = front_end_.step(scan, odom, &local_pose);
+  if (!fs.is_ok()) {
+    // A scan RBSM cannot use (e.g. no valid returns in an open space) is bad luck, not a fault:
+    // count it and repeat the last estimate; the next good scan continues the local map.
+    ++front_end_failures_;
+    *out = last_out_;
+    out->timestamp_ns = scan.timestamp_ns;
+    out->scan_id = scan.scan_id;
+    return Status::ok();
+  }
   ++steps_;
 
   // Remember a subsample of this observation (local frame) for Eq. 5.37.
@@ -166,6 +177,7 @@ Status MmlLocalizer::step(const hal::LaserScan& scan, const hal::Odometry& odom,
   FW_RETURN_IF_ERROR(gather_local_map());
   if (local_map_.total_points() < config_.mml.min_local_map_points || num_scene_ < 3) {
     out->status = hal::LocalizationStatus::kSearching;
+    last_out_ = *out;
     return Status::ok();
   }
 
@@ -209,6 +221,17 @@ Status MmlLocalizer::step(const hal::LaserScan& scan, const hal::Odometry& odom,
   if (have_h_) {
     interp_.report_unknown(unknown_contact(last_h_), static_cast<std::uint32_t>(observations_.size()), &last_);
   }
+  const MmlOptions& mo = config_.mml;
+  if (last_.hypotheses_valid == 0 && in.count == 0 && mp.omega_thres <= mo.omega_thres_min + 1e-6f &&
+      local_map_.total_points() >= 2u * mo.min_local_map_points) {
+    ++no_match_steps_;
+  } else {
+    no_match_steps_ = 0;
+  }
+  if (mo.detect_unknown && mo.outside_map_no_match_steps > 0 && no_match_steps_ >= mo.outside_map_no_match_steps &&
+      last_.status != hal::LocalizationStatus::kLocalized) {
+    last_.status = hal::LocalizationStatus::kOutsideMap;
+  }
 
   out->status = last_.status;
   if (last_.have_pose) {
@@ -221,6 +244,7 @@ Status MmlLocalizer::step(const hal::LaserScan& scan, const hal::Odometry& odom,
   out->hypothesis_count = static_cast<std::uint16_t>(last_.hypotheses_valid > 65535 ? 65535 : last_.hypotheses_valid);
   out->cluster_count = static_cast<std::uint16_t>(last_.cluster_count > 65535 ? 65535 : last_.cluster_count);
   out->rating = last_.best_rating;
+  last_out_ = *out;
   return Status::ok();
 }
 

@@ -57,6 +57,7 @@ class MmlLocalizer final : public Localizer {
   const InterpretResult& last() const { return last_; }
   std::size_t local_map_points() const { return num_scene_; }
   const PerfCounter& match_perf() const { return perf_match_; }
+  std::uint32_t front_end_failures() const { return front_end_failures_; }
   bool using_precomputed_table() const { return matcher_.has_precomputed_table(); }
 
  private:
@@ -92,6 +93,9 @@ class MmlLocalizer final : public Localizer {
   bool have_h_ = false;
   Se2f last_h_;  // map ← local of the best hypothesis
   std::uint64_t steps_ = 0;
+  std::uint32_t front_end_failures_ = 0;
+  std::uint32_t no_match_steps_ = 0;
+  hal::PoseEstimate last_out_;
   PerfCounter perf_match_{"mml.pransam"};
 };
 

@@ -60,7 +60,8 @@ struct MmlOptions {
   float bollinger_k = 4.0f;
   float bollinger_delta_l = 0.01f;
   float bollinger_delta_u = 0.07f;
-  float omega_thres_min = 0.30f;   // never ask pRANSAM for less than this
+  float omega_thres_min = 0.60f;   // never ask pRANSAM for less than this (weak matches fool
+                                   // the constraints when only one cluster survives)
   float omega_thres_max = 0.95f;
 
   // --- Unknown regions (Sec. 5.6, Eq. 5.37).
@@ -68,6 +69,10 @@ struct MmlOptions {
   std::uint32_t tau_up = 10;
   float outside_map_contact = 0.35f;   // Ω' below ⇒ outside-map
   float contact_distance_m = 0.15f;    // "contact" = a map point within this distance
+  // Extension: no hypothesis at all for this many consecutive steps although the threshold sits
+  // at omega_thres_min and the local map is ≥ 2·min_local_map_points ⇒ outside-map too (covers a
+  // start inside the unknown region, where no H_best exists for Eq. 5.37). 0 = off.
+  std::uint32_t outside_map_no_match_steps = 10;
 
   // --- Local map (Sec. 5.4–5.5).
   std::uint32_t local_map_fragments = 0;   // keep only the last m fragments (0 = all that fit)

@@ -1,0 +1,208 @@
+// System tests of MML on small synthetic worlds where the answer is known.
+#include "firmware/mml/mml_localizer.h"
+
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <cstdio>
+#include <cstdlib>
+#include <memory>
+
+#include "firmware/mml/mml_test_util.h"
+
+namespace fw {
+namespace mml {
+namespace {
+
+using testing::GridWorld;
+using testing::OwnedGlobalMap;
+
+std::function<void(testing::StepRecord*)> note_hook(const MmlLocalizer* loc) {
+  return [loc](testing::StepRecord* r) {
+    const InterpretResult& l = loc->last();
+    char buf[200];
+    std::snprintf(buf, sizeof(buf), "thr %.2f d2 %.1f smed %.1f unk %.2f pts %zu", l.omega_thres_next, l.d2, l.sigma_med,
+                  l.omega_unknown, loc->local_map_points());
+    r->note = buf;
+  };
+}
+
+struct Rig {
+  StartupArena arena;
+  std::unique_ptr<MmlLocalizer> loc = std::make_unique<MmlLocalizer>();
+  Status init(const GlobalMap& map, MmlLocalizerConfig cfg = default_mml_config()) {
+    FW_RETURN_IF_ERROR(arena.init_mapped(192u << 20, false, "mml-test"));
+    return loc->init(cfg, map, nullptr, 0, arena, nullptr);
+  }
+};
+
+MmlLocalizerConfig test_config() {
+  MmlLocalizerConfig c = default_mml_config();
+  c.mml.matching_iterations = 20000;
+  c.mml.table_triples = 400000;
+  c.mml.min_local_map_points = 100;
+  return c;
+}
+
+int count(const std::vector<testing::StepRecord>& rec, hal::LocalizationStatus s) {
+  int n = 0;
+  for (const auto& r : rec) n += r.est.status == s;
+  return n;
+}
+
+void print_trace(const std::vector<testing::StepRecord>& rec) {
+  if (std::getenv("MML_TRACE_OFF")) return;
+  for (std::size_t i = 0; i < rec.size(); ++i) {
+    const auto& r = rec[i];
+    if (!r.error.empty()) std::printf("%3zu error: %s\n", i, r.error.c_str());
+    std::printf("%3zu %-11s hyp %4u cl %3u r %.2f est (%.2f %.2f %.2f) truth (%.2f %.2f %.2f) %s\n", i,
+                hal::status_name(r.est.status), r.est.hypothesis_count, r.est.cluster_count, r.est.rating, r.est.x,
+                r.est.y, r.est.theta, r.truth.x, r.truth.y, r.truth.theta, r.note.c_str());
+  }
+}
+
+// Unique room ⇒ localizes, and every `localized` estimate is right.
+TEST(MmlLocalizerTest, UniqueRoomLocalizes) {
+  static GridWorld g = mcl::testing::unique_room();
+  static OwnedGlobalMap gm(g);
+  Rig rig;
+  ASSERT_TRUE(rig.init(gm.map, test_config()).is_ok());
+  const auto path = testing::waypoint_path({{1.5f, 1.5f}, {1.5f, 6.5f}, {4.5f, 6.5f}, {4.5f, 2.0f}, {10.5f, 3.5f}}, 0.1f);
+  const auto rec = testing::drive(rig.loc.get(), g, path, 1, note_hook(rig.loc.get()));
+  int first = -1;
+  for (std::size_t i = 0; i < rec.size(); ++i) {
+    const auto& r = rec[i];
+    ASSERT_NE(r.est.status, hal::LocalizationStatus::kFault) << i << ": " << r.error;
+    if (r.est.status == hal::LocalizationStatus::kLocalized) {
+      if (first < 0) first = static_cast<int>(i);
+      EXPECT_LT(std::hypot(r.est.x - r.truth.x, r.est.y - r.truth.y), 0.3f) << "step " << i;
+    }
+  }
+  if (first < 0 || ::testing::Test::HasFailure() || std::getenv("MML_TRACE")) print_trace(rec);
+  EXPECT_GE(first, 0) << "never localized";
+  EXPECT_GT(count(rec, hal::LocalizationStatus::kLocalized), static_cast<int>(rec.size()) / 3);
+}
+
+// A featureless corridor with both ends alike: the position along it (and the direction) cannot
+// be isolated ⇒ never localized.
+TEST(MmlLocalizerTest, SymmetricCorridorStaysAmbiguous) {
+  static GridWorld g;
+  g.w = 600; g.h = 60;
+  g.occ.assign(g.w * g.h, 0);
+  g.box(0.2f, 0.5f, 29.8f, 2.5f);
+  g.finish();
+  static OwnedGlobalMap gm(g);
+  Rig rig;
+  ASSERT_TRUE(rig.init(gm.map, test_config()).is_ok());
+  const auto path = testing::waypoint_path({{8.0f, 1.5f}, {20.0f, 1.5f}}, 0.1f);
+  const auto rec = testing::drive(rig.loc.get(), g, path, 2, note_hook(rig.loc.get()));
+  EXPECT_EQ(count(rec, hal::LocalizationStatus::kLocalized), 0);
+  EXPECT_GT(count(rec, hal::LocalizationStatus::kAmbiguous), static_cast<int>(rec.size()) / 2);
+  if (::testing::Test::HasFailure()) print_trace(rec);
+}
+
+// The right part of the building (x > 6 m) is missing from the global map, and it is a different
+// layout from anything mapped.
+struct UnknownWorld {
+  GridWorld world = mcl::testing::unique_room();
+  GridWorld mapped;
+  UnknownWorld() {
+    mapped = world;
+    for (std::uint32_t y = 0; y < mapped.h; ++y)
+      for (std::uint32_t x = 0; x < mapped.w; ++x)
+        if (x * mapped.res > 6.0f) mapped.occ[y * mapped.w + x] = 255;
+    mapped.finish();
+    for (std::uint32_t y = 0; y < world.h; ++y)
+      for (std::uint32_t x = 0; x < world.w; ++x)
+        if (x * world.res > 6.5f && world.occ[y * world.w + x] == 100) world.occ[y * world.w + x] = 0;
+    world.wall(6.6f, 0.2f, 11.8f, 0.2f);
+    world.wall(11.8f, 0.2f, 11.8f, 7.8f);
+    world.wall(11.8f, 7.8f, 6.6f, 7.8f);
+    world.wall(6.6f, 7.8f, 6.6f, 4.5f);  // doorway 1.2 m < y < 4.5 m into the unmapped part
+    world.wall(8.0f, 5.5f, 10.5f, 3.5f);
+    world.wall(9.0f, 7.8f, 9.0f, 6.0f);
+    world.box(10.0f, 1.0f, 11.0f, 1.6f);
+    world.finish();
+  }
+};
+
+// Starts in the mapped part, localizes, then drives into the unmapped part ⇒ outside-map there,
+// and no `localized` estimate is ever wrong.
+TEST(MmlLocalizerTest, UnknownAreaReportsOutsideMap) {
+  static UnknownWorld uw;
+  static OwnedGlobalMap gm(uw.mapped);
+  Rig rig;
+  ASSERT_TRUE(rig.init(gm.map, test_config()).is_ok());
+  const auto path = testing::waypoint_path(
+      {{1.5f, 1.5f}, {1.5f, 6.5f}, {4.5f, 6.5f}, {4.5f, 2.0f}, {8.0f, 2.0f}, {11.0f, 2.6f}, {10.5f, 6.8f}}, 0.1f);
+  const auto rec = testing::drive(rig.loc.get(), uw.world, path, 3, note_hook(rig.loc.get()));
+  int outside_in_unknown = 0, localized_known = 0;
+  for (std::size_t i = 0; i < rec.size(); ++i) {
+    const auto& r = rec[i];
+    if (r.est.status == hal::LocalizationStatus::kLocalized) {
+      EXPECT_LT(std::hypot(r.est.x - r.truth.x, r.est.y - r.truth.y), 0.5f) << "wrong localized pose at " << i;
+      localized_known += r.truth.x < 6.0f;
+    }
+    outside_in_unknown += r.est.status == hal::LocalizationStatus::kOutsideMap && r.truth.x > 8.0f;
+  }
+  EXPECT_GT(localized_known, 20);
+  EXPECT_GT(outside_in_unknown, 10);
+  if (::testing::Test::HasFailure() || std::getenv("MML_TRACE")) print_trace(rec);
+}
+
+// Starts inside the unmapped part: must never claim a pose there.
+TEST(MmlLocalizerTest, StartInUnknownAreaNeverLocalizes) {
+  static UnknownWorld uw;
+  static OwnedGlobalMap gm(uw.mapped);
+  Rig rig;
+  ASSERT_TRUE(rig.init(gm.map, test_config()).is_ok());
+  const auto path = testing::waypoint_path({{10.5f, 6.8f}, {10.5f, 2.5f}, {8.0f, 1.0f}, {7.5f, 6.5f}}, 0.1f);
+  const auto rec = testing::drive(rig.loc.get(), uw.world, path, 5, note_hook(rig.loc.get()));
+  EXPECT_EQ(count(rec, hal::LocalizationStatus::kLocalized), 0);
+  EXPECT_GT(count(rec, hal::LocalizationStatus::kOutsideMap), 0);
+  if (::testing::Test::HasFailure() || std::getenv("MML_TRACE")) print_trace(rec);
+}
+
+TEST(MmlLocalizerTest, DeterministicAndResettable) {
+  static GridWorld g = mcl::testing::unique_room();
+  static OwnedGlobalMap gm(g);
+  Rig a, b;
+  ASSERT_TRUE(a.init(gm.map, test_config()).is_ok());
+  ASSERT_TRUE(b.init(gm.map, test_config()).is_ok());
+  const auto path = testing::waypoint_path({{1.5f, 1.5f}, {1.5f, 6.5f}, {5.5f, 6.5f}}, 0.1f);
+  const auto ra = testing::drive(a.loc.get(), g, path, 4);
+  const auto rb = testing::drive(b.loc.get(), g, path, 4);
+  a.loc->reset();
+  const auto rc = testing::drive(a.loc.get(), g, path, 4);
+  ASSERT_EQ(ra.size(), rb.size());
+  for (std::size_t i = 0; i < ra.size(); ++i) {
+    EXPECT_EQ(ra[i].est.status, rb[i].est.status) << i;
+    EXPECT_EQ(ra[i].est.x, rb[i].est.x) << i;
+    EXPECT_EQ(ra[i].est.x, rc[i].est.x) << i;
+    EXPECT_EQ(ra[i].est.hypothesis_count, rc[i].est.hypothesis_count) << i;
+  }
+}
+
+TEST(MmlLocalizerTest, MalformedConfigRejected) {
+  static GridWorld g = mcl::testing::unique_room();
+  static OwnedGlobalMap gm(g);
+  MmlLocalizerConfig c = test_config();
+  c.mml.delta_r = 1.5f;
+  Rig rig;
+  const Status s = rig.init(gm.map, c);
+  EXPECT_FALSE(s.is_ok());
+  EXPECT_NE(std::string(s.message()).find("delta_r"), std::string::npos) << s.message();
+  c = test_config();
+  c.mml.max_local_map_points = 100000;
+  Rig rig2;
+  const Status s2 = rig2.init(gm.map, c);
+  EXPECT_FALSE(s2.is_ok());
+  EXPECT_NE(std::string(s2.message()).find("max_local_map_points"), std::string::npos) << s2.message();
+  GlobalMap empty;
+  Rig rig3;
+  EXPECT_FALSE(rig3.init(empty, test_config()).is_ok());
+}
+
+}  // namespace
+}  // namespace mml
+}  // namespace fw
