@@ -388,12 +388,22 @@ bool ros_map_to_grid(const RosMap& m, OccupancyGrid* out, std::string* error) {
   return true;
 }
 
+// The double whose shortest decimal form is that of the float (0.05f -> 0.05, not 0.0500000007):
+// readable YAML, and converting it back to float gives the same float.
+static double float_to_clean_double(float f) {
+  char buf[32];
+  auto r = std::to_chars(buf, buf + sizeof(buf), f);
+  double d = 0.0;
+  std::from_chars(buf, r.ptr, d);
+  return d;
+}
+
 RosMap grid_to_ros_map(const OccupancyGrid& grid, const std::string& image_name) {
   RosMap m;
   m.image = image_name;
-  m.resolution = grid.geometry.resolution;
-  m.origin[0] = grid.geometry.origin_x;
-  m.origin[1] = grid.geometry.origin_y;
+  m.resolution = float_to_clean_double(grid.geometry.resolution);
+  m.origin[0] = float_to_clean_double(grid.geometry.origin_x);
+  m.origin[1] = float_to_clean_double(grid.geometry.origin_y);
   m.origin[2] = 0.0;
   m.negate = false;
   m.occupied_thresh = 0.65;

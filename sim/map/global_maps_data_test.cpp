@@ -1,0 +1,100 @@
+// Global maps of the real datasets (needs ../shared/data; skipped when absent).
+#include "sim/map/global_maps.h"
+
+#include <gtest/gtest.h>
+#include <unistd.h>
+
+#include <chrono>
+#include <cmath>
+#include <filesystem>
+
+#include "firmware/base/arena.h"
+#include "firmware/map/map_image.h"
+#include "sim/io/carmen_log.h"
+#include "sim/io/datasets.h"
+#include "sim/map/map_image_writer.h"
+
+namespace sim {
+namespace {
+
+bool have_data(const std::string& rel) { return std::filesystem::exists(data_path(rel)); }
+
+// Builds intel at 5 cm from its corrected log, checks the size of the building, that the corrected
+// scans agree with the map (their end points lie on occupied cells), and that the firmware loads
+// the compiled image.
+TEST(GlobalMapsDataTest, IntelMapIsConsistentWithItsScans) {
+  const Dataset* d = find_dataset("intel");
+  ASSERT_NE(d, nullptr);
+  if (!have_data(d->corrected_log)) GTEST_SKIP() << "data not found: " << data_path(d->corrected_log);
+  const auto t0 = std::chrono::steady_clock::now();
+  RosMap map;
+  OccupancyBuildStats st;
+  std::string err;
+  ASSERT_TRUE(build_global_map("intel", 0.05, &map, &err, &st)) << err;
+  const double secs = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+  std::printf("intel map: %dx%d, built in %.2f s\n", map.width, map.height, secs);
+  EXPECT_LT(secs, 10.0);
+  EXPECT_EQ(st.scans, 910u);
+  // The Intel lab is about 30 x 30 m; with the 1 m margin and stray beams, 35..45 m each way.
+  EXPECT_GT(map.width * map.resolution, 35.0);
+  EXPECT_LT(map.width * map.resolution, 45.0);
+  EXPECT_GT(map.height * map.resolution, 33.0);
+  EXPECT_LT(map.height * map.resolution, 45.0);
+
+  std::vector<std::uint8_t> image;
+  ASSERT_TRUE(compile_map_image(map, &image, &err)) << err;
+  fw::StartupArena arena;
+  ASSERT_TRUE(arena.init_mapped(image.size() + 4096, false, "test").is_ok());
+  fw::GlobalMap gm;
+  const fw::Status s = fw::load_map_image(image.data(), image.size(), arena, &gm, "intel");
+  ASSERT_TRUE(s.is_ok()) << s.message();
+  EXPECT_GT(gm.num_points, 10000u);
+
+  // Every 10th corrected scan: ≥ 90% of its valid end points within 10 cm of an occupied cell.
+  CarmenLog log;
+  ASSERT_TRUE(read_carmen_log(data_path(d->corrected_log), CarmenReadOptions{}, &log, &err)) << err;
+  std::size_t near = 0, total = 0;
+  for (std::size_t k = 0; k < log.scans.size(); k += 10) {
+    const CarmenScan& sc = log.scans[k];
+    for (std::size_t i = 0; i < sc.ranges.size(); ++i) {
+      const float r = sc.ranges[i];
+      if (!(r > 0.01f) || r >= sc.max_range - 0.01f || r > 25.0f) continue;
+      const double a = sc.pose.theta + sc.angle_min + i * sc.angle_increment;
+      const float x = static_cast<float>(sc.pose.x + r * std::cos(a)), y = static_cast<float>(sc.pose.y + r * std::sin(a));
+      ++total;
+      near += gm.distance_at(x, y, 1e9f) <= 0.1f ? 1 : 0;
+    }
+  }
+  ASSERT_GT(total, 10000u);
+  const double frac = static_cast<double>(near) / total;
+  std::printf("intel: %.1f%% of %zu scan end points within 10 cm of the map\n", 100.0 * frac, total);
+  EXPECT_GT(frac, 0.9);
+}
+
+TEST(GlobalMapsDataTest, CacheIsWrittenAndReused) {
+  const Dataset* d = find_dataset("aces");
+  ASSERT_NE(d, nullptr);
+  if (!have_data(d->corrected_log)) GTEST_SKIP() << "data not found: " << data_path(d->corrected_log);
+  const std::string dir = (std::filesystem::temp_directory_path() / ("global_maps_test_" + std::to_string(::getpid()))).string();
+  RosMap a, b;
+  std::string err;
+  bool rebuilt = false;
+  ASSERT_TRUE(ensure_global_map("aces", 0.1, dir, &a, &err, &rebuilt)) << err;
+  EXPECT_TRUE(rebuilt);
+  for (const char* ext : {".yaml", ".pgm", ".png", ".mmap", ".build.txt"}) {
+    EXPECT_TRUE(std::filesystem::exists(dir + "/aces" + ext)) << ext;
+  }
+  ASSERT_TRUE(ensure_global_map("aces", 0.1, dir, &b, &err, &rebuilt)) << err;
+  EXPECT_FALSE(rebuilt);
+  EXPECT_EQ(a.pixels, b.pixels);
+  // Another resolution invalidates the cache.
+  ASSERT_TRUE(ensure_global_map("aces", 0.2, dir, &b, &err, &rebuilt)) << err;
+  EXPECT_TRUE(rebuilt);
+  EXPECT_EQ(b.resolution, 0.2);
+  EXPECT_FALSE(ensure_global_map("nowhere", 0.1, dir, &b, &err));
+  EXPECT_NE(err.find("unknown dataset 'nowhere'"), std::string::npos) << err;
+  std::filesystem::remove_all(dir);
+}
+
+}  // namespace
+}  // namespace sim
