@@ -1,0 +1,56 @@
+// SickLaser: LMS2xx driver over any hal::SerialPort. Requests continuous output of all measured
+// values (mode change 0x20 0x24), parses telegrams with SickParser and turns each 0xB0 telegram
+// into a hal::LaserScan (receive time from the HAL clock). Geometry follows the configured field
+// of view: n values over 180° (n odd: both ends included, e.g. 181 → 1°, 361 → 0.5°; n even:
+// π/n spacing from -π/2, the CARMEN FLASER convention of the logs in ../shared/data).
+#pragma once
+
+#include <cstdint>
+
+#include "hal/clock.h"
+#include "hal/sensor_io.h"
+#include "hal/serial_port.h"
+#include "hal_serial/sick_telegram.h"
+
+namespace hal_serial {
+
+struct SickLaserOptions {
+  float fov_rad = 3.14159265f;
+  float range_max_m = 81.91f;     // cm mode: 0x1FFF cm; readings at 0x1FFF are "no return"
+  bool request_continuous = true; // send 0x20 0x24 on start()
+};
+
+struct SickLaserStats {
+  std::uint32_t scans = 0;
+  std::uint32_t bad_measurements = 0;  // CRC-valid 0xB0 telegrams with impossible content
+  std::uint32_t other_telegrams = 0;   // responses we do not use (0xA0 acknowledges our request)
+  std::uint32_t mode_acks = 0;
+  std::uint32_t overwritten = 0;       // scans replaced before the loop took them
+  std::uint32_t read_errors = 0;
+};
+
+class SickLaser final : public hal::LaserScanSource {
+ public:
+  void init(hal::SerialPort* port, const hal::Clock* clock, const SickLaserOptions& options);
+  // Sends the request for continuous output (if configured). False if the write failed.
+  bool start();
+  bool poll(hal::LaserScan* out) override;
+  const SickParserStats& parser_stats() const { return parser_.stats(); }
+  const SickLaserStats& stats() const { return stats_; }
+
+ private:
+  void convert(const MeasuredValues& v, std::uint64_t t_ns);
+  hal::SerialPort* port_ = nullptr;
+  const hal::Clock* clock_ = nullptr;
+  SickLaserOptions options_;
+  SickParser parser_;
+  SickTelegram telegram_;
+  MeasuredValues values_;
+  hal::LaserScan scan_;
+  bool has_scan_ = false;
+  std::uint32_t next_id_ = 0;
+  SickLaserStats stats_;
+  std::uint8_t rx_[1024] = {};
+};
+
+}  // namespace hal_serial

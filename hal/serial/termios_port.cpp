@@ -1,0 +1,122 @@
+#include "hal_serial/termios_port.h"
+
+#include <errno.h>
+#include <fcntl.h>
+#include <poll.h>
+#include <string.h>
+#include <termios.h>
+#include <unistd.h>
+
+#include <cstring>
+
+namespace hal_serial {
+namespace {
+using fw::Errc;
+using fw::Status;
+
+bool speed_of(std::uint32_t baud, speed_t* out) {
+  switch (baud) {
+    case 9600: *out = B9600; return true;
+    case 19200: *out = B19200; return true;
+    case 38400: *out = B38400; return true;
+    case 57600: *out = B57600; return true;
+    case 115200: *out = B115200; return true;
+    case 230400: *out = B230400; return true;
+    case 500000: *out = B500000; return true;
+    default: return false;
+  }
+}
+}  // namespace
+
+Status TermiosPort::open(const char* device, std::uint32_t baud) {
+  close();
+  if (!device || !*device || std::strlen(device) >= sizeof(device_)) {
+    return Status::error(Errc::kInvalidArgument, "serial: device path '%s' empty or too long", device ? device : "");
+  }
+  std::strncpy(device_, device, sizeof(device_) - 1);
+  const int fd = ::open(device, O_RDWR | O_NOCTTY | O_NONBLOCK | O_CLOEXEC);
+  if (fd < 0) {
+    const int e = errno;
+    return Status::error(Errc::kIoError, "serial '%s': open: %s", device, strerror(e));
+  }
+  termios t{};
+  if (::tcgetattr(fd, &t) != 0) {
+    const int e = errno;
+    ::close(fd);
+    return Status::error(Errc::kIoError, "serial '%s': not a tty (tcgetattr: %s)", device, strerror(e));
+  }
+  cfmakeraw(&t);
+  t.c_cflag |= CLOCAL | CREAD;
+  t.c_cflag &= ~(CSTOPB | PARENB | CRTSCTS);
+  t.c_cc[VMIN] = 0;
+  t.c_cc[VTIME] = 0;
+  if (::tcsetattr(fd, TCSANOW, &t) != 0) {
+    const int e = errno;
+    ::close(fd);
+    return Status::error(Errc::kIoError, "serial '%s': tcsetattr: %s", device, strerror(e));
+  }
+  fd_ = fd;
+  Status s = set_baud(baud);
+  if (!s.is_ok()) close();
+  return s;
+}
+
+Status TermiosPort::set_baud(std::uint32_t baud) {
+  speed_t sp;
+  if (!speed_of(baud, &sp)) {
+    return Status::error(Errc::kInvalidArgument, "serial '%s': baud %u not supported (9600..230400, 500000)", device_,
+                         baud);
+  }
+  termios t{};
+  if (fd_ < 0 || ::tcgetattr(fd_, &t) != 0) return Status::error(Errc::kIoError, "serial '%s': not open", device_);
+  cfsetispeed(&t, sp);
+  cfsetospeed(&t, sp);
+  if (::tcsetattr(fd_, TCSANOW, &t) != 0) {
+    const int e = errno;
+    return Status::error(Errc::kUnsupported, "serial '%s': %u Bd refused: %s", device_, baud, strerror(e));
+  }
+  termios back{};
+  if (::tcgetattr(fd_, &back) != 0 || cfgetospeed(&back) != sp) {
+    return Status::error(Errc::kUnsupported, "serial '%s': %u Bd not kept by the driver", device_, baud);
+  }
+  baud_ = baud;
+  return Status::ok();
+}
+
+void TermiosPort::close() {
+  if (fd_ >= 0) ::close(fd_);
+  fd_ = -1;
+}
+
+long TermiosPort::read(std::uint8_t* buf, std::size_t len) {
+  if (fd_ < 0) return -1;
+  const ssize_t n = ::read(fd_, buf, len);
+  if (n < 0) return (errno == EAGAIN || errno == EWOULDBLOCK || errno == EINTR) ? 0 : -1;
+  return static_cast<long>(n);
+}
+
+long TermiosPort::write(const std::uint8_t* buf, std::size_t len) {
+  if (fd_ < 0) return -1;
+  std::size_t done = 0;
+  int spins = 0;
+  while (done < len) {
+    const ssize_t n = ::write(fd_, buf + done, len - done);
+    if (n > 0) {
+      done += static_cast<std::size_t>(n);
+      continue;
+    }
+    if (n < 0 && errno != EAGAIN && errno != EINTR) return -1;
+    if (++spins > 200) break;  // ~2 s of a full output queue: give up, report a short write
+    pollfd p{fd_, POLLOUT, 0};
+    ::poll(&p, 1, 10);
+  }
+  return static_cast<long>(done);
+}
+
+bool TermiosPort::wait_readable(int timeout_ms) const {
+  if (fd_ < 0) return false;
+  pollfd p{fd_, POLLIN, 0};
+  return ::poll(&p, 1, timeout_ms) > 0 && (p.revents & POLLIN);
+}
+
+}  // namespace hal_serial
