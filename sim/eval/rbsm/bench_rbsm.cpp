@@ -1,0 +1,127 @@
+// bench_rbsm: per-match timing of RBSM (250/500/1000/2000 particles, one thread and over a 2-worker
+// fw::WorkerPool, median and p99) and the scan-matcher-only odometry accuracy on intel and fr079
+// (relations metric: RBSM averaged over kSeeds seeds, trimmed ICP, raw odometry). Writes the flat
+// JSON of issue 4 to argv[1]. Budget: < 10 min on 2 cores.
+#include <chrono>
+#include <cmath>
+#include <cstdio>
+#include <string>
+#include <vector>
+
+#include "sim/common/bench_json.h"
+#include "sim/eval/rbsm/rbsm_eval_lib.h"
+
+namespace {
+
+constexpr int kSeeds = 3;             // the full tool uses 20 (mml-rbsm-eval odometry --seeds 20)
+constexpr size_t kTimingScans = 800;  // intel prefix used for the particle-count table
+
+double mean(const std::vector<double>& v) {
+  double s = 0;
+  for (double x : v) s += x;
+  return v.empty() ? NAN : s / v.size();
+}
+double stddev(const std::vector<double>& v) {
+  const double m = mean(v);
+  double s = 0;
+  for (double x : v) s += (x - m) * (x - m);
+  return v.empty() ? NAN : std::sqrt(s / v.size());
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  if (argc < 2) {
+    std::fprintf(stderr, "usage: bench_rbsm OUT.json\n");
+    return 2;
+  }
+  const auto t_start = std::chrono::steady_clock::now();
+  sim::BenchJson json;
+  std::string err;
+  json.add_int("rbsm_bench_seeds", kSeeds);
+  bool all_ok = true;
+  for (const std::string ds : {"intel", "fr079"}) {
+    sim::EvalDataset d;
+    sim::CarmenLog log;
+    std::vector<sim::Relation> rel;
+    if (!sim::find_eval_dataset(ds, &d, &err) || !sim::read_carmen_log(d.raw_log, {}, &log, &err) ||
+        !sim::read_relations(d.relations, &rel, &err)) {
+      std::fprintf(stderr, "bench_rbsm: %s (is MMLFW_DATA_DIR set?)\n", err.c_str());
+      all_ok = false;
+      continue;
+    }
+    sim::MatcherConfig cfg = sim::default_matcher_config();
+    if (ds == "intel") {
+      // Timing table on the intel prefix (real scans, real map growth).
+      for (int particles : {250, 500, 1000, 2000}) {
+        for (int workers : {1, 2}) {
+          sim::MatcherConfig c = cfg;
+          c.rbsm.num_particles = particles;
+          c.workers = workers;
+          sim::OdometryRun run;
+          if (!sim::run_scan_matching_odometry(log, sim::MatcherKind::kRbsm, c, kTimingScans, &run, &err)) {
+            std::fprintf(stderr, "bench_rbsm: %s\n", err.c_str());
+            return 1;
+          }
+          const std::string suffix = workers == 1 ? "" : "_pool";
+          json.add("rbsm_match_ms_p50_" + std::to_string(particles) + suffix, sim::percentile(run.match_ms, 50));
+          json.add("rbsm_match_ms_p99_" + std::to_string(particles) + suffix, sim::percentile(run.match_ms, 99));
+          if (particles == 1000 && workers == 2) {
+            json.add("rbsm_match_ms_p50_pool", sim::percentile(run.match_ms, 50));
+            json.add("rbsm_match_ms_p99_pool", sim::percentile(run.match_ms, 99));
+          }
+        }
+      }
+    }
+    sim::CarmenLog& head = log;
+    std::vector<fw::Se2d> odom;
+    for (const auto& s : log.scans) odom.push_back(s.odom);
+    const auto mo = sim::evaluate_relations(rel, sim::make_trajectory(head, odom));
+    json.add(ds + "_trans_err_odom", mo.trans_mean);
+    json.add(ds + "_rot_err_odom", mo.rot_mean_deg);
+    sim::OdometryRun icp;
+    if (!sim::run_scan_matching_odometry(log, sim::MatcherKind::kIcp, cfg, 0, &icp, &err)) {
+      std::fprintf(stderr, "bench_rbsm: %s\n", err.c_str());
+      return 1;
+    }
+    const auto mi = sim::evaluate_relations(rel, sim::make_trajectory(head, icp.poses));
+    json.add(ds + "_trans_err_icp", mi.trans_mean);
+    json.add(ds + "_rot_err_icp", mi.rot_mean_deg);
+    json.add(ds + "_icp_match_ms_p50", sim::percentile(icp.match_ms, 50));
+    std::vector<double> tm, rm, tmax, ms;
+    size_t failures = 0;
+    for (int s = 1; s <= kSeeds; ++s) {
+      cfg.rbsm.seed = static_cast<uint64_t>(s);
+      sim::OdometryRun run;
+      if (!sim::run_scan_matching_odometry(log, sim::MatcherKind::kRbsm, cfg, 0, &run, &err)) {
+        std::fprintf(stderr, "bench_rbsm: %s\n", err.c_str());
+        return 1;
+      }
+      const auto m = sim::evaluate_relations(rel, sim::make_trajectory(head, run.poses));
+      tm.push_back(m.trans_mean);
+      rm.push_back(m.rot_mean_deg);
+      tmax.push_back(m.trans_max);
+      ms.insert(ms.end(), run.match_ms.begin(), run.match_ms.end());
+      failures += run.failures;
+    }
+    json.add(ds + "_trans_err_rbsm", mean(tm));
+    json.add(ds + "_trans_err_rbsm_std", stddev(tm));
+    json.add(ds + "_rot_err_rbsm", mean(rm));
+    json.add(ds + "_rot_err_rbsm_std", stddev(rm));
+    json.add(ds + "_trans_err_max_rbsm", mean(tmax));
+    json.add(ds + "_trans_err_max_icp", mi.trans_max);
+    json.add(ds + "_trans_err_max_odom", mo.trans_max);
+    json.add_int(ds + "_rbsm_failures", static_cast<long long>(failures));
+    json.add_int(ds + "_relations_used", static_cast<long long>(mo.used));
+    json.add(ds + "_rbsm_match_ms_p50_full", sim::percentile(ms, 50));
+    if (ds == "intel") {
+      // The headline figures: 1000 particles, one thread, over the full intel runs.
+      json.add("rbsm_match_ms_p50", sim::percentile(ms, 50));
+      json.add("rbsm_match_ms_p99", sim::percentile(ms, 99));
+    }
+  }
+  json.add("rbsm_bench_seconds",
+           std::chrono::duration<double>(std::chrono::steady_clock::now() - t_start).count());
+  if (!json.write(argv[1])) return 1;
+  return all_ok ? 0 : 1;
+}

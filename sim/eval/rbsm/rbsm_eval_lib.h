@@ -1,0 +1,93 @@
+// Host evaluation of the scan matchers (issue 4): scan-matcher-only odometry over the real CARMEN
+// logs scored with the relations metric, the pairwise ground-truth experiment (Tables 2.3–2.6 in
+// spirit), per-match timing, and map pictures (PNG). Shared by the tool mml-rbsm-eval and the
+// benchmark bench_rbsm.
+#pragma once
+
+#include <cstdint>
+#include <memory>
+#include <string>
+#include <vector>
+
+#include "firmware/base/worker_pool.h"
+#include "firmware/icp/trimmed_icp.h"
+#include "firmware/rbsm/rbsm.h"
+#include "firmware/rbsm/scan_matching_odometry.h"
+#include "sim/io/carmen_log.h"
+#include "sim/io/reference_trajectory.h"
+#include "sim/io/relations.h"
+
+namespace sim {
+
+enum class MatcherKind { kRbsm, kIcp };
+const char* matcher_name(MatcherKind kind);
+
+struct MatcherConfig {
+  fw::RbsmOptions rbsm;
+  fw::TrimmedIcpOptions icp;
+  fw::ScanMatchingOdometryOptions front;
+  int workers = 1;  // >1: RBSM sampling/weighting over a fw::WorkerPool
+};
+// 5 cm cells, 1024-cell (51 m) scrolling window, 1000 particles, points up to 15 m.
+MatcherConfig default_matcher_config();
+
+// A matcher with its own arena (host side: the block is one vector allocated at construction).
+class MatcherInstance {
+ public:
+  static std::unique_ptr<MatcherInstance> create(MatcherKind kind, const MatcherConfig& config, std::string* error);
+  ~MatcherInstance();
+  fw::ScanMatcher* matcher() { return matcher_; }
+  fw::Rbsm* rbsm() { return rbsm_.get(); }
+
+ private:
+  MatcherInstance() = default;
+  std::vector<unsigned char> block_;
+  fw::StartupArena arena_;
+  std::unique_ptr<fw::Rbsm> rbsm_;
+  std::unique_ptr<fw::TrimmedIcp> icp_;
+  std::unique_ptr<fw::WorkerPool> pool_;
+  fw::ScanMatcher* matcher_ = nullptr;
+};
+
+struct OdometryRun {
+  std::vector<fw::Se2d> poses;     // one per processed scan (log order)
+  std::vector<double> match_ms;    // wall time of each match() call
+  size_t failures = 0;             // scans the matcher refused (pose = odometry prediction)
+  std::vector<std::string> failure_messages;  // first few
+};
+// Scan-matching odometry over the first max_scans scans (0 = all).
+bool run_scan_matching_odometry(const CarmenLog& log, MatcherKind kind, const MatcherConfig& config, size_t max_scans,
+                                OdometryRun* out, std::string* error);
+
+struct ErrorSummary {
+  size_t n = 0;
+  double mean = 0, p95 = 0, max = 0;
+};
+ErrorSummary summarize(std::vector<double> values);
+
+struct PairwiseResult {
+  std::vector<double> trans_err_m, rot_err_deg, ms;
+  size_t failures = 0;
+};
+// Pairs of consecutive corrected scans (reference poses from the corrected log), every `stride`-th
+// pair up to max_pairs: map = first scan, guess = true relative pose ⊕ N(0, σ_xy, σ_θ) noise
+// (thesis: 10 cm, 6°); errors of the matched relative pose.
+bool run_pairwise(const CarmenLog& log, const std::vector<CorrectedPose>& reference, MatcherKind kind,
+                  const MatcherConfig& config, size_t max_pairs, std::uint64_t seed, double sigma_xy,
+                  double sigma_theta_deg, PairwiseResult* out, std::string* error);
+
+// Renders every `stride`-th scan at the given poses into a grey end-point image (res m/px) with the
+// trajectory in red (and an optional second one in blue) and writes a PNG.
+bool write_map_png(const std::string& path, const CarmenLog& log, const std::vector<fw::Se2d>& poses,
+                   const std::vector<fw::Se2d>* second_path, double resolution, float max_range, size_t stride,
+                   std::string* error);
+
+// Per-dataset paths (raw log, relations, corrected poses) resolved under data_dir().
+struct EvalDataset {
+  std::string name, raw_log, relations, corrected_poses;
+};
+bool find_eval_dataset(const std::string& name, EvalDataset* out, std::string* error);
+
+double percentile(std::vector<double> v, double p);
+
+}  // namespace sim
