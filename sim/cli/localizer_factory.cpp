@@ -1,0 +1,100 @@
+#include "sim/cli/localizer_factory.h"
+
+#include <algorithm>
+
+#include "firmware/runtime/odometry_localizer.h"
+
+namespace sim {
+
+namespace {
+
+struct Entry {
+  std::string name, description;
+  LocalizerFactoryFn fn;
+};
+
+std::unique_ptr<fw::Localizer> make_odom(const LocalizerContext& ctx, std::string* err) {
+  const std::string bad = unknown_option_keys("odom", ctx.options, {"anchor"});
+  if (!bad.empty()) {
+    *err = bad;
+    return nullptr;
+  }
+  fw::OdometryLocalizerOptions opt;
+  const auto it = ctx.options.find("anchor");
+  const std::string anchor = it == ctx.options.end() ? "origin" : it->second;
+  if (anchor == "truth") {
+    if (!ctx.has_true_start) {
+      *err = "localizer odom: anchor=truth needs a known start pose (synthetic world or --reference)";
+      return nullptr;
+    }
+    opt.initial_pose = ctx.true_start.cast<float>();
+  } else if (anchor != "origin") {
+    *err = "localizer odom: option anchor='" + anchor + "' (expected origin or truth)";
+    return nullptr;
+  }
+  const fw::Status s = opt.validate();
+  if (!s.is_ok()) {
+    *err = std::string("localizer odom: ") + s.message();
+    return nullptr;
+  }
+  return std::make_unique<fw::OdometryLocalizer>(opt);
+}
+
+// The built-in table. Owners: add your localizer here ({"mml", "...", &make_mml}).
+std::vector<Entry>& registry() {
+  static std::vector<Entry> entries = {
+      {"odom", "odometry pass-through (dead reckoning; status always searching); --opt anchor=origin|truth",
+       &make_odom},
+  };
+  return entries;
+}
+
+}  // namespace
+
+std::string unknown_option_keys(const std::string& localizer, const std::map<std::string, std::string>& options,
+                                const std::vector<std::string>& known) {
+  std::string bad;
+  for (const auto& [k, v] : options) {
+    if (std::find(known.begin(), known.end(), k) == known.end()) bad += (bad.empty() ? "" : ", ") + k;
+  }
+  if (bad.empty()) return {};
+  std::string list;
+  for (const auto& k : known) list += (list.empty() ? "" : ", ") + k;
+  return "localizer " + localizer + ": unknown option(s) " + bad + " (known: " + (list.empty() ? "none" : list) + ")";
+}
+
+void register_localizer(const std::string& name, const std::string& description, LocalizerFactoryFn fn) {
+  for (Entry& e : registry()) {
+    if (e.name == name) {
+      e.description = description;
+      e.fn = std::move(fn);
+      return;
+    }
+  }
+  registry().push_back({name, description, std::move(fn)});
+}
+
+std::vector<LocalizerInfo> localizer_names() {
+  std::vector<LocalizerInfo> out;
+  for (const Entry& e : registry()) out.push_back({e.name, e.description});
+  return out;
+}
+
+std::unique_ptr<fw::Localizer> make_localizer(const std::string& name, const LocalizerContext& ctx, std::string* err) {
+  for (const Entry& e : registry()) {
+    if (e.name == name) {
+      std::string local;
+      auto loc = e.fn(ctx, &local);
+      if (!loc && err) *err = local.empty() ? "localizer " + name + ": could not be created" : local;
+      return loc;
+    }
+  }
+  if (err) {
+    std::string list;
+    for (const Entry& e : registry()) list += (list.empty() ? "" : ", ") + e.name;
+    *err = "unknown localizer '" + name + "' (available: " + list + ")";
+  }
+  return nullptr;
+}
+
+}  // namespace sim

@@ -1,0 +1,47 @@
+// mml-sim: the simulator CLI. See sim_args.cpp for the options and sim_runner.h for what it does.
+#include <cstdio>
+#include <string>
+#include <vector>
+
+#include "firmware/base/fault.h"
+#include "sim/cli/sim_args.h"
+#include "sim/cli/sim_runner.h"
+
+namespace {
+void fatal_fault(fw::Fault fault, std::uint32_t bits) {
+  // Bad programming is fatal in the simulator (ArduPilot's internal-error policy).
+  std::fprintf(stderr, "mml-sim: FATAL firmware fault '%s' (bits 0x%x)\n", fw::fault_name(fault), bits);
+  std::fflush(stderr);
+  std::abort();
+}
+}  // namespace
+
+int main(int argc, char** argv) {
+  fw::set_fault_handler(&fatal_fault);
+  std::vector<std::string> args(argv + 1, argv + argc);
+  sim::SimConfig cfg;
+  sim::SimArgsAction action;
+  std::string err;
+  if (!sim::parse_sim_args(args, &cfg, &action, &err)) {
+    std::fprintf(stderr, "mml-sim: %s\n", err.c_str());
+    return 2;
+  }
+  if (action == sim::SimArgsAction::kHelp) {
+    std::fputs(sim::sim_usage().c_str(), stdout);
+    return 0;
+  }
+  if (action == sim::SimArgsAction::kList) {
+    std::fputs(sim::sim_list().c_str(), stdout);
+    return 0;
+  }
+  sim::SimResult result;
+  if (!sim::run_simulation(cfg, &result, &err)) {
+    std::fprintf(stderr, "mml-sim: %s\n", err.c_str());
+    return 1;
+  }
+  if (!cfg.out_dir.empty()) {
+    std::fprintf(stderr, "mml-sim: wrote %s/steps.csv, summary.json%s\n", cfg.out_dir.c_str(),
+                 cfg.pictures ? ", run.svg, run.png" : "");
+  }
+  return 0;
+}

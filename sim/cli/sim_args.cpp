@@ -1,0 +1,236 @@
+#include "sim/cli/sim_args.h"
+
+#include <cerrno>
+#include <cmath>
+#include <cstdlib>
+
+#include "sim/world/builtin_worlds.h"
+
+namespace sim {
+
+namespace {
+
+bool parse_double(const std::string& flag, const std::string& v, double lo, double hi, double* out, std::string* err) {
+  errno = 0;
+  char* end = nullptr;
+  const double d = std::strtod(v.c_str(), &end);
+  if (v.empty() || end != v.c_str() + v.size() || errno != 0 || !std::isfinite(d)) {
+    *err = flag + ": '" + v + "' is not a number";
+    return false;
+  }
+  if (d < lo || d > hi) {
+    *err = flag + ": " + v + " is outside [" + std::to_string(lo) + ", " + std::to_string(hi) + "]";
+    return false;
+  }
+  *out = d;
+  return true;
+}
+
+bool parse_u64(const std::string& flag, const std::string& v, unsigned long long hi, unsigned long long* out,
+               std::string* err) {
+  errno = 0;
+  char* end = nullptr;
+  if (v.empty() || v[0] == '-' || v[0] == '+') {
+    *err = flag + ": '" + v + "' is not a non-negative integer";
+    return false;
+  }
+  const unsigned long long n = std::strtoull(v.c_str(), &end, 10);
+  if (end != v.c_str() + v.size() || errno != 0) {
+    *err = flag + ": '" + v + "' is not a non-negative integer";
+    return false;
+  }
+  if (n > hi) {
+    *err = flag + ": " + v + " is larger than " + std::to_string(hi);
+    return false;
+  }
+  *out = n;
+  return true;
+}
+
+}  // namespace
+
+std::string sim_usage() {
+  return R"(usage: mml-sim (--world NAME | --log FILE.clf[.gz] [--reference POSES.txt] [--map MAP.yaml]) [options]
+
+Feeds a synthetic world or a CARMEN log through the hal/sim backend into the firmware's localization
+loop and writes DIR/steps.csv, DIR/summary.json, DIR/run.svg, DIR/run.png and DIR/map.yaml/.pgm.
+
+source:
+  --world NAME            built-in world: small-office, large-office, corridor
+  --log FILE              CARMEN log (plain or gzip) to replay
+  --reference FILE        *.corrected-poses.txt: ground truth for the log's scans
+  --map FILE.yaml         ROS map_server map for the log (the localizer's global map)
+run:
+  --localizer NAME        localizer (default odom; --list shows all)
+  --opt KEY=VALUE         localizer option (repeatable), e.g. --opt anchor=truth for odom
+  --seed N                random seed (route, people, noise; default 1)
+  --steps N               stop after N scans (default: the whole route / log)
+  --paced                 pace at the data's real time (default: lockstep, as fast as possible)
+  --speed F               pacing speed factor with --paced (default 1)
+  --threads N             worker threads offered to the localizer (default 1)
+  --out DIR               output directory (default build/run)
+  --timing wall|none      measure step times with the wall clock (default) or not (byte-identical CSV)
+  --quiet                 no progress line
+  --no-pictures           skip run.svg / run.png
+synthetic world:
+  --people N              moving people (default: per world)
+  --beams N               laser beams over 180 deg (181 or 361 for an LMS 200; default 361)
+  --max-range M           laser maximum range in m (8 or 80 for an LMS 200; default 8)
+  --range-noise SIGMA     laser range noise in m (default 0.005)
+  --dropout P             probability of a max-range dropout per beam (default 0.01)
+  --odom-noise T,R        odometry noise per scan step: T m, R deg (default 0.04,4)
+  --scan-period S         seconds between scans (default 0.4)
+  --route-length M        metres to drive (default: per world)
+  --start-node N          route-graph node to start at (default: drawn from the seed)
+  --enter-unknown         the route may enter the unknown area
+  --map-unknown           keep the unknown area in the map (default: erased)
+  --resolution M          map resolution in m (default: per world; large-office 0.06)
+other:
+  --list                  list worlds and localizers
+  --help                  this text
+)";
+}
+
+std::string sim_list() {
+  std::string s = "worlds:\n";
+  for (const auto& w : builtin_world_names()) s += "  " + w + "\n";
+  s += "localizers:\n";
+  for (const auto& l : localizer_names()) s += "  " + l.name + "  " + l.description + "\n";
+  return s;
+}
+
+bool parse_sim_args(const std::vector<std::string>& args, SimConfig* cfg, SimArgsAction* action, std::string* err) {
+  *action = SimArgsAction::kRun;
+  cfg->out_dir = "build/run";
+  for (size_t i = 0; i < args.size(); ++i) {
+    const std::string& a = args[i];
+    auto value = [&](std::string* v) {
+      if (i + 1 >= args.size() || (args[i + 1].rfind("--", 0) == 0 && args[i + 1].size() > 2)) {
+        *err = a + " needs a value";
+        return false;
+      }
+      *v = args[++i];
+      return true;
+    };
+    std::string v;
+    double d = 0;
+    unsigned long long n = 0;
+    if (a == "--help" || a == "-h") {
+      *action = SimArgsAction::kHelp;
+    } else if (a == "--list") {
+      *action = SimArgsAction::kList;
+    } else if (a == "--world") {
+      if (!value(&cfg->world)) return false;
+    } else if (a == "--log") {
+      if (!value(&cfg->log_path)) return false;
+    } else if (a == "--reference") {
+      if (!value(&cfg->reference_path)) return false;
+    } else if (a == "--map") {
+      if (!value(&cfg->map_yaml)) return false;
+    } else if (a == "--localizer") {
+      if (!value(&cfg->localizer)) return false;
+    } else if (a == "--opt") {
+      if (!value(&v)) return false;
+      const size_t eq = v.find('=');
+      if (eq == std::string::npos || eq == 0) {
+        *err = "--opt: '" + v + "' is not KEY=VALUE";
+        return false;
+      }
+      cfg->localizer_options[v.substr(0, eq)] = v.substr(eq + 1);
+    } else if (a == "--seed") {
+      if (!value(&v) || !parse_u64(a, v, ~0ull, &n, err)) return false;
+      cfg->seed = n;
+    } else if (a == "--steps") {
+      if (!value(&v) || !parse_u64(a, v, 100000000ull, &n, err)) return false;
+      cfg->steps = static_cast<size_t>(n);
+    } else if (a == "--paced") {
+      cfg->paced = true;
+    } else if (a == "--speed") {
+      if (!value(&v) || !parse_double(a, v, 0.01, 1000, &cfg->pace_speed, err)) return false;
+    } else if (a == "--threads") {
+      if (!value(&v) || !parse_u64(a, v, 64, &n, err)) return false;
+      if (n == 0) {
+        *err = "--threads: must be at least 1";
+        return false;
+      }
+      cfg->threads = static_cast<int>(n);
+    } else if (a == "--out") {
+      if (!value(&cfg->out_dir)) return false;
+    } else if (a == "--timing") {
+      if (!value(&v)) return false;
+      if (v != "wall" && v != "none") {
+        *err = "--timing: '" + v + "' (expected wall or none)";
+        return false;
+      }
+      cfg->wall_timing = v == "wall";
+    } else if (a == "--quiet") {
+      cfg->progress = false;
+    } else if (a == "--no-pictures") {
+      cfg->pictures = false;
+    } else if (a == "--people") {
+      if (!value(&v) || !parse_u64(a, v, 200, &n, err)) return false;
+      cfg->synthetic.people = static_cast<int>(n);
+    } else if (a == "--beams") {
+      if (!value(&v) || !parse_u64(a, v, hal::LaserScan::kMaxBeams, &n, err)) return false;
+      if (n < 2) {
+        *err = "--beams: need at least 2";
+        return false;
+      }
+      cfg->synthetic.laser.beams = static_cast<int>(n);
+    } else if (a == "--max-range") {
+      if (!value(&v) || !parse_double(a, v, 0.5, 200, &cfg->synthetic.laser.max_range, err)) return false;
+    } else if (a == "--range-noise") {
+      if (!value(&v) || !parse_double(a, v, 0, 1, &cfg->synthetic.laser.sigma_range, err)) return false;
+    } else if (a == "--dropout") {
+      if (!value(&v) || !parse_double(a, v, 0, 1, &cfg->synthetic.laser.dropout_rate, err)) return false;
+    } else if (a == "--odom-noise") {
+      if (!value(&v)) return false;
+      const size_t comma = v.find(',');
+      if (comma == std::string::npos) {
+        *err = "--odom-noise: '" + v + "' is not T,R (metres,degrees per scan step)";
+        return false;
+      }
+      if (!parse_double(a, v.substr(0, comma), 0, 10, &cfg->synthetic.odometry.sigma_trans, err) ||
+          !parse_double(a, v.substr(comma + 1), 0, 180, &cfg->synthetic.odometry.sigma_rot_deg, err)) {
+        return false;
+      }
+    } else if (a == "--scan-period") {
+      if (!value(&v) || !parse_double(a, v, 0.01, 10, &cfg->synthetic.scan_period_s, err)) return false;
+    } else if (a == "--route-length") {
+      if (!value(&v) || !parse_double(a, v, 1, 100000, &cfg->synthetic.route.length_m, err)) return false;
+    } else if (a == "--start-node") {
+      if (!value(&v) || !parse_u64(a, v, 1000000, &n, err)) return false;
+      cfg->synthetic.route.start_node = static_cast<int>(n);
+    } else if (a == "--enter-unknown") {
+      cfg->synthetic.route.avoid_unknown = false;
+    } else if (a == "--map-unknown") {
+      cfg->raster.erase_unknown_areas = false;
+    } else if (a == "--resolution") {
+      if (!value(&v) || !parse_double(a, v, 0.01, 1, &d, err)) return false;
+      cfg->raster.resolution = d;
+    } else {
+      *err = "unknown argument '" + a + "' (see --help)";
+      return false;
+    }
+  }
+  if (*action != SimArgsAction::kRun) return true;
+  if (cfg->world.empty() && cfg->log_path.empty()) {
+    *err = "no input: give --world NAME or --log FILE (see --help)";
+    return false;
+  }
+  if (!cfg->world.empty() && !cfg->log_path.empty()) {
+    *err = "--world and --log exclude each other";
+    return false;
+  }
+  if (!cfg->reference_path.empty() && cfg->log_path.empty()) {
+    *err = "--reference needs --log";
+    return false;
+  }
+  if (!cfg->map_yaml.empty() && cfg->log_path.empty()) {
+    *err = "--map is for --log replays (worlds bring their own map)";
+    return false;
+  }
+  return true;
+}
+
+}  // namespace sim

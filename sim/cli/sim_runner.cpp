@@ -1,0 +1,556 @@
+#include "sim/cli/sim_runner.h"
+
+#include <unistd.h>
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <cstdio>
+#include <filesystem>
+#include <fstream>
+#include <memory>
+#include <thread>
+
+#include "firmware/base/arena.h"
+#include "firmware/map/map_image.h"
+#include "firmware/runtime/localization_loop.h"
+#include "hal/hal.h"
+#include "hal_linux/linux_clock.h"
+#include "hal_sim/sim_log_sink.h"
+#include "hal_sim/sim_sensor_io.h"
+#include "hal_sim/sim_task_runner.h"
+#include "hal_sim/stepped_clock.h"
+#include "sim/io/carmen_log.h"
+#include "sim/io/reference_trajectory.h"
+#include "sim/map/map_image_writer.h"
+#include "sim/viz/picture.h"
+#include "sim/world/builtin_worlds.h"
+
+namespace sim {
+
+namespace {
+
+constexpr double kRadToDeg = 180.0 / M_PI;
+// Success bounds of the dissertation (Sec. 5.7): a localized estimate farther off is a failure.
+constexpr double kWrongM = 0.5, kWrongDeg = 20.0;
+
+struct Frame {
+  std::uint32_t index = 0;
+  double t = 0;
+  bool has_truth = false;
+  fw::Se2d truth;
+  double travelled_m = 0;
+  std::vector<hal::Odometry> odometry;
+  hal::LaserScan scan;
+};
+
+struct FrameInfo {
+  double t = 0;
+  bool has_truth = false;
+  fw::Se2d truth;
+  double travelled_m = 0;
+};
+
+// A CARMEN log prepared as frames: odometry records in file order before each scan, plus the
+// scan's own odometry triple (FLASER/RLASER/ROBOTLASER1) at the scan time.
+bool load_log_frames(const SimConfig& cfg, std::vector<Frame>* frames, std::string* err) {
+  CarmenLog log;
+  CarmenReadOptions ro;
+  ro.max_scans = cfg.steps;
+  if (!read_carmen_log(cfg.log_path, ro, &log, err)) return false;
+  if (log.scans.empty()) {
+    *err = "log '" + cfg.log_path + "' contains no laser scans";
+    return false;
+  }
+  std::vector<fw::Se2d> truth;
+  if (!cfg.reference_path.empty()) {
+    std::vector<CorrectedPose> corrected;
+    if (!read_corrected_poses(cfg.reference_path, &corrected, err)) return false;
+    truth = reference_at_every_scan(log, corrected);
+    if (truth.empty()) {
+      *err = "reference '" + cfg.reference_path + "' has no pose matching a scan of '" + cfg.log_path + "'";
+      return false;
+    }
+  }
+  const double t0 = log.scans.front().ipc_timestamp;
+  size_t next_odom = 0;
+  double travelled = 0;
+  fw::Se2d prev;
+  for (size_t i = 0; i < log.scans.size(); ++i) {
+    const CarmenScan& s = log.scans[i];
+    Frame f;
+    f.index = static_cast<std::uint32_t>(i);
+    f.t = s.ipc_timestamp - t0;
+    auto to_ns = [&](double ts) { return static_cast<std::uint64_t>(std::llround((ts - t0 + 1.0) * 1e9)); };
+    while (next_odom < log.odom.size() && log.odom[next_odom].line < s.line) {
+      const CarmenOdom& o = log.odom[next_odom++];
+      hal::Odometry h;
+      h.timestamp_ns = o.ipc_timestamp >= t0 - 1.0 ? to_ns(o.ipc_timestamp) : 0;
+      h.x = static_cast<float>(o.pose.x);
+      h.y = static_cast<float>(o.pose.y);
+      h.theta = static_cast<float>(o.pose.theta);
+      h.v = static_cast<float>(o.tv);
+      h.omega = static_cast<float>(o.rv);
+      f.odometry.push_back(h);
+    }
+    if (s.type.rfind("RAWLASER", 0) != 0) {
+      hal::Odometry h;
+      h.timestamp_ns = to_ns(s.ipc_timestamp);
+      h.x = static_cast<float>(s.odom.x);
+      h.y = static_cast<float>(s.odom.y);
+      h.theta = static_cast<float>(s.odom.theta);
+      f.odometry.push_back(h);
+    }
+    f.scan = to_laser_scan(s, to_ns(s.ipc_timestamp));
+    f.scan.scan_id = f.index;
+    if (i < truth.size()) {
+      f.has_truth = true;
+      f.truth = truth[i];
+    }
+    const fw::Se2d here = f.has_truth ? f.truth : s.odom;
+    if (i > 0) travelled += std::hypot(here.x - prev.x, here.y - prev.y);
+    prev = here;
+    f.travelled_m = travelled;
+    frames->push_back(std::move(f));
+  }
+  return true;
+}
+
+double percentile(std::vector<double> v, double p) {
+  if (v.empty()) return 0;
+  std::sort(v.begin(), v.end());
+  size_t idx = static_cast<size_t>(p * static_cast<double>(v.size() - 1) + 0.5);
+  return v[std::min(idx, v.size() - 1)];
+}
+
+Rgb status_colour(hal::LocalizationStatus s) {
+  switch (s) {
+    case hal::LocalizationStatus::kSearching: return {150, 150, 150};
+    case hal::LocalizationStatus::kAmbiguous: return {240, 150, 0};
+    case hal::LocalizationStatus::kLocalized: return {20, 90, 230};
+    case hal::LocalizationStatus::kOutsideMap: return {150, 60, 200};
+    case hal::LocalizationStatus::kFault: return {220, 0, 0};
+  }
+  return {0, 0, 0};
+}
+
+bool write_pictures(const SimConfig& cfg, const SimResult& r, const World* world, const OccupancyGrid* grid,
+                    std::string* err) {
+  Picture pic;
+  const SimSummary& s = r.summary;
+  pic.title = "mml-sim: " + s.source + ", localizer " + s.localizer + ", seed " + std::to_string(cfg.seed);
+  char buf[256];
+  if (s.first_localized_step >= 0) {
+    std::snprintf(buf, sizeof(buf), "localized at step %ld after %.1f m (error %.2f m); wrong-localized steps %zu",
+                  s.first_localized_step, s.first_localized_travelled_m, s.first_localized_err_m, s.wrong_localized_steps);
+  } else {
+    std::snprintf(buf, sizeof(buf), "never localized in %zu steps (%.1f m driven)", s.steps, s.path_length_m);
+  }
+  pic.notes.push_back(buf);
+  std::snprintf(buf, sizeof(buf), "step time mean %.2f ms, p99 %.2f ms; final error %.2f m", s.step_ms_mean,
+                s.step_ms_p99, s.final_err_m);
+  pic.notes.push_back(buf);
+  pic.map = grid;
+  if (world != nullptr) {
+    for (const Box& b : world->unknown_areas) {
+      pic.boxes.push_back({b.min.x(), b.min.y(), b.max.x(), b.max.y(), {200, 40, 160}, "unknown area (not in map)"});
+    }
+  }
+  Polyline truth{{}, {0, 160, 60}, 3.0, "ground truth"};
+  Polyline est{{}, {20, 90, 230}, 1.5, "estimate"};
+  PointSet by_status[5];
+  const char* names[5] = {"searching", "ambiguous", "localized", "outside-map", "fault"};
+  for (int i = 0; i < 5; ++i) {
+    by_status[i].color = status_colour(static_cast<hal::LocalizationStatus>(i));
+    by_status[i].radius_px = 2.0;
+    by_status[i].label = std::string("estimate: ") + names[i];
+  }
+  for (const StepRecord& st : r.steps) {
+    if (st.has_truth) truth.points.push_back({st.truth.x, st.truth.y});
+    est.points.push_back({st.estimate.x, st.estimate.y});
+    const int k = static_cast<int>(st.estimate.status);
+    if (k >= 0 && k < 5) by_status[k].points.push_back({st.estimate.x, st.estimate.y});
+  }
+  pic.lines.push_back(truth);
+  pic.lines.push_back(est);
+  for (auto& ps : by_status) {
+    if (!ps.points.empty()) pic.point_sets.push_back(ps);
+  }
+  if (!r.last_hypotheses.empty()) {
+    PointSet h{{}, {230, 30, 30}, 3.0, "hypotheses (last step)"};
+    for (const auto& p : r.last_hypotheses) h.points.push_back({p.x, p.y});
+    pic.point_sets.push_back(h);
+  }
+  if (!r.steps.empty() && r.steps.front().has_truth) {
+    const auto& f = r.steps.front().truth;
+    pic.markers.push_back({f.x, f.y, f.theta, {0, 160, 60}, 7.0, "start"});
+    const auto& l = r.steps.back().truth;
+    pic.markers.push_back({l.x, l.y, l.theta, {0, 110, 40}, 5.0, "end"});
+  }
+  if (s.first_localized_step >= 0) {
+    const auto& e = r.steps[static_cast<size_t>(s.first_localized_step)].estimate;
+    pic.markers.push_back({e.x, e.y, e.theta, {20, 90, 230}, 9.0, "localized"});
+  }
+  // Without a map, frame the picture on the ground truth only (a dead-reckoning estimate from the
+  // origin may be far away).
+  if (grid == nullptr && world != nullptr) {
+    pic.x_min = world->bounds.min.x() - 1;
+    pic.y_min = world->bounds.min.y() - 1;
+    pic.x_max = world->bounds.max.x() + 1;
+    pic.y_max = world->bounds.max.y() + 1;
+  }
+  const std::string base = cfg.out_dir + "/run";
+  return write_svg(pic, base + ".svg", err) && write_png(pic, base + ".png", err);
+}
+
+}  // namespace
+
+bool write_steps_csv(const std::string& path, const std::vector<StepRecord>& steps, std::string* err) {
+  std::FILE* f = std::fopen(path.c_str(), "w");
+  if (!f) {
+    *err = "cannot write '" + path + "'";
+    return false;
+  }
+  std::fprintf(f,
+               "step,t_s,scan_id,status,mode,x,y,theta,truth_x,truth_y,truth_theta,err_m,err_deg,travelled_m,"
+               "hypotheses,clusters,rating,odom_x,odom_y,odom_theta,cov_xx,cov_yy,cov_tt,step_ms\n");
+  for (const StepRecord& s : steps) {
+    const hal::PoseEstimate& e = s.estimate;
+    std::fprintf(f, "%u,%.3f,%u,%s,%s,%.4f,%.4f,%.5f,", s.step, s.t, e.scan_id, hal::status_name(e.status),
+                 e.mode == hal::LocalizationMode::kTracking ? "tracking" : "global", e.x, e.y, e.theta);
+    if (s.has_truth) {
+      std::fprintf(f, "%.4f,%.4f,%.5f,%.4f,%.3f,", s.truth.x, s.truth.y, s.truth.theta, s.err_m, s.err_deg);
+    } else {
+      std::fprintf(f, ",,,,,");
+    }
+    std::fprintf(f, "%.3f,%u,%u,%.4f,%.4f,%.4f,%.5f,%.6g,%.6g,%.6g,%.4f\n", s.travelled_m, e.hypothesis_count,
+                 e.cluster_count, e.rating, s.odom.x, s.odom.y, s.odom.theta, e.cov[0], e.cov[4], e.cov[8], s.step_ms);
+  }
+  const bool ok = std::fclose(f) == 0;
+  if (!ok) *err = "error writing '" + path + "'";
+  return ok;
+}
+
+bool write_summary_json(const std::string& path, const SimSummary& s, std::string* err) {
+  std::FILE* f = std::fopen(path.c_str(), "w");
+  if (!f) {
+    *err = "cannot write '" + path + "'";
+    return false;
+  }
+  auto num = [](double v) {
+    char b[48];
+    if (!std::isfinite(v)) return std::string("null");
+    std::snprintf(b, sizeof(b), "%.6g", v);
+    return std::string(b);
+  };
+  std::fprintf(f, "{\n  \"source\": \"%s\",\n  \"localizer\": \"%s\",\n  \"steps\": %zu,\n", s.source.c_str(),
+               s.localizer.c_str(), s.steps);
+  std::fprintf(f, "  \"first_localized_step\": %ld,\n  \"first_localized_t_s\": %s,\n", s.first_localized_step,
+               s.first_localized_step >= 0 ? num(s.first_localized_t).c_str() : "null");
+  std::fprintf(f, "  \"first_localized_travelled_m\": %s,\n  \"first_localized_err_m\": %s,\n",
+               s.first_localized_step >= 0 ? num(s.first_localized_travelled_m).c_str() : "null",
+               s.first_localized_step >= 0 ? num(s.first_localized_err_m).c_str() : "null");
+  std::fprintf(f, "  \"localized_steps\": %zu,\n  \"wrong_localized_steps\": %zu,\n", s.localized_steps,
+               s.wrong_localized_steps);
+  std::fprintf(f, "  \"mean_err_localized_m\": %s,\n  \"max_err_localized_m\": %s,\n  \"final_err_m\": %s,\n",
+               num(s.mean_err_localized_m).c_str(), num(s.max_err_localized_m).c_str(), num(s.final_err_m).c_str());
+  const char* names[5] = {"searching", "ambiguous", "localized", "outside_map", "fault"};
+  for (int i = 0; i < 5; ++i) std::fprintf(f, "  \"steps_%s\": %zu,\n", names[i], s.status_counts[i]);
+  std::fprintf(f, "  \"step_ms_mean\": %s,\n  \"step_ms_p50\": %s,\n  \"step_ms_p99\": %s,\n  \"step_ms_max\": %s,\n",
+               num(s.step_ms_mean).c_str(), num(s.step_ms_p50).c_str(), num(s.step_ms_p99).c_str(),
+               num(s.step_ms_max).c_str());
+  std::fprintf(f, "  \"path_length_m\": %s,\n  \"wall_s\": %s,\n  \"scans_per_s\": %s,\n", num(s.path_length_m).c_str(),
+               num(s.wall_s).c_str(), num(s.scans_per_s).c_str());
+  std::fprintf(f, "  \"scans_dropped\": %zu,\n  \"ring_drops\": %llu,\n  \"odom_rejected\": %llu,\n", s.scans_dropped,
+               static_cast<unsigned long long>(s.ring_drops), static_cast<unsigned long long>(s.odom_rejected));
+  std::fprintf(f, "  \"scans_held\": %llu,\n  \"step_errors\": %llu\n}\n", static_cast<unsigned long long>(s.scans_held),
+               static_cast<unsigned long long>(s.step_errors));
+  const bool ok = std::fclose(f) == 0;
+  if (!ok) *err = "error writing '" + path + "'";
+  return ok;
+}
+
+bool run_simulation(const SimConfig& cfg, SimResult* out, std::string* err) {
+  *out = SimResult();
+  if (cfg.world.empty() == cfg.log_path.empty()) {
+    *err = "give exactly one of a world (--world) or a log (--log)";
+    return false;
+  }
+  if (!cfg.reference_path.empty() && cfg.log_path.empty()) {
+    *err = "--reference needs --log";
+    return false;
+  }
+  // ---- source and map ----
+  World world;
+  SyntheticRun synthetic;
+  std::vector<Frame> log_frames;
+  OccupancyGrid grid;
+  bool have_grid = false;
+  std::size_t total = 0;
+  SimSummary& sum = out->summary;
+  sum.localizer = cfg.localizer;
+  if (!cfg.world.empty()) {
+    if (!make_builtin_world(cfg.world, &world, err)) return false;
+    SyntheticRunOptions so = cfg.synthetic;
+    so.seed = cfg.seed;
+    if (cfg.steps > 0) so.max_scans = cfg.steps;
+    if (!synthetic.init(world, so, err)) {
+      *err = "world '" + cfg.world + "': " + *err;
+      return false;
+    }
+    if (!rasterize_world(world, cfg.raster, &grid, err)) return false;
+    have_grid = true;
+    total = synthetic.num_scans();
+    sum.source = "world:" + cfg.world;
+  } else {
+    if (!load_log_frames(cfg, &log_frames, err)) return false;
+    total = log_frames.size();
+    if (!cfg.map_yaml.empty()) {
+      RosMap rm;
+      if (!read_ros_map(cfg.map_yaml, &rm, err) || !ros_map_to_grid(rm, &grid, err)) return false;
+      have_grid = true;
+    }
+    sum.source = "log:" + std::filesystem::path(cfg.log_path).filename().string();
+  }
+
+  // ---- compiled map image, loaded by the firmware's own loader into a start-up arena ----
+  std::vector<std::uint8_t> image;
+  fw::StartupArena arena;
+  fw::GlobalMap global_map;
+  if (have_grid) {
+    MapImageWriter writer;
+    if (!writer.set_grid(grid, err)) return false;
+    image = writer.bytes();
+    fw::Status s = arena.init_mapped(image.size() + (1u << 20), false, "map");
+    if (s.is_ok()) s = fw::load_map_image(image.data(), image.size(), arena, &global_map, "simulated map");
+    if (!s.is_ok()) {
+      *err = std::string("map: ") + s.message();
+      return false;
+    }
+  }
+
+  // ---- localizer ----
+  LocalizerHooks hooks;
+  LocalizerContext ctx;
+  ctx.global_map = have_grid ? &global_map : nullptr;
+  ctx.map_image = have_grid ? &image : nullptr;
+  ctx.grid = have_grid ? &grid : nullptr;
+  ctx.map_name = cfg.world.empty() ? cfg.map_yaml : cfg.world;
+  ctx.seed = cfg.seed;
+  ctx.threads = cfg.threads;
+  ctx.options = cfg.localizer_options;
+  ctx.hooks = &hooks;
+  if (!cfg.world.empty()) {
+    ctx.has_true_start = true;
+    ctx.true_start = synthetic.trajectory().pose_at(0);
+  } else if (!log_frames.empty() && log_frames.front().has_truth) {
+    ctx.has_true_start = true;
+    ctx.true_start = log_frames.front().truth;
+  }
+  std::unique_ptr<fw::Localizer> localizer = make_localizer(cfg.localizer, ctx, err);
+  if (!localizer) return false;
+
+  // ---- HAL (simulation backend) and the firmware loop ----
+  auto clock = std::make_unique<hal_sim::SteppedClock>();
+  auto laser = std::make_unique<hal_sim::SimLaserSource>();
+  auto odom = std::make_unique<hal_sim::SimOdometrySource>();
+  auto sink = std::make_unique<hal_sim::SimPoseSink>();
+  auto logs = std::make_unique<hal_sim::SimLogSink>(hal::LogLevel::kWarning);
+  auto tasks = std::make_unique<hal_sim::SimTaskRunner>(*clock);
+  hal_linux::LinuxClock wall_clock;
+  hal_sim::SteppedClock frozen_clock;  // perf clock when timing is off: every duration is 0
+  hal::Hal hal;
+  hal.clock = clock.get();
+  hal.laser = laser.get();
+  hal.odometry = odom.get();
+  hal.pose_sink = sink.get();
+  hal.log = logs.get();
+  hal.tasks = tasks.get();
+  auto loop = std::make_unique<fw::LocalizationLoop>();
+  fw::LocalizationLoopOptions lo;
+  lo.perf_clock = cfg.wall_timing ? static_cast<const hal::Clock*>(&wall_clock) : &frozen_clock;
+  fw::Status s = loop->init(hal, *localizer, lo);
+  if (!s.is_ok()) {
+    *err = s.message();
+    return false;
+  }
+  struct TaskCtx {
+    fw::LocalizationLoop* loop;
+    fw::Status status;
+  } task_ctx{loop.get(), fw::Status::ok()};
+  tasks->add_task("localization", [](void* c) {
+    auto* tc = static_cast<TaskCtx*>(c);
+    tc->status = tc->loop->spin_once();
+  }, &task_ctx, 0);
+
+  // ---- run ----
+  std::vector<FrameInfo> info;
+  info.reserve(total);
+  const auto wall_start = std::chrono::steady_clock::now();
+  auto last_progress = wall_start - std::chrono::seconds(1);
+  const bool tty = isatty(fileno(stderr)) != 0;
+  hal::LocalizationStatus last_status = hal::LocalizationStatus::kSearching;
+  std::uint64_t ring_drops = 0;
+
+  auto drain = [&]() {
+    hal::PoseEstimate e;
+    while (sink->pop(&e)) {
+      StepRecord r;
+      r.step = static_cast<std::uint32_t>(out->steps.size());
+      r.estimate = e;
+      if (e.scan_id < info.size()) {
+        const FrameInfo& fi = info[e.scan_id];
+        r.t = fi.t;
+        r.has_truth = fi.has_truth;
+        r.truth = fi.truth;
+        r.travelled_m = fi.travelled_m;
+      }
+      if (r.has_truth) {
+        r.err_m = std::hypot(e.x - r.truth.x, e.y - r.truth.y);
+        r.err_deg = std::fabs(fw::wrap_angle(static_cast<double>(e.theta) - r.truth.theta)) * kRadToDeg;
+      }
+      const hal::Odometry& o = loop->last_odometry();
+      r.odom = fw::Se2d(o.x, o.y, o.theta);
+      r.step_ms = static_cast<double>(loop->last_step_ns()) * 1e-6;
+      if (e.status != last_status && cfg.progress) {
+        std::fprintf(stderr, "%sstep %u (t=%.1f s, %.1f m): %s -> %s at (%.2f, %.2f, %.1f deg)", tty ? "\r\033[K" : "",
+                     r.step, r.t, r.travelled_m, hal::status_name(last_status), hal::status_name(e.status), e.x, e.y,
+                     e.theta * kRadToDeg);
+        if (r.has_truth) std::fprintf(stderr, "; truth (%.2f, %.2f), error %.2f m", r.truth.x, r.truth.y, r.err_m);
+        std::fprintf(stderr, "\n");
+      }
+      last_status = e.status;
+      out->steps.push_back(r);
+      if (hooks.hypotheses) {
+        out->last_hypotheses.clear();
+        hooks.hypotheses(&out->last_hypotheses);
+      }
+    }
+  };
+
+  Frame frame;
+  SyntheticFrame sframe;
+  double t_first = 0;
+  for (std::size_t k = 0; k < total; ++k) {
+    if (!cfg.world.empty()) {
+      if (!synthetic.next(&sframe)) break;
+      frame.index = sframe.index;
+      frame.t = sframe.t;
+      frame.has_truth = true;
+      frame.truth = sframe.truth;
+      frame.travelled_m = sframe.travelled_m;
+      frame.odometry.swap(sframe.odometry);
+      frame.scan = sframe.scan;
+    } else {
+      frame = std::move(log_frames[k]);
+    }
+    if (k == 0) t_first = frame.t;
+    if (cfg.paced) {
+      const auto due = wall_start + std::chrono::duration_cast<std::chrono::steady_clock::duration>(
+                                        std::chrono::duration<double>((frame.t - t_first) / cfg.pace_speed));
+      std::this_thread::sleep_until(due);
+    }
+    if (info.size() <= frame.scan.scan_id) info.resize(frame.scan.scan_id + 1);
+    info[frame.scan.scan_id] = {frame.t, frame.has_truth, frame.truth, frame.travelled_m};
+    for (const hal::Odometry& o : frame.odometry) {
+      if (!odom->push(o)) ++ring_drops;
+    }
+    if (!laser->push(frame.scan)) ++ring_drops;
+    if (frame.scan.timestamp_ns > clock->now_ns()) clock->set_ns(frame.scan.timestamp_ns);
+    tasks->run_once();
+    if (!task_ctx.status.is_ok()) ++sum.step_errors;
+    drain();
+    if (cfg.progress) {
+      const auto now = std::chrono::steady_clock::now();
+      if (now - last_progress > std::chrono::milliseconds(tty ? 200 : 5000) || k + 1 == total) {
+        last_progress = now;
+        const StepRecord* lr = out->steps.empty() ? nullptr : &out->steps.back();
+        std::fprintf(stderr, "%s[%s %s] step %zu/%zu  t=%.1f s  %.1f m  status=%s", tty ? "\r\033[K" : "",
+                     sum.source.c_str(), cfg.localizer.c_str(), k + 1, total, frame.t, frame.travelled_m,
+                     lr ? hal::status_name(lr->estimate.status) : "-");
+        if (lr && lr->has_truth) std::fprintf(stderr, "  err=%.2f m", lr->err_m);
+        if (lr) std::fprintf(stderr, "  hyps=%u  %.2f ms/step", lr->estimate.hypothesis_count, lr->step_ms);
+        if (!tty) std::fprintf(stderr, "\n");
+      }
+    }
+  }
+  // Flush a scan still waiting for odometry.
+  if (loop->scan_pending()) {
+    clock->advance_ns(lo.odom_wait_ns + 1);
+    tasks->run_once();
+    drain();
+  }
+  if (cfg.progress && tty) std::fprintf(stderr, "\n");
+  const double wall_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - wall_start).count();
+
+  // ---- summary ----
+  sum.steps = out->steps.size();
+  sum.wall_s = wall_s;
+  sum.scans_per_s = wall_s > 0 ? static_cast<double>(sum.steps) / wall_s : 0;
+  sum.scans_dropped = loop->health().dropped_scans;
+  sum.ring_drops = ring_drops + laser->stats().dropped + odom->stats().dropped;
+  sum.odom_rejected = loop->counters().odom_rejected;
+  sum.scans_held = loop->counters().scans_held;
+  std::vector<double> ms;
+  double err_sum = 0;
+  for (const StepRecord& r : out->steps) {
+    ms.push_back(r.step_ms);
+    const int k = static_cast<int>(r.estimate.status);
+    if (k >= 0 && k < 5) ++sum.status_counts[k];
+    if (r.estimate.status == hal::LocalizationStatus::kLocalized) {
+      ++sum.localized_steps;
+      if (sum.first_localized_step < 0) {
+        sum.first_localized_step = r.step;
+        sum.first_localized_t = r.t;
+        sum.first_localized_travelled_m = r.travelled_m;
+        sum.first_localized_err_m = r.err_m;
+      }
+      if (r.has_truth) {
+        err_sum += r.err_m;
+        sum.max_err_localized_m = std::max(sum.max_err_localized_m, r.err_m);
+        if (r.err_m >= kWrongM || r.err_deg >= kWrongDeg) ++sum.wrong_localized_steps;
+      }
+    }
+  }
+  if (sum.localized_steps > 0) sum.mean_err_localized_m = err_sum / static_cast<double>(sum.localized_steps);
+  if (!out->steps.empty()) {
+    sum.final_err_m = out->steps.back().err_m;
+    sum.path_length_m = out->steps.back().travelled_m;
+    double tot = 0;
+    for (double v : ms) tot += v;
+    sum.step_ms_mean = tot / static_cast<double>(ms.size());
+    sum.step_ms_p50 = percentile(ms, 0.5);
+    sum.step_ms_p99 = percentile(ms, 0.99);
+    sum.step_ms_max = *std::max_element(ms.begin(), ms.end());
+  }
+  if (cfg.progress) {
+    if (sum.first_localized_step >= 0) {
+      std::fprintf(stderr, "LOCALIZED at step %ld (t=%.1f s, after %.1f m) with error %.2f m\n", sum.first_localized_step,
+                   sum.first_localized_t, sum.first_localized_travelled_m, sum.first_localized_err_m);
+    } else {
+      std::fprintf(stderr, "not localized in %zu steps (%.1f m); localizer '%s'\n", sum.steps, sum.path_length_m,
+                   cfg.localizer.c_str());
+    }
+    for (std::size_t i = 0; i < logs->size(); ++i) std::fprintf(stderr, "firmware: %s\n", logs->line(i).text);
+  }
+
+  // ---- outputs ----
+  if (!cfg.out_dir.empty()) {
+    std::error_code ec;
+    std::filesystem::create_directories(cfg.out_dir, ec);
+    if (ec) {
+      *err = "cannot create output directory '" + cfg.out_dir + "': " + ec.message();
+      return false;
+    }
+    if (!write_steps_csv(cfg.out_dir + "/steps.csv", out->steps, err)) return false;
+    if (!write_summary_json(cfg.out_dir + "/summary.json", sum, err)) return false;
+    if (have_grid && !write_ros_map(cfg.out_dir + "/map.yaml", grid_to_ros_map(grid, "map.pgm"), err)) return false;
+    if (cfg.pictures && !write_pictures(cfg, *out, cfg.world.empty() ? nullptr : &synthetic.world(),
+                                        have_grid ? &grid : nullptr, err)) {
+      return false;
+    }
+  }
+  return true;
+}
+
+}  // namespace sim

@@ -1,0 +1,56 @@
+// Robot path generator: a seeded random walk over the world's route graph (corridor centre lines,
+// doorways, room centres), driven as "turn in place, then drive straight" at constant speeds, so the
+// ground truth is a continuous function of time (scans and odometry sample it at their own rates).
+#pragma once
+
+#include <string>
+#include <vector>
+
+#include "firmware/base/rng.h"
+#include "firmware/base/se2.h"
+#include "sim/world/world.h"
+
+namespace sim {
+
+struct RouteOptions {
+  double length_m = 0;        // path length to drive; 0 = a world-dependent default
+  double speed = 0.75;        // m/s
+  double turn_rate_deg = 60;  // deg/s
+  int start_node = -1;        // route-graph node to start from; −1 = drawn from the seed
+  bool avoid_unknown = true;  // never enter the world's unknown areas
+  // Weight of continuing straight at a junction relative to turning (long corridor runs).
+  double straight_weight = 3.0;
+
+  std::string validate() const;
+};
+
+// A piecewise motion: segments of pure rotation or pure straight driving.
+class RouteTrajectory {
+ public:
+  struct Piece {
+    double t0, t1;      // time span, s
+    fw::Se2d start;     // pose at t0
+    double v, omega;    // forward speed, turn rate during the piece
+  };
+  void add_turn(double target_heading, double turn_rate);
+  void add_drive(const Vec2& to, double speed);
+  void start_at(const fw::Se2d& pose);
+  fw::Se2d pose_at(double t) const;  // clamped to [0, duration]
+  double duration() const { return pieces_.empty() ? 0.0 : pieces_.back().t1; }
+  double length() const { return length_; }
+  const std::vector<Piece>& pieces() const { return pieces_; }
+  const fw::Se2d& end_pose() const { return end_; }
+
+ private:
+  std::vector<Piece> pieces_;
+  fw::Se2d end_;
+  double length_ = 0;
+};
+
+// Random walk over the route graph from a seeded start node until length_m is driven.
+bool generate_route(const World& world, const RouteOptions& opt, fw::RandomStream* rng, RouteTrajectory* out,
+                    std::vector<int>* visited_nodes, std::string* err);
+
+double default_route_length(const World& world);
+
+}  // namespace sim

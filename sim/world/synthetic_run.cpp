@@ -1,0 +1,116 @@
+#include "sim/world/synthetic_run.h"
+
+#include <algorithm>
+#include <cmath>
+
+namespace sim {
+
+std::string SyntheticRunOptions::validate() const {
+  std::string e = route.validate();
+  if (e.empty()) e = laser.validate();
+  if (e.empty()) e = odometry.validate();
+  if (!e.empty()) return e;
+  if (!(scan_period_s >= 0.01 && scan_period_s <= 10)) return "scan period must be in [0.01, 10] s";
+  if (odometry_per_scan < 1 || odometry_per_scan > 100) return "odometry samples per scan must be in [1, 100]";
+  if (!(odometry_phase >= 0 && odometry_phase < 1)) return "odometry phase must be in [0, 1)";
+  if (people < -1 || people > 200) return "people count must be in [0, 200]";
+  if (!(people_speed > 0 && people_speed < 5)) return "people speed must be in (0, 5) m/s";
+  return {};
+}
+
+void add_people(World* world, int count, double speed, fw::RandomStream* rng) {
+  const RouteGraph& g = world->route;
+  if (g.nodes.size() < 2) return;
+  for (int i = 0; i < count; ++i) {
+    // A straight run of 2–5 edges from a random node: corridor walkers, sometimes into a room.
+    int a = static_cast<int>(rng->uniform_index(static_cast<std::uint32_t>(g.nodes.size())));
+    if (g.adjacent[a].empty()) continue;
+    int b = g.adjacent[a][rng->uniform_index(static_cast<std::uint32_t>(g.adjacent[a].size()))];
+    Person p;
+    p.path = {g.nodes[a], g.nodes[b]};
+    const Vec2 dir = (g.nodes[b] - g.nodes[a]).normalized();
+    const int hops = 1 + static_cast<int>(rng->uniform_index(4));
+    for (int h = 0; h < hops; ++h) {
+      int next = -1;
+      for (int c : g.adjacent[b]) {
+        if ((g.nodes[c] - g.nodes[b]).normalized().dot(dir) > 0.99) next = c;
+      }
+      if (next < 0) break;
+      p.path.push_back(g.nodes[next]);
+      b = next;
+    }
+    // Walk 0.5 m beside the centre line (people keep to one side; the robot drives the middle).
+    const Vec2 side(-dir.y(), dir.x());
+    const double offset = rng->uniform01() < 0.5 ? -0.5 : 0.5;
+    for (Vec2& q : p.path) q += side * offset;
+    p.speed = speed * (0.7 + 0.6 * rng->uniform01());
+    p.phase_s = rng->uniform01() * 100.0;
+    p.radius = 0.2 + 0.1 * rng->uniform01();
+    world->people.push_back(p);
+  }
+}
+
+std::uint64_t SyntheticRun::time_ns(double t) const {
+  return opt_.start_time_ns + static_cast<std::uint64_t>(std::llround(t * 1e9));
+}
+
+bool SyntheticRun::init(const World& world, const SyntheticRunOptions& opt, std::string* err) {
+  const std::string bad = opt.validate();
+  if (!bad.empty()) {
+    if (err) *err = bad;
+    return false;
+  }
+  world_ = world;
+  opt_ = opt;
+  fw::RandomStream route_rng(opt.seed, 1), people_rng(opt.seed, 4);
+  if (!generate_route(world_, opt.route, &route_rng, &trajectory_, &route_nodes_, err)) return false;
+  int people = opt.people;
+  if (people < 0) {
+    const Vec2 size = world_.bounds.max - world_.bounds.min;
+    people = std::min(12, static_cast<int>(size.x() * size.y() / 150.0));
+  }
+  add_people(&world_, people, opt.people_speed, &people_rng);
+  num_scans_ = static_cast<std::size_t>(std::floor(trajectory_.duration() / opt.scan_period_s)) + 1;
+  if (opt.max_scans > 0) num_scans_ = std::min(num_scans_, opt.max_scans);
+  next_scan_ = 0;
+  next_odom_ = 0;
+  last_odom_t_ = 0;
+  travelled_ = 0;
+  laser_rng_.reseed(opt.seed, 3);
+  odom_sim_ = OdometrySimulator(opt.odometry, opt.seed);
+  last_truth_ = trajectory_.pose_at(0);
+  return true;
+}
+
+bool SyntheticRun::next(SyntheticFrame* out) {
+  if (next_scan_ >= num_scans_) return false;
+  const double t = static_cast<double>(next_scan_) * opt_.scan_period_s;
+  const double odom_period = opt_.scan_period_s / opt_.odometry_per_scan;
+  out->index = static_cast<std::uint32_t>(next_scan_);
+  out->t = t;
+  out->truth = trajectory_.pose_at(t);
+  travelled_ += std::hypot(out->truth.x - last_truth_.x, out->truth.y - last_truth_.y);
+  last_truth_ = out->truth;
+  out->travelled_m = travelled_;
+  out->odometry.clear();
+  // Odometry sample j is at (j − 1 + phase)·period for j ≥ 1, sample 0 at t = 0 (power-on); emit
+  // samples up to and including the first at or after the scan time, so the scan is bracketed.
+  while (next_odom_ == 0 || last_odom_t_ < t) {
+    const double tau = next_odom_ == 0 ? 0.0 : (static_cast<double>(next_odom_ - 1) + opt_.odometry_phase) * odom_period;
+    const fw::Se2d truth = trajectory_.pose_at(tau);
+    if (next_odom_ == 0) {
+      out->odometry.push_back(odom_sim_.start(truth, time_ns(tau)));
+    } else {
+      out->odometry.push_back(odom_sim_.next(truth, time_ns(tau), (tau - last_odom_t_) / opt_.scan_period_s));
+    }
+    last_odom_t_ = tau;
+    ++next_odom_;
+  }
+  out->scan.timestamp_ns = time_ns(t);
+  out->scan.scan_id = static_cast<std::uint32_t>(next_scan_);
+  simulate_scan(world_, out->truth, t, opt_.laser, &laser_rng_, &out->scan);
+  ++next_scan_;
+  return true;
+}
+
+}  // namespace sim
