@@ -1,0 +1,189 @@
+#include "firmware/app/app_config.h"
+
+#include <errno.h>
+#include <fcntl.h>
+#include <string.h>
+#include <unistd.h>
+
+#include <cmath>
+#include <cstdlib>
+#include <cstring>
+
+namespace fw {
+namespace {
+
+bool parse_int(const char* v, long lo, long hi, long* out) {
+  char* end = nullptr;
+  errno = 0;
+  const long x = std::strtol(v, &end, 10);
+  if (end == v || *end || errno || x < lo || x > hi) return false;
+  *out = x;
+  return true;
+}
+
+bool parse_bool(const char* v, bool* out) {
+  if (!std::strcmp(v, "true") || !std::strcmp(v, "1") || !std::strcmp(v, "yes")) { *out = true; return true; }
+  if (!std::strcmp(v, "false") || !std::strcmp(v, "0") || !std::strcmp(v, "no")) { *out = false; return true; }
+  return false;
+}
+
+bool copy(char* dst, std::size_t cap, const char* v) {
+  if (std::strlen(v) >= cap) return false;
+  std::strcpy(dst, v);
+  return true;
+}
+
+bool spec_ok(const char* v, bool allow_serial, const char* extra) {
+  if (extra && !std::strcmp(v, extra)) return true;
+  if (!std::strncmp(v, "socketcan:", 10) && v[10]) return true;
+  if (allow_serial && !std::strncmp(v, "serial:", 7) && v[7]) return true;
+  return false;
+}
+
+}  // namespace
+
+#define CFG_ERR(fmt, ...) \
+  Status::error(Errc::kInvalidArgument, "config '%s' line %d: key '%s': " fmt, name, line, key, ##__VA_ARGS__)
+
+Status parse_app_config(const char* name, const char* text, std::size_t len, AppConfig* out) {
+  *out = AppConfig{};
+  char buf[512];
+  int line = 0;
+  std::size_t pos = 0;
+  bool seen_laser = false;
+  while (pos < len) {
+    std::size_t e = pos;
+    while (e < len && text[e] != '\n') ++e;
+    ++line;
+    const std::size_t n = e - pos;
+    if (n >= sizeof(buf)) {
+      return Status::error(Errc::kInvalidArgument, "config '%s' line %d: longer than %zu characters", name, line,
+                           sizeof(buf) - 1);
+    }
+    std::memcpy(buf, text + pos, n);
+    buf[n] = '\0';
+    pos = e + 1;
+    if (char* hash = std::strchr(buf, '#')) *hash = '\0';
+    // Trim.
+    char* s = buf;
+    while (*s == ' ' || *s == '\t' || *s == '\r') ++s;
+    char* end = s + std::strlen(s);
+    while (end > s && (end[-1] == ' ' || end[-1] == '\t' || end[-1] == '\r')) *--end = '\0';
+    if (!*s) continue;
+    char* eq = std::strchr(s, '=');
+    if (!eq) {
+      return Status::error(Errc::kInvalidArgument, "config '%s' line %d: '%s' is not 'key = value'", name, line, s);
+    }
+    *eq = '\0';
+    char* key = s;
+    char* kend = eq;
+    while (kend > key && (kend[-1] == ' ' || kend[-1] == '\t')) *--kend = '\0';
+    char* v = eq + 1;
+    while (*v == ' ' || *v == '\t') ++v;
+    if (!*key) return Status::error(Errc::kInvalidArgument, "config '%s' line %d: empty key", name, line);
+    if (!*v) return CFG_ERR("empty value");
+    long x = 0;
+    if (!std::strcmp(key, "laser")) {
+      if (!spec_ok(v, true, nullptr) || !copy(out->laser, sizeof(out->laser), v))
+        return CFG_ERR("'%s' is not socketcan:IFACE or serial:DEVICE[@BAUD]", v);
+      seen_laser = true;
+    } else if (!std::strcmp(key, "odometry")) {
+      if (!spec_ok(v, false, "none") || !copy(out->odometry, sizeof(out->odometry), v))
+        return CFG_ERR("'%s' is not socketcan:IFACE or none", v);
+    } else if (!std::strcmp(key, "output")) {
+      if (!spec_ok(v, false, "log") || !copy(out->output, sizeof(out->output), v))
+        return CFG_ERR("'%s' is not socketcan:IFACE or log", v);
+    } else if (!std::strcmp(key, "can_fd")) {
+      bool b = false;
+      if (!std::strcmp(v, "auto")) out->can_fd = -1;
+      else if (parse_bool(v, &b)) out->can_fd = b ? 1 : 0;
+      else return CFG_ERR("'%s' is not auto, true or false", v);
+    } else if (!std::strcmp(key, "localizer")) {
+      if (std::strcmp(v, "odom") && std::strcmp(v, "mml"))
+        return CFG_ERR("'%s' unknown (odom, mml)", v);
+      copy(out->localizer, sizeof(out->localizer), v);
+    } else if (!std::strcmp(key, "map")) {
+      if (!copy(out->map, sizeof(out->map), v)) return CFG_ERR("path longer than %zu characters", sizeof(out->map) - 1);
+    } else if (!std::strcmp(key, "workers")) {
+      if (!parse_int(v, 1, 16, &x)) return CFG_ERR("'%s' is not an integer in 1..16", v);
+      out->workers = static_cast<int>(x);
+    } else if (!std::strcmp(key, "cores")) {
+      out->num_cores = 0;
+      char* tok = v;
+      while (tok && *tok) {
+        char* comma = std::strchr(tok, ',');
+        if (comma) *comma = '\0';
+        while (*tok == ' ') ++tok;
+        char* te = tok + std::strlen(tok);
+        while (te > tok && te[-1] == ' ') *--te = '\0';
+        if (out->num_cores >= AppConfig::kMaxCores) return CFG_ERR("more than %d cores", AppConfig::kMaxCores);
+        if (!parse_int(tok, 0, 1023, &x)) return CFG_ERR("'%s' is not a CPU number 0..1023", tok);
+        out->cores[out->num_cores++] = static_cast<int>(x);
+        tok = comma ? comma + 1 : nullptr;
+      }
+    } else if (!std::strcmp(key, "realtime")) {
+      if (!parse_bool(v, &out->realtime)) return CFG_ERR("'%s' is not true or false", v);
+    } else if (!std::strcmp(key, "arena_mib")) {
+      if (!parse_int(v, 1, 4096, &x)) return CFG_ERR("'%s' is not an integer in 1..4096", v);
+      out->arena_mib = static_cast<std::uint32_t>(x);
+    } else if (!std::strcmp(key, "step_deadline_ms")) {
+      char* pe = nullptr;
+      const double d = std::strtod(v, &pe);
+      if (pe == v || *pe || !std::isfinite(d) || d < 0.1 || d > 1000) return CFG_ERR("'%s' is not a number in 0.1..1000", v);
+      out->step_deadline_ms = d;
+    } else if (!std::strcmp(key, "health_period_ms")) {
+      if (!parse_int(v, 10, 10000, &x)) return CFG_ERR("'%s' is not an integer in 10..10000", v);
+      out->health_period_ms = static_cast<std::uint32_t>(x);
+    } else if (!std::strcmp(key, "seed")) {
+      if (!parse_int(v, 0, 0x7FFFFFFF, &x)) return CFG_ERR("'%s' is not a non-negative integer", v);
+      out->seed = static_cast<std::uint64_t>(x);
+    } else if (!std::strcmp(key, "log_level")) {
+      static const char* const kLevels[] = {"debug", "info", "warning", "error"};
+      int lvl = -1;
+      for (int i = 0; i < 4; ++i)
+        if (!std::strcmp(v, kLevels[i])) lvl = i;
+      if (lvl < 0) return CFG_ERR("'%s' is not debug, info, warning or error", v);
+      out->log_level = lvl;
+    } else {
+      return Status::error(Errc::kInvalidArgument, "config '%s' line %d: unknown key '%s'", name, line, key);
+    }
+  }
+  if (!seen_laser) return Status::error(Errc::kInvalidArgument, "config '%s': key 'laser' is required", name);
+  if (std::strcmp(out->localizer, "odom") && !out->map[0]) {
+    return Status::error(Errc::kInvalidArgument, "config '%s': key 'map' is required for localizer '%s'", name,
+                         out->localizer);
+  }
+  if (out->num_cores > 0 && out->num_cores < out->workers) {
+    return Status::error(Errc::kInvalidArgument, "config '%s': key 'cores' lists %d CPUs for %d workers", name,
+                         out->num_cores, out->workers);
+  }
+  return Status::ok();
+}
+
+Status load_app_config(const char* path, AppConfig* out) {
+  static char text[16384];
+  const int fd = ::open(path, O_RDONLY | O_CLOEXEC);
+  if (fd < 0) {
+    const int e = errno;
+    return Status::error(Errc::kIoError, "config '%s': %s", path, strerror(e));
+  }
+  std::size_t len = 0;
+  for (;;) {
+    const ssize_t n = ::read(fd, text + len, sizeof(text) - len);
+    if (n < 0) {
+      const int e = errno;
+      ::close(fd);
+      return Status::error(Errc::kIoError, "config '%s': read: %s", path, strerror(e));
+    }
+    if (n == 0) break;
+    len += static_cast<std::size_t>(n);
+    if (len == sizeof(text)) {
+      ::close(fd);
+      return Status::error(Errc::kCapacityExceeded, "config '%s': larger than %zu bytes", path, sizeof(text) - 1);
+    }
+  }
+  ::close(fd);
+  return parse_app_config(path, text, len, out);
+}
+
+}  // namespace fw

@@ -1,0 +1,50 @@
+// mmlfw configuration: a "key = value" text file ('#' comments), validated once at start-up.
+// Every error names the file, the line and the key. Keys (defaults in brackets):
+//   laser            socketcan:IFACE | serial:DEVICE[@BAUD]            (required)
+//   odometry         socketcan:IFACE | none              [laser's interface when socketcan, else none]
+//   output           socketcan:IFACE | log               [laser's interface when socketcan, else log]
+//   can_fd           auto | true | false                 [auto: FD when the interface MTU is 72]
+//   localizer        odom | mml                          [odom]
+//   map              path of the compiled map image (mml-mapc / mml-mapbuild)   (required for mml)
+//   workers          1..16 worker threads, created once  [2]
+//   cores            comma list of CPU ids for worker i  [0,1,...]; pinned to (core mod online CPUs)
+//   realtime         true | false  SCHED_FIFO workers + mlockall   [false]
+//   arena_mib        1..4096 start-up arena (map + localizer storage) [256]
+//   step_deadline_ms 0.1..1000 Localizer::step longer than this is a deadline miss [13.333 = 75 Hz]
+//   health_period_ms 10..10000 heartbeat period when no scans arrive [200]
+//   seed             random seed of the localizer    [1]
+//   log_level        debug | info | warning | error  [info]
+#pragma once
+
+#include <cstddef>
+#include <cstdint>
+
+#include "firmware/base/status.h"
+
+namespace fw {
+
+struct AppConfig {
+  static constexpr int kMaxCores = 16;
+  char laser[128] = {0};
+  char odometry[128] = {0};  // empty = default
+  char output[128] = {0};
+  int can_fd = -1;           // -1 auto, 0 classic, 1 FD required
+  char localizer[16] = "odom";
+  char map[256] = {0};
+  int workers = 2;
+  int cores[kMaxCores] = {0};
+  int num_cores = 0;         // 0 = default (worker i → core i)
+  bool realtime = false;
+  std::uint32_t arena_mib = 256;
+  double step_deadline_ms = 1000.0 / 75.0;
+  std::uint32_t health_period_ms = 200;
+  std::uint64_t seed = 1;
+  int log_level = 1;         // hal::LogLevel
+};
+
+// Parses `text` (len bytes); `name` is used in messages.
+Status parse_app_config(const char* name, const char* text, std::size_t len, AppConfig* out);
+// Reads the file (at most 16 KiB) with read(2) into a static buffer and parses it.
+Status load_app_config(const char* path, AppConfig* out);
+
+}  // namespace fw

@@ -1,0 +1,222 @@
+// mmlfw: the firmware binary. Start-up (everything that may fail happens here, once):
+// configuration → HAL board (backends from the config) → start-up arena → map image → worker
+// threads (pinned, created once) → localizer → LocalizationLoop; then the arena is sealed and the
+// loop runs until SIGINT/SIGTERM (or --max-scans / --duration). Steady state allocates nothing.
+//   mmlfw --config FILE [--memory-report] [--max-scans N] [--duration S]
+// --memory-report: performs the full start-up, prints the static memory budget by module and exits.
+// On exit a one-line summary "mmlfw summary: {...}" goes to stderr.
+#include <signal.h>
+#include <sys/mman.h>
+
+#include <cstdio>
+#include <cstdlib>
+#include <cstring>
+
+#include "firmware/app/app_config.h"
+#include "firmware/base/arena.h"
+#include "firmware/base/memory_report.h"
+#include "firmware/base/worker_pool.h"
+#include "firmware/map/global_map.h"
+#include "firmware/map/map_image.h"
+#include "firmware/map/map_image_file.h"
+#include "firmware/mml/mml_localizer.h"
+#include "firmware/runtime/localization_loop.h"
+#include "firmware/runtime/odometry_localizer.h"
+#include "hal_linux/board.h"
+
+namespace {
+
+// All big objects live in static storage (sized at compile time, listed in the memory report).
+hal_linux::Board g_board;
+fw::StartupArena g_arena;
+fw::WorkerPool g_pool;
+fw::OdometryLocalizer g_odom;
+fw::mml::MmlLocalizer g_mml;
+fw::LocalizationLoop g_loop;
+fw::AppConfig g_config;
+volatile sig_atomic_t g_stop = 0;
+
+void on_signal(int) { g_stop = 1; }
+
+int usage(const char* msg) {
+  std::fprintf(stderr, "mmlfw: %s\nusage: mmlfw --config FILE [--memory-report] [--max-scans N] [--duration S]\n", msg);
+  return 2;
+}
+
+int fail(const char* stage, const fw::Status& s) {
+  std::fprintf(stderr, "mmlfw: %s: %s\n", stage, s.message());
+  return 1;
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  const char* config_path = nullptr;
+  bool memory_report = false;
+  long max_scans = 0;
+  double duration_s = 0;
+  for (int i = 1; i < argc; ++i) {
+    if (!std::strcmp(argv[i], "--config") && i + 1 < argc) {
+      config_path = argv[++i];
+    } else if (!std::strcmp(argv[i], "--memory-report")) {
+      memory_report = true;
+    } else if (!std::strcmp(argv[i], "--max-scans") && i + 1 < argc) {
+      max_scans = std::strtol(argv[++i], nullptr, 10);
+      if (max_scans <= 0) return usage("--max-scans needs a positive integer");
+    } else if (!std::strcmp(argv[i], "--duration") && i + 1 < argc) {
+      duration_s = std::strtod(argv[++i], nullptr);
+      if (!(duration_s > 0)) return usage("--duration needs a positive number of seconds");
+    } else {
+      return usage("unknown or incomplete argument");
+    }
+  }
+  if (!config_path) return usage("--config FILE is required");
+  fw::Status st = fw::load_app_config(config_path, &g_config);
+  if (!st) {
+    std::fprintf(stderr, "mmlfw: %s\n", st.message());
+    return 2;
+  }
+  const fw::AppConfig& c = g_config;
+
+  hal_linux::BoardSpec spec;
+  spec.laser = c.laser;
+  spec.odometry = c.odometry[0] ? c.odometry : nullptr;
+  spec.output = c.output[0] ? c.output : nullptr;
+  spec.can_fd = c.can_fd;
+  spec.log_level = static_cast<hal::LogLevel>(c.log_level);
+  st = g_board.create(spec);
+  if (!st) return fail("board", st);
+  hal::Hal& hal = g_board.hal();
+  hal.log->log(hal::LogLevel::kInfo, "mmlfw: board %s", g_board.describe());
+
+  if (c.realtime && mlockall(MCL_CURRENT | MCL_FUTURE) != 0) {
+    hal.log->log(hal::LogLevel::kWarning, "mmlfw: mlockall refused; continuing without locked memory");
+  }
+  st = g_arena.init_mapped(static_cast<std::size_t>(c.arena_mib) << 20, c.realtime, "arena");
+  if (!st) return fail("arena", st);
+
+  fw::GlobalMap map{};
+  fw::MapImageFile image;
+  const std::uint8_t* table = nullptr;
+  std::size_t table_len = 0;
+  if (c.map[0]) {
+    st = image.open(c.map);
+    if (!st) return fail("map", st);
+    st = fw::load_map_image(image.data(), image.size(), g_arena, &map, c.map);
+    if (!st) return fail("map", st);
+    table = fw::find_section(image.data(), image.size(), fw::MapSectionType::kRelationTable2D, &table_len);
+    hal.log->log(hal::LogLevel::kInfo, "mmlfw: map '%s' %ux%u cells at %.3f m, %u points%s", c.map,
+                 map.geometry.width, map.geometry.height, static_cast<double>(map.geometry.resolution), map.num_points,
+                 table ? ", precomputed relation table" : "");
+  }
+
+  fw::WorkerPoolOptions po;
+  po.num_workers = c.workers;
+  for (int i = 0; i < c.num_cores && i < fw::WorkerPoolOptions::kMaxWorkers; ++i) po.cores[i] = c.cores[i];
+  po.realtime = c.realtime;
+  st = g_pool.start(po);
+  if (!st) return fail("workers", st);
+  if (g_pool.warning_count() > 0) {
+    hal.log->log(hal::LogLevel::kWarning, "mmlfw: %d worker warning(s), last: %s", g_pool.warning_count(),
+                 g_pool.warning());
+  }
+
+  fw::Localizer* localizer = nullptr;
+  if (!std::strcmp(c.localizer, "mml")) {
+    fw::mml::MmlLocalizerConfig mc = fw::mml::default_mml_config();
+    mc.mml.seed = c.seed;
+    if (!table) mc.mml.precomputed_table = false;
+    st = g_mml.init(mc, map, table, table_len, g_arena, &g_pool);
+    if (!st) return fail("localizer mml", st);
+    localizer = &g_mml;
+  } else {
+    fw::OdometryLocalizerOptions oo;
+    st = oo.validate();
+    if (!st) return fail("localizer odom", st);
+    g_odom = fw::OdometryLocalizer(oo);
+    localizer = &g_odom;
+  }
+  image.close();  // the map now lives in the arena
+
+  fw::LocalizationLoopOptions lo;
+  lo.step_deadline_ns = static_cast<std::uint64_t>(c.step_deadline_ms * 1e6);
+  st = g_loop.init(hal, *localizer, lo);
+  if (!st) return fail("loop", st);
+
+  fw::MemoryReport& mr = fw::MemoryReport::instance();
+  mr.add({"hal", "board (sockets, CAN node rings, SICK parser)", sizeof(g_board), 0, nullptr});
+  mr.add({"runtime", "localization loop (odometry ring, pending scan, perf)", sizeof(g_loop), 0, nullptr});
+  mr.add({"runtime", "worker pool", sizeof(g_pool), static_cast<std::size_t>(c.workers), nullptr});
+  if (localizer == &g_mml) {
+    mr.add({"mml", "MmlLocalizer object (static)", sizeof(g_mml), 0, nullptr});
+  } else {
+    mr.add({"runtime", "OdometryLocalizer object (static)", sizeof(g_odom), 0, nullptr});
+  }
+  g_arena.seal();
+  if (memory_report) {
+    std::printf("mmlfw memory report (config '%s', localizer %s, arena used %zu of %zu bytes)\n", config_path,
+                localizer->name(), g_arena.used(), g_arena.capacity());
+    mr.print(stdout);
+    g_pool.stop();
+    return 0;
+  }
+
+  struct sigaction sa {};
+  sa.sa_handler = on_signal;
+  sigemptyset(&sa.sa_mask);
+  sigaction(SIGINT, &sa, nullptr);
+  sigaction(SIGTERM, &sa, nullptr);
+  signal(SIGPIPE, SIG_IGN);
+
+  hal.log->log(hal::LogLevel::kInfo, "mmlfw: running (localizer %s, %d workers)", localizer->name(), c.workers);
+  const std::uint64_t t_start = hal.clock->now_ns();
+  const std::uint64_t health_period = static_cast<std::uint64_t>(c.health_period_ms) * 1000000ull;
+  std::uint64_t last_health = t_start;
+  std::uint64_t scans = 0, step_errors = 0;
+  while (!g_stop) {
+    g_board.wait_for_input(5);
+    for (int k = 0; k < 16 && !g_stop; ++k) {
+      st = g_loop.spin_once();
+      if (!st) ++step_errors;
+      if (!g_loop.stepped()) break;
+      ++scans;
+      last_health = hal.clock->now_ns();  // the loop published health with the pose
+      if (max_scans > 0 && static_cast<long>(scans) >= max_scans) g_stop = 1;
+    }
+    const std::uint64_t now = hal.clock->now_ns();
+    if (now - last_health >= health_period) {
+      g_board.publish_heartbeat(g_loop.health());
+      last_health = now;
+    }
+    if (duration_s > 0 && static_cast<double>(now - t_start) * 1e-9 >= duration_s) g_stop = 1;
+  }
+
+  const fw::PerfStats step = g_loop.perf_step().stats();
+  const fw::PerfStats total = g_loop.perf_total().stats();
+  const hal::Health& h = g_loop.health();
+  const hal_can::CanNode* node = g_board.can_node();
+  const hal::CanBusStats* bus = g_board.can_bus() ? &g_board.can_bus()->stats() : nullptr;
+  std::fprintf(stderr,
+               "mmlfw summary: {\"scans_processed\": %u, \"step_errors\": %llu, \"step_p50_ms\": %.3f, "
+               "\"step_p99_ms\": %.3f, \"step_max_ms\": %.3f, \"cycle_p99_ms\": %.3f, \"deadline_misses\": %u, "
+               "\"dropped_scans\": %u, \"timeouts\": %u, \"can_scans_ok\": %u, \"can_scans_dropped\": %u, "
+               "\"can_crc_errors\": %u, \"can_lost_segments\": %u, \"can_duplicate_segments\": %u, "
+               "\"can_odometry\": %u, \"can_rx_frames\": %llu, \"can_rx_dropped\": %llu, \"can_error_frames\": %llu, "
+               "\"can_bus_off\": %llu, \"can_tx_failed\": %llu, \"serial_scans\": %u, \"serial_crc_errors\": %u, "
+               "\"last_status\": \"%s\"}\n",
+               h.scans_processed, static_cast<unsigned long long>(step_errors), step.p50_ms, step.p99_ms, step.max_ms,
+               total.p99_ms, h.deadline_misses, h.dropped_scans, h.timeouts,
+               node ? node->decoder_stats().scans_ok : 0, node ? node->decoder_stats().scans_dropped : 0,
+               node ? node->decoder_stats().crc_errors : 0, node ? node->decoder_stats().lost_segments : 0,
+               node ? node->decoder_stats().duplicate_segments : 0, node ? node->decoder_stats().odometry_ok : 0,
+               bus ? static_cast<unsigned long long>(bus->rx_frames) : 0ull,
+               bus ? static_cast<unsigned long long>(bus->rx_dropped) : 0ull,
+               bus ? static_cast<unsigned long long>(bus->error_frames) : 0ull,
+               bus ? static_cast<unsigned long long>(bus->bus_off) : 0ull,
+               bus ? static_cast<unsigned long long>(bus->tx_failed) : 0ull,
+               g_board.sick() ? g_board.sick()->stats().scans : 0,
+               g_board.sick() ? g_board.sick()->parser_stats().crc_errors : 0,
+               hal::status_name(g_loop.last_estimate().status));
+  g_pool.stop();
+  return 0;
+}

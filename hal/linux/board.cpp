@@ -1,0 +1,150 @@
+#include "hal_linux/board.h"
+
+#include <poll.h>
+
+#include <cstdio>
+#include <cstdlib>
+#include <cstring>
+
+namespace hal_linux {
+
+using fw::Errc;
+using fw::Status;
+
+Status parse_backend_spec(const char* what, const char* spec, char* kind, std::size_t kind_len, char* arg,
+                          std::size_t arg_len) {
+  if (!spec || !*spec) return Status::error(Errc::kInvalidArgument, "%s: empty backend spec", what);
+  const char* colon = std::strchr(spec, ':');
+  if (!colon) {
+    if (std::strlen(spec) >= kind_len) return Status::error(Errc::kInvalidArgument, "%s: '%s' unknown", what, spec);
+    std::strcpy(kind, spec);
+    arg[0] = '\0';
+    return Status::ok();
+  }
+  const std::size_t kl = static_cast<std::size_t>(colon - spec);
+  if (kl == 0 || kl >= kind_len || std::strlen(colon + 1) >= arg_len || !colon[1]) {
+    return Status::error(Errc::kInvalidArgument, "%s: '%s' is not KIND:ARG (socketcan:IFACE, serial:DEVICE[@BAUD])",
+                         what, spec);
+  }
+  std::memcpy(kind, spec, kl);
+  kind[kl] = '\0';
+  std::strcpy(arg, colon + 1);
+  return Status::ok();
+}
+
+bool Board::ZeroOdometry::poll(hal::Odometry* out) {
+  // A parked robot: zero pose samples every 10 ms of HAL time so scans always pair.
+  const std::uint64_t now = board_->clock_.now_ns();
+  if (last_ns_ != 0 && now - last_ns_ < 10'000'000) return false;
+  last_ns_ = now;
+  *out = hal::Odometry{};
+  out->timestamp_ns = now;
+  return true;
+}
+
+void Board::LogPoseSink::publish(const hal::PoseEstimate& e) {
+  board_->log_.log(hal::LogLevel::kInfo, "pose scan=%u x=%.3f y=%.3f th=%.4f status=%s", e.scan_id,
+                   static_cast<double>(e.x), static_cast<double>(e.y), static_cast<double>(e.theta),
+                   hal::status_name(e.status));
+}
+
+void Board::LogPoseSink::publish_health(const hal::Health& h) {
+  if (++health_count_ % 50 != 1) return;
+  board_->log_.log(hal::LogLevel::kInfo, "health scans=%u dropped=%u timeouts=%u deadline_misses=%u faults=0x%x",
+                   h.scans_processed, h.dropped_scans, h.timeouts, h.deadline_misses, h.fault_bits);
+}
+
+Status Board::create(const BoardSpec& spec) {
+  log_ = StderrLogSink(spec.log_level);
+  hal_ = hal::Hal{};
+  hal_.clock = &clock_;
+  hal_.log = &log_;
+  char lkind[16], larg[96];
+  FW_RETURN_IF_ERROR(parse_backend_spec("laser", spec.laser, lkind, sizeof(lkind), larg, sizeof(larg)));
+  const bool laser_can = std::strcmp(lkind, "socketcan") == 0;
+  const bool laser_serial = std::strcmp(lkind, "serial") == 0;
+  if (!laser_can && !laser_serial) {
+    return Status::error(Errc::kInvalidArgument, "laser: backend '%s' unknown (socketcan:IFACE or serial:DEVICE)",
+                         lkind);
+  }
+  const char* odom_spec = spec.odometry ? spec.odometry : (laser_can ? spec.laser : "none");
+  const char* out_spec = spec.output ? spec.output : (laser_can ? spec.laser : "log");
+  char okind[16], oarg[96], pkind[16], parg[96];
+  FW_RETURN_IF_ERROR(parse_backend_spec("odometry", odom_spec, okind, sizeof(okind), oarg, sizeof(oarg)));
+  FW_RETURN_IF_ERROR(parse_backend_spec("output", out_spec, pkind, sizeof(pkind), parg, sizeof(parg)));
+
+  // All CAN roles must share one interface (one socket, one CanNode).
+  char can_iface_buf[96] = {0};
+  auto want_can = [&can_iface_buf](const char* role, const char* kind, const char* arg) -> Status {
+    if (std::strcmp(kind, "socketcan") != 0) return Status::ok();
+    if (can_iface_buf[0] && std::strcmp(can_iface_buf, arg) != 0) {
+      return Status::error(Errc::kUnsupported, "%s: socketcan:%s differs from socketcan:%s (one CAN interface per board)",
+                           role, arg, can_iface_buf);
+    }
+    std::snprintf(can_iface_buf, sizeof(can_iface_buf), "%s", arg);
+    return Status::ok();
+  };
+  FW_RETURN_IF_ERROR(want_can("laser", lkind, larg));
+  FW_RETURN_IF_ERROR(want_can("odometry", okind, oarg));
+  FW_RETURN_IF_ERROR(want_can("output", pkind, parg));
+  const char* can_iface = can_iface_buf[0] ? can_iface_buf : nullptr;
+  if (std::strcmp(okind, "socketcan") != 0 && std::strcmp(okind, "none") != 0) {
+    return Status::error(Errc::kInvalidArgument, "odometry: backend '%s' unknown (socketcan:IFACE or none)", okind);
+  }
+  if (std::strcmp(pkind, "socketcan") != 0 && std::strcmp(pkind, "log") != 0) {
+    return Status::error(Errc::kInvalidArgument, "output: backend '%s' unknown (socketcan:IFACE or log)", pkind);
+  }
+
+  if (can_iface) {
+    hal_socketcan::SocketCanOptions o;
+    o.want_fd = spec.can_fd != 0;
+    o.require_fd = spec.can_fd == 1;
+    // Only our message set: IDs 0x100..0x13F and their FD variants 0x500..0x53F.
+    o.filters[0] = {0x100, 0x7C0, false};
+    o.filters[1] = {0x500, 0x7C0, false};
+    o.num_filters = 2;
+    FW_RETURN_IF_ERROR(bus_.open(can_iface, o));
+    can_fd_ = bus_.fd_enabled();
+    node_.init(&bus_, &clock_, can_fd_);
+    node_used_ = true;
+  }
+  if (laser_can) {
+    hal_.laser = &node_.laser();
+  } else {
+    // serial:DEVICE[@BAUD]
+    char dev[96];
+    std::strcpy(dev, larg);
+    std::uint32_t baud = 38400;
+    if (char* at = std::strchr(dev, '@')) {
+      *at = '\0';
+      char* end = nullptr;
+      const unsigned long b = std::strtoul(at + 1, &end, 10);
+      if (end == at + 1 || *end) return Status::error(Errc::kInvalidArgument, "laser: baud '%s' is not a number", at + 1);
+      baud = static_cast<std::uint32_t>(b);
+    }
+    FW_RETURN_IF_ERROR(port_.open(dev, baud));
+    sick_.init(&port_, &clock_, hal_serial::SickLaserOptions{});
+    if (!sick_.start()) return Status::error(Errc::kIoError, "laser: serial '%s': request write failed", dev);
+    sick_used_ = true;
+    hal_.laser = &sick_;
+  }
+  hal_.odometry = std::strcmp(okind, "socketcan") == 0 ? &node_.odometry() : static_cast<hal::OdometrySource*>(&zero_odom_);
+  hal_.pose_sink = std::strcmp(pkind, "socketcan") == 0 ? &node_.pose_sink() : static_cast<hal::PoseSink*>(&log_sink_pose_);
+  std::snprintf(description_, sizeof(description_), "laser=%s odometry=%s output=%s%s", spec.laser, odom_spec,
+                out_spec, can_iface ? (can_fd_ ? " (CAN FD)" : " (classic CAN)") : "");
+  return Status::ok();
+}
+
+void Board::wait_for_input(int timeout_ms) {
+  pollfd p[2];
+  int n = 0;
+  if (bus_.is_open()) p[n++] = {bus_.native_handle(), POLLIN, 0};
+  if (port_.is_open()) p[n++] = {port_.native_handle(), POLLIN, 0};
+  if (n == 0) {
+    ::poll(nullptr, 0, timeout_ms);
+    return;
+  }
+  ::poll(p, static_cast<nfds_t>(n), timeout_ms);
+}
+
+}  // namespace hal_linux
