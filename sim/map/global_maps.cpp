@@ -1,14 +1,20 @@
 #include "sim/map/global_maps.h"
 
+#include <unistd.h>
+
+#include <cmath>
 #include <cstdlib>
 #include <filesystem>
 #include <fstream>
+#include <map>
 #include <sstream>
 
 #include "sim/io/carmen_log.h"
 #include "sim/io/datasets.h"
+#include "sim/io/relations.h"
 #include "sim/map/map_image_writer.h"
 #include "sim/map/png_writer.h"
+#include "sim/map/pose_graph.h"
 
 #ifndef MMLFW_SOURCE_DIR
 #define MMLFW_SOURCE_DIR "."
@@ -53,7 +59,9 @@ const std::vector<std::string>& global_map_datasets() {
   return k;
 }
 
-double default_map_resolution(const std::string& dataset) { return dataset == "mit-killian" ? 0.10 : 0.05; }
+double default_map_resolution(const std::string& dataset) {
+  return (dataset == "mit-killian" || dataset == "fr-clinic") ? 0.10 : 0.05;
+}
 
 OccupancyBuildOptions global_map_options(const std::string& dataset, double resolution) {
   OccupancyBuildOptions o;
@@ -66,7 +74,8 @@ OccupancyBuildOptions global_map_options(const std::string& dataset, double reso
 
 std::string global_map_source(const std::string& dataset) {
   if (dataset == "fr-clinic") {
-    return "fr-clinic/fr-clinic_robotlaser.clf.gz laser poses (raw odometry: no corrected log exists)";
+    return "fr-clinic/fr-clinic_robotlaser.clf.gz scans at the 1316 relation timestamps, poses from a pose graph of "
+           "fr-clinic/fr-clinic.relations (no corrected log exists)";
   }
   const Dataset* d = find_dataset(dataset);
   if (d == nullptr || d->corrected_log.empty()) return "";
@@ -74,7 +83,7 @@ std::string global_map_source(const std::string& dataset) {
 }
 
 bool build_global_map(const std::string& dataset, double resolution, RosMap* out, std::string* error,
-                      OccupancyBuildStats* stats) {
+                      OccupancyBuildStats* stats, std::string* report_out) {
   if (!known(dataset)) {
     return fail(error, "unknown dataset '" + dataset + "' (known: intel, fr079, aces, mit-killian, fr-clinic)");
   }
@@ -86,11 +95,32 @@ bool build_global_map(const std::string& dataset, double resolution, RosMap* out
   }
   CarmenLog log;
   if (!read_carmen_log(log_path, CarmenReadOptions{}, &log, error)) return false;
+  std::vector<const CarmenScan*> used;
+  std::vector<fw::Se2d> laser_poses;
+  if (dataset == "fr-clinic") {
+    std::vector<std::size_t> idx;
+    std::vector<fw::Se2d> robot;
+    std::string report;
+    if (!relation_graph_trajectory(dataset, &idx, &robot, &report, error)) return false;
+    if (report_out != nullptr) *report_out = report;
+    for (std::size_t k = 0; k < idx.size(); ++k) {
+      const CarmenScan& s = log.scans[idx[k]];
+      // ROBOTLASER1: pose = laser pose, odom = robot pose (same odometry frame): mount offset.
+      laser_poses.push_back(robot[k].compose(s.odom.between(s.pose)));
+      used.push_back(&s);
+    }
+  } else {
+    for (const CarmenScan& s : log.scans) {
+      used.push_back(&s);
+      laser_poses.push_back(s.pose);
+    }
+  }
   std::vector<PosedScan> scans;
-  scans.reserve(log.scans.size());
-  for (const CarmenScan& s : log.scans) {
+  scans.reserve(used.size());
+  for (std::size_t k = 0; k < used.size(); ++k) {
+    const CarmenScan& s = *used[k];
     PosedScan p;
-    p.pose = s.pose;
+    p.pose = laser_poses[k];
     p.angle_min = s.angle_min;
     p.angle_increment = s.angle_increment;
     p.max_range = s.max_range;
@@ -104,6 +134,93 @@ bool build_global_map(const std::string& dataset, double resolution, RosMap* out
     return false;
   }
   *out = grid_to_ros_map(grid, dataset + ".pgm");
+  return true;
+}
+
+bool relation_graph_trajectory(const std::string& dataset, std::vector<std::size_t>* scan_indices,
+                               std::vector<fw::Se2d>* robot_poses, std::string* report, std::string* error) {
+  const Dataset* d = find_dataset(dataset);
+  if (d == nullptr || d->relations.empty() || d->raw_log.empty() || !d->relations_match_log) {
+    return fail(error, "dataset '" + dataset + "': no relations that match its raw log");
+  }
+  CarmenLog log;
+  if (!read_carmen_log(data_path(d->raw_log), CarmenReadOptions{}, &log, error)) return false;
+  std::vector<Relation> rel;
+  if (!read_relations(data_path(d->relations), &rel, error)) return false;
+  // Scan lookup by ipc timestamp (the relation files print the log's 6-decimal timestamps).
+  std::map<long long, std::size_t> by_time;
+  for (std::size_t k = 0; k < log.scans.size(); ++k) by_time.emplace(std::llround(log.scans[k].ipc_timestamp * 1e6), k);
+  std::map<long long, std::size_t> node_of;  // timestamp -> node
+  for (const Relation& r : rel) {
+    for (double t : {r.t1, r.t2}) {
+      const long long key = std::llround(t * 1e6);
+      if (by_time.count(key) == 0) {
+        char buf[64];
+        std::snprintf(buf, sizeof(buf), "%.6f", t);
+        return fail(error, data_path(d->relations) + ": timestamp " + buf + " is not a scan of " + data_path(d->raw_log));
+      }
+      node_of.emplace(key, 0);
+    }
+  }
+  std::vector<std::size_t> idx;
+  for (auto& [key, node] : node_of) {
+    node = idx.size();
+    idx.push_back(by_time[key]);
+  }
+  const std::size_t n = idx.size();
+  std::vector<PoseGraphEdge> edges;
+  // σ 5 cm / 0.02 rad per relation: only the ratio matters for the optimum.
+  Eigen::Matrix3d info = Eigen::Matrix3d::Zero();
+  info(0, 0) = info(1, 1) = 1.0 / (0.05 * 0.05);
+  info(2, 2) = 1.0 / (0.02 * 0.02);
+  std::vector<const PoseGraphEdge*> next(n, nullptr);
+  for (const Relation& r : rel) {
+    PoseGraphEdge e;
+    e.i = node_of[std::llround(r.t1 * 1e6)];
+    e.j = node_of[std::llround(r.t2 * 1e6)];
+    e.z = r.delta;
+    e.information = info;
+    if (e.i == e.j) continue;
+    edges.push_back(e);
+  }
+  for (const PoseGraphEdge& e : edges) {
+    if (e.j == e.i + 1) next[e.i] = &e;
+  }
+  // Initial guess: chain the consecutive relations (odometry where a link is missing).
+  std::vector<fw::Se2d> x(n);
+  x[0] = log.scans[idx[0]].odom;
+  std::size_t odometry_links = 0;
+  for (std::size_t k = 0; k + 1 < n; ++k) {
+    fw::Se2d step;
+    if (next[k] != nullptr) {
+      step = next[k]->z;
+    } else {
+      step = log.scans[idx[k]].odom.between(log.scans[idx[k + 1]].odom);
+      ++odometry_links;
+    }
+    x[k + 1] = x[k].compose(step);
+  }
+  PoseGraphResult pg;
+  if (!optimize_pose_graph(&x, edges, PoseGraphOptions{}, &pg, error)) return false;
+  Trajectory traj, odom;
+  for (std::size_t k = 0; k < n; ++k) {
+    traj.push_back({log.scans[idx[k]].ipc_timestamp, x[k]});
+    odom.push_back({log.scans[idx[k]].ipc_timestamp, log.scans[idx[k]].odom});
+  }
+  const RelationsMetric m = evaluate_relations(rel, traj);
+  const RelationsMetric mo = evaluate_relations(rel, odom);
+  if (report != nullptr) {
+    char buf[512];
+    std::snprintf(buf, sizeof(buf),
+                  "%s: pose graph of %zu relation scans, %zu relations (%zu links from odometry); chi2 %.4g -> %.4g in "
+                  "%d GN iterations; relation error of the result: %.4f m / %.3f deg mean (max %.3f m / %.2f deg); "
+                  "raw odometry: %.4f m / %.3f deg",
+                  dataset.c_str(), n, edges.size(), odometry_links, pg.initial_chi2, pg.final_chi2, pg.iterations,
+                  m.trans_mean, m.rot_mean_deg, m.trans_max, m.rot_max_deg, mo.trans_mean, mo.rot_mean_deg);
+    *report = buf;
+  }
+  *scan_indices = std::move(idx);
+  *robot_poses = std::move(x);
   return true;
 }
 
@@ -127,6 +244,40 @@ bool write_map_png(const std::string& path, const RosMap& map, std::string* erro
   return write_png(path, map.width, map.height, 1, px, error);
 }
 
+bool write_global_map(const std::string& dataset, double resolution, const std::string& dir, RosMap* out,
+                      std::string* error, OccupancyBuildStats* stats, std::string* report) {
+  if (resolution <= 0.0) resolution = default_map_resolution(dataset);
+  RosMap map;
+  if (!build_global_map(dataset, resolution, &map, error, stats, report)) return false;
+  // Written into a private folder, then renamed into place (atomic per file, build.txt last), so
+  // a concurrent reader (tests of other modules share build/maps) never sees a half-written file.
+  const std::string tmp = dir + "/.tmp-" + dataset + "-" + std::to_string(::getpid());
+  std::error_code ec;
+  std::filesystem::create_directories(tmp, ec);
+  if (ec) return fail(error, tmp + ": cannot create directory: " + ec.message());
+  std::vector<std::uint8_t> image;
+  const std::string sig = build_signature(dataset, global_map_options(dataset, resolution));
+  bool ok = write_ros_map(global_map_yaml_path(dataset, tmp), map, error) &&
+            write_map_png(tmp + "/" + dataset + ".png", map, error) && compile_map_image(map, &image, error) &&
+            write_file_bytes(global_map_image_path(dataset, tmp), image, error);
+  if (ok) {
+    std::ofstream s(tmp + "/" + dataset + ".build.txt", std::ios::trunc);
+    s << sig << "\n";
+    s.close();
+    ok = static_cast<bool>(s) || fail(error, tmp + ": write failed");
+  }
+  for (const char* ext : {".pgm", ".png", ".mmap", ".yaml", ".build.txt"}) {
+    if (!ok) break;
+    std::filesystem::rename(tmp + "/" + dataset + ext, dir + "/" + dataset + ext, ec);
+    if (ec) ok = fail(error, dir + "/" + dataset + ext + ": cannot move into place: " + ec.message());
+  }
+  std::filesystem::remove_all(tmp, ec);
+  if (!ok) return false;
+  map.yaml_path = global_map_yaml_path(dataset, dir);
+  *out = std::move(map);
+  return true;
+}
+
 bool ensure_global_map(const std::string& dataset, double resolution, const std::string& dir, RosMap* out,
                        std::string* error, bool* rebuilt) {
   if (resolution <= 0.0) resolution = default_map_resolution(dataset);
@@ -137,26 +288,13 @@ bool ensure_global_map(const std::string& dataset, double resolution, const std:
   const std::string yaml = global_map_yaml_path(dataset, dir);
   const std::string sig_path = dir + "/" + dataset + ".build.txt";
   const std::string sig = build_signature(dataset, global_map_options(dataset, resolution));
-  std::error_code ec;
   if (std::filesystem::exists(yaml) && std::filesystem::exists(global_map_image_path(dataset, dir)) &&
       read_text(sig_path) == sig + "\n") {
     if (read_ros_map(yaml, out, error)) return true;
     // Unreadable cache: rebuild below.
   }
-  std::filesystem::create_directories(dir, ec);
-  if (ec) return fail(error, dir + ": cannot create directory: " + ec.message());
-  RosMap map;
-  if (!build_global_map(dataset, resolution, &map, error)) return false;
-  std::vector<std::uint8_t> image;
-  if (!write_ros_map(yaml, map, error) || !write_map_png(dir + "/" + dataset + ".png", map, error) ||
-      !compile_map_image(map, &image, error) || !write_file_bytes(global_map_image_path(dataset, dir), image, error)) {
-    return false;
-  }
-  {
-    std::ofstream s(sig_path, std::ios::trunc);
-    s << sig << "\n";
-    if (!s) return fail(error, sig_path + ": write failed");
-  }
+  RosMap built;
+  if (!write_global_map(dataset, resolution, dir, &built, error)) return false;
   if (rebuilt != nullptr) *rebuilt = true;
   return read_ros_map(yaml, out, error);
 }

@@ -1,7 +1,7 @@
 // mml-mapbuild: global occupancy maps of the real datasets from their SLAM-corrected logs.
 //   mml-mapbuild --dataset intel|fr079|aces|mit-killian|fr-clinic|all [--resolution R] [--out DIR]
 // writes DIR/<dataset>.yaml + .pgm (ROS map_server), .png (picture), .mmap (compiled firmware map
-// image), .build.txt (parameters). Default DIR: build/maps; default R: 0.05 m (0.10 m mit-killian).
+// image), .build.txt (parameters). Default DIR: build/maps; default R: 0.05 m (0.10 m mit-killian, fr-clinic).
 //   mml-mapbuild --log FILE.clf[.gz] --name NAME [--resolution R] [--max-range M] [--out DIR]
 // builds from any CARMEN log whose scan poses are known (e.g. a corrected log).
 #include <chrono>
@@ -118,12 +118,14 @@ int main(int argc, char** argv) {
     const double r = resolution > 0.0 ? resolution : sim::default_map_resolution(ds);
     sim::RosMap map;
     sim::OccupancyBuildStats stats;
-    if (!sim::build_global_map(ds, r, &map, &err, &stats) || !write_all(out, ds, map, &err)) {
+    std::string report;
+    if (!sim::write_global_map(ds, r, out, &map, &err, &stats, &report)) {
       std::fprintf(stderr, "mml-mapbuild: %s: %s\n", ds.c_str(), err.c_str());
       rc = 1;
       continue;
     }
     print_stats(ds, map, stats, std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count());
+    if (!report.empty()) std::printf("  %s\n", report.c_str());
     std::printf("  source: %s\n  wrote %s/%s.{yaml,pgm,png,mmap}\n", sim::global_map_source(ds).c_str(), out.c_str(),
                 ds.c_str());
   }

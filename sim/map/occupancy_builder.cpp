@@ -41,7 +41,9 @@ bool build_occupancy_grid(const std::vector<PosedScan>& scans, const OccupancyBu
   if (scans.empty()) return fail(error, "map build: no scans");
   OccupancyBuildStats st;
 
-  // Pass 1: bounds of everything the rays touch.
+  // Pass 1: bounds of the scan poses and the beam end points that hit something (rays that only
+  // clear free space — beyond max_usable_range or no return — are clipped to these bounds, so long
+  // free fans through windows do not inflate the grid).
   double minx = std::numeric_limits<double>::infinity(), miny = minx, maxx = -minx, maxy = -minx;
   auto extend = [&](double x, double y) {
     minx = std::min(minx, x);
@@ -58,7 +60,7 @@ bool build_occupancy_grid(const std::vector<PosedScan>& scans, const OccupancyBu
     extend(s.pose.x, s.pose.y);
     for (std::size_t i = 0; i < s.count; i += o.beam_stride) {
       double len = 0;
-      if (classify(s.ranges[i], s, o, &len) == BeamKind::kInvalid) continue;
+      if (classify(s.ranges[i], s, o, &len) != BeamKind::kHit) continue;
       const double a = s.pose.theta + s.angle_min + static_cast<double>(i) * s.angle_increment;
       extend(s.pose.x + len * std::cos(a), s.pose.y + len * std::sin(a));
     }
@@ -109,8 +111,22 @@ bool build_occupancy_grid(const std::vector<PosedScan>& scans, const OccupancyBu
         ++st.hits;
       }
       const double a = s.pose.theta + s.angle_min + static_cast<double>(i) * s.angle_increment;
+      double ex = s.pose.x + len * std::cos(a), ey = s.pose.y + len * std::sin(a);
+      if (kind == BeamKind::kFreeOnly) {
+        // Clip to the grid (the start, a scan pose, is inside): shrink the ray to the first exit.
+        const double gx0 = ox, gy0 = oy, gx1 = ox + W * res, gy1 = oy + H * res;
+        double t = 1.0;
+        const double ddx = ex - s.pose.x, ddy = ey - s.pose.y;
+        if (ddx > 0) t = std::min(t, (gx1 - s.pose.x) / ddx);
+        if (ddx < 0) t = std::min(t, (gx0 - s.pose.x) / ddx);
+        if (ddy > 0) t = std::min(t, (gy1 - s.pose.y) / ddy);
+        if (ddy < 0) t = std::min(t, (gy0 - s.pose.y) / ddy);
+        t = std::max(0.0, t);
+        ex = s.pose.x + t * ddx;
+        ey = s.pose.y + t * ddy;
+      }
       int x1 = 0, y1 = 0;
-      cell_of(s.pose.x + len * std::cos(a), s.pose.y + len * std::sin(a), &x1, &y1);
+      cell_of(ex, ey, &x1, &y1);
       // Bresenham: every cell from (x0,y0) up to but excluding (x1,y1) is free.
       const int dx = std::abs(x1 - x0), sx = x0 < x1 ? 1 : -1;
       const int dy = -std::abs(y1 - y0), sy = y0 < y1 ? 1 : -1;
