@@ -7,6 +7,8 @@
 #include <vector>
 
 #include "firmware/icp/trimmed_icp.h"
+#include "firmware/rbsm/local_map.h"
+#include "firmware/rbsm/scan_matching_odometry.h"
 #include "firmware/rbsm/synthetic_world_test_util.h"
 #include "tests/alloc_counter.h"
 
@@ -237,6 +239,77 @@ TEST(RbsmTest, MatchAndIntegrateAllocateNothing) {
   const long n = mmlfw_test::AllocCounter::end();
   EXPECT_TRUE(s1.is_ok() && s2.is_ok() && s3.is_ok() && s4.is_ok());
   EXPECT_EQ(n, 0);
+}
+
+}  // namespace
+
+namespace {
+
+TEST(ScanMatchingOdometryTest, TracksBiasedOdometryAndFillsLocalMapFragments) {
+  RbsmHarness h;
+  fw::RbsmOptions o = small_options();
+  o.num_particles = 500;
+  ASSERT_TRUE(h.init(o).is_ok());
+  std::vector<unsigned char> lm_block(1 << 20);
+  fw::StartupArena lm_arena;
+  ASSERT_TRUE(lm_arena.init(lm_block.data(), lm_block.size(), "local map").is_ok());
+  fw::LocalMap local_map;
+  fw::LocalMapOptions lo;
+  lo.fragment_length_m = 2.0f;
+  ASSERT_TRUE(local_map.init(lo, lm_arena).is_ok());
+  fw::ScanMatchingOdometry front;
+  ASSERT_TRUE(front.init(fw::ScanMatchingOdometryOptions{}, h.rbsm.get(), &local_map).is_ok());
+  const auto world = rbsm_test::l_corner_world();
+  // Drive east along the L's arm; the odometry over-reports translation by 8 % and drifts 0.5°/step.
+  fw::Se2f truth(-1.0f, 0.0f, 0.0f), odom(10.0f, 5.0f, 1.0f);
+  auto scan = std::make_unique<hal::LaserScan>();
+  for (std::uint32_t k = 0; k < 25; ++k) {
+    if (k > 0) {
+      const fw::Se2f step(0.2f, 0.0f, 0.0f);
+      truth = truth.compose(step);
+      odom = odom.compose(fw::Se2f(0.216f, 0.0f, 0.5f * kDeg));
+    }
+    // Polar scan from the ray caster: range = |p| of the 361-beam cast (beams without a hit are max range).
+    *scan = hal::LaserScan{};
+    scan->scan_id = k;
+    scan->beam_count = 361;
+    scan->angle_min = static_cast<float>(-M_PI / 2);
+    scan->angle_increment = static_cast<float>(M_PI / 360);
+    scan->range_min = 0.01f;
+    scan->range_max = 30.0f;
+    for (std::uint32_t i = 0; i < 361; ++i) scan->ranges[i] = 30.0f;
+    for (const auto& p : rbsm_test::cast_scan(world, truth, 361, 29.0f)) {
+      const double a = std::atan2(p(1), p(0));
+      const long i = std::lround((a + M_PI / 2) / (M_PI / 360));
+      if (i >= 0 && i < 361) scan->ranges[i] = p.norm();
+    }
+    hal::Odometry od;
+    od.x = odom.x;
+    od.y = odom.y;
+    od.theta = odom.theta;
+    fw::Se2f pose;
+    ASSERT_TRUE(front.step(*scan, od, &pose).is_ok()) << "step " << k;
+  }
+  // The front end starts at the origin; compare displacements from the first pose (-1, 0, 0).
+  const fw::Se2f est = front.pose();
+  EXPECT_NEAR(est.x, truth.x + 1.0f, 0.05f);
+  EXPECT_NEAR(est.y, truth.y, 0.05f);
+  EXPECT_NEAR(est.theta, 0.0f, 1.0f * kDeg);
+  EXPECT_GE(local_map.num_fragments(), 2u);
+  EXPECT_GT(local_map.total_points(), 200u);
+  EXPECT_EQ(front.failures(), 0u);
+  // A scan of NaN ranges is refused with a status naming the scan; the pose follows odometry.
+  for (std::uint32_t i = 0; i < 361; ++i) scan->ranges[i] = NAN;
+  scan->scan_id = 77;
+  hal::Odometry od;
+  od.x = odom.x;
+  od.y = odom.y;
+  od.theta = odom.theta;
+  fw::Se2f pose;
+  const fw::Status st = front.step(*scan, od, &pose);
+  EXPECT_FALSE(st.is_ok());
+  EXPECT_NE(std::string(st.message()).find("scan 77"), std::string::npos) << st.message();
+  EXPECT_EQ(front.failures(), 1u);
 }
 
 }  // namespace

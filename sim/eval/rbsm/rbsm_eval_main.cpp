@@ -3,6 +3,9 @@
 //     scan-matcher-only odometry; relations metric (Kümmerle et al. 2009) per seed and mean ± std;
 //     writes DIR/DATASET_{rbsm_best,rbsm_worst,icp,odom}.png and trajectories DIR/DATASET_*.txt.
 //   mml-rbsm-eval pairwise DATASET [--pairs N] [--seeds N] [--particles N]
+//   --set KEY=VALUE overrides the matcher configuration (max_range, resolution, size_log2, subcell_log2,
+//     shrink, accept_ratio, max_iterations, sigma_xy2, sigma_psi2, hill_climbing, mahalanobis,
+//     min_translation, min_rotation_deg, icp_max_corr); --no-maps skips the PNGs.
 //     consecutive corrected-scan pairs, guess perturbed by N(0, 10 cm, 6°): mean/p95/max errors.
 #include <cmath>
 #include <cstdio>
@@ -56,7 +59,8 @@ int main(int argc, char** argv) {
   const std::string cmd = argv[1], ds = argv[2];
   int seeds = 20, particles = 1000, workers = 1;
   size_t scans = 0, pairs = 300;
-  bool icp = true;
+  bool icp = true, maps = true;
+  std::vector<std::string> sets;  // key=value overrides of the matcher configuration
   std::string out_dir = "build/rbsm-eval";
   for (int i = 3; i < argc; ++i) {
     const std::string a = argv[i];
@@ -74,6 +78,8 @@ int main(int argc, char** argv) {
     else if (a == "--workers") workers = std::atoi(next());
     else if (a == "--out") out_dir = next();
     else if (a == "--no-icp") icp = false;
+    else if (a == "--no-maps") maps = false;
+    else if (a == "--set") sets.push_back(next());
     else {
       std::fprintf(stderr, "mml-rbsm-eval: unknown option '%s'\n", a.c_str());
       return usage();
@@ -98,6 +104,47 @@ int main(int argc, char** argv) {
   sim::MatcherConfig cfg = sim::default_matcher_config();
   cfg.rbsm.num_particles = static_cast<uint32_t>(particles);
   cfg.workers = workers;
+  for (const std::string& kv : sets) {
+    const size_t eq = kv.find('=');
+    const std::string key = kv.substr(0, eq);
+    const double v = eq == std::string::npos ? NAN : std::atof(kv.c_str() + eq + 1);
+    if (std::isnan(v)) {
+      std::fprintf(stderr, "mml-rbsm-eval: --set %s: expected key=value\n", kv.c_str());
+      return 2;
+    }
+    if (key == "max_range") {
+      cfg.rbsm.max_range = cfg.icp.max_range = cfg.front.scan.max_range = static_cast<float>(v);
+    } else if (key == "resolution") {
+      cfg.rbsm.grid.resolution = cfg.icp.grid.resolution = static_cast<float>(v);
+    } else if (key == "size_log2") {
+      cfg.rbsm.grid.size_log2 = cfg.icp.grid.size_log2 = static_cast<uint32_t>(v);
+    } else if (key == "subcell_log2") {
+      cfg.rbsm.grid.subcell_log2 = cfg.icp.grid.subcell_log2 = static_cast<uint32_t>(v);
+    } else if (key == "shrink") {
+      cfg.rbsm.shrink = static_cast<float>(v);
+    } else if (key == "accept_ratio") {
+      cfg.rbsm.accept_ratio = static_cast<float>(v);
+    } else if (key == "max_iterations") {
+      cfg.rbsm.max_iterations = static_cast<uint32_t>(v);
+    } else if (key == "sigma_xy2") {
+      cfg.rbsm.sigma_xy2_cells2 = static_cast<float>(v);
+    } else if (key == "sigma_psi2") {
+      cfg.rbsm.sigma_psi2_deg2 = static_cast<float>(v);
+    } else if (key == "hill_climbing") {
+      cfg.rbsm.hill_climbing = v != 0;
+    } else if (key == "mahalanobis") {
+      cfg.rbsm.mahalanobis = v != 0;
+    } else if (key == "min_translation") {
+      cfg.front.min_translation_m = static_cast<float>(v);
+    } else if (key == "min_rotation_deg") {
+      cfg.front.min_rotation_rad = static_cast<float>(v * M_PI / 180.0);
+    } else if (key == "icp_max_corr") {
+      cfg.icp.max_correspondence_m = static_cast<float>(v);
+    } else {
+      std::fprintf(stderr, "mml-rbsm-eval: --set: unknown key '%s'\n", key.c_str());
+      return 2;
+    }
+  }
 
   if (cmd == "pairwise") {
     std::vector<sim::CorrectedPose> ref;
@@ -145,7 +192,7 @@ int main(int argc, char** argv) {
   for (size_t i = 0; i < n; ++i) odom_poses.push_back(log.scans[i].odom);
   const auto mo = sim::evaluate_relations(rel, sim::make_trajectory(head, odom_poses));
   std::printf("%s odom: %s\n", ds.c_str(), sim::to_string(mo).c_str());
-  sim::write_map_png(out_dir + "/" + ds + "_odom.png", log, odom_poses, nullptr, 0.05, 15.0f, 1, &err);
+  if (maps) sim::write_map_png(out_dir + "/" + ds + "_odom.png", log, odom_poses, nullptr, 0.05, 15.0f, 1, &err);
   if (icp) {
     sim::OdometryRun run;
     if (!sim::run_scan_matching_odometry(log, sim::MatcherKind::kIcp, cfg, n, &run, &err)) {
@@ -155,7 +202,7 @@ int main(int argc, char** argv) {
     const auto m = sim::evaluate_relations(rel, sim::make_trajectory(head, run.poses));
     std::printf("%s icp: %s | %.2f ms/match p50, %zu failures\n", ds.c_str(), sim::to_string(m).c_str(),
                 sim::percentile(run.match_ms, 50), run.failures);
-    sim::write_map_png(out_dir + "/" + ds + "_icp.png", log, run.poses, nullptr, 0.05, 15.0f, 1, &err);
+    if (maps) sim::write_map_png(out_dir + "/" + ds + "_icp.png", log, run.poses, nullptr, 0.05, 15.0f, 1, &err);
     write_traj(out_dir + "/" + ds + "_icp.txt", log, run.poses);
   }
   std::vector<double> tm, rm;
@@ -174,12 +221,12 @@ int main(int argc, char** argv) {
                 sim::to_string(m).c_str(), sim::percentile(run.match_ms, 50), sim::percentile(run.match_ms, 99),
                 run.failures);
     std::fflush(stdout);
-    if (m.trans_mean < best) {
+    if (maps && m.trans_mean < best) {
       best = m.trans_mean;
       sim::write_map_png(out_dir + "/" + ds + "_rbsm_best.png", log, run.poses, nullptr, 0.05, 15.0f, 1, &err);
       write_traj(out_dir + "/" + ds + "_rbsm_best.txt", log, run.poses);
     }
-    if (m.trans_mean > worst) {
+    if (maps && m.trans_mean > worst) {
       worst = m.trans_mean;
       sim::write_map_png(out_dir + "/" + ds + "_rbsm_worst.png", log, run.poses, nullptr, 0.05, 15.0f, 1, &err);
     }
