@@ -1,0 +1,163 @@
+#!/bin/bash
+# HIL test over virtual CAN (CTest label hil): prepares replay logs from ../shared/data, boots
+# user-mode Linux once (run-in-uml.sh) to run mmlfw + canplayer + candump on vcan0 (CAN FD) and
+# vcan1 (classic), then scores the captured pose/health frames on the host and asserts.
+#   hil_vcan.sh BUILD_DIR   (results: BUILD_DIR/hil/vcan/results.json)
+# Exit 77 = skipped (no UML, no data); CTest maps it to "Skipped".
+# Environment: HIL_SCANS (FD scenario scans, default 300), HIL_SPEED (replay speed-up, default 4),
+#              HIL_LOCALIZER (mml when the map can be built, else odom), HIL_REQUIRE_LOCALIZED (0/1).
+set -u
+B=$(cd "$1" && pwd)
+here=$(cd "$(dirname "$0")" && pwd)
+DATA=${MMLFW_DATA_DIR:-$here/../../../shared/data}
+W=$B/hil/vcan
+SCANS=${HIL_SCANS:-300}
+CLASSIC_SCANS=${HIL_CLASSIC_SCANS:-120}
+SPEED=${HIL_SPEED:-4}
+DS=aces
+fail=0
+say() { echo "hil_vcan: $*"; }
+check() {  # check DESCRIPTION COMMAND...: records a failed assertion
+  if "${@:2}"; then say "ok   - $1"; else say "FAIL - $1"; fail=1; fi
+}
+
+if [ ! -f "$DATA/$DS/$DS.clf.gz" ]; then say "SKIP: $DATA/$DS/$DS.clf.gz not found (set MMLFW_DATA_DIR)"; exit 77; fi
+for t in candump canplayer cansend; do
+  command -v $t >/dev/null || { say "SKIP: $t not installed (apt-get install can-utils)"; exit 77; }
+done
+for exe in firmware/app/mmlfw sim/devices/mml-candev hal/socketcan/hal_socketcan_test; do
+  [ -x "$B/$exe" ] || { say "FAIL: $B/$exe not built"; exit 1; }
+done
+rm -rf "$W"; mkdir -p "$W"
+export MMLFW_DATA_DIR=$DATA
+CANDEV=$B/sim/devices/mml-candev
+
+# The map for MML: built from the corrected log by mml-mapbuild (cached in BUILD_DIR/maps).
+LOC=${HIL_LOCALIZER:-}
+MAP=$B/maps/$DS.mmap
+if [ -z "$LOC" ]; then
+  LOC=odom
+  if [ -f "$MAP" ]; then LOC=mml
+  elif [ -x "$B/sim/map/mml-mapbuild" ]; then
+    mkdir -p "$B/maps"
+    if timeout 300 "$B/sim/map/mml-mapbuild" --dataset $DS --out "$B/maps" > "$W/mapbuild.log" 2>&1 && [ -f "$MAP" ]; then
+      LOC=mml
+    else
+      say "NOTE: mml-mapbuild failed (see $W/mapbuild.log); running with the odometry localizer"
+    fi
+  fi
+fi
+say "localizer $LOC (map $MAP)"
+
+write_config() {  # write_config FILE IFACE FD
+  {
+    echo "laser = socketcan:$2"
+    echo "can_fd = $3"
+    echo "localizer = $LOC"
+    [ "$LOC" != odom ] && echo "map = $MAP"
+    echo "workers = 2"          # inside UML: 1 CPU, pinning degrades to core 0 with a warning
+    echo "arena_mib = 512"
+    echo "health_period_ms = 200"
+  } > "$1"
+}
+
+# Scenario fd: CAN FD on vcan0, clean. classic: classic CAN on vcan1. fault: FD with corrupt,
+# missing and duplicated segments and a bus-off burst (error frames with CAN_ERR_FLAG|CAN_ERR_BUSOFF:
+# vcan has no controller, so bus-off is injected as the error frames a controller would report).
+write_config "$W/fd.conf" vcan0 true
+write_config "$W/classic.conf" vcan1 false
+write_config "$W/fault.conf" vcan0 true
+"$CANDEV" log2can --dataset $DS --count "$SCANS" --fd --speed "$SPEED" --out "$W/fd.replay" > "$W/fd.sent.json" || exit 1
+"$CANDEV" log2can --dataset $DS --count "$CLASSIC_SCANS" --speed "$SPEED" --out "$W/classic.replay" > "$W/classic.sent.json" || exit 1
+"$CANDEV" log2can --dataset $DS --first 1000 --count 150 --fd --speed "$SPEED" --corrupt-every 10 --drop-every 13 \
+  --dup-every 17 --bus-off-at 60 --bus-off-burst 20 --out "$W/fault.replay" > "$W/fault.sent.json" || exit 1
+{
+  echo "fd vcan0 $W/fd.conf $W/fd.replay"
+  echo "classic vcan1 $W/classic.conf $W/classic.replay"
+  echo "fault vcan0 $W/fault.conf $W/fault.replay"
+} > "$W/scenarios"
+
+t0=$(date +%s)
+UML_TIMEOUT=${UML_TIMEOUT:-170} "$here/run-in-uml.sh" "$here/hil_guest.sh" "$W" "$B" 2>&1 | tee "$W/guest.log"
+urc=${PIPESTATUS[0]}
+say "UML run took $(( $(date +%s) - t0 )) s, exit $urc"
+if [ "$urc" = 77 ]; then say "SKIP: user-mode Linux unavailable"; exit 77; fi
+check "guest run completed (exit $urc)" test "$urc" = 0
+check "SocketCAN backend tests pass inside UML" test "$(cat "$W/socketcan_test.rc" 2>/dev/null)" = 0
+
+jget() { python3 -c "import json,sys; print(json.load(open(sys.argv[1]))[sys.argv[2]])" "$1" "$2"; }
+summary() { grep -o '{.*}' <(grep "mmlfw summary:" "$W/$1/mmlfw.log") > "$W/$1/summary.json" && cat "$W/$1/summary.json"; }
+
+for s in fd classic fault; do
+  first=0; count=$SCANS
+  [ $s = classic ] && count=$CLASSIC_SCANS
+  [ $s = fault ] && { first=1000; count=150; }
+  check "$s: mmlfw stopped cleanly on SIGTERM" test "$(cat "$W/$s/mmlfw.rc" 2>/dev/null)" = 0
+  check "$s: canplayer replayed the log" test "$(cat "$W/$s/canplayer.rc" 2>/dev/null)" = 0
+  summary $s > /dev/null || { say "FAIL - $s: no mmlfw summary"; fail=1; continue; }
+  "$CANDEV" score --dataset $DS --first $first --count $count --capture "$W/$s/capture.log" --bound 1.0 \
+    --json "$W/$s/score.json" > /dev/null 2> "$W/$s/score.err" || { say "FAIL - $s: scoring failed"; cat "$W/$s/score.err"; fail=1; continue; }
+  sent=$(jget "$W/$s.sent.json" scans_sent); intact=$(jget "$W/$s.sent.json" scans_intact)
+  ok=$(jget "$W/$s/summary.json" can_scans_ok); dropped=$(jget "$W/$s/summary.json" can_scans_dropped)
+  processed=$(jget "$W/$s/summary.json" scans_processed); poses=$(jget "$W/$s/score.json" poses)
+  say "$s: sent $sent (intact $intact), decoded $ok, dropped $dropped, processed $processed, pose frames $poses, health frames $(jget "$W/$s/score.json" health)"
+  check "$s: every intact scan decoded ($ok == $intact)" test "$ok" = "$intact"
+  check "$s: every faulty scan counted ($dropped == $((sent - intact)))" test "$dropped" = "$((sent - intact))"
+  check "$s: a pose frame per processed scan ($poses == $processed)" test "$poses" = "$processed"
+  check "$s: most decoded scans processed ($processed >= 0.8*$ok)" test $((processed * 10)) -ge $((ok * 8))
+  check "$s: health frames present" test "$(jget "$W/$s/score.json" health)" -ge 1
+  check "$s: status frames follow the protocol (0 violations)" test "$(jget "$W/$s/score.json" violations)" = 0
+  check "$s: no wrong 'localized' pose (> 1 m from the reference)" test "$(jget "$W/$s/score.json" wrong_localized)" = 0
+done
+# Fault scenario: the counters reach the health frame.
+f=$W/fault
+check "fault: CRC errors counted ($(jget $f/summary.json can_crc_errors) == $(jget $W/fault.sent.json scans_corrupted))" \
+  test "$(jget $f/summary.json can_crc_errors)" = "$(jget $W/fault.sent.json scans_corrupted)"
+check "fault: duplicate segments counted" test "$(jget $f/summary.json can_duplicate_segments)" = "$(jget $W/fault.sent.json scans_duplicated)"
+check "fault: lost segments counted" test "$(jget $f/summary.json can_lost_segments)" -ge "$(jget $W/fault.sent.json scans_missing_segment)"
+check "fault: bus-off burst counted ($(jget $f/summary.json can_bus_off) == 20)" test "$(jget $f/summary.json can_bus_off)" = 20
+check "fault: health frame reports bus-off" test "$(jget $f/score.json health_bus_off)" = 20
+check "fault: health frame reports CRC errors" test "$(jget $f/score.json health_crc_errors)" = "$(jget $W/fault.sent.json scans_corrupted)"
+check "classic: runs on a classic-only bus (no FD frames in the capture)" bash -c "! grep -q '##' '$W/classic/capture.log'"
+check "fd: pose frames are CAN FD" grep -q '520##' "$W/fd/capture.log"
+
+LOCALIZED=$(jget "$W/fd/score.json" localized)
+if [ "$LOC" = mml ]; then
+  say "fd: MML localized on $LOCALIZED of $(jget "$W/fd/score.json" poses) scans, first after $(jget "$W/fd/score.json" first_localized_scan) scans, mean error while localized $(jget "$W/fd/score.json" mean_err_localized_m) m"
+  if [ "${HIL_REQUIRE_LOCALIZED:-1}" = 1 ]; then
+    check "fd: the robot localizes (MML)" test "$LOCALIZED" -ge 1
+  fi
+else
+  say "NOTE: odometry localizer: localization is not asserted (status is always 'searching')"
+fi
+
+python3 - "$W" "$LOC" <<'PY'
+import json, sys
+w, loc = sys.argv[1], sys.argv[2]
+j = lambda p: json.load(open(p))
+fd, fds, fs = j(f"{w}/fd/score.json"), j(f"{w}/fd/summary.json"), j(f"{w}/fd.sent.json")
+cl = j(f"{w}/classic/summary.json")
+fa, fas, fsent = j(f"{w}/fault/score.json"), j(f"{w}/fault/summary.json"), j(f"{w}/fault.sent.json")
+out = {
+  "hil_localizer": loc,
+  "hil_vcan_scans_sent": fs["scans_sent"],
+  "hil_vcan_scans_decoded": fds["can_scans_ok"],
+  "hil_vcan_scans_processed": fds["scans_processed"],
+  "hil_vcan_localized": fd["localized"] > 0,
+  "hil_vcan_localized_scans": fd["localized"],
+  "hil_vcan_pose_err_m": fd["mean_err_localized_m"] if fd["localized"] else None,
+  "hil_vcan_pose_err_all_m": fd["mean_err_m"],
+  "hil_fd_ok": fds["can_scans_ok"] == fs["scans_sent"] and fd["violations"] == 0,
+  "hil_classic_scans_decoded": cl["can_scans_ok"],
+  "corrupt_segments_counted": fas["can_crc_errors"] + fas["can_duplicate_segments"] + fas["can_lost_segments"],
+  "fault_scans_dropped_counted": fas["can_scans_dropped"],
+  "fault_scans_faulty": fsent["scans_sent"] - fsent["scans_intact"],
+  "fault_crc_errors": fas["can_crc_errors"],
+  "fault_bus_off": fas["can_bus_off"],
+  "fault_wrong_localized": fa["wrong_localized"],
+}
+json.dump(out, open(f"{w}/results.json", "w"), indent=1)
+print(json.dumps(out))
+PY
+if [ $fail -ne 0 ]; then say "FAILED (details in $W)"; exit 1; fi
+say "PASSED"
