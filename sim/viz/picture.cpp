@@ -125,11 +125,14 @@ void png_flush_noop(png_structp) {}
 struct Canvas {
   int w, h;
   std::vector<std::uint8_t> rgb;
+  int clip_x0 = 0, clip_y0 = 0, clip_x1 = 0, clip_y1 = 0;  // drawing limited to [x0, x1) × [y0, y1)
   Canvas(int w_, int h_, Rgb bg) : w(w_), h(h_), rgb(static_cast<size_t>(w_) * h_ * 3) {
     for (size_t i = 0; i < rgb.size(); i += 3) { rgb[i] = bg.r; rgb[i + 1] = bg.g; rgb[i + 2] = bg.b; }
+    no_clip();
   }
+  void no_clip() { clip_x0 = 0; clip_y0 = 0; clip_x1 = w; clip_y1 = h; }
   void set(int x, int y, Rgb c, double alpha = 1.0) {
-    if (x < 0 || y < 0 || x >= w || y >= h) return;
+    if (x < clip_x0 || y < clip_y0 || x >= clip_x1 || y >= clip_y1) return;
     std::uint8_t* p = &rgb[(static_cast<size_t>(y) * w + x) * 3];
     if (alpha >= 1.0) { p[0] = c.r; p[1] = c.g; p[2] = c.b; return; }
     p[0] = static_cast<std::uint8_t>(p[0] * (1 - alpha) + c.r * alpha);
@@ -267,6 +270,8 @@ bool write_svg(const Picture& pic, const std::string& path, std::string* err) {
       << g.size_y() * L.ppm << "\" preserveAspectRatio=\"none\" style=\"image-rendering:pixelated\" "
       << "href=\"data:image/png;base64," << base64(png) << "\"/>\n";
   }
+  s << "<clipPath id=\"maparea\"><rect x=\"" << kMargin << "\" y=\"" << L.header << "\" width=\"" << L.map_w
+    << "\" height=\"" << L.map_h << "\"/></clipPath>\n<g clip-path=\"url(#maparea)\">\n";
   for (const auto& b : pic.boxes) {
     s << "<rect x=\"" << L.px(b.x0) << "\" y=\"" << L.py(b.y1) << "\" width=\"" << (b.x1 - b.x0) * L.ppm
       << "\" height=\"" << (b.y1 - b.y0) * L.ppm << "\" fill=\"" << hex(b.color) << "\" fill-opacity=\"0.18\" stroke=\""
@@ -302,6 +307,7 @@ bool write_svg(const Picture& pic, const std::string& path, std::string* err) {
         << "</text>\n";
     }
   }
+  s << "</g>\n";
   const auto items = legend_items(pic);
   const int col_w = (L.width - 2 * kMargin) / 3;
   for (size_t i = 0; i < items.size(); ++i) {
@@ -361,6 +367,11 @@ bool write_png(const Picture& pic, const std::string& path, std::string* err) {
       }
     }
   }
+  // Overlays stay inside the map area (a dead-reckoning estimate may leave the map far behind).
+  c.clip_x0 = kMargin;
+  c.clip_y0 = L.header;
+  c.clip_x1 = kMargin + L.map_w;
+  c.clip_y1 = L.header + L.map_h;
   for (const auto& b : pic.boxes) {
     c.fill_rect(static_cast<int>(L.px(b.x0)), static_cast<int>(L.py(b.y1)), static_cast<int>(L.px(b.x1)),
                 static_cast<int>(L.py(b.y0)), b.color, 0.15);
@@ -393,6 +404,7 @@ bool write_png(const Picture& pic, const std::string& path, std::string* err) {
       c.text(tx, ty, m.text, m.color);
     }
   }
+  c.no_clip();
   const auto items = legend_items(pic);
   const int col_w = (L.width - 2 * kMargin) / 3;
   for (size_t i = 0; i < items.size(); ++i) {

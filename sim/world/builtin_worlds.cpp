@@ -10,8 +10,6 @@ namespace {
 constexpr double kDoor = 1.0;        // door width, m
 constexpr double kDoorInset = 1.0;   // route node this far inside a room from its door
 
-enum NodeKind { kCorridor = 0, kDoorway = 1, kRoom = 2 };
-
 // Route bookkeeping while a world is built: corridor centre lines collect nodes that are later
 // linked in order along the line.
 struct CorridorLine {
@@ -50,8 +48,8 @@ struct Builder {
   // line `line` (dir = +1 if the corridor is above the wall, −1 below); centre (cx, cy).
   void room_route(int line, double door_x, double wall_y, int dir, const Vec2& centre) {
     const int c = on_line(line, door_x);
-    const int inner = w->route.add_node(Vec2(door_x, wall_y - dir * kDoorInset));
-    const int room = w->route.add_node(centre);
+    const int inner = w->route.add_node(Vec2(door_x, wall_y - dir * kDoorInset), RouteGraph::kDoorway);
+    const int room = w->route.add_node(centre, RouteGraph::kRoom);
     w->route.connect(c, inner);
     w->route.connect(inner, room);
   }

@@ -8,7 +8,7 @@
 namespace sim {
 
 bool rasterize_world(const World& world, const RasterOptions& opt, OccupancyGrid* out, std::string* err) {
-  const double res = opt.resolution > 0 ? opt.resolution : world.default_resolution;
+  const double res = opt.resolution == 0 ? world.default_resolution : opt.resolution;
   if (!(res >= 0.01 && res <= 1.0)) {
     if (err) *err = "map resolution " + std::to_string(res) + " m outside [0.01, 1]";
     return false;

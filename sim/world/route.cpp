@@ -9,7 +9,7 @@ std::string RouteOptions::validate() const {
   if (!(length_m >= 0 && std::isfinite(length_m))) return "route length must be ≥ 0";
   if (!(speed > 0 && speed < 10)) return "route speed must be in (0, 10) m/s";
   if (!(turn_rate_deg > 0 && turn_rate_deg <= 720)) return "route turn rate must be in (0, 720] deg/s";
-  if (!(straight_weight > 0)) return "route straight_weight must be > 0";
+  if (!(straight_weight > 0 && unvisited_weight > 0 && room_weight > 0)) return "route choice weights must be > 0";
   return {};
 }
 
@@ -100,6 +100,8 @@ bool generate_route(const World& world, const RouteOptions& opt, fw::RandomStrea
   out->start_at(fw::Se2d(g.nodes[cur].x(), g.nodes[cur].y(), heading0));
   if (visited_nodes) visited_nodes->assign(1, cur);
   int prev = -1;
+  std::vector<bool> visited(g.nodes.size(), false);
+  visited[cur] = true;
   for (int guard = 0; out->length() < length && guard < 100000; ++guard) {
     std::vector<int> cand;
     std::vector<double> weight;
@@ -111,8 +113,10 @@ bool generate_route(const World& world, const RouteOptions& opt, fw::RandomStrea
       if (prev >= 0) {
         const Vec2 d_in = (g.nodes[cur] - g.nodes[prev]).normalized();
         const Vec2 d_out = (g.nodes[n] - g.nodes[cur]).normalized();
-        if (d_in.dot(d_out) > 0.95) wgt = opt.straight_weight;
+        if (d_in.dot(d_out) > 0.95) wgt *= opt.straight_weight;
       }
+      if (!visited[n]) wgt *= opt.unvisited_weight;
+      if (g.kinds[cur] == RouteGraph::kCorridor && g.kinds[n] == RouteGraph::kDoorway) wgt *= opt.room_weight;
       weight.push_back(wgt);
     }
     if (cand.empty()) {  // dead end that is only reachable back through prev
@@ -134,6 +138,7 @@ bool generate_route(const World& world, const RouteOptions& opt, fw::RandomStrea
     out->add_drive(to, opt.speed);
     prev = cur;
     cur = next;
+    visited[cur] = true;
     if (visited_nodes) visited_nodes->push_back(cur);
   }
   return true;

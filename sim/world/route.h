@@ -18,8 +18,11 @@ struct RouteOptions {
   double turn_rate_deg = 60;  // deg/s
   int start_node = -1;        // route-graph node to start from; −1 = drawn from the seed
   bool avoid_unknown = true;  // never enter the world's unknown areas
-  // Weight of continuing straight at a junction relative to turning (long corridor runs).
+  // Choice weights at a junction: continuing straight (long corridor runs), a node not visited
+  // yet (explore the building instead of pacing), entering a room (rooms are dead ends).
   double straight_weight = 3.0;
+  double unvisited_weight = 4.0;
+  double room_weight = 0.35;
 
   std::string validate() const;
 };

@@ -25,11 +25,12 @@ Vec2 person_position(const Person& p, double t) {
   return p.path.back();
 }
 
-int RouteGraph::add_node(const Vec2& p) {
+int RouteGraph::add_node(const Vec2& p, int kind) {
   for (size_t i = 0; i < nodes.size(); ++i) {
     if ((nodes[i] - p).norm() < 1e-6) return static_cast<int>(i);
   }
   nodes.push_back(p);
+  kinds.push_back(kind);
   adjacent.emplace_back();
   return static_cast<int>(nodes.size() - 1);
 }

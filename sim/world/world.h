@@ -34,9 +34,12 @@ Vec2 person_position(const Person& p, double t);
 
 // Route graph: nodes where the robot may drive, edges are straight free lines between them.
 struct RouteGraph {
+  enum Kind { kCorridor = 0, kDoorway = 1, kRoom = 2 };
   std::vector<Vec2> nodes;
   std::vector<std::vector<int>> adjacent;
-  int add_node(const Vec2& p);
+  std::vector<int> kinds;
+  // Returns the existing node at p (within 1 µm) or a new one of `kind`.
+  int add_node(const Vec2& p, int kind = kCorridor);
   void connect(int a, int b);
 };
 
