@@ -114,6 +114,43 @@ float ContactField<D>::distance(const Point<D>& p) const {
   return std::sqrt(dist2_[idx]) * options_.resolution;
 }
 
+template <int D>
+bool ContactField<D>::distance_gradient(const Point<D>& p, float* d, Point<D>* grad) const {
+  std::size_t base[D];
+  float frac[D];
+  for (int a = 0; a < D; ++a) {
+    const float f = (p(a) - origin_(a)) * inv_res_ - 0.5f;  // relative to cell centres
+    if (!(f >= 0.0f && f < dims_f_[a] - 1.0f)) return false;
+    base[a] = static_cast<std::size_t>(f);
+    frac[a] = f - static_cast<float>(base[a]);
+  }
+  float val = 0.0f;
+  Point<D> g = Point<D>::Zero();
+  for (int corner = 0; corner < (1 << D); ++corner) {
+    std::size_t idx = 0;
+    float w = 1.0f;
+    float dw[D];
+    for (int a = 0; a < D; ++a) {
+      const int bit = (corner >> a) & 1;
+      idx = idx * dims_[a] + base[a] + static_cast<std::size_t>(bit);
+      dw[a] = bit ? 1.0f : -1.0f;
+    }
+    float wa[D];
+    for (int a = 0; a < D; ++a) wa[a] = ((corner >> a) & 1) ? frac[a] : 1.0f - frac[a];
+    for (int a = 0; a < D; ++a) w *= wa[a];
+    const float v = std::sqrt(dist2_[idx]) * options_.resolution;
+    val += w * v;
+    for (int a = 0; a < D; ++a) {
+      float wo = dw[a];
+      for (int b = 0; b < D; ++b) if (b != a) wo *= wa[b];
+      g(a) += wo * v;
+    }
+  }
+  *d = val;
+  *grad = g * inv_res_;
+  return true;
+}
+
 template class ContactField<2>;
 template class ContactField<3>;
 

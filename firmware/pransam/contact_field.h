@@ -44,6 +44,9 @@ class ContactField {
   }
   // Distance (metres) to the nearest point of B at p's cell; +inf outside.
   float distance(const Point<D>& p) const;
+  // Multilinear interpolation of the distance between cell centres and its gradient (for the
+  // optional local refinement); false outside the field.
+  bool distance_gradient(const Point<D>& p, float* d, Point<D>* grad) const;
 
   const ContactFieldOptions& options() const { return options_; }
   std::size_t cells() const { return total_; }

@@ -1,0 +1,139 @@
+// mml-pransam-eval: pRANSAM experiments (dissertation Sec. 4.5) on real data and a synthetic 3-D scene.
+//   mml-pransam-eval scan-map [--dataset intel] [--mode precomp|online] [--threads 2] [--T 2] [--every 10]
+//                             [--iters 100000] [--thres 0.8] [--hard] [--seed 1] [--max-range 12]
+//                             [--triples 2000000] [--extent 10] [--max-queries 0] [--verbose]
+//   mml-pransam-eval theorem1 [--dataset intel] [--queries 20]
+//   mml-pransam-eval 3d [--trials 10] [--iters 200000] [--threads 2]
+//   mml-pransam-eval build-table [--dataset intel] [--triples 2000000] [--extent 10] --out FILE.mmap
+#include <cstdio>
+#include <cmath>
+#include <cstdlib>
+#include <map>
+#include <string>
+
+#include "sim/eval/pransam_eval/pransam_eval_lib.h"
+#include "sim/map/map_image_writer.h"
+
+using namespace sim::pransam_eval;
+
+namespace {
+std::map<std::string, std::string> parse(int argc, char** argv, int first) {
+  std::map<std::string, std::string> a;
+  for (int i = first; i < argc; ++i) {
+    std::string k = argv[i];
+    if (k.rfind("--", 0) != 0) continue;
+    k = k.substr(2);
+    if (i + 1 < argc && std::string(argv[i + 1]).rfind("--", 0) != 0) a[k] = argv[++i]; else a[k] = "1";
+  }
+  return a;
+}
+std::string get(const std::map<std::string, std::string>& a, const std::string& k, const std::string& d) {
+  auto it = a.find(k);
+  return it == a.end() ? d : it->second;
+}
+int usage() {
+  std::fprintf(stderr, "usage: mml-pransam-eval scan-map|theorem1|3d|build-table [options] (see source header)\n");
+  return 2;
+}
+}  // namespace
+
+int main(int argc, char** argv) {
+  if (argc < 2) return usage();
+  const std::string cmd = argv[1];
+  const auto a = parse(argc, argv, 2);
+  std::string err;
+  if (cmd == "3d") {
+    const ThreeDRun r = run_3d(std::stoul(get(a, "trials", "10")), std::stoi(get(a, "threads", "2")),
+                               static_cast<std::uint32_t>(std::stoul(get(a, "iters", "200000"))), &err);
+    if (!err.empty()) { std::fprintf(stderr, "%s\n", err.c_str()); return 1; }
+    for (std::size_t i = 0; i < r.trials; ++i)
+      std::printf("trial %zu: %.1f ms  trans err %.3f m  rot err %.2f deg\n", i, r.ms[i], r.trans_err[i], r.rot_err_deg[i]);
+    std::printf("3d: success %zu/%zu  p50 %.1f ms\n", r.success, r.trials, r.p50());
+    return 0;
+  }
+  CaseOptions co;
+  co.every = std::stoul(get(a, "every", "10"));
+  co.max_range = std::stof(get(a, "max-range", "12"));
+  co.max_queries = std::stoul(get(a, "max-queries", "0"));
+  RealCase c;
+  if (!load_real_case(get(a, "dataset", "intel"), co, &c, &err)) { std::fprintf(stderr, "%s\n", err.c_str()); return 1; }
+  c.eps_hard = std::stof(get(a, "eps-hard", "0.1"));
+  c.eps_soft = std::stof(get(a, "eps-soft", "0.2"));
+  std::printf("%s: map %u points (%ux%u @ %.3f m), %zu queries\n", c.dataset.c_str(), c.map.num_points,
+              c.map.geometry.width, c.map.geometry.height, c.map.geometry.resolution, c.queries.size());
+  TableBuild tb;
+  tb.triples = std::stoull(get(a, "triples", "2000000"));
+  tb.extent = std::stof(get(a, "extent", "10"));
+  if (cmd == "build-table") {
+    double sec = 0;
+    if (!build_table_section(&c, tb, &sec, &err)) { std::fprintf(stderr, "%s\n", err.c_str()); return 1; }
+    const std::string out = get(a, "out", "");
+    if (out.empty()) return usage();
+    if (!sim::write_file_bytes(out, c.image, &err)) { std::fprintf(stderr, "%s\n", err.c_str()); return 1; }
+    std::printf("relation table (%llu triples, extent %.1f m) built in %.2f s; image %zu bytes -> %s\n",
+                static_cast<unsigned long long>(tb.triples), tb.extent, sec, c.image.size(), out.c_str());
+    return 0;
+  }
+  if (cmd == "theorem1") {
+    const auto rows = theorem1(c, 4, {2000, 5000, 10000, 20000, 40000}, std::stoul(get(a, "queries", "20")), 1, &err);
+    if (rows.empty()) { std::fprintf(stderr, "%s\n", err.c_str()); return 1; }
+    std::printf("T=4 tau I_max  mean_best_Ω  mean_collisions  mean_ms  success\n");
+    for (const auto& r : rows)
+      std::printf("     %d  %6u  %.3f  %10.1f  %7.2f  %.2f\n", r.tau, r.max_iterations, r.mean_best_quality,
+                  r.mean_collisions, r.mean_ms, r.success);
+    return 0;
+  }
+  if (cmd == "diag") {
+    MatcherHandle m;
+    if (!make_matcher(c, 2, 2, false, &m, &err)) { std::fprintf(stderr, "%s\n", err.c_str()); return 1; }
+    double sum = 0;
+    std::vector<double> qs;
+    for (const auto& q : c.queries) {
+      fw::pransam::Hypothesis<2> h;
+      const float cs = std::cos(static_cast<float>(q.theta)), sn = std::sin(static_cast<float>(q.theta));
+      h.rotation << cs, -sn, sn, cs;
+      h.translation = P2(static_cast<float>(q.x), static_cast<float>(q.y));
+      double f = 0, hd = 0;
+      for (const auto& pt : q.points) {
+        const int v = m.matcher->field().contact(h.apply(pt));
+        f += v == 255 ? 1.0 : v / 255.0;
+        hd += v == 255 ? 1.0 : 0.0;
+      }
+      f /= q.points.size();
+      hd /= q.points.size();
+      qs.push_back(f);
+      sum += f;
+      if (a.count("verbose")) std::printf("scan %zu: true-pose Ω fuzzy %.3f hard %.3f (%zu pts)\n", q.index, f, hd, q.points.size());
+    }
+    std::printf("true-pose fuzzy Ω: mean %.3f p10 %.3f p50 %.3f\n", sum / qs.size(), percentile(qs, 0.1), percentile(qs, 0.5));
+    return 0;
+  }
+  if (cmd != "scan-map") return usage();
+  // (--thres 1 runs I_max; then "found" means nothing, so judge the best hypothesis.)
+  const bool precomp = get(a, "mode", "precomp") == "precomp";
+  if (precomp) {
+    double sec = 0;
+    if (!build_table_section(&c, tb, &sec, &err)) { std::fprintf(stderr, "%s\n", err.c_str()); return 1; }
+    std::printf("offline table: %.2f s\n", sec);
+  }
+  MatcherHandle m;
+  if (!make_matcher(c, std::stoi(get(a, "threads", "2")), std::stoi(get(a, "T", "2")), precomp, &m, &err)) {
+    std::fprintf(stderr, "%s\n", err.c_str());
+    return 1;
+  }
+  fw::pransam::MatchParams p;
+  p.seed = std::stoull(get(a, "seed", "1"));
+  p.max_iterations = static_cast<std::uint32_t>(std::stoul(get(a, "iters", "100000")));
+  p.omega_thres = std::stof(get(a, "thres", "0.8"));
+  p.fuzzy = a.count("hard") == 0;
+  p.max_extent = tb.extent;
+  p.refine_iterations = static_cast<std::uint32_t>(std::stoul(get(a, "refine", "0")));
+  p.refine_min_quality = std::stof(get(a, "refine-min", "0.6"));
+  const ScanMapRun r = run_scan_map(c, m, p, Criterion(), a.count("verbose") != 0);
+  std::printf("%s %s T=%s threads=%s %s: correct %zu wrong %zu nothing %zu of %zu (%.1f %%)  p50 %.2f ms  p99 %.2f ms  "
+              "mean iterations %.0f\n",
+              c.dataset.c_str(), precomp ? "precomp" : "online", get(a, "T", "2").c_str(), get(a, "threads", "2").c_str(),
+              p.fuzzy ? "fuzzy" : "hard", r.correct, r.wrong, r.nothing, r.n, 100.0 * r.success(), r.p50(), r.p99(),
+              r.mean_iterations());
+  return 0;
+}
