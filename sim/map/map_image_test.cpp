@@ -16,6 +16,7 @@
 #include "firmware/map/map_image.h"
 #include "firmware/map/map_image_file.h"
 #include "sim/map/map_image_writer.h"
+#include "tests/alloc_counter.h"
 
 namespace sim {
 namespace {
@@ -325,6 +326,33 @@ TEST(MapImageTest, BadFloatsAndInconsistentContentsAreRejected) {
   put_f(&b, geo + 24, 99.0f);
   refresh_crcs(&b);
   expect_rejected(b, "max distance");
+}
+
+TEST(MapImageTest, LoadingDoesNotTouchTheHeap) {
+  if (!mmlfw_test::AllocCounter::available()) GTEST_SKIP() << "allocation counter unavailable under sanitizers";
+  MapImageWriter w;
+  std::string err;
+  ASSERT_TRUE(w.set_grid(test_grid(), &err)) << err;
+  ASSERT_TRUE(w.add_section(fw::MapSectionType::kRelationTable2D, {9, 9, 9}, 1, &err)) << err;
+  const std::string path =
+      (std::filesystem::temp_directory_path() / ("map_image_heap_" + std::to_string(::getpid()) + ".mmap")).string();
+  ASSERT_TRUE(w.write(path, &err)) << err;
+  fw::StartupArena arena;
+  ASSERT_TRUE(arena.init_mapped(1 << 20, false, "t").is_ok());
+  fw::GlobalMap m;
+  fw::MapImageFile file;
+  mmlfw_test::AllocCounter::begin();
+  const fw::Status open = file.open(path.c_str());
+  const fw::Status st = open.is_ok() ? fw::load_map_image(file.data(), file.size(), arena, &m, path.c_str()) : open;
+  std::size_t len = 0;
+  const std::uint8_t* extra = fw::find_section(file.data(), file.size(), fw::MapSectionType::kRelationTable2D, &len);
+  file.close();
+  const long allocations = mmlfw_test::AllocCounter::end();
+  std::filesystem::remove(path);
+  ASSERT_TRUE(st.is_ok()) << st.message();
+  EXPECT_NE(extra, nullptr);
+  EXPECT_EQ(len, 3u);
+  EXPECT_EQ(allocations, 0);
 }
 
 TEST(MapImageTest, ArenaTooSmallIsAnErrorNotACrash) {
