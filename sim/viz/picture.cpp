@@ -62,6 +62,10 @@ bool make_layout(const Picture& pic, Layout* L, std::string* err) {
       for (const auto& l : pic.lines) for (const auto& p : l.points) grow(p.x, p.y);
       for (const auto& s : pic.point_sets) for (const auto& p : s.points) grow(p.x, p.y);
       for (const auto& m : pic.markers) grow(m.x, m.y);
+      if (!any) {
+        if (err) *err = "picture: nothing to draw (no map, no points: empty extent)";
+        return false;
+      }
       x0 -= 1; y0 -= 1; x1 += 1; y1 += 1;
     }
   }
