@@ -50,13 +50,16 @@ bool parse_u64(const std::string& flag, const std::string& v, unsigned long long
 }  // namespace
 
 std::string sim_usage() {
-  return R"(usage: mml-sim (--world NAME | --log FILE.clf[.gz] [--reference POSES.txt] [--map MAP.yaml]) [options]
+  return R"(usage: mml-sim (--world NAME | --dataset NAME | --log FILE.clf[.gz] [--reference POSES.txt] [--map MAP.yaml])
+               [options]
 
 Feeds a synthetic world or a CARMEN log through the hal/sim backend into the firmware's localization
 loop and writes DIR/steps.csv, DIR/summary.json, DIR/run.svg, DIR/run.png and DIR/map.yaml/.pgm.
 
 source:
   --world NAME            built-in world: small-office, large-office, corridor
+  --dataset NAME          a dataset of ../shared/data (intel, fr079, aces, mit-killian, fr-clinic): its raw
+                          log, reference poses and global map (built once, cached in build/maps)
   --log FILE              CARMEN log (plain or gzip) to replay
   --reference FILE        *.corrected-poses.txt: ground truth for the log's scans
   --map FILE.yaml         ROS map_server map for the log (the localizer's global map)
@@ -121,6 +124,8 @@ bool parse_sim_args(const std::vector<std::string>& args, SimConfig* cfg, SimArg
       *action = SimArgsAction::kList;
     } else if (a == "--world") {
       if (!value(&cfg->world)) return false;
+    } else if (a == "--dataset") {
+      if (!value(&cfg->dataset)) return false;
     } else if (a == "--log") {
       if (!value(&cfg->log_path)) return false;
     } else if (a == "--reference") {
@@ -214,19 +219,20 @@ bool parse_sim_args(const std::vector<std::string>& args, SimConfig* cfg, SimArg
     }
   }
   if (*action != SimArgsAction::kRun) return true;
-  if (cfg->world.empty() && cfg->log_path.empty()) {
-    *err = "no input: give --world NAME or --log FILE (see --help)";
+  const int sources = !cfg->world.empty() + !cfg->log_path.empty() + !cfg->dataset.empty();
+  if (sources == 0) {
+    *err = "no input: give --world NAME, --dataset NAME or --log FILE (see --help)";
     return false;
   }
-  if (!cfg->world.empty() && !cfg->log_path.empty()) {
-    *err = "--world and --log exclude each other";
+  if (sources > 1) {
+    *err = "--world, --dataset and --log exclude each other";
     return false;
   }
-  if (!cfg->reference_path.empty() && cfg->log_path.empty()) {
+  if (!cfg->reference_path.empty() && cfg->log_path.empty() && cfg->dataset.empty()) {
     *err = "--reference needs --log";
     return false;
   }
-  if (!cfg->map_yaml.empty() && cfg->log_path.empty()) {
+  if (!cfg->map_yaml.empty() && cfg->log_path.empty() && cfg->dataset.empty()) {
     *err = "--map is for --log replays (worlds bring their own map)";
     return false;
   }

@@ -21,7 +21,9 @@
 #include "hal_sim/sim_task_runner.h"
 #include "hal_sim/stepped_clock.h"
 #include "sim/io/carmen_log.h"
+#include "sim/io/datasets.h"
 #include "sim/io/reference_trajectory.h"
+#include "sim/map/global_maps.h"
 #include "sim/map/map_image_writer.h"
 #include "sim/viz/picture.h"
 #include "sim/world/builtin_worlds.h"
@@ -53,7 +55,7 @@ struct FrameInfo {
 
 // A CARMEN log prepared as frames: odometry records in file order before each scan, plus the
 // scan's own odometry triple (FLASER/RLASER/ROBOTLASER1) at the scan time.
-bool load_log_frames(const SimConfig& cfg, std::vector<Frame>* frames, std::string* err) {
+bool load_log_frames(const SimConfig& cfg, std::vector<Frame>* frames, std::size_t* restamped, std::string* err) {
   CarmenLog log;
   CarmenReadOptions ro;
   ro.max_scans = cfg.steps;
@@ -73,6 +75,7 @@ bool load_log_frames(const SimConfig& cfg, std::vector<Frame>* frames, std::stri
     }
   }
   const double t0 = log.scans.front().ipc_timestamp;
+  double last_ts = t0;
   size_t next_odom = 0;
   double travelled = 0;
   fw::Se2d prev;
@@ -81,9 +84,25 @@ bool load_log_frames(const SimConfig& cfg, std::vector<Frame>* frames, std::stri
     Frame f;
     f.index = static_cast<std::uint32_t>(i);
     f.t = s.ipc_timestamp - t0;
+    // Some logs step back in time (intel: 631 scans whose ipc and logger stamps are earlier than the
+    // previous scan's). The scan line carries its own odometry, so file order is the truth: such a
+    // scan is re-stamped 1 ms after its predecessor (counted), keeping scan and odometry together.
+    double ts_scan = s.ipc_timestamp;
+    if (i > 0 && ts_scan <= last_ts) {
+      ts_scan = last_ts + 1e-3;
+      ++*restamped;
+    }
+    last_ts = ts_scan;
+    f.t = ts_scan - t0;
     auto to_ns = [&](double ts) { return static_cast<std::uint64_t>(std::llround((ts - t0 + 1.0) * 1e9)); };
+    // Scans that carry the odometry at their own time stamp (FLASER, RLASER, ROBOTLASER1) are paired
+    // with exactly that; separate ODOM records are used only for scans without it (RAWLASER). Mixing
+    // both would feed the loop out-of-order samples: in intel, ODOM records are stamped up to 0.4 s
+    // after the FLASER lines that follow them.
+    const bool scan_has_odom = s.type.rfind("RAWLASER", 0) != 0;
     while (next_odom < log.odom.size() && log.odom[next_odom].line < s.line) {
       const CarmenOdom& o = log.odom[next_odom++];
+      if (scan_has_odom) continue;
       hal::Odometry h;
       h.timestamp_ns = o.ipc_timestamp >= t0 - 1.0 ? to_ns(o.ipc_timestamp) : 0;
       h.x = static_cast<float>(o.pose.x);
@@ -93,15 +112,15 @@ bool load_log_frames(const SimConfig& cfg, std::vector<Frame>* frames, std::stri
       h.omega = static_cast<float>(o.rv);
       f.odometry.push_back(h);
     }
-    if (s.type.rfind("RAWLASER", 0) != 0) {
+    if (scan_has_odom) {
       hal::Odometry h;
-      h.timestamp_ns = to_ns(s.ipc_timestamp);
+      h.timestamp_ns = to_ns(ts_scan);
       h.x = static_cast<float>(s.odom.x);
       h.y = static_cast<float>(s.odom.y);
       h.theta = static_cast<float>(s.odom.theta);
       f.odometry.push_back(h);
     }
-    f.scan = to_laser_scan(s, to_ns(s.ipc_timestamp));
+    f.scan = to_laser_scan(s, to_ns(ts_scan));
     f.scan.scan_id = f.index;
     if (i < truth.size()) {
       f.has_truth = true;
@@ -263,6 +282,7 @@ bool write_summary_json(const std::string& path, const SimSummary& s, std::strin
                num(s.wall_s).c_str(), num(s.scans_per_s).c_str());
   std::fprintf(f, "  \"scans_dropped\": %zu,\n  \"ring_drops\": %llu,\n  \"odom_rejected\": %llu,\n", s.scans_dropped,
                static_cast<unsigned long long>(s.ring_drops), static_cast<unsigned long long>(s.odom_rejected));
+  std::fprintf(f, "  \"scans_restamped\": %zu,\n", s.scans_restamped);
   std::fprintf(f, "  \"scans_held\": %llu,\n  \"step_errors\": %llu\n}\n", static_cast<unsigned long long>(s.scans_held),
                static_cast<unsigned long long>(s.step_errors));
   const bool ok = std::fclose(f) == 0;
@@ -270,8 +290,47 @@ bool write_summary_json(const std::string& path, const SimSummary& s, std::strin
   return ok;
 }
 
-bool run_simulation(const SimConfig& cfg, SimResult* out, std::string* err) {
+// --dataset NAME: the raw log, its reference poses and the global map built from the corrected log
+// (cached by sim/map/global_maps.h under build/maps).
+bool resolve_dataset(SimConfig* cfg, std::string* err) {
+  const Dataset* ds = find_dataset(cfg->dataset);
+  if (ds == nullptr) {
+    std::string names;
+    for (const Dataset& d : datasets()) names += (names.empty() ? "" : ", ") + d.name;
+    *err = "unknown dataset '" + cfg->dataset + "' (known: " + names + ")";
+    return false;
+  }
+  if (ds->raw_log.empty()) {
+    *err = "dataset '" + cfg->dataset + "' has no raw log";
+    return false;
+  }
+  cfg->log_path = data_path(ds->raw_log);
+  if (!std::filesystem::exists(cfg->log_path)) {
+    *err = "dataset '" + cfg->dataset + "': log '" + cfg->log_path + "' not found (MMLFW_DATA_DIR=" + data_dir() + ")";
+    return false;
+  }
+  if (cfg->reference_path.empty() && !ds->corrected_poses.empty()) cfg->reference_path = data_path(ds->corrected_poses);
+  if (cfg->map_yaml.empty()) {
+    RosMap m;
+    if (!ensure_global_map(cfg->dataset, 0.0, map_cache_dir(), &m, err)) {
+      *err = "dataset '" + cfg->dataset + "': global map: " + *err;
+      return false;
+    }
+    cfg->map_yaml = global_map_yaml_path(cfg->dataset);
+  }
+  return true;
+}
+
+bool run_simulation(const SimConfig& cfg_in, SimResult* out, std::string* err) {
   *out = SimResult();
+  SimConfig cfg = cfg_in;
+  if (!cfg.dataset.empty()) {
+    if (!cfg.world.empty() || !cfg.log_path.empty()) {
+      *err = "--dataset excludes --world and --log";
+      return false;
+    }
+    if (!resolve_dataset(&cfg, err)) return false;
+  }
   if (cfg.world.empty() == cfg.log_path.empty()) {
     *err = "give exactly one of a world (--world) or a log (--log)";
     return false;
@@ -303,14 +362,15 @@ bool run_simulation(const SimConfig& cfg, SimResult* out, std::string* err) {
     total = synthetic.num_scans();
     sum.source = "world:" + cfg.world;
   } else {
-    if (!load_log_frames(cfg, &log_frames, err)) return false;
+    if (!load_log_frames(cfg, &log_frames, &sum.scans_restamped, err)) return false;
     total = log_frames.size();
     if (!cfg.map_yaml.empty()) {
       RosMap rm;
       if (!read_ros_map(cfg.map_yaml, &rm, err) || !ros_map_to_grid(rm, &grid, err)) return false;
       have_grid = true;
     }
-    sum.source = "log:" + std::filesystem::path(cfg.log_path).filename().string();
+    sum.source = cfg.dataset.empty() ? "log:" + std::filesystem::path(cfg.log_path).filename().string()
+                                     : "dataset:" + cfg.dataset;
   }
 
   // ---- compiled map image, loaded by the firmware's own loader into a start-up arena ----
@@ -531,7 +591,14 @@ bool run_simulation(const SimConfig& cfg, SimResult* out, std::string* err) {
       std::fprintf(stderr, "not localized in %zu steps (%.1f m); localizer '%s'\n", sum.steps, sum.path_length_m,
                    cfg.localizer.c_str());
     }
-    for (std::size_t i = 0; i < logs->size(); ++i) std::fprintf(stderr, "firmware: %s\n", logs->line(i).text);
+    const std::size_t shown = std::min<std::size_t>(logs->size(), 10);
+    for (std::size_t i = logs->size() - shown; i < logs->size(); ++i) {
+      std::fprintf(stderr, "firmware: %s\n", logs->line(i).text);
+    }
+    if (logs->total() > shown) {
+      std::fprintf(stderr, "firmware: (%llu warnings/errors in total, last %zu shown)\n",
+                   static_cast<unsigned long long>(logs->total()), shown);
+    }
   }
 
   // ---- outputs ----

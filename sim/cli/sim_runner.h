@@ -19,6 +19,7 @@ namespace sim {
 
 struct SimConfig {
   std::string world;           // built-in world name, or
+  std::string dataset;         // a dataset of ../shared/data (log, reference and cached global map), or
   std::string log_path;        // CARMEN log (plain or .gz)
   std::string reference_path;  // *.corrected-poses.txt for a log (ground truth)
   std::string map_yaml;        // ROS map for a log replay (optional)
@@ -60,6 +61,7 @@ struct SimSummary {
   double step_ms_mean = 0, step_ms_p50 = 0, step_ms_p99 = 0, step_ms_max = 0;
   double path_length_m = 0, wall_s = 0, scans_per_s = 0;
   std::uint64_t odom_rejected = 0, scans_held = 0, ring_drops = 0, step_errors = 0;
+  std::size_t scans_restamped = 0;  // log scans whose time stamp stepped back (re-stamped, see sim_runner.cpp)
 };
 
 struct SimResult {
