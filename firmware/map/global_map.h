@@ -3,6 +3,7 @@
 // so the struct is cheap to copy and never owns memory.
 #pragma once
 
+#include <cmath>
 #include <cstddef>
 #include <cstdint>
 
@@ -32,6 +33,30 @@ struct GlobalMap {
     std::int32_t cx = 0, cy = 0;
     if (!geometry.world_to_cell(x, y, &cx, &cy)) return outside;
     return distance_m[geometry.index(cx, cy)];
+  }
+  // Bilinear interpolation of the distance field between cell centres (continuous, for gradient-
+  // based matching and likelihood fields); optional gradient in metres per metre. Points outside
+  // the grid (or NaN) give `outside` and a zero gradient; within half a cell of the border the
+  // edge values are extended.
+  float distance_bilinear(float x, float y, float outside, float* grad_x = nullptr, float* grad_y = nullptr) const {
+    if (grad_x != nullptr) *grad_x = 0.0f;
+    if (grad_y != nullptr) *grad_y = 0.0f;
+    float gx = 0.0f, gy = 0.0f;
+    geometry.world_to_grid(x, y, &gx, &gy);
+    const float w = static_cast<float>(geometry.width), h = static_cast<float>(geometry.height);
+    if (!(gx >= 0.0f && gy >= 0.0f && gx < w && gy < h)) return outside;
+    gx = std::fmin(std::fmax(gx - 0.5f, 0.0f), w - 1.0f);
+    gy = std::fmin(std::fmax(gy - 0.5f, 0.0f), h - 1.0f);
+    const std::int32_t x0 = static_cast<std::int32_t>(gx), y0 = static_cast<std::int32_t>(gy);
+    const std::int32_t x1 = x0 + 1 < static_cast<std::int32_t>(geometry.width) ? x0 + 1 : x0;
+    const std::int32_t y1 = y0 + 1 < static_cast<std::int32_t>(geometry.height) ? y0 + 1 : y0;
+    const float fx = gx - static_cast<float>(x0), fy = gy - static_cast<float>(y0);
+    const float d00 = distance_m[geometry.index(x0, y0)], d10 = distance_m[geometry.index(x1, y0)];
+    const float d01 = distance_m[geometry.index(x0, y1)], d11 = distance_m[geometry.index(x1, y1)];
+    const float a = d00 + fx * (d10 - d00), b = d01 + fx * (d11 - d01);
+    if (grad_x != nullptr) *grad_x = ((1.0f - fy) * (d10 - d00) + fy * (d11 - d01)) / geometry.resolution;
+    if (grad_y != nullptr) *grad_y = (b - a) / geometry.resolution;
+    return a + fy * (b - a);
   }
 };
 

@@ -98,6 +98,29 @@ TEST(MapImageFormatTest, LoadsHandMadeImage) {
   EXPECT_EQ(arena.used(), 12u + 12u * 4u + 2u * 8u);  // occupancy, distances, points
 }
 
+TEST(MapImageFormatTest, BilinearDistanceAndGradient) {
+  const std::vector<std::uint8_t> img = hand_made_image();
+  alignas(16) static unsigned char storage[4096];
+  StartupArena arena;
+  ASSERT_TRUE(arena.init(storage, sizeof(storage), "test").is_ok());
+  GlobalMap m;
+  ASSERT_TRUE(load_map_image(img.data(), img.size(), arena, &m, "hand.mmap").is_ok());
+  float gx = 0, gy = 0;
+  // At a cell centre: the cell value.
+  EXPECT_FLOAT_EQ(m.distance_bilinear(1.75f, -0.75f, -1.0f), 0.5f);
+  // Halfway between centres of (0,0) [0] and (1,0) [0.5]: 0.25, gradient +1 m/m along x.
+  EXPECT_FLOAT_EQ(m.distance_bilinear(1.5f, -0.75f, -1.0f, &gx, &gy), 0.25f);
+  EXPECT_FLOAT_EQ(gx, 1.0f);
+  // Between (0,0) [0] and (0,1) [0.5] along y.
+  EXPECT_FLOAT_EQ(m.distance_bilinear(1.25f, -0.5f, -1.0f, &gx, &gy), 0.25f);
+  EXPECT_FLOAT_EQ(gy, 1.0f);
+  // Border region (within half a cell of the edge) is clamped; outside gives `outside`.
+  EXPECT_FLOAT_EQ(m.distance_bilinear(1.01f, -0.99f, -1.0f), 0.0f);
+  EXPECT_EQ(m.distance_bilinear(0.9f, 0.0f, -1.0f, &gx, &gy), -1.0f);
+  EXPECT_EQ(gx, 0.0f);
+  EXPECT_EQ(m.distance_bilinear(NAN, 0.0f, -2.0f), -2.0f);
+}
+
 TEST(MapImageFormatTest, RejectsCorruption) {
   const std::vector<std::uint8_t> good = hand_made_image();
   alignas(16) static unsigned char storage[4096];
