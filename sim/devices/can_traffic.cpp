@@ -168,6 +168,10 @@ PoseScore score_pose_frames(const std::vector<hal::CanFrame>& frames, const std:
       if (index < reference.size()) {
         const fw::Se2d& r = reference[index];
         const double e = std::hypot(p.x - r.x, p.y - r.y);
+        if (o.dump) {
+          std::fprintf(o.dump, "%zu %s %.3f %.3f %.3f %.3f %.3f\n", index, hal::status_name(p.status),
+                       static_cast<double>(p.x), static_cast<double>(p.y), r.x, r.y, e);
+        }
         ++s.scored;
         sum += e;
         s.max_err_m = std::max(s.max_err_m, e);

@@ -4,6 +4,7 @@
 #pragma once
 
 #include <cstdint>
+#include <cstdio>
 #include <string>
 #include <vector>
 
@@ -50,6 +51,7 @@ bool write_candump_log(const std::string& path, const std::string& iface, const 
 struct PoseScoreOptions {
   size_t first_scan = 0, num_scans = 0;  // the scans that were sent (scan_id = index & 0xFFFF)
   double localized_bound_m = 1.0;        // a `localized` pose farther than this from the reference is wrong
+  std::FILE* dump = nullptr;             // optional: one line per pose (index status x y ref_x ref_y err)
 };
 
 struct PoseScore {

@@ -182,7 +182,14 @@ int main(int argc, char** argv) {
     so.first_scan = static_cast<size_t>(first);
     so.num_scans = static_cast<size_t>(count);
     so.localized_bound_m = bound;
+    std::FILE* dump = nullptr;
+    if (a.has("dump")) {
+      dump = std::fopen(a.get("dump").c_str(), "w");
+      if (!dump) return usage(("cannot write --dump " + a.get("dump")).c_str());
+      so.dump = dump;
+    }
     sim::PoseScore s = sim::score_pose_frames(frames, ref, so);
+    if (dump) std::fclose(dump);
     char buf[2048];
     std::snprintf(buf, sizeof(buf),
                   "{\"frames\": %zu, \"poses\": %zu, \"health\": %zu, \"searching\": %zu, \"ambiguous\": %zu, "
