@@ -1,0 +1,249 @@
+#include "tests/hil/replay_budget.h"
+
+#include <time.h>
+
+#include <algorithm>
+#include <cmath>
+#include <fstream>
+#include <memory>
+#include <sstream>
+
+#include "firmware/base/arena.h"
+#include "firmware/base/memory_report.h"
+#include "firmware/base/worker_pool.h"
+#include "firmware/map/global_map.h"
+#include "firmware/map/map_image.h"
+#include "firmware/map/map_image_file.h"
+#include "firmware/mml/mml_localizer.h"
+#include "firmware/runtime/localization_loop.h"
+#include "firmware/runtime/odometry_localizer.h"
+#include "hal/hal.h"
+#include "hal_linux/linux_clock.h"
+#include "hal_sim/sim_sensor_io.h"
+#include "sim/io/carmen_log.h"
+#include "sim/io/datasets.h"
+#include "sim/map/global_maps.h"
+
+namespace mmlfw_hil {
+namespace {
+
+std::uint64_t mono_ns() {
+  timespec t{};
+  clock_gettime(CLOCK_MONOTONIC, &t);
+  return static_cast<std::uint64_t>(t.tv_sec) * 1000000000ull + static_cast<std::uint64_t>(t.tv_nsec);
+}
+
+// Static storage as in mmlfw (the MML object is large).
+fw::mml::MmlLocalizer g_mml;
+
+}  // namespace
+
+bool run_replay(const ReplayOptions& o, ReplayResult* r, std::string* error) {
+  *r = ReplayResult{};
+  const sim::Dataset* ds = sim::find_dataset(o.dataset);
+  if (!ds || ds->raw_log.empty()) {
+    *error = "dataset '" + o.dataset + "' unknown or without a raw log";
+    return false;
+  }
+  sim::CarmenLog log;
+  sim::CarmenReadOptions ro;
+  ro.max_scans = o.first_scan + o.num_scans;
+  if (!sim::read_carmen_log(sim::data_path(ds->raw_log), ro, &log, error)) return false;
+  if (log.scans.size() <= o.first_scan) {
+    *error = "log has no scans after " + std::to_string(o.first_scan);
+    return false;
+  }
+  const std::string dir = o.map_dir.empty() ? sim::map_cache_dir() : o.map_dir;
+  sim::RosMap ros;
+  if (!sim::ensure_global_map(o.dataset, 0, dir, &ros, error)) return false;
+  const std::string image_path = sim::global_map_image_path(o.dataset, dir);
+
+  fw::MemoryReport::instance().clear();
+  static fw::StartupArena arena;
+  fw::Status st = arena.init_mapped(256u << 20, false, "arena");
+  if (!st) { *error = st.message(); return false; }
+  fw::GlobalMap map{};
+  fw::MapImageFile image;
+  st = image.open(image_path.c_str());
+  if (st) st = fw::load_map_image(image.data(), image.size(), arena, &map, image_path.c_str());
+  if (!st) { *error = st.message(); return false; }
+  std::size_t table_len = 0;
+  const std::uint8_t* table =
+      fw::find_section(image.data(), image.size(), fw::MapSectionType::kRelationTable2D, &table_len);
+  r->map_width = map.geometry.width;
+  r->map_height = map.geometry.height;
+  r->map_resolution = map.geometry.resolution;
+
+  static fw::WorkerPool pool;
+  fw::WorkerPoolOptions po;
+  po.num_workers = o.workers;
+  st = pool.start(po);
+  if (!st) { *error = st.message(); return false; }
+  r->pin_warnings = pool.warning_count();
+
+  static fw::OdometryLocalizer odom_loc;
+  fw::Localizer* loc = &odom_loc;
+  if (o.localizer == "mml") {
+    fw::mml::MmlLocalizerConfig mc = fw::mml::default_mml_config();
+    mc.mml.seed = o.seed;
+    if (!table) mc.mml.precomputed_table = false;
+    st = g_mml.init(mc, map, table, table_len, arena, &pool);
+    if (!st) { *error = std::string("mml: ") + st.message(); pool.stop(); return false; }
+    loc = &g_mml;
+  }
+  image.close();
+
+  static hal_linux::LinuxClock clock;
+  static hal_sim::SimLaserSource laser;
+  static hal_sim::SimOdometrySource odom;
+  static hal_sim::SimPoseSink sink;
+  hal::Hal hal;
+  hal.clock = &clock;
+  hal.laser = &laser;
+  hal.odometry = &odom;
+  hal.pose_sink = &sink;
+  static fw::LocalizationLoop loop;
+  fw::LocalizationLoopOptions lo;
+  lo.step_deadline_ns = static_cast<std::uint64_t>(o.deadline_ms * 1e6);
+  st = loop.init(hal, *loc, lo);
+  if (!st) { *error = st.message(); pool.stop(); return false; }
+  arena.seal();
+
+  // Memory: arena used + the static objects of the firmware binary.
+  const double mib = 1.0 / (1024.0 * 1024.0);
+  const auto& mr = fw::MemoryReport::instance();
+  for (std::size_t i = 0; i < mr.region_count(); ++i) {
+    const fw::MemoryRegion& reg = mr.region(i);
+    if (std::string(reg.module) == "arena") continue;
+    r->module_mib[reg.module] += static_cast<double>(reg.bytes) * mib;
+  }
+  const double statics = static_cast<double>(sizeof(g_mml) + sizeof(loop) + sizeof(pool) + sizeof(laser) +
+                                             sizeof(odom) + sizeof(sink)) * mib;
+  r->module_mib["statics"] = statics;
+  r->module_mib["arena_used"] = static_cast<double>(arena.used()) * mib;
+  r->static_memory_mib = static_cast<double>(arena.used()) * mib + statics;
+
+  // Feed: scans at rate_hz of the wall clock; sensor time compressed the same way (per-scan
+  // motion unchanged), odometry records between scans interleaved by their log time.
+  const size_t last = std::min(log.scans.size(), o.first_scan + o.num_scans);
+  const double log_t0 = log.scans[o.first_scan].ipc_timestamp;
+  const double period = 1.0 / o.rate_hz;
+  auto sensor_ns = [&](double ipc) {
+    // Piecewise-linear time warp: scan k of the log is at k * period.
+    return ipc;  // replaced below
+  };
+  (void)sensor_ns;
+  std::vector<double> scan_t;  // log times of the scans fed
+  for (size_t i = o.first_scan; i < last; ++i) scan_t.push_back(log.scans[i].ipc_timestamp);
+  auto warp = [&](double ipc) -> std::uint64_t {
+    auto it = std::upper_bound(scan_t.begin(), scan_t.end(), ipc);
+    size_t k = static_cast<size_t>(it - scan_t.begin());
+    double t;
+    if (k == 0) t = 0;
+    else if (k >= scan_t.size()) t = (scan_t.size() - 1) * period;
+    else {
+      const double a = scan_t[k - 1], b = scan_t[k];
+      t = ((k - 1) + (b > a ? (ipc - a) / (b - a) : 0)) * period;
+    }
+    return static_cast<std::uint64_t>(1e9 + t * 1e9);
+  };
+  size_t oi = 0;
+  while (oi < log.odom.size() && log.odom[oi].ipc_timestamp < log_t0 - 0.5) ++oi;
+  const std::uint64_t t0 = mono_ns() + 10'000'000;
+  size_t k = 0;
+  const double to_ms = 1e-6;
+  (void)to_ms;
+  const std::uint64_t end_ns = t0 + static_cast<std::uint64_t>((last - o.first_scan) * period * 1e9) + 3'000'000'000ull;
+  while (true) {
+    const std::uint64_t now = mono_ns();
+    // Push everything due.
+    while (k < scan_t.size() && now >= t0 + static_cast<std::uint64_t>(k * period * 1e9)) {
+      const double tk = scan_t[k];
+      while (oi < log.odom.size() && log.odom[oi].ipc_timestamp <= tk + 0.5 * (k + 1 < scan_t.size() ? scan_t[k + 1] - tk : 0)) {
+        const sim::CarmenOdom& c = log.odom[oi++];
+        hal::Odometry od;
+        od.timestamp_ns = warp(c.ipc_timestamp);
+        od.x = static_cast<float>(c.pose.x);
+        od.y = static_cast<float>(c.pose.y);
+        od.theta = static_cast<float>(c.pose.theta);
+        odom.push(od);
+      }
+      hal::LaserScan s = sim::to_laser_scan(log.scans[o.first_scan + k], warp(tk));
+      if (!laser.push(s)) ++r->scans_dropped;
+      ++r->scans_fed;
+      ++k;
+    }
+    loop.spin_once();
+    hal::PoseEstimate e;
+    while (sink.pop(&e)) {
+      ++r->scans_processed;
+      if (e.status == hal::LocalizationStatus::kLocalized) ++r->localized;
+    }
+    if (k >= scan_t.size() && laser.pending() == 0 && !loop.scan_pending()) break;
+    if (mono_ns() > end_ns) break;
+    if (!loop.stepped()) {
+      timespec ts{0, 200'000};  // 0.2 ms: idle until the next scan is due
+      nanosleep(&ts, nullptr);
+    }
+  }
+  const double wall = static_cast<double>(mono_ns() - t0) * 1e-9;
+  pool.stop();
+  const fw::PerfStats step = loop.perf_step().stats();
+  r->step_p50_ms = step.p50_ms;
+  r->step_p99_ms = step.p99_ms;
+  r->step_max_ms = step.max_ms;
+  r->cycle_p99_ms = loop.perf_total().stats().p99_ms;
+  r->deadline_misses = loop.health().deadline_misses;
+  r->scans_dropped += loop.health().dropped_scans;
+  r->achieved_rate_hz = wall > 0 ? static_cast<double>(r->scans_processed) / wall : 0;
+  return true;
+}
+
+bool read_budget(const std::string& path, std::map<std::string, double>* out, std::string* error) {
+  std::ifstream in(path);
+  if (!in) { *error = path + ": cannot open"; return false; }
+  std::string line;
+  int n = 0;
+  while (std::getline(in, line)) {
+    ++n;
+    const auto hash = line.find('#');
+    if (hash != std::string::npos) line.resize(hash);
+    std::istringstream ls(line);
+    std::string key, eq, value;
+    if (!(ls >> key)) continue;
+    if (!(ls >> eq >> value) || eq != "=") {
+      *error = path + ":" + std::to_string(n) + ": expected 'key = value'";
+      return false;
+    }
+    char* end = nullptr;
+    const double v = std::strtod(value.c_str(), &end);
+    if (*end || !std::isfinite(v)) {
+      if (key == "dataset" || key == "localizer") continue;  // text keys
+      *error = path + ":" + std::to_string(n) + ": key '" + key + "': '" + value + "' is not a number";
+      return false;
+    }
+    (*out)[key] = v;
+  }
+  return true;
+}
+
+std::vector<std::string> check_budget(const std::map<std::string, double>& b, const ReplayResult& r) {
+  std::vector<std::string> v;
+  auto lim = [&](const char* key, double value, bool max = true) {
+    auto it = b.find(key);
+    if (it == b.end()) return;
+    if (max ? value > it->second : value < it->second) {
+      v.push_back(std::string(key) + ": measured " + std::to_string(value) + (max ? " > " : " < ") + std::to_string(it->second));
+    }
+  };
+  lim("static_memory_total_mib", r.static_memory_mib);
+  for (const auto& [module, mib] : r.module_mib) lim(("static_memory_mib." + module).c_str(), mib);
+  lim("step_p99_ms", r.step_p99_ms);
+  lim("cycle_p99_ms", r.cycle_p99_ms);
+  lim("deadline_miss_fraction", r.scans_processed ? static_cast<double>(r.deadline_misses) / r.scans_processed : 1.0);
+  lim("dropped_fraction", r.scans_fed ? static_cast<double>(r.scans_dropped) / r.scans_fed : 1.0);
+  lim("processed_rate_hz_min", r.achieved_rate_hz, false);
+  return v;
+}
+
+}  // namespace mmlfw_hil

@@ -1,0 +1,46 @@
+// Real-time replay on the host for the budget check: a CARMEN log is fed to the same firmware
+// stack as mmlfw (LocalizationLoop + MmlLocalizer with pinned WorkerPool threads, map image in a
+// StartupArena) through the hal/sim rings, scans due at the sensor rate (75 Hz) of the wall clock.
+// A step slower than the period delays later scans (they queue in the ring, overflow is counted);
+// a step longer than the deadline is a deadline miss.
+#pragma once
+
+#include <cstddef>
+#include <map>
+#include <cstdint>
+#include <string>
+#include <vector>
+
+namespace mmlfw_hil {
+
+struct ReplayOptions {
+  std::string dataset = "aces";
+  std::string map_dir;          // map cache; empty = sim::map_cache_dir()
+  std::string localizer = "mml";
+  size_t first_scan = 0, num_scans = 600;
+  double rate_hz = 75.0;
+  double deadline_ms = 1000.0 / 75.0;
+  int workers = 2;
+  std::uint64_t seed = 1;
+};
+
+struct ReplayResult {
+  size_t scans_fed = 0, scans_processed = 0, scans_dropped = 0, localized = 0;
+  size_t deadline_misses = 0;
+  double step_p50_ms = 0, step_p99_ms = 0, step_max_ms = 0, cycle_p99_ms = 0;
+  double achieved_rate_hz = 0;    // processed scans per second of wall time
+  double static_memory_mib = 0;   // arena used + static objects
+  std::map<std::string, double> module_mib;  // memory report by module (arena regions, statics)
+  size_t map_width = 0, map_height = 0;
+  double map_resolution = 0;
+  int pin_warnings = 0;
+};
+
+bool run_replay(const ReplayOptions& options, ReplayResult* out, std::string* error);
+
+// Budget file: "key = value" lines, '#' comments (firmware/app/budget.txt).
+bool read_budget(const std::string& path, std::map<std::string, double>* out, std::string* error);
+// Compares; returns human-readable violations (empty = within budget).
+std::vector<std::string> check_budget(const std::map<std::string, double>& budget, const ReplayResult& r);
+
+}  // namespace mmlfw_hil

@@ -1,0 +1,37 @@
+// Budget check (CTest label budget, RUN_SERIAL): replays aces at 75 Hz on the host with pinned
+// worker threads and compares memory, step latency and deadline misses with firmware/app/budget.txt.
+#include <gtest/gtest.h>
+
+#include <cstdio>
+
+#include "sim/io/datasets.h"
+#include "tests/hil/replay_budget.h"
+
+#ifndef MMLFW_BUDGET_FILE
+#error MMLFW_BUDGET_FILE must name firmware/app/budget.txt
+#endif
+
+TEST(ReplayBudget, Aces75HzWithinBudget) {
+  std::map<std::string, double> budget;
+  std::string err;
+  ASSERT_TRUE(mmlfw_hil::read_budget(MMLFW_BUDGET_FILE, &budget, &err)) << err;
+  const sim::Dataset* ds = sim::find_dataset("aces");
+  if (!ds || std::fopen(sim::data_path(ds->raw_log).c_str(), "rb") == nullptr) {
+    GTEST_SKIP() << "aces log not found under " << sim::data_dir() << " (set MMLFW_DATA_DIR)";
+  }
+  mmlfw_hil::ReplayOptions o;
+  o.num_scans = static_cast<size_t>(budget.count("replay_scans") ? budget["replay_scans"] : 600);
+  o.rate_hz = budget.count("scan_rate_hz") ? budget["scan_rate_hz"] : 75.0;
+  o.deadline_ms = 1000.0 / o.rate_hz;
+  mmlfw_hil::ReplayResult r;
+  ASSERT_TRUE(mmlfw_hil::run_replay(o, &r, &err)) << err;
+  std::printf("replay aces %zu scans at %.0f Hz: processed %zu (%.1f Hz), dropped %zu, localized %zu, "
+              "step p50 %.2f ms p99 %.2f ms max %.2f ms, cycle p99 %.2f ms, deadline misses %zu, "
+              "static memory %.1f MiB, map %zux%zu @ %.2f m, pin warnings %d\n",
+              r.scans_fed, o.rate_hz, r.scans_processed, r.achieved_rate_hz, r.scans_dropped, r.localized,
+              r.step_p50_ms, r.step_p99_ms, r.step_max_ms, r.cycle_p99_ms, r.deadline_misses, r.static_memory_mib,
+              r.map_width, r.map_height, r.map_resolution, r.pin_warnings);
+  for (const auto& [m, mib] : r.module_mib) std::printf("  memory %-12s %8.2f MiB\n", m.c_str(), mib);
+  EXPECT_GT(r.scans_processed, 0u);
+  for (const std::string& v : mmlfw_hil::check_budget(budget, r)) ADD_FAILURE() << "budget exceeded: " << v;
+}
