@@ -276,6 +276,31 @@ void Matcher<D>::refine(Hypothesis<D>* h) const {
 }
 
 template <int D>
+float Matcher<D>::blocked_fraction(const Hypothesis<D>& h) const {
+  const Point<D> origin = h.translation;  // the sensor (A's origin) in B
+  const float res = field_.options().resolution;
+  std::uint32_t blocked_n = 0;
+  for (std::uint32_t i = 0; i < scene_n_; ++i) {
+    const Point<D> p = h.rotation * scene_[i] + h.translation;
+    const Point<D> ray = p - origin;
+    const float len = ray.norm();
+    const float free_len = len - params_.free_space_margin;
+    if (!(free_len > 0.0f)) continue;
+    // Sphere tracing on B's distance field: a step never jumps over a point of B; the beam is
+    // blocked when it enters a cell that holds a point of B.
+    const Point<D> dir = ray / len;
+    float s = 0.0f;
+    while (s < free_len) {
+      const float d = field_.distance(origin + dir * s);
+      if (!(d < 1e30f)) break;  // left the field: free
+      if (d < 0.5f * res) { ++blocked_n; break; }
+      s += d - 0.75f * res > 0.5f * res ? d - 0.75f * res : 0.5f * res;
+    }
+  }
+  return static_cast<float>(blocked_n) / static_cast<float>(scene_n_);
+}
+
+template <int D>
 void Matcher<D>::run_worker(int w) {
   WorkerState& st = workers_[w];
   st.num_inserts = 0;
@@ -324,6 +349,10 @@ void Matcher<D>::run_worker(int w) {
       refine(&h);
       ++st.stats.refined;
       q = rate(h, 0.0f, 0, &complete, &st.stats.point_checks);
+    }
+    if (params_.scene_origin_is_sensor && q >= thres && blocked_fraction(h) > params_.max_blocked_fraction) {
+      ++st.stats.free_space_rejected;
+      continue;  // beams through walls of B: impossible pose whatever Ω says
     }
     h.quality = q;
     if (!st.best_valid || q > st.best.quality) {
@@ -540,6 +569,7 @@ Status Matcher<D>::match(const Point<D>* scene, std::size_t n, const MatchParams
     s.extrapolation_cut += ws.extrapolation_cut;
     s.point_checks += ws.point_checks;
     s.refined += ws.refined;
+    s.free_space_rejected += ws.free_space_rejected;
     dropped += workers_[w].dropped;
   }
   s.rounds = rounds;

@@ -72,6 +72,13 @@ struct MatchParams {
   // triangle correspondence is only as precise as the point spacing, so without this a correct
   // hypothesis often misses a tight Ω_thres by a few centimetres / a degree.
   std::uint32_t refine_iterations = 0;
+  // Optional free-space test for scans (an addition, off by default): A's origin is the sensor.
+  // A hypothesis reaching Ω ≥ Ω_thres is rejected when more than max_blocked_fraction of its beams
+  // (sensor → point, ignoring the last free_space_margin metres) pass through a point of B: a beam
+  // through a wall of the map is impossible. Rejects mirrored / rotated corridor matches.
+  bool scene_origin_is_sensor = false;
+  float free_space_margin = 0.3f;
+  float max_blocked_fraction = 0.1f;
   float refine_min_quality = 0.6f;
   float refine_cutoff = 0.4f;
 };
@@ -86,6 +93,7 @@ struct MatchStats {
   std::uint64_t extrapolation_cut = 0;  // rated but dropped early (Eq. 4.8)
   std::uint64_t point_checks = 0;     // contact look-ups
   std::uint64_t refined = 0;          // hypotheses polished (refine_iterations > 0)
+  std::uint64_t free_space_rejected = 0;  // Ω ≥ Ω_thres but not after the free-space test
   std::uint32_t rounds = 0;
   StopReason stop = StopReason::kMaxIterations;
 };
@@ -156,6 +164,7 @@ class Matcher {
   void run_worker(int w);
   void reset_online_table(int table);
   void refine(Hypothesis<D>* h) const;
+  float blocked_fraction(const Hypothesis<D>& h) const;
   float rate(const Hypothesis<D>& h, float bound, std::uint32_t start, bool* complete, std::uint64_t* checks) const;
 
   MatcherOptions options_;

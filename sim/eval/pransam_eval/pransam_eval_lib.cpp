@@ -43,6 +43,11 @@ double ScanMapRun::mean_iterations() const {
   for (double v : iterations) s += v;
   return iterations.empty() ? 0 : s / static_cast<double>(iterations.size());
 }
+double ScanMapRun::total_ms() const {
+  double s = 0;
+  for (double v : ms) s += v;
+  return s;
+}
 double ThreeDRun::p50() const { return percentile(ms, 0.5); }
 
 bool load_real_case(const std::string& dataset, const CaseOptions& options, RealCase* out, std::string* error) {
@@ -227,16 +232,18 @@ ScanMapRun run_scan_map(const RealCase& c, MatcherHandle& m, const fw::pransam::
     run.trans_err.push_back(et);
     run.rot_err_deg.push_back(er);
     const char* verdict;
-    if (!s.is_ok() || !r.found) {
+    if (!s.is_ok() || !r.best_valid) {
       ++run.nothing;
       verdict = "nothing";
     } else if (et < crit.max_trans && er < crit.max_rot_deg) {
       ++run.correct;
-      verdict = "correct";
+      verdict = r.found ? "correct" : "correct (below Ω_thres)";
+      if (!r.found) ++run.correct_below_thres;
     } else {
       ++run.wrong;
-      verdict = "WRONG";
+      verdict = r.found ? "WRONG" : "WRONG (below Ω_thres)";
     }
+    if (s.is_ok() && r.best_valid && !r.found) ++run.below_thres;
     if (verbose) {
       std::printf("  scan %5zu pts %3zu  %7.2f ms  it %6llu coll %6llu  Ω %.3f  err %.2f m %.1f°  %s%s%s\n", q.index,
                   q.points.size(), dt, static_cast<unsigned long long>(r.stats.iterations),

@@ -67,8 +67,11 @@ struct MatcherHandle {
 bool make_matcher(const RealCase& c, int pool_threads, int T, bool precomputed, MatcherHandle* out,
                   std::string* error);
 
+// Classification of the RETURNED pose (pRANSAM returns its best hypothesis when Ω_thres was
+// reached or I_max ran out, Sec. 4.3): correct / wrong by the criterion, nothing = no hypothesis
+// at all (or an error status). below_thres counts returned poses whose Ω stayed below Ω_thres.
 struct ScanMapRun {
-  std::size_t n = 0, correct = 0, wrong = 0, nothing = 0;
+  std::size_t n = 0, correct = 0, wrong = 0, nothing = 0, below_thres = 0, correct_below_thres = 0;
   std::vector<double> ms;           // per query
   std::vector<double> iterations;   // per query
   std::vector<double> collisions;
@@ -77,6 +80,7 @@ struct ScanMapRun {
   double p50() const;
   double p99() const;
   double mean_iterations() const;
+  double total_ms() const;
   double success() const { return n ? static_cast<double>(correct) / static_cast<double>(n) : 0.0; }
 };
 

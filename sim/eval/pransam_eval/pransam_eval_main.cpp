@@ -129,11 +129,14 @@ int main(int argc, char** argv) {
   p.max_extent = tb.extent;
   p.refine_iterations = static_cast<std::uint32_t>(std::stoul(get(a, "refine", "0")));
   p.refine_min_quality = std::stof(get(a, "refine-min", "0.6"));
+  p.scene_origin_is_sensor = a.count("free-space") != 0;
+  p.free_space_margin = std::stof(get(a, "free-margin", "0.3"));
+  p.max_blocked_fraction = std::stof(get(a, "max-blocked", "0.1"));
   const ScanMapRun r = run_scan_map(c, m, p, Criterion(), a.count("verbose") != 0);
-  std::printf("%s %s T=%s threads=%s %s: correct %zu wrong %zu nothing %zu of %zu (%.1f %%)  p50 %.2f ms  p99 %.2f ms  "
-              "mean iterations %.0f\n",
+  std::printf("%s %s T=%s threads=%s %s: correct %zu wrong %zu nothing %zu of %zu (%.1f %%; %zu returned below "
+              "Ω_thres, %zu of them correct)  p50 %.2f ms  p99 %.2f ms  mean iterations %.0f\n",
               c.dataset.c_str(), precomp ? "precomp" : "online", get(a, "T", "2").c_str(), get(a, "threads", "2").c_str(),
-              p.fuzzy ? "fuzzy" : "hard", r.correct, r.wrong, r.nothing, r.n, 100.0 * r.success(), r.p50(), r.p99(),
-              r.mean_iterations());
+              p.fuzzy ? "fuzzy" : "hard", r.correct, r.wrong, r.nothing, r.n, 100.0 * r.success(), r.below_thres,
+              r.correct_below_thres, r.p50(), r.p99(), r.mean_iterations());
   return 0;
 }
