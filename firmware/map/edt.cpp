@@ -21,7 +21,11 @@ void squared_edt_1d(float* data, std::size_t n, std::size_t stride, const EdtScr
         continue;
       }
       const float fv = static_cast<float>(vk);
-      const float sx = ((s.f[qi] + q * q) - (s.f[vk] + fv * fv)) / (2.0f * q - 2.0f * fv);
+      // Intersection of the parabolas rooted at q and v, written as (f_q - f_v) / 2(q - v) + (q + v) / 2
+      // instead of ((f_q + q²) - (f_v + v²)) / 2(q - v): q² exceeds float's exact-integer range (2^24)
+      // beyond 4096 cells, and the rounded intersection then put occupied cells (f = 0) under a
+      // neighbour's parabola (distance √2 cells on a cell that is itself a feature).
+      const float sx = (s.f[qi] - s.f[vk]) / (2.0f * (q - fv)) + 0.5f * (q + fv);
       if (sx <= s.z[k]) {
         if (k == 0) { s.v[0] = static_cast<int>(qi); s.z[0] = -kEdtInf; s.z[1] = kEdtInf; break; }
         --k;

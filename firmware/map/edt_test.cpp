@@ -60,6 +60,35 @@ TEST(EdtTest, Matches3DBruteForce) {
   check_against_brute_force<3>(dims, 3, 10);
 }
 
+// Long rows (beyond 4096 cells, where q² is no longer exact in float): features must keep distance
+// 0 and every cell must match brute force. Regression: the fr-clinic map (4404 cells wide) had
+// occupied cells at √2 cells before the intersection formula was made relative.
+TEST(EdtTest, LongRowsStayExact) {
+  const std::size_t dims[2] = {3, 6000};
+  std::vector<float> grid(dims[0] * dims[1], kEdtInf);
+  // Dense feature runs far from the origin plus a few isolated ones with finite column values.
+  std::vector<std::size_t> feats;
+  for (std::size_t x = 4200; x < 4300; x += 1) feats.push_back(1 * dims[1] + x);
+  for (std::size_t x = 5000; x < 5990; x += 3) feats.push_back(0 * dims[1] + x);
+  feats.push_back(2 * dims[1] + 10);
+  feats.push_back(2 * dims[1] + 5999);
+  for (std::size_t f : feats) grid[f] = 0.0f;
+  Scratch sc(dims[1]);
+  squared_edt<2>(grid.data(), dims, sc.s);
+  for (std::size_t f : feats) ASSERT_EQ(grid[f], 0.0f) << "feature " << f;
+  for (std::size_t y = 0; y < dims[0]; ++y) {
+    for (std::size_t x = 0; x < dims[1]; x += 7) {
+      double best = 1e30;
+      for (std::size_t f : feats) {
+        const double dy = static_cast<double>(y) - static_cast<double>(f / dims[1]);
+        const double dx = static_cast<double>(x) - static_cast<double>(f % dims[1]);
+        best = std::min(best, dx * dx + dy * dy);
+      }
+      ASSERT_EQ(grid[y * dims[1] + x], static_cast<float>(best)) << y << "," << x;
+    }
+  }
+}
+
 TEST(EdtTest, EmptyGridStaysInfinite) {
   std::vector<float> grid(50, kEdtInf);
   Scratch sc(10);

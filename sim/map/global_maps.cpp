@@ -38,7 +38,7 @@ bool known(const std::string& ds) {
 std::string build_signature(const std::string& ds, const OccupancyBuildOptions& o) {
   std::ostringstream s;
   s.precision(17);
-  s << "mmlfw global map v1 dataset=" << ds << " resolution=" << o.resolution << " max_usable_range="
+  s << "mmlfw global map v2 dataset=" << ds << " resolution=" << o.resolution << " max_usable_range="
     << o.max_usable_range << " free_on_no_return=" << o.free_on_no_return << " margin=" << o.margin
     << " l_occ=" << o.l_occ << " l_free=" << o.l_free << " occupied_logodds=" << o.occupied_logodds
     << " beam_stride=" << o.beam_stride << " source=" << global_map_source(ds);

@@ -108,6 +108,16 @@ TEST(GlobalMapsDataTest, FrClinicRelationGraphTrajectory) {
   ASSERT_TRUE(ros_map_to_grid(map, &grid, &err)) << err;
   std::vector<float> dist;
   ASSERT_TRUE(distance_field_m(grid, &dist, &err)) << err;
+  // The firmware accepts the compiled image (4404 cells wide: beyond float's exact q² range).
+  {
+    std::vector<std::uint8_t> image;
+    ASSERT_TRUE(compile_map_image(map, &image, &err)) << err;
+    fw::StartupArena arena;
+    ASSERT_TRUE(arena.init_mapped(image.size() + 4096, false, "test").is_ok());
+    fw::GlobalMap gm;
+    const fw::Status s = fw::load_map_image(image.data(), image.size(), arena, &gm, "fr-clinic");
+    ASSERT_TRUE(s.is_ok()) << s.message();
+  }
   std::size_t near = 0, total = 0;
   for (std::size_t k = 0; k < idx.size(); k += 10) {
     const CarmenScan& sc = log.scans[idx[k]];

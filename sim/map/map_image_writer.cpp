@@ -74,7 +74,15 @@ bool distance_field_m(const OccupancyGrid& grid, std::vector<float>* out, std::s
   const std::size_t dims[2] = {h, w};
   fw::squared_edt<2>(d.data(), dims, scratch);
   const float res = grid.geometry.resolution;
-  for (float& x : d) x = std::sqrt(x) * res;
+  for (std::size_t i = 0; i < d.size(); ++i) {
+    // The firmware loader rejects images where "distance 0" and "occupied" disagree; check here so
+    // a bad field is reported when it is made, not when the robot boots.
+    if ((d[i] == 0.0f) != (grid.cells[i] == fw::kCellOccupied) || !(d[i] < fw::kEdtInf)) {
+      return fail(error, "distance field: EDT inconsistent at cell " + std::to_string(i) + " (squared distance " +
+                             std::to_string(d[i]) + ")");
+    }
+    d[i] = std::sqrt(d[i]) * res;
+  }
   *out = std::move(d);
   return true;
 }
