@@ -16,6 +16,10 @@ Status EndpointGridOptions::validate() const {
   if (subcell_log2 > 3) {
     return Status::error(Errc::kInvalidArgument, "endpoint grid: subcell_log2 %u outside [0, 3]", subcell_log2);
   }
+  if (size_log2 + subcell_log2 < 6) {
+    return Status::error(Errc::kInvalidArgument, "endpoint grid: lookup side 2^%u sub-cells below the 64 of a page tile",
+                         size_log2 + subcell_log2);
+  }
   if (size_log2 + subcell_log2 > 15) {
     return Status::error(Errc::kInvalidArgument, "endpoint grid: lookup side 2^%u sub-cells too large (max 2^15)",
                          size_log2 + subcell_log2);
@@ -35,7 +39,7 @@ Status EndpointGridOptions::validate() const {
 std::size_t EndpointGrid::required_bytes(const EndpointGridOptions& o) {
   const std::size_t side = std::size_t{1} << o.size_log2;
   const std::size_t sub = side << o.subcell_log2;
-  return side * side + sub * sub + 128;
+  return side * side + sub * sub + 256;  // + zero sentinel line + alignment
 }
 
 Status EndpointGrid::init(const EndpointGridOptions& options, StartupArena& arena) {
@@ -50,12 +54,14 @@ Status EndpointGrid::init(const EndpointGridOptions& options, StartupArena& aren
   const std::size_t subs = static_cast<std::size_t>(sub_mask_ + 1) * (sub_mask_ + 1);
   Result<void*> occ = arena.allocate(cells, 64, "rbsm endpoint grid");
   if (!occ) return occ.status();
-  Result<void*> lut = arena.allocate(subs, 64, "rbsm likelihood lookup");
+  // One extra line: index `subs` is a permanent zero (LookupView::zero_index) for points outside
+  // the window, so the weighting loop needs no branch.
+  Result<void*> lut = arena.allocate(subs + 64, 64, "rbsm likelihood lookup");
   if (!lut) return lut.status();
   occupancy_ = static_cast<std::uint8_t*>(*occ);
   lookup_ = static_cast<std::uint8_t*>(*lut);
   std::memset(occupancy_, 0, cells);
-  std::memset(lookup_, 0, subs);
+  std::memset(lookup_, 0, subs + 64);
   // Eq. 2.9 in cells: δ = exp(−d²) for d ≤ ξ, else 0; quantised to 1/255.
   const float xi2 = options.xi_cells * options.xi_cells;
   for (int dy = -1; dy <= 1; ++dy) {
@@ -92,8 +98,9 @@ void EndpointGrid::clear_cell(std::int32_t gx, std::int32_t gy) {
   c = 0;
   for (std::uint32_t b = 0; b < k_; ++b) {
     const std::uint32_t sy = static_cast<std::uint32_t>(gy) * k_ + b;
-    std::uint8_t* row = lookup_ + (static_cast<std::size_t>(sy & sub_mask_) << sub_shift_);
-    for (std::uint32_t a = 0; a < k_; ++a) row[(static_cast<std::uint32_t>(gx) * k_ + a) & sub_mask_] = 0;
+    for (std::uint32_t a = 0; a < k_; ++a) {
+      lookup_[tiled_index((static_cast<std::uint32_t>(gx) * k_ + a) & sub_mask_, sy & sub_mask_, sub_shift_)] = 0;
+    }
   }
 }
 
@@ -188,13 +195,12 @@ void EndpointGrid::refresh(std::int32_t gx, std::int32_t gy) {
   }
   for (std::uint32_t b = 0; b < k_; ++b) {
     const std::uint32_t sy = static_cast<std::uint32_t>(gy) * k_ + b;
-    std::uint8_t* row = lookup_ + (static_cast<std::size_t>(sy & sub_mask_) << sub_shift_);
     for (std::uint32_t a = 0; a < k_; ++a) {
       std::uint8_t v = 0;
       for (int n = 0; n < 9; ++n) {
         if (occ[n] && table_[n][b * k_ + a] > v) v = table_[n][b * k_ + a];
       }
-      row[(static_cast<std::uint32_t>(gx) * k_ + a) & sub_mask_] = v;
+      lookup_[tiled_index((static_cast<std::uint32_t>(gx) * k_ + a) & sub_mask_, sy & sub_mask_, sub_shift_)] = v;
     }
   }
 }
@@ -208,9 +214,9 @@ void EndpointGrid::splat(std::int32_t gx, std::int32_t gy) {
       const std::uint8_t* t = table_[(dy + 1) * 3 + (dx + 1)];
       for (std::uint32_t b = 0; b < k_; ++b) {
         const std::uint32_t sy = static_cast<std::uint32_t>(cy) * k_ + b;
-        std::uint8_t* row = lookup_ + (static_cast<std::size_t>(sy & sub_mask_) << sub_shift_);
         for (std::uint32_t a = 0; a < k_; ++a) {
-          std::uint8_t& v = row[(static_cast<std::uint32_t>(cx) * k_ + a) & sub_mask_];
+          std::uint8_t& v =
+              lookup_[tiled_index((static_cast<std::uint32_t>(cx) * k_ + a) & sub_mask_, sy & sub_mask_, sub_shift_)];
           if (t[b * k_ + a] > v) v = t[b * k_ + a];
         }
       }
@@ -257,7 +263,7 @@ std::uint8_t EndpointGrid::likelihood(float x, float y) const {
   if (!(fx >= 0.0f && fx < v.extent && fy >= 0.0f && fy < v.extent)) return 0;
   const std::uint32_t sx = static_cast<std::uint32_t>(static_cast<std::int32_t>(fx) + v.origin_sx) & v.mask;
   const std::uint32_t sy = static_cast<std::uint32_t>(static_cast<std::int32_t>(fy) + v.origin_sy) & v.mask;
-  return v.values[(static_cast<std::size_t>(sy) << v.shift) | sx];
+  return v.values[tiled_index(sx, sy, v.shift)];
 }
 
 EndpointGrid::LookupView EndpointGrid::lookup_view() const {
@@ -271,6 +277,7 @@ EndpointGrid::LookupView EndpointGrid::lookup_view() const {
   v.origin_sy = origin_cy_ * static_cast<std::int32_t>(k_);
   v.mask = sub_mask_;
   v.shift = sub_shift_;
+  v.zero_index = static_cast<std::uint32_t>(static_cast<std::size_t>(sub_mask_ + 1) * (sub_mask_ + 1));
   return v;
 }
 

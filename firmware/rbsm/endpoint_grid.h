@@ -64,6 +64,15 @@ class EndpointGrid {
   // Nearest occupied cell centre within max_dist_m of (x, y) (exact search over rings of cells).
   bool nearest_occupied(float x, float y, float max_dist_m, float* nx, float* ny, float* dist2_m) const;
 
+  // Storage index of sub-cell (sx, sy) (already masked to the window) in the tiled lookup: 8×8
+  // sub-cells per 64-byte line, 8×8 lines per 4 KiB page, pages row-major. A particle cloud's
+  // points for one beam then touch a few lines on one or two pages instead of one page per row
+  // (row-major storage thrashed the TLB: ~20 ms per match instead of ~2 ms).
+  static std::uint32_t tiled_index(std::uint32_t sx, std::uint32_t sy, std::uint32_t shift) {
+    const std::uint32_t page = ((sy >> 6) << (shift - 6)) | (sx >> 6);
+    return (page << 12) | (((sy >> 3) & 7u) << 9) | (((sx >> 3) & 7u) << 6) | ((sy & 7u) << 3) | (sx & 7u);
+  }
+
   // Raw view for the vectorisable inner loop of RBSM's weighting (see rbsm.cpp).
   struct LookupView {
     const std::uint8_t* values;
@@ -72,7 +81,8 @@ class EndpointGrid {
     float extent;               // window side in sub-cells (as float, for the bounds test)
     std::int32_t origin_sx, origin_sy;  // global sub-cell index of the lower-left corner
     std::uint32_t mask;         // side in sub-cells − 1
-    std::uint32_t shift;        // log2(side in sub-cells)
+    std::uint32_t shift;        // log2(side in sub-cells); index with tiled_index()
+    std::uint32_t zero_index;   // values[zero_index] is always 0 (outside-the-window sentinel)
   };
   LookupView lookup_view() const;
 

@@ -26,6 +26,10 @@ Status RbsmOptions::validate() const {
   if (max_iterations < 1 || max_iterations > 1000) {
     return Status::error(Errc::kInvalidArgument, "rbsm: max_iterations %u outside [1, 1000]", max_iterations);
   }
+  if (min_iterations < 1 || min_iterations > max_iterations) {
+    return Status::error(Errc::kInvalidArgument, "rbsm: min_iterations %u outside [1, max_iterations %u]", min_iterations,
+                         max_iterations);
+  }
   if (min_points < 1) return Status::error(Errc::kInvalidArgument, "rbsm: min_points must be at least 1");
   if (!(max_range >= 0.0f) || !std::isfinite(max_range)) {
     return Status::error(Errc::kInvalidArgument, "rbsm: max_range %g must be >= 0", static_cast<double>(max_range));
@@ -73,16 +77,19 @@ void Rbsm::reset() {
   }
 }
 
+// One pose, same arithmetic (and so the same values) as weigh_block.
 std::uint32_t Rbsm::weigh_single(float x, float y, float c, float s) const {
   const EndpointGrid::LookupView& v = view_;
+  const float ox = (x - v.origin_x) * v.inv_subcell, oy = (y - v.origin_y) * v.inv_subcell;
+  const float cs = c * v.inv_subcell, sn = s * v.inv_subcell;
   std::uint32_t w = 0;
   for (std::uint32_t i = 0; i < num_points_; ++i) {
-    const float wx = x + c * px_[i] - s * py_[i], wy = y + s * px_[i] + c * py_[i];
-    const float fx = (wx - v.origin_x) * v.inv_subcell, fy = (wy - v.origin_y) * v.inv_subcell;
+    const float fx = ox + (cs * px_[i] - sn * py_[i]);
+    const float fy = oy + (sn * px_[i] + cs * py_[i]);
     if (!(fx >= 0.0f && fx < v.extent && fy >= 0.0f && fy < v.extent)) continue;
     const std::uint32_t ix = static_cast<std::uint32_t>(static_cast<std::int32_t>(fx) + v.origin_sx) & v.mask;
     const std::uint32_t iy = static_cast<std::uint32_t>(static_cast<std::int32_t>(fy) + v.origin_sy) & v.mask;
-    w += v.values[(static_cast<std::size_t>(iy) << v.shift) | ix];
+    w += v.values[EndpointGrid::tiled_index(ix, iy, v.shift)];
   }
   return w;
 }
@@ -117,11 +124,15 @@ std::uint32_t Rbsm::weigh_mahalanobis(float x, float y, float psi, float c, floa
   return w;
 }
 
-std::uint32_t Rbsm::score_pose(const Se2f& pose) const {
+std::uint32_t Rbsm::score_pose(const Se2f& pose) {
+  view_ = grid_.lookup_view();
   return weigh_single(pose.x, pose.y, std::cos(pose.theta), std::sin(pose.theta));
 }
 
-// Weights of sampled particles [begin, end): beams outer, particles inner (vectorisable body).
+// Weights of sampled particles [begin, end): beams outer, particles inner. Per chunk of particles
+// the window-relative sub-cell coordinates are precomputed; pass 1 (branch-free float/int
+// arithmetic, vectorisable) turns each point into a lookup index (the zero sentinel when outside
+// the window), pass 2 gathers and accumulates. Same values as weigh_single().
 void Rbsm::weigh_block(std::uint32_t begin, std::uint32_t end) {
   if (options_.mahalanobis) {
     for (std::uint32_t j = begin; j < end; ++j) w_[j] = weigh_mahalanobis(sx_[j], sy_[j], spsi_[j], cos_[j], sin_[j]);
@@ -129,27 +140,38 @@ void Rbsm::weigh_block(std::uint32_t begin, std::uint32_t end) {
   }
   const EndpointGrid::LookupView v = view_;
   const float lim = v.extent - 1.0f;
-  for (std::uint32_t j = begin; j < end; ++j) w_[j] = 0;
-  const float* __restrict xs = sx_;
-  const float* __restrict ys = sy_;
-  const float* __restrict cs = cos_;
-  const float* __restrict ss = sin_;
-  std::uint32_t* __restrict ws = w_;
-  for (std::uint32_t i = 0; i < num_points_; ++i) {
-    const float bx = px_[i], by = py_[i];
-    for (std::uint32_t j = begin; j < end; ++j) {
-      const float wx = xs[j] + cs[j] * bx - ss[j] * by;
-      const float wy = ys[j] + ss[j] * bx + cs[j] * by;
-      float fx = (wx - v.origin_x) * v.inv_subcell;
-      float fy = (wy - v.origin_y) * v.inv_subcell;
-      const bool inside = fx >= 0.0f && fx < v.extent && fy >= 0.0f && fy < v.extent;
-      fx = fx < 0.0f ? 0.0f : (fx > lim ? lim : fx);
-      fy = fy < 0.0f ? 0.0f : (fy > lim ? lim : fy);
-      const std::uint32_t ix = static_cast<std::uint32_t>(static_cast<std::int32_t>(fx) + v.origin_sx) & v.mask;
-      const std::uint32_t iy = static_cast<std::uint32_t>(static_cast<std::int32_t>(fy) + v.origin_sy) & v.mask;
-      const std::uint32_t val = v.values[(static_cast<std::size_t>(iy) << v.shift) | ix];
-      ws[j] += inside ? val : 0u;
+  constexpr std::uint32_t kChunk = 256;
+  alignas(64) float ox[kChunk], oy[kChunk], cs[kChunk], sn[kChunk];
+  alignas(64) std::uint32_t idx[kChunk], acc[kChunk];
+  const std::uint32_t osx = static_cast<std::uint32_t>(v.origin_sx), osy = static_cast<std::uint32_t>(v.origin_sy);
+  const std::uint32_t mask = v.mask, pshift = v.shift - 6, zero = v.zero_index;
+  for (std::uint32_t c0 = begin; c0 < end; c0 += kChunk) {
+    const std::uint32_t n = end - c0 < kChunk ? end - c0 : kChunk;
+    for (std::uint32_t j = 0; j < n; ++j) {
+      ox[j] = (sx_[c0 + j] - v.origin_x) * v.inv_subcell;
+      oy[j] = (sy_[c0 + j] - v.origin_y) * v.inv_subcell;
+      cs[j] = cos_[c0 + j] * v.inv_subcell;
+      sn[j] = sin_[c0 + j] * v.inv_subcell;
+      acc[j] = 0;
     }
+    for (std::uint32_t i = 0; i < num_points_; ++i) {
+      const float bx = px_[i], by = py_[i];
+      for (std::uint32_t j = 0; j < n; ++j) {
+        float fx = ox[j] + (cs[j] * bx - sn[j] * by);
+        float fy = oy[j] + (sn[j] * bx + cs[j] * by);
+        const bool inside = (fx >= 0.0f) & (fx < v.extent) & (fy >= 0.0f) & (fy < v.extent);
+        fx = fx < 0.0f ? 0.0f : (fx > lim ? lim : fx);
+        fy = fy < 0.0f ? 0.0f : (fy > lim ? lim : fy);
+        const std::uint32_t sx = (static_cast<std::uint32_t>(static_cast<std::int32_t>(fx)) + osx) & mask;
+        const std::uint32_t sy = (static_cast<std::uint32_t>(static_cast<std::int32_t>(fy)) + osy) & mask;
+        const std::uint32_t page = ((sy >> 6) << pshift) | (sx >> 6);
+        const std::uint32_t t =
+            (page << 12) | (((sy >> 3) & 7u) << 9) | (((sx >> 3) & 7u) << 6) | ((sy & 7u) << 3) | (sx & 7u);
+        idx[j] = inside ? t : zero;
+      }
+      for (std::uint32_t j = 0; j < n; ++j) acc[j] += v.values[idx[j]];
+    }
+    for (std::uint32_t j = 0; j < n; ++j) w_[c0 + j] = acc[j];
   }
 }
 
@@ -352,7 +374,7 @@ Status Rbsm::match(const Point2f* points, std::size_t count, const Se2f& guess, 
     // l. 20: M_eff = 1/Σ ŵ² with ŵ = w/Σw, i.e. (Σw)²/Σw².
     const double meff = static_cast<double>(total) * static_cast<double>(total) / static_cast<double>(total2);
     ratio = static_cast<float>(meff / m);
-    if (meff >= static_cast<double>(options_.accept_ratio) * m) {
+    if (meff >= static_cast<double>(options_.accept_ratio) * m && it >= options_.min_iterations) {
       converged = true;
       break;
     }

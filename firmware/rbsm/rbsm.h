@@ -42,6 +42,9 @@ struct RbsmOptions {
   float accept_ratio = 0.8f;           // Δ: stop when M_eff ≥ Δ·M (Alg. 1 l. 7)
   float shrink = 0.5f;                 // δ: Σ ← δ·Σ per round (Alg. 1 l. 21), 0 < δ < 1
   std::uint32_t max_iterations = 20;   // cap on resampling rounds
+  // Rounds before the M_eff rule may stop (1 = Alg. 1 exactly). With an accumulated end-point map
+  // the summed weights (Eq. 2.8) are flat enough that M_eff ≥ Δ·M often holds after one round.
+  std::uint32_t min_iterations = 1;
   std::uint32_t min_points = 10;       // fewer valid points → status, no match
   float max_range = 0.0f;              // ignore points farther than this (m); 0 = keep all
   bool hill_climbing = false;          // Alg. 1 l. 12 (deterministic local correction)
@@ -82,7 +85,7 @@ class Rbsm final : public ScanMatcher {
   std::uint32_t num_particles() const { return options_.num_particles; }
   Se2f particle(std::uint32_t i) const { return Se2f(x_[i], y_[i], psi_[i]); }
   // Score (Σ δ, in units of 1/255) of one pose against the current map, for tests and tools.
-  std::uint32_t score_pose(const Se2f& pose) const;
+  std::uint32_t score_pose(const Se2f& pose);
 
  private:
   struct Job;

@@ -6,6 +6,7 @@
 #include <chrono>
 #include <cmath>
 #include <cstdio>
+#include <ctime>
 
 #include "firmware/base/rng.h"
 #include "sim/io/datasets.h"
@@ -68,14 +69,20 @@ namespace {
 // Times match() by wrapping the matcher (the front end calls it once per scan).
 class TimedMatcher final : public fw::ScanMatcher {
  public:
-  TimedMatcher(fw::ScanMatcher* inner, std::vector<double>* ms) : inner_(inner), ms_(ms) {}
+  TimedMatcher(fw::ScanMatcher* inner, std::vector<double>* ms, std::vector<double>* cpu_ms)
+      : inner_(inner), ms_(ms), cpu_ms_(cpu_ms) {}
   const char* name() const override { return inner_->name(); }
   void reset() override { inner_->reset(); }
   fw::Status match(const fw::Point2f* p, std::size_t n, const fw::Se2f& g, fw::ScanMatchResult* out) override {
+    const double c0 = thread_cpu_ms();
     const auto t0 = std::chrono::steady_clock::now();
     fw::Status st = inner_->match(p, n, g, out);
     const auto t1 = std::chrono::steady_clock::now();
-    if (st.is_ok() && !out->map_was_empty) ms_->push_back(std::chrono::duration<double, std::milli>(t1 - t0).count());
+    const double c1 = thread_cpu_ms();
+    if (st.is_ok() && !out->map_was_empty) {
+      ms_->push_back(std::chrono::duration<double, std::milli>(t1 - t0).count());
+      cpu_ms_->push_back(c1 - c0);
+    }
     return st;
   }
   fw::Status integrate(const fw::Point2f* p, std::size_t n, const fw::Se2f& pose, fw::Point2f* nc, std::size_t cap,
@@ -84,8 +91,14 @@ class TimedMatcher final : public fw::ScanMatcher {
   }
 
  private:
+  static double thread_cpu_ms() {
+    timespec ts;
+    clock_gettime(CLOCK_THREAD_CPUTIME_ID, &ts);
+    return static_cast<double>(ts.tv_sec) * 1e3 + static_cast<double>(ts.tv_nsec) * 1e-6;
+  }
   fw::ScanMatcher* inner_;
   std::vector<double>* ms_;
+  std::vector<double>* cpu_ms_;
 };
 
 uint64_t stamp_ns(const CarmenScan& s) {
@@ -99,7 +112,7 @@ bool run_scan_matching_odometry(const CarmenLog& log, MatcherKind kind, const Ma
   *out = OdometryRun{};
   auto inst = MatcherInstance::create(kind, config, error);
   if (!inst) return false;
-  TimedMatcher timed(inst->matcher(), &out->match_ms);
+  TimedMatcher timed(inst->matcher(), &out->match_ms, &out->match_cpu_ms);
   auto front = std::make_unique<fw::ScanMatchingOdometry>();
   fw::Status st = front->init(config.front, &timed, nullptr);
   if (!st.is_ok()) {
@@ -118,7 +131,12 @@ bool run_scan_matching_odometry(const CarmenLog& log, MatcherKind kind, const Ma
     odom.y = static_cast<float>(cs.odom.y);
     odom.theta = static_cast<float>(cs.odom.theta);
     fw::Se2f pose;
-    st = front->step(*scan, odom, &pose);
+    fw::ScanMatchResult res;
+    st = front->step(*scan, odom, &pose, &res);
+    if (st.is_ok() && res.iterations > 0) {
+      out->iterations.push_back(res.iterations);
+      if (!res.converged) ++out->not_converged;
+    }
     if (!st.is_ok()) {
       ++out->failures;
       if (out->failure_messages.size() < 5) out->failure_messages.push_back(log.path + ": " + st.message());

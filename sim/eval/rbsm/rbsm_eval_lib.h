@@ -52,6 +52,10 @@ class MatcherInstance {
 struct OdometryRun {
   std::vector<fw::Se2d> poses;     // one per processed scan (log order)
   std::vector<double> match_ms;    // wall time of each match() call
+  std::vector<double> match_cpu_ms;  // CPU time of the calling thread (robust on a loaded machine;
+                                     // excludes pool workers)
+  std::vector<uint32_t> iterations;  // per match (RBSM rounds / ICP iterations)
+  size_t not_converged = 0;        // matches that hit the iteration cap
   size_t failures = 0;             // scans the matcher refused (pose = odometry prediction)
   std::vector<std::string> failure_messages;  // first few
 };

@@ -4,9 +4,10 @@
 //     writes DIR/DATASET_{rbsm_best,rbsm_worst,icp,odom}.png and trajectories DIR/DATASET_*.txt.
 //   mml-rbsm-eval pairwise DATASET [--pairs N] [--seeds N] [--particles N]
 //   --set KEY=VALUE overrides the matcher configuration (max_range, resolution, size_log2, subcell_log2,
-//     shrink, accept_ratio, max_iterations, sigma_xy2, sigma_psi2, hill_climbing, mahalanobis,
+//     shrink, accept_ratio, min_iterations, max_iterations, sigma_xy2, sigma_psi2, hill_climbing, mahalanobis,
 //     min_translation, min_rotation_deg, icp_max_corr); --no-maps skips the PNGs.
 //     consecutive corrected-scan pairs, guess perturbed by N(0, 10 cm, 6°): mean/p95/max errors.
+#include <algorithm>
 #include <cmath>
 #include <cstdio>
 #include <cstdlib>
@@ -124,6 +125,10 @@ int main(int argc, char** argv) {
       cfg.rbsm.shrink = static_cast<float>(v);
     } else if (key == "accept_ratio") {
       cfg.rbsm.accept_ratio = static_cast<float>(v);
+    } else if (key == "min_iterations") {
+      cfg.rbsm.min_iterations = static_cast<uint32_t>(v);
+    } else if (key == "particles") {
+      cfg.rbsm.num_particles = static_cast<uint32_t>(v);
     } else if (key == "max_iterations") {
       cfg.rbsm.max_iterations = static_cast<uint32_t>(v);
     } else if (key == "sigma_xy2") {
@@ -217,9 +222,13 @@ int main(int argc, char** argv) {
     const auto m = sim::evaluate_relations(rel, sim::make_trajectory(head, run.poses));
     tm.push_back(m.trans_mean);
     rm.push_back(m.rot_mean_deg);
-    std::printf("%s rbsm seed %2d: %s | %.2f ms/match p50 p99 %.2f, %zu failures\n", ds.c_str(), s,
-                sim::to_string(m).c_str(), sim::percentile(run.match_ms, 50), sim::percentile(run.match_ms, 99),
-                run.failures);
+    double it_mean = 0;
+    for (uint32_t k : run.iterations) it_mean += k;
+    it_mean /= std::max<size_t>(1, run.iterations.size());
+    std::printf("%s rbsm seed %2d: %s | %.2f ms/match p50 p99 %.2f (cpu p50 %.2f), %.1f rounds/match, %zu of %zu at the cap, %zu "
+                "failures\n",
+                ds.c_str(), s, sim::to_string(m).c_str(), sim::percentile(run.match_ms, 50),
+                sim::percentile(run.match_ms, 99), sim::percentile(run.match_cpu_ms, 50), it_mean, run.not_converged, run.iterations.size(), run.failures);
     std::fflush(stdout);
     if (maps && m.trans_mean < best) {
       best = m.trans_mean;
