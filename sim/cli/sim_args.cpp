@@ -86,6 +86,8 @@ synthetic world:
   --route-length M        metres to drive (default: per world)
   --start-node N          route-graph node to start at (default: drawn from the seed)
   --enter-unknown         the route may enter the unknown area
+  --via-unknown           drive into the unknown area first (the localizer should say outside-map there)
+  --kidnap-at N           at scan N carry the robot to another place (odometry does not see it)
   --map-unknown           keep the unknown area in the map (default: erased)
   --resolution M          map resolution in m (default: per world; large-office 0.06)
 other:
@@ -206,6 +208,15 @@ bool parse_sim_args(const std::vector<std::string>& args, SimConfig* cfg, SimArg
     } else if (a == "--start-node") {
       if (!value(&v) || !parse_u64(a, v, 1000000, &n, err)) return false;
       cfg->synthetic.route.start_node = static_cast<int>(n);
+    } else if (a == "--via-unknown") {
+      cfg->synthetic.route.via_unknown = true;
+    } else if (a == "--kidnap-at") {
+      if (!value(&v) || !parse_u64(a, v, 100000000ull, &n, err)) return false;
+      if (n == 0) {
+        *err = "--kidnap-at: the scan index must be at least 1";
+        return false;
+      }
+      cfg->synthetic.kidnap_at_scan = static_cast<size_t>(n);
     } else if (a == "--enter-unknown") {
       cfg->synthetic.route.avoid_unknown = false;
     } else if (a == "--map-unknown") {

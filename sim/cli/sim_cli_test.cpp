@@ -55,6 +55,9 @@ TEST(SimArgs, MalformedArgumentsGiveAClearError) {
             std::string::npos);
   EXPECT_NE(parse_error({"--world", "small-office", "--beams", "1"}).find("--beams"), std::string::npos);
   EXPECT_NE(parse_error({"--world", "small-office", "--threads", "0"}).find("--threads"), std::string::npos);
+  EXPECT_NE(parse_error({"--world", "small-office", "--kidnap-at", "0"}).find("--kidnap-at"), std::string::npos);
+  EXPECT_NE(parse_error({"--dataset", "intel", "--world", "small-office"}).find("exclude each other"),
+            std::string::npos);
 }
 
 TEST(SimArgs, ParsesAFullCommandLine) {

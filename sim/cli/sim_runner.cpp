@@ -39,6 +39,7 @@ constexpr double kWrongM = 0.5, kWrongDeg = 20.0;
 struct Frame {
   std::uint32_t index = 0;
   double t = 0;
+  bool kidnapped = false;
   bool has_truth = false;
   fw::Se2d truth;
   double travelled_m = 0;
@@ -51,6 +52,7 @@ struct FrameInfo {
   bool has_truth = false;
   fw::Se2d truth;
   double travelled_m = 0;
+  bool kidnapped = false;
 };
 
 // A CARMEN log prepared as frames: odometry records in file order before each scan, plus the
@@ -184,12 +186,19 @@ bool write_pictures(const SimConfig& cfg, const SimResult& r, const World* world
     by_status[i].radius_px = 2.0;
     by_status[i].label = std::string("estimate: ") + names[i];
   }
+  std::vector<Polyline> truth_before;
   for (const StepRecord& st : r.steps) {
+    if (st.kidnapped && !truth.points.empty()) {  // no line across the carry
+      truth_before.push_back(truth);
+      truth_before.back().label.clear();
+      truth.points.clear();
+    }
     if (st.has_truth) truth.points.push_back({st.truth.x, st.truth.y});
     est.points.push_back({st.estimate.x, st.estimate.y});
     const int k = static_cast<int>(st.estimate.status);
     if (k >= 0 && k < 5) by_status[k].points.push_back({st.estimate.x, st.estimate.y});
   }
+  for (const auto& l : truth_before) pic.lines.push_back(l);
   pic.lines.push_back(truth);
   pic.lines.push_back(est);
   for (auto& ps : by_status) {
@@ -205,6 +214,10 @@ bool write_pictures(const SimConfig& cfg, const SimResult& r, const World* world
     pic.markers.push_back({f.x, f.y, f.theta, {0, 160, 60}, 7.0, "start"});
     const auto& l = r.steps.back().truth;
     pic.markers.push_back({l.x, l.y, l.theta, {0, 110, 40}, 5.0, "end"});
+  }
+  if (s.kidnap_step >= 0) {
+    const auto& k = r.steps[static_cast<size_t>(s.kidnap_step)].truth;
+    pic.markers.push_back({k.x, k.y, k.theta, {200, 0, 0}, 7.0, "kidnapped to"});
   }
   if (s.first_localized_step >= 0) {
     const auto& e = r.steps[static_cast<size_t>(s.first_localized_step)].estimate;
@@ -232,7 +245,7 @@ bool write_steps_csv(const std::string& path, const std::vector<StepRecord>& ste
   }
   std::fprintf(f,
                "step,t_s,scan_id,status,mode,x,y,theta,truth_x,truth_y,truth_theta,err_m,err_deg,travelled_m,"
-               "hypotheses,clusters,rating,odom_x,odom_y,odom_theta,cov_xx,cov_yy,cov_tt,step_ms\n");
+               "hypotheses,clusters,rating,odom_x,odom_y,odom_theta,cov_xx,cov_yy,cov_tt,step_ms,kidnapped\n");
   for (const StepRecord& s : steps) {
     const hal::PoseEstimate& e = s.estimate;
     std::fprintf(f, "%u,%.3f,%u,%s,%s,%.4f,%.4f,%.5f,", s.step, s.t, e.scan_id, hal::status_name(e.status),
@@ -242,8 +255,9 @@ bool write_steps_csv(const std::string& path, const std::vector<StepRecord>& ste
     } else {
       std::fprintf(f, ",,,,,");
     }
-    std::fprintf(f, "%.3f,%u,%u,%.4f,%.4f,%.4f,%.5f,%.6g,%.6g,%.6g,%.4f\n", s.travelled_m, e.hypothesis_count,
-                 e.cluster_count, e.rating, s.odom.x, s.odom.y, s.odom.theta, e.cov[0], e.cov[4], e.cov[8], s.step_ms);
+    std::fprintf(f, "%.3f,%u,%u,%.4f,%.4f,%.4f,%.5f,%.6g,%.6g,%.6g,%.4f,%d\n", s.travelled_m, e.hypothesis_count,
+                 e.cluster_count, e.rating, s.odom.x, s.odom.y, s.odom.theta, e.cov[0], e.cov[4], e.cov[8], s.step_ms,
+                 s.kidnapped ? 1 : 0);
   }
   const bool ok = std::fclose(f) == 0;
   if (!ok) *err = "error writing '" + path + "'";
@@ -269,6 +283,7 @@ bool write_summary_json(const std::string& path, const SimSummary& s, std::strin
   std::fprintf(f, "  \"first_localized_travelled_m\": %s,\n  \"first_localized_err_m\": %s,\n",
                s.first_localized_step >= 0 ? num(s.first_localized_travelled_m).c_str() : "null",
                s.first_localized_step >= 0 ? num(s.first_localized_err_m).c_str() : "null");
+  std::fprintf(f, "  \"kidnap_step\": %ld,\n  \"relocalized_step\": %ld,\n", s.kidnap_step, s.relocalized_step);
   std::fprintf(f, "  \"localized_steps\": %zu,\n  \"wrong_localized_steps\": %zu,\n", s.localized_steps,
                s.wrong_localized_steps);
   std::fprintf(f, "  \"mean_err_localized_m\": %s,\n  \"max_err_localized_m\": %s,\n  \"final_err_m\": %s,\n",
@@ -464,6 +479,7 @@ bool run_simulation(const SimConfig& cfg_in, SimResult* out, std::string* err) {
         r.has_truth = fi.has_truth;
         r.truth = fi.truth;
         r.travelled_m = fi.travelled_m;
+        r.kidnapped = fi.kidnapped;
       }
       if (r.has_truth) {
         r.err_m = std::hypot(e.x - r.truth.x, e.y - r.truth.y);
@@ -499,6 +515,7 @@ bool run_simulation(const SimConfig& cfg_in, SimResult* out, std::string* err) {
       frame.has_truth = true;
       frame.truth = sframe.truth;
       frame.travelled_m = sframe.travelled_m;
+      frame.kidnapped = sframe.kidnapped;
       frame.odometry.swap(sframe.odometry);
       frame.scan = sframe.scan;
     } else {
@@ -511,7 +528,7 @@ bool run_simulation(const SimConfig& cfg_in, SimResult* out, std::string* err) {
       std::this_thread::sleep_until(due);
     }
     if (info.size() <= frame.scan.scan_id) info.resize(frame.scan.scan_id + 1);
-    info[frame.scan.scan_id] = {frame.t, frame.has_truth, frame.truth, frame.travelled_m};
+    info[frame.scan.scan_id] = {frame.t, frame.has_truth, frame.truth, frame.travelled_m, frame.kidnapped};
     for (const hal::Odometry& o : frame.odometry) {
       if (!odom->push(o)) ++ring_drops;
     }
@@ -555,6 +572,10 @@ bool run_simulation(const SimConfig& cfg_in, SimResult* out, std::string* err) {
   double err_sum = 0;
   for (const StepRecord& r : out->steps) {
     ms.push_back(r.step_ms);
+    if (r.kidnapped && sum.kidnap_step < 0) sum.kidnap_step = r.step;
+    if (sum.kidnap_step >= 0 && sum.relocalized_step < 0 && r.estimate.status == hal::LocalizationStatus::kLocalized) {
+      sum.relocalized_step = r.step;
+    }
     const int k = static_cast<int>(r.estimate.status);
     if (k >= 0 && k < 5) ++sum.status_counts[k];
     if (r.estimate.status == hal::LocalizationStatus::kLocalized) {

@@ -46,6 +46,7 @@ struct StepRecord {
   fw::Se2d truth;
   double err_m = 0, err_deg = 0;
   double travelled_m = 0;
+  bool kidnapped = false;  // the robot was carried away just before this scan
   fw::Se2d odom;
   double step_ms = 0;
 };
@@ -54,6 +55,9 @@ struct SimSummary {
   std::string source, localizer;
   std::size_t steps = 0, scans_dropped = 0;
   long first_localized_step = -1;
+  long kidnap_step = -1;
+  // After a kidnapping: first step localized again (−1 = never).
+  long relocalized_step = -1;
   double first_localized_t = 0, first_localized_travelled_m = 0, first_localized_err_m = 0;
   std::size_t localized_steps = 0, wrong_localized_steps = 0;  // wrong: error ≥ 0.5 m or ≥ 20° while localized
   double mean_err_localized_m = 0, max_err_localized_m = 0, final_err_m = 0;

@@ -403,9 +403,18 @@ bool write_png(const Picture& pic, const std::string& path, std::string* err) {
     }
     c.line(cx, cy, cx + 2 * m.radius_px * std::cos(m.theta), cy - 2 * m.radius_px * std::sin(m.theta), 2.5, m.color);
     if (!m.text.empty()) {
-      const int tx = static_cast<int>(cx + m.radius_px + 4), ty = static_cast<int>(cy - m.radius_px - 16);
+      // Labels may leave the map area but not the picture: flip to the left near the right edge.
+      c.no_clip();
+      const int text_w = 12 * static_cast<int>(m.text.size());
+      int tx = static_cast<int>(cx + m.radius_px + 4);
+      if (tx + text_w > L.width - 2) tx = static_cast<int>(cx - m.radius_px - 4) - text_w;
+      const int ty = static_cast<int>(cy - m.radius_px - 16);
       c.fill_rect(tx - 2, ty - 2, tx + 12 * static_cast<int>(m.text.size()) + 2, ty + 16, {255, 255, 255}, 0.8);
       c.text(tx, ty, m.text, m.color);
+      c.clip_x0 = kMargin;
+      c.clip_y0 = L.header;
+      c.clip_x1 = kMargin + L.map_w;
+      c.clip_y1 = L.header + L.map_h;
     }
   }
   c.no_clip();

@@ -28,6 +28,8 @@ class OdometrySimulator {
   hal::Odometry start(const fw::Se2d& truth, std::uint64_t t_ns);
   // Next sample. `fraction_of_scan_step` = (τ − τ₋) / scan period scales the variance.
   hal::Odometry next(const fw::Se2d& truth, std::uint64_t t_ns, double fraction_of_scan_step);
+  // The robot is carried to `truth` (kidnapped): the wheels see nothing, odometry does not move.
+  void teleport(const fw::Se2d& truth) { last_truth_ = truth; }
   const fw::Se2d& odom_pose() const { return odom_; }
 
  private:

@@ -68,7 +68,8 @@ bool in_unknown(const World& w, const Vec2& p) {
 }  // namespace
 
 bool generate_route(const World& world, const RouteOptions& opt, fw::RandomStream* rng, RouteTrajectory* out,
-                    std::vector<int>* visited_nodes, std::string* err) {
+                    std::vector<int>* visited_nodes, std::string* err, const Vec2* exclude_near,
+                    double exclude_radius) {
   const std::string bad = opt.validate();
   if (!bad.empty()) {
     if (err) *err = bad;
@@ -77,7 +78,9 @@ bool generate_route(const World& world, const RouteOptions& opt, fw::RandomStrea
   const RouteGraph& g = world.route;
   std::vector<int> allowed;
   for (size_t i = 0; i < g.nodes.size(); ++i) {
-    if (!(opt.avoid_unknown && in_unknown(world, g.nodes[i])) && !g.adjacent[i].empty()) allowed.push_back(static_cast<int>(i));
+    const bool blocked = (opt.avoid_unknown || opt.via_unknown) && in_unknown(world, g.nodes[i]);
+    const bool too_near = exclude_near != nullptr && (g.nodes[i] - *exclude_near).norm() <= exclude_radius;
+    if (!blocked && !too_near && !g.adjacent[i].empty()) allowed.push_back(static_cast<int>(i));
   }
   if (allowed.empty()) {
     if (err) *err = "world '" + world.name + "' has no route graph to drive on";
@@ -102,11 +105,57 @@ bool generate_route(const World& world, const RouteOptions& opt, fw::RandomStrea
   int prev = -1;
   std::vector<bool> visited(g.nodes.size(), false);
   visited[cur] = true;
+  bool avoid_unknown = opt.avoid_unknown;
+  if (opt.via_unknown) {
+    // Dijkstra to the nearest node inside an unknown area, then drive there.
+    const size_t n = g.nodes.size();
+    std::vector<double> dist(n, 1e300);
+    std::vector<int> from(n, -1);
+    std::vector<bool> done(n, false);
+    dist[cur] = 0;
+    int target = -1;
+    for (;;) {
+      int u = -1;
+      for (size_t i = 0; i < n; ++i) {
+        if (!done[i] && dist[i] < 1e299 && (u < 0 || dist[i] < dist[u])) u = static_cast<int>(i);
+      }
+      if (u < 0) break;
+      done[u] = true;
+      if (in_unknown(world, g.nodes[u])) {
+        target = u;
+        break;
+      }
+      for (int v : g.adjacent[u]) {
+        const double d = dist[u] + (g.nodes[v] - g.nodes[u]).norm();
+        if (d < dist[v]) {
+          dist[v] = d;
+          from[v] = u;
+        }
+      }
+    }
+    if (target < 0) {
+      if (err) *err = "world '" + world.name + "' has no unknown area reachable by the route graph";
+      return false;
+    }
+    std::vector<int> path;
+    for (int v = target; v != cur; v = from[v]) path.push_back(v);
+    for (auto it = path.rbegin(); it != path.rend() && out->length() < length; ++it) {
+      const Vec2 d = g.nodes[*it] - g.nodes[cur];
+      out->add_turn(std::atan2(d.y(), d.x()), turn_rate);
+      const double remaining = length - out->length();
+      out->add_drive(d.norm() > remaining ? Vec2(g.nodes[cur] + d.normalized() * remaining) : g.nodes[*it], opt.speed);
+      prev = cur;
+      cur = *it;
+      visited[cur] = true;
+      if (visited_nodes) visited_nodes->push_back(cur);
+    }
+    avoid_unknown = false;
+  }
   for (int guard = 0; out->length() < length && guard < 100000; ++guard) {
     std::vector<int> cand;
     std::vector<double> weight;
     for (int n : g.adjacent[cur]) {
-      if (opt.avoid_unknown && in_unknown(world, g.nodes[n])) continue;
+      if (avoid_unknown && in_unknown(world, g.nodes[n])) continue;
       if (n == prev && g.adjacent[cur].size() > 1) continue;
       cand.push_back(n);
       double wgt = 1.0;

@@ -17,7 +17,10 @@ struct RouteOptions {
   double speed = 0.75;        // m/s
   double turn_rate_deg = 60;  // deg/s
   int start_node = -1;        // route-graph node to start from; −1 = drawn from the seed
-  bool avoid_unknown = true;  // never enter the world's unknown areas
+  bool avoid_unknown = true;  // never enter the world's unknown areas (unless via_unknown)
+  // First drive the shortest way into the nearest unknown area, then walk on at random (for
+  // unknown-region experiments, Sec. 5.6: the localizer must report outside-map there).
+  bool via_unknown = false;
   // Choice weights at a junction: continuing straight (long corridor runs), a node not visited
   // yet (explore the building instead of pacing), entering a room (rooms are dead ends).
   double straight_weight = 3.0;
@@ -51,8 +54,11 @@ class RouteTrajectory {
 };
 
 // Random walk over the route graph from a seeded start node until length_m is driven.
+// `exclude_near`/`exclude_radius`: the drawn start node must be farther than that from the point
+// (used to kidnap the robot somewhere else).
 bool generate_route(const World& world, const RouteOptions& opt, fw::RandomStream* rng, RouteTrajectory* out,
-                    std::vector<int>* visited_nodes, std::string* err);
+                    std::vector<int>* visited_nodes, std::string* err, const Vec2* exclude_near = nullptr,
+                    double exclude_radius = 0);
 
 double default_route_length(const World& world);
 

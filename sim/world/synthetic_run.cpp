@@ -50,6 +50,11 @@ void add_people(World* world, int count, double speed, fw::RandomStream* rng) {
   }
 }
 
+fw::Se2d SyntheticRun::truth_at(double t) const {
+  if (kidnap_t_ >= 0 && t >= kidnap_t_) return after_kidnap_.pose_at(t - kidnap_t_);
+  return trajectory_.pose_at(t);
+}
+
 std::uint64_t SyntheticRun::time_ns(double t) const {
   return opt_.start_time_ns + static_cast<std::uint64_t>(std::llround(t * 1e9));
 }
@@ -64,13 +69,30 @@ bool SyntheticRun::init(const World& world, const SyntheticRunOptions& opt, std:
   opt_ = opt;
   fw::RandomStream route_rng(opt.seed, 1), people_rng(opt.seed, 4);
   if (!generate_route(world_, opt.route, &route_rng, &trajectory_, &route_nodes_, err)) return false;
+  kidnap_t_ = -1;
+  odom_teleported_ = false;
+  if (opt.kidnap_at_scan > 0) {
+    kidnap_t_ = static_cast<double>(opt.kidnap_at_scan) * opt.scan_period_s;
+    if (kidnap_t_ >= trajectory_.duration()) {
+      if (err) *err = "kidnap at scan " + std::to_string(opt.kidnap_at_scan) + " is after the end of the route";
+      return false;
+    }
+    const fw::Se2d at = trajectory_.pose_at(kidnap_t_);
+    const Vec2 here(at.x, at.y);
+    RouteOptions ro = opt.route;
+    ro.start_node = -1;
+    ro.via_unknown = false;
+    fw::RandomStream kidnap_rng(opt.seed, 5);
+    if (!generate_route(world_, ro, &kidnap_rng, &after_kidnap_, nullptr, err, &here, 10.0)) return false;
+  }
   int people = opt.people;
   if (people < 0) {
     const Vec2 size = world_.bounds.max - world_.bounds.min;
     people = std::min(12, static_cast<int>(size.x() * size.y() / 150.0));
   }
   add_people(&world_, people, opt.people_speed, &people_rng);
-  num_scans_ = static_cast<std::size_t>(std::floor(trajectory_.duration() / opt.scan_period_s)) + 1;
+  const double duration = kidnap_t_ >= 0 ? kidnap_t_ + after_kidnap_.duration() : trajectory_.duration();
+  num_scans_ = static_cast<std::size_t>(std::floor(duration / opt.scan_period_s)) + 1;
   if (opt.max_scans > 0) num_scans_ = std::min(num_scans_, opt.max_scans);
   next_scan_ = 0;
   next_odom_ = 0;
@@ -88,8 +110,17 @@ bool SyntheticRun::next(SyntheticFrame* out) {
   const double odom_period = opt_.scan_period_s / opt_.odometry_per_scan;
   out->index = static_cast<std::uint32_t>(next_scan_);
   out->t = t;
-  out->truth = trajectory_.pose_at(t);
-  travelled_ += std::hypot(out->truth.x - last_truth_.x, out->truth.y - last_truth_.y);
+  out->truth = truth_at(t);
+  const double prev_t = t - opt_.scan_period_s;
+  out->kidnapped = kidnap_t_ >= 0 && prev_t < kidnap_t_ && t >= kidnap_t_ && next_scan_ > 0;
+  if (out->kidnapped) {
+    // Only the driving before the jump and after the new start counts.
+    const fw::Se2d before = trajectory_.pose_at(kidnap_t_), after = after_kidnap_.pose_at(0);
+    travelled_ += std::hypot(before.x - last_truth_.x, before.y - last_truth_.y) +
+                  std::hypot(out->truth.x - after.x, out->truth.y - after.y);
+  } else {
+    travelled_ += std::hypot(out->truth.x - last_truth_.x, out->truth.y - last_truth_.y);
+  }
   last_truth_ = out->truth;
   out->travelled_m = travelled_;
   out->odometry.clear();
@@ -97,7 +128,16 @@ bool SyntheticRun::next(SyntheticFrame* out) {
   // samples up to and including the first at or after the scan time, so the scan is bracketed.
   while (next_odom_ == 0 || last_odom_t_ < t) {
     const double tau = next_odom_ == 0 ? 0.0 : (static_cast<double>(next_odom_ - 1) + opt_.odometry_phase) * odom_period;
-    const fw::Se2d truth = trajectory_.pose_at(tau);
+    if (kidnap_t_ >= 0 && tau >= kidnap_t_ && !odom_teleported_) {
+      // The odometry delta is taken from the pre-jump pose to the kidnap point, then the reference
+      // jumps: the wheels never see the carry.
+      odom_teleported_ = true;
+      if (last_odom_t_ < kidnap_t_) {
+        odom_sim_.next(trajectory_.pose_at(kidnap_t_), time_ns(kidnap_t_), 0.0);
+      }
+      odom_sim_.teleport(after_kidnap_.pose_at(0));
+    }
+    const fw::Se2d truth = truth_at(tau);
     if (next_odom_ == 0) {
       out->odometry.push_back(odom_sim_.start(truth, time_ns(tau)));
     } else {

@@ -31,6 +31,9 @@ struct SyntheticRunOptions {
   int people = -1;                   // moving people; −1 = world default (1 per 150 m² of floor, ≤ 12)
   double people_speed = 0.8;         // m/s
   std::size_t max_scans = 0;         // 0 = the whole route
+  // Kidnapping: at this scan index (> 0; 0 = never) the robot is carried to a random route node at
+  // least 10 m away and drives on from there; odometry does not see the jump.
+  std::size_t kidnap_at_scan = 0;
   std::uint64_t start_time_ns = 1'000'000'000;  // time stamp of t = 0
 
   std::string validate() const;
@@ -40,7 +43,8 @@ struct SyntheticFrame {
   std::uint32_t index = 0;
   double t = 0;                       // s since start
   fw::Se2d truth;                     // true robot (= laser) pose at the scan time
-  double travelled_m = 0;             // true path length up to this scan
+  double travelled_m = 0;             // true path length up to this scan (the kidnap jump excluded)
+  bool kidnapped = false;             // first scan after the robot was carried away
   std::vector<hal::Odometry> odometry;  // to push before the scan
   hal::LaserScan scan;
 };
@@ -55,6 +59,10 @@ class SyntheticRun {
 
   const World& world() const { return world_; }
   const RouteTrajectory& trajectory() const { return trajectory_; }
+  // Ground truth at time t (s since start), across a kidnapping.
+  fw::Se2d truth_at(double t) const;
+  // Time of the kidnapping (s), or a negative value.
+  double kidnap_time() const { return kidnap_t_; }
   const std::vector<int>& route_nodes() const { return route_nodes_; }
   std::uint64_t time_ns(double t) const;
 
@@ -62,6 +70,9 @@ class SyntheticRun {
   World world_;
   SyntheticRunOptions opt_;
   RouteTrajectory trajectory_;
+  RouteTrajectory after_kidnap_;
+  double kidnap_t_ = -1;
+  bool odom_teleported_ = false;
   std::vector<int> route_nodes_;
   std::size_t num_scans_ = 0;
   std::size_t next_scan_ = 0;

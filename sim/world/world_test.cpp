@@ -307,5 +307,69 @@ TEST(SyntheticRun, DeterministicAndEveryScanIsBracketedByOdometry) {
   EXPECT_NE(err.find("odometry samples"), std::string::npos);
 }
 
+TEST(Route, ViaUnknownDrivesIntoTheUnknownArea) {
+  World w;
+  std::string err;
+  ASSERT_TRUE(make_builtin_world("large-office", &w, &err));
+  RouteOptions opt;
+  opt.via_unknown = true;
+  opt.length_m = 200;
+  for (std::uint64_t seed : {1, 2, 3}) {
+    fw::RandomStream rng(seed, 1);
+    RouteTrajectory t;
+    ASSERT_TRUE(generate_route(w, opt, &rng, &t, nullptr, &err)) << err;
+    EXPECT_FALSE(w.unknown_areas[0].contains(Vec2(t.pose_at(0).x, t.pose_at(0).y)));
+    bool inside = false;
+    for (double s = 0; s <= t.duration(); s += 0.2) {
+      const fw::Se2d p = t.pose_at(s);
+      inside |= w.unknown_areas[0].contains(Vec2(p.x, p.y));
+    }
+    EXPECT_TRUE(inside) << "seed " << seed;
+  }
+  World corridor;
+  ASSERT_TRUE(make_builtin_world("corridor", &corridor, &err));
+  fw::RandomStream rng(1, 1);
+  RouteTrajectory t;
+  EXPECT_FALSE(generate_route(corridor, opt, &rng, &t, nullptr, &err));
+  EXPECT_NE(err.find("no unknown area"), std::string::npos);
+}
+
+TEST(SyntheticRun, KidnappingJumpsTheTruthButNotTheOdometry) {
+  World w;
+  std::string err;
+  ASSERT_TRUE(make_builtin_world("large-office", &w, &err));
+  SyntheticRunOptions opt;
+  opt.seed = 9;
+  opt.kidnap_at_scan = 50;
+  opt.max_scans = 80;
+  SyntheticRun run;
+  ASSERT_TRUE(run.init(w, opt, &err)) << err;
+  SyntheticFrame f;
+  fw::Se2d prev_truth;
+  hal::Odometry prev_odom;
+  int kidnaps = 0;
+  while (run.next(&f)) {
+    if (f.index > 0) {
+      const double jump = std::hypot(f.truth.x - prev_truth.x, f.truth.y - prev_truth.y);
+      const hal::Odometry& o = f.odometry.back();
+      const double odom_step = std::hypot(o.x - prev_odom.x, o.y - prev_odom.y);
+      EXPECT_LT(odom_step, 1.0) << f.index;  // wheels: at most one scan period of driving + noise
+      if (f.kidnapped) {
+        ++kidnaps;
+        EXPECT_EQ(f.index, 50u);
+        EXPECT_GT(jump, 9.0);
+      } else {
+        EXPECT_LT(jump, 0.75 * opt.scan_period_s + 1e-6) << f.index;
+      }
+    }
+    prev_truth = f.truth;
+    prev_odom = f.odometry.back();
+  }
+  EXPECT_EQ(kidnaps, 1);
+  opt.kidnap_at_scan = 1000000;
+  EXPECT_FALSE(run.init(w, opt, &err));
+  EXPECT_NE(err.find("kidnap"), std::string::npos);
+}
+
 }  // namespace
 }  // namespace sim
