@@ -4,16 +4,16 @@
 # vcan1 (classic), then scores the captured pose/health frames on the host and asserts.
 #   hil_vcan.sh BUILD_DIR   (results: BUILD_DIR/hil/vcan/results.json)
 # Exit 77 = skipped (no UML, no data); CTest maps it to "Skipped".
-# Environment: HIL_SCANS (FD scenario scans, default 300), HIL_SPEED (replay speed-up, default 4),
+# Environment: HIL_SCANS (FD scenario scans, default 250), HIL_SPEED (replay speed-up, default 2),
 #              HIL_LOCALIZER (mml when the map can be built, else odom), HIL_REQUIRE_LOCALIZED (0/1).
 set -u
 B=$(cd "$1" && pwd)
 here=$(cd "$(dirname "$0")" && pwd)
 DATA=${MMLFW_DATA_DIR:-$here/../../../shared/data}
 W=$B/hil/vcan
-SCANS=${HIL_SCANS:-300}
-CLASSIC_SCANS=${HIL_CLASSIC_SCANS:-120}
-SPEED=${HIL_SPEED:-4}
+SCANS=${HIL_SCANS:-250}
+CLASSIC_SCANS=${HIL_CLASSIC_SCANS:-100}
+SPEED=${HIL_SPEED:-2}
 DS=aces
 fail=0
 say() { echo "hil_vcan: $*"; }
@@ -69,7 +69,7 @@ write_config "$W/classic.conf" vcan1 false
 write_config "$W/fault.conf" vcan0 true
 "$CANDEV" log2can --dataset $DS --count "$SCANS" --fd --speed "$SPEED" --out "$W/fd.replay" > "$W/fd.sent.json" || exit 1
 "$CANDEV" log2can --dataset $DS --count "$CLASSIC_SCANS" --speed "$SPEED" --out "$W/classic.replay" > "$W/classic.sent.json" || exit 1
-"$CANDEV" log2can --dataset $DS --first 1000 --count 150 --fd --speed "$SPEED" --corrupt-every 10 --drop-every 13 \
+"$CANDEV" log2can --dataset $DS --first 1000 --count 120 --fd --speed "$SPEED" --corrupt-every 10 --drop-every 13 \
   --dup-every 17 --bus-off-at 60 --bus-off-burst 20 --out "$W/fault.replay" > "$W/fault.sent.json" || exit 1
 {
   echo "fd vcan0 $W/fd.conf $W/fd.replay"
@@ -91,7 +91,7 @@ summary() { grep -o '{.*}' <(grep "mmlfw summary:" "$W/$1/mmlfw.log") > "$W/$1/s
 for s in fd classic fault; do
   first=0; count=$SCANS
   [ $s = classic ] && count=$CLASSIC_SCANS
-  [ $s = fault ] && { first=1000; count=150; }
+  [ $s = fault ] && { first=1000; count=120; }
   check "$s: mmlfw stopped cleanly on SIGTERM" test "$(cat "$W/$s/mmlfw.rc" 2>/dev/null)" = 0
   check "$s: canplayer replayed the log" test "$(cat "$W/$s/canplayer.rc" 2>/dev/null)" = 0
   summary $s > /dev/null || { say "FAIL - $s: no mmlfw summary"; fail=1; continue; }

@@ -1,0 +1,101 @@
+// bench_hal: the figures of the HAL/HIL issue in build/bench/hal.json. Runs the vcan HIL (user-mode
+// Linux) and the serial pty HIL scripts on this build directory, then the 75 Hz host replay with
+// pinned workers (budget check), and merges everything into one flat JSON object.
+#include <cmath>
+#include <cstdio>
+#include <cstdlib>
+#include <fstream>
+#include <sstream>
+#include <string>
+
+#include "sim/common/bench_json.h"
+#include "tests/hil/replay_budget.h"
+
+namespace {
+
+// Minimal reader for the flat JSON objects the HIL scripts write: "key": value pairs.
+std::string read_all(const std::string& path) {
+  std::ifstream in(path);
+  std::stringstream ss;
+  ss << in.rdbuf();
+  return ss.str();
+}
+bool json_value(const std::string& text, const std::string& key, std::string* out) {
+  const std::string k = "\"" + key + "\":";
+  size_t p = text.find(k);
+  if (p == std::string::npos) return false;
+  p += k.size();
+  while (p < text.size() && text[p] == ' ') ++p;
+  size_t e = p;
+  while (e < text.size() && text[e] != ',' && text[e] != '}' && text[e] != '\n') ++e;
+  *out = text.substr(p, e - p);
+  return true;
+}
+void copy_num(sim::BenchJson& j, const std::string& text, const std::string& key, const std::string& as = "") {
+  std::string v;
+  const std::string name = as.empty() ? key : as;
+  if (!json_value(text, key, &v) || v == "null") {
+    j.add(name, std::nan(""));
+  } else if (v == "true" || v == "false") {
+    j.add_bool(name, v == "true");
+  } else {
+    j.add(name, std::strtod(v.c_str(), nullptr));
+  }
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  if (argc < 2) {
+    std::fprintf(stderr, "usage: bench_hal OUT.json\n");
+    return 2;
+  }
+  std::string exe = argv[0];
+  const std::string bench_dir = exe.substr(0, exe.find_last_of('/') == std::string::npos ? 0 : exe.find_last_of('/'));
+  const std::string build = (bench_dir.empty() ? std::string(".") : bench_dir) + "/..";
+  const std::string src = MMLFW_SOURCE_DIR;
+  sim::BenchJson j;
+
+  std::printf("bench_hal: vcan HIL inside user-mode Linux ...\n");
+  std::fflush(stdout);
+  const int vrc = std::system(("bash " + src + "/tests/hil/hil_vcan.sh " + build + " > " + build + "/hil_vcan.log 2>&1").c_str());
+  const std::string v = read_all(build + "/hil/vcan/results.json");
+  j.add_bool("hil_vcan_passed", vrc == 0);
+  for (const char* k : {"hil_vcan_scans_sent", "hil_vcan_scans_decoded", "hil_vcan_scans_processed", "hil_vcan_localized",
+                        "hil_vcan_localized_scans", "hil_vcan_pose_err_m", "hil_vcan_pose_err_all_m", "hil_fd_ok",
+                        "hil_classic_scans_decoded", "corrupt_segments_counted", "fault_scans_faulty", "fault_crc_errors",
+                        "fault_bus_off", "fault_wrong_localized"}) {
+    copy_num(j, v, k);
+  }
+  std::printf("bench_hal: serial HIL over a socat pty pair ...\n");
+  std::fflush(stdout);
+  const int src_rc = std::system(("bash " + src + "/tests/hil/hil_serial.sh " + build + " > " + build + "/hil_serial.log 2>&1").c_str());
+  const std::string s = read_all(build + "/hil/serial/results.json");
+  std::string ok;
+  j.add_bool("serial_pty_ok", src_rc == 0 && json_value(s, "serial_pty_ok", &ok) && ok == "true");
+  copy_num(j, s, "serial_scans_sent");
+  copy_num(j, s, "serial_scans_received");
+
+  std::printf("bench_hal: 75 Hz host replay (aces, MML, 2 pinned workers) ...\n");
+  std::fflush(stdout);
+  mmlfw_hil::ReplayOptions o;
+  mmlfw_hil::ReplayResult r;
+  std::string err;
+  if (mmlfw_hil::run_replay(o, &r, &err)) {
+    j.add("replay_75hz_step_ms_p50", r.step_p50_ms);
+    j.add("replay_75hz_step_ms_p99", r.step_p99_ms);
+    j.add_int("replay_75hz_deadline_misses", static_cast<long long>(r.deadline_misses));
+    j.add_int("replay_75hz_scans_fed", static_cast<long long>(r.scans_fed));
+    j.add_int("replay_75hz_scans_processed", static_cast<long long>(r.scans_processed));
+    j.add("replay_75hz_processed_rate_hz", r.achieved_rate_hz);
+    j.add("static_memory_mib", r.static_memory_mib);
+    std::map<std::string, double> budget;
+    if (mmlfw_hil::read_budget(src + "/firmware/app/budget.txt", &budget, &err)) {
+      j.add_int("budget_violations", static_cast<long long>(mmlfw_hil::check_budget(budget, r).size()));
+    }
+  } else {
+    std::fprintf(stderr, "bench_hal: replay failed: %s\n", err.c_str());
+    j.add("replay_75hz_step_ms_p99", std::nan(""));
+  }
+  return j.write(argv[1]) ? 0 : 1;
+}
