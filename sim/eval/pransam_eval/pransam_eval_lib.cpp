@@ -296,7 +296,8 @@ std::vector<Theorem1Row> theorem1(const RealCase& c, int T, const std::vector<st
   return rows;
 }
 
-ThreeDRun run_3d(std::size_t trials, int pool_threads, std::uint32_t max_iterations, std::string* error) {
+ThreeDRun run_3d(std::size_t trials, int pool_threads, std::uint32_t max_iterations, std::string* error,
+                 std::uint32_t refine_iterations, float refine_min_quality) {
   ThreeDRun run;
   fw::pransam::MatcherOptions o;
   o.num_workers = 2;
@@ -343,6 +344,8 @@ ThreeDRun run_3d(std::size_t trials, int pool_threads, std::uint32_t max_iterati
     p.seed = 77 + k;
     p.max_iterations = max_iterations;
     p.omega_thres = 1.0f;  // run I_max, keep the best (the room is nearly 180°-symmetric)
+    p.refine_iterations = refine_iterations;
+    p.refine_min_quality = refine_min_quality;
     fw::pransam::MatchResult<3> res;
     const double t0 = now_ms();
     s = m.match(a.data(), a.size(), p, &res);

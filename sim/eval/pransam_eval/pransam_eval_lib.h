@@ -107,7 +107,8 @@ struct ThreeDRun {
   std::vector<double> ms, trans_err, rot_err_deg;
   double p50() const;
 };
-ThreeDRun run_3d(std::size_t trials, int pool_threads, std::uint32_t max_iterations, std::string* error);
+ThreeDRun run_3d(std::size_t trials, int pool_threads, std::uint32_t max_iterations, std::string* error,
+                 std::uint32_t refine_iterations = 0, float refine_min_quality = 0.45f);
 
 // Same seed ⇒ identical hypothesis set on 1 and 2 pool threads (collect-all, real scan).
 bool determinism_check(const RealCase& c, bool precomputed, std::string* detail);

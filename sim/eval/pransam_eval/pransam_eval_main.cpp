@@ -44,7 +44,9 @@ int main(int argc, char** argv) {
   std::string err;
   if (cmd == "3d") {
     const ThreeDRun r = run_3d(std::stoul(get(a, "trials", "10")), std::stoi(get(a, "threads", "2")),
-                               static_cast<std::uint32_t>(std::stoul(get(a, "iters", "200000"))), &err);
+                               static_cast<std::uint32_t>(std::stoul(get(a, "iters", "200000"))), &err,
+                               static_cast<std::uint32_t>(std::stoul(get(a, "refine", "0"))),
+                               std::stof(get(a, "refine-min", "0.45")));
     if (!err.empty()) { std::fprintf(stderr, "%s\n", err.c_str()); return 1; }
     for (std::size_t i = 0; i < r.trials; ++i)
       std::printf("trial %zu: %.1f ms  trans err %.3f m  rot err %.2f deg\n", i, r.ms[i], r.trans_err[i], r.rot_err_deg[i]);
