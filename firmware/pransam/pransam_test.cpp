@@ -246,6 +246,27 @@ TEST_F(Matcher2DTest, RecoversKnownScanPoseWithPrecomputedTableAndSectionRoundTr
   ASSERT_TRUE(matcher_->set_model(world_->map.data(), world_->map.size(), "floor plan").is_ok());
 }
 
+TEST_F(Matcher2DTest, RefinementAndFreeSpaceGateKeepTheRightAnswer) {
+  RandomStream rng(47, 0);
+  const Se2f pose(20.0f, 13.0f, -0.8f);
+  const std::vector<P2> scan = sim::pransam_scenes::cast_scan(world_->segs, pose, 10.0f, 0.01f, rng);
+  MatchParams p;
+  p.seed = 21;
+  p.max_iterations = 200000;
+  p.omega_thres = 0.97f;
+  p.refine_iterations = 5;
+  p.refine_min_quality = 0.8f;
+  p.scene_origin_is_sensor = true;
+  MatchResult<2> r;
+  ASSERT_TRUE(matcher_->match(scan.data(), scan.size(), p, &r).is_ok());
+  ASSERT_TRUE(r.found) << r.best.quality;
+  EXPECT_GT(r.stats.refined, 0u);
+  const Se2f e = to_se2(r.best);
+  // Refined: much tighter than the raw triangle hypothesis.
+  EXPECT_LT(std::hypot(e.x - pose.x, e.y - pose.y), 0.05f);
+  EXPECT_LT(angle_diff(e.theta, pose.theta), 1.0f * kPi / 180.0f);
+}
+
 TEST_F(Matcher2DTest, MalformedInputsReturnAStatus) {
   MatchParams p;
   MatchResult<2> r;
