@@ -2,6 +2,7 @@
 
 #include <unistd.h>
 
+#include <chrono>
 #include <cmath>
 #include <cstdlib>
 #include <filesystem>
@@ -261,6 +262,32 @@ TEST(SimRunner, ReplaysARealLogWithReference) {
   EXPECT_GT(r.summary.scans_restamped, 0u);
   EXPECT_EQ(r.summary.odom_rejected, 0u);
   for (size_t i = 1; i < r.steps.size(); ++i) EXPECT_GT(r.steps[i].t, r.steps[i - 1].t);
+}
+
+TEST(SimRunner, CustomWorldAndPacing) {
+  World w;
+  w.name = "box-room";
+  w.bounds = {Vec2(0, 0), Vec2(6, 4)};
+  add_rect(&w, 0, 0, 6, 4);
+  const int a = w.route.add_node(Vec2(1, 2)), b = w.route.add_node(Vec2(5, 2));
+  w.route.connect(a, b);
+  SimConfig cfg;
+  cfg.custom_world = &w;
+  cfg.progress = false;
+  cfg.steps = 6;
+  cfg.paced = true;
+  cfg.synthetic.scan_period_s = 0.05;
+  cfg.synthetic.people = 0;
+  SimResult r;
+  std::string err;
+  const auto t0 = std::chrono::steady_clock::now();
+  ASSERT_TRUE(run_simulation(cfg, &r, &err)) << err;
+  const double wall = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+  EXPECT_EQ(r.steps.size(), 6u);
+  EXPECT_EQ(r.summary.source, "world:box-room");
+  EXPECT_GE(wall, 0.25 - 0.01);  // scans at 0, 0.05, ..., 0.25 s, paced at real time
+  cfg.pace_speed = 100;           // paced 100× faster
+  ASSERT_TRUE(run_simulation(cfg, &r, &err)) << err;
 }
 
 TEST(Picture, Base64AndPngEncoding) {

@@ -346,6 +346,13 @@ bool run_simulation(const SimConfig& cfg_in, SimResult* out, std::string* err) {
     }
     if (!resolve_dataset(&cfg, err)) return false;
   }
+  if (cfg.custom_world != nullptr) {
+    if (!cfg.world.empty() || !cfg.log_path.empty()) {
+      *err = "a custom world excludes --world and --log";
+      return false;
+    }
+    cfg.world = cfg.custom_world->name.empty() ? "custom" : cfg.custom_world->name;
+  }
   if (cfg.world.empty() == cfg.log_path.empty()) {
     *err = "give exactly one of a world (--world) or a log (--log)";
     return false;
@@ -364,7 +371,11 @@ bool run_simulation(const SimConfig& cfg_in, SimResult* out, std::string* err) {
   SimSummary& sum = out->summary;
   sum.localizer = cfg.localizer;
   if (!cfg.world.empty()) {
-    if (!make_builtin_world(cfg.world, &world, err)) return false;
+    if (cfg.custom_world != nullptr) {
+      world = *cfg.custom_world;
+    } else if (!make_builtin_world(cfg.world, &world, err)) {
+      return false;
+    }
     SyntheticRunOptions so = cfg.synthetic;
     so.seed = cfg.seed;
     if (cfg.steps > 0) so.max_scans = cfg.steps;
@@ -488,7 +499,13 @@ bool run_simulation(const SimConfig& cfg_in, SimResult* out, std::string* err) {
       const hal::Odometry& o = loop->last_odometry();
       r.odom = fw::Se2d(o.x, o.y, o.theta);
       r.step_ms = static_cast<double>(loop->last_step_ns()) * 1e-6;
-      if (e.status != last_status && cfg.progress) {
+      // Status changes worth a line of their own: becoming sure (or faulty, or outside the map)
+      // and losing it; searching <-> ambiguous flapping stays in the progress line.
+      const auto notable = [](hal::LocalizationStatus st) {
+        return st == hal::LocalizationStatus::kLocalized || st == hal::LocalizationStatus::kOutsideMap ||
+               st == hal::LocalizationStatus::kFault;
+      };
+      if (e.status != last_status && cfg.progress && (notable(e.status) || notable(last_status))) {
         std::fprintf(stderr, "%sstep %u (t=%.1f s, %.1f m): %s -> %s at (%.2f, %.2f, %.1f deg)", tty ? "\r\033[K" : "",
                      r.step, r.t, r.travelled_m, hal::status_name(last_status), hal::status_name(e.status), e.x, e.y,
                      e.theta * kRadToDeg);

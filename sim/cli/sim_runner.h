@@ -19,6 +19,7 @@ namespace sim {
 
 struct SimConfig {
   std::string world;           // built-in world name, or
+  const World* custom_world = nullptr;  // a world built in code (tests: a unique room, a symmetric corridor), or
   std::string dataset;         // a dataset of ../shared/data (log, reference and cached global map), or
   std::string log_path;        // CARMEN log (plain or .gz)
   std::string reference_path;  // *.corrected-poses.txt for a log (ground truth)
