@@ -168,6 +168,9 @@ bool build_table_section(RealCase* c, const TableBuild& build, double* seconds, 
 bool make_matcher(const RealCase& c, int pool_threads, int T, bool precomputed, MatcherHandle* out,
                   std::string* error) {
   fw::pransam::MatcherOptions o = options_for(c.map, T, !precomputed, c.eps_hard, c.eps_soft);
+  // Online matching runs two barriers per round (draw/rate, then apply inserts): larger rounds.
+  // Precomputed matching stops early, and a large last round would be wasted work.
+  o.max_batch = precomputed ? 1024 : 4096;
   out->arena = std::make_unique<fw::StartupArena>();
   fw::Status s = out->arena->init_mapped(arena_bytes(o), false, "pransam eval");
   if (!s.is_ok()) {
