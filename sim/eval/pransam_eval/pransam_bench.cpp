@@ -131,8 +131,8 @@ int main(int argc, char** argv) {
     json.add_bool("deterministic", det && detp);
   }
   {
-    // Theorem 1: T = 4, τ = 1, 2, 3; quality and collisions after I_max (10 scans each).
-    const auto rows = theorem1(intel, 4, {2000, 5000, 10000, 20000}, 10, 1, &err);
+    // Theorem 1: T = 4, τ = 1, 2, 3; quality and collisions after I_max (20 scans each).
+    const auto rows = theorem1(intel, 4, {5000, 10000, 20000, 40000}, 20, 1, &err);
     if (rows.empty()) return fail(err);
     std::printf("Theorem 1 (T=4): tau I_max mean_best_Ω mean_collisions mean_ms success\n");
     for (const auto& r : rows) {
@@ -142,6 +142,16 @@ int main(int argc, char** argv) {
       json.add(k + "_quality", r.mean_best_quality);
       json.add(k + "_collisions", r.mean_collisions);
     }
+    // Which τ collected the most collisions / the best quality at the largest I_max (Theorem 1: T/2).
+    int best_c = 0, best_q = 0;
+    double max_c = -1, max_q = -1;
+    for (const auto& r : rows) {
+      if (r.max_iterations != 40000) continue;
+      if (r.mean_collisions > max_c) { max_c = r.mean_collisions; best_c = r.tau; }
+      if (r.mean_best_quality > max_q) { max_q = r.mean_best_quality; best_q = r.tau; }
+    }
+    json.add_int("theorem1_argmax_tau_collisions", best_c);
+    json.add_int("theorem1_argmax_tau_quality", best_q);
   }
   // ---------------------------------------------------------------- aces
   {
