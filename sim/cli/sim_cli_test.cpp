@@ -89,6 +89,7 @@ TEST(SimArgs, ParsesAFullCommandLine) {
 SimConfig small_run(const std::string& out, std::uint64_t seed) {
   SimConfig cfg;
   cfg.world = "small-office";
+  cfg.localizer = "odom";
   cfg.seed = seed;
   cfg.steps = 60;
   cfg.out_dir = out;
@@ -241,6 +242,7 @@ TEST(SimRunner, ReplaysARealLogWithReference) {
     GTEST_SKIP() << "intel log not found under MMLFW_DATA_DIR=" << data_dir();
   }
   SimConfig cfg;
+  cfg.localizer = "odom";
   cfg.log_path = data_path(ds->raw_log);
   if (!ds->corrected_poses.empty()) cfg.reference_path = data_path(ds->corrected_poses);
   cfg.steps = 300;
@@ -272,6 +274,7 @@ TEST(SimRunner, CustomWorldAndPacing) {
   const int a = w.route.add_node(Vec2(1, 2)), b = w.route.add_node(Vec2(5, 2));
   w.route.connect(a, b);
   SimConfig cfg;
+  cfg.localizer = "odom";
   cfg.custom_world = &w;
   cfg.progress = false;
   cfg.steps = 6;

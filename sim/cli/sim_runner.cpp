@@ -346,6 +346,20 @@ bool run_simulation(const SimConfig& cfg_in, SimResult* out, std::string* err) {
     }
     if (!resolve_dataset(&cfg, err)) return false;
   }
+  if (!cfg.out_dir.empty()) {  // fail before a long run, not after it
+    std::error_code ec;
+    std::filesystem::create_directories(cfg.out_dir, ec);
+    if (ec || !std::filesystem::is_directory(cfg.out_dir)) {
+      *err = "cannot create output directory '" + cfg.out_dir + "'" + (ec ? ": " + ec.message() : "");
+      return false;
+    }
+  }
+  if (cfg.localizer.empty()) {
+    cfg.localizer = "odom";
+    for (const LocalizerInfo& l : localizer_names()) {
+      if (l.name == "mml") cfg.localizer = "mml";
+    }
+  }
   if (cfg.custom_world != nullptr) {
     if (!cfg.world.empty() || !cfg.log_path.empty()) {
       *err = "a custom world excludes --world and --log";
@@ -641,12 +655,6 @@ bool run_simulation(const SimConfig& cfg_in, SimResult* out, std::string* err) {
 
   // ---- outputs ----
   if (!cfg.out_dir.empty()) {
-    std::error_code ec;
-    std::filesystem::create_directories(cfg.out_dir, ec);
-    if (ec) {
-      *err = "cannot create output directory '" + cfg.out_dir + "': " + ec.message();
-      return false;
-    }
     if (!write_steps_csv(cfg.out_dir + "/steps.csv", out->steps, err)) return false;
     if (!write_summary_json(cfg.out_dir + "/summary.json", sum, err)) return false;
     if (have_grid && !write_ros_map(cfg.out_dir + "/map.yaml", grid_to_ros_map(grid, "map.pgm"), err)) return false;

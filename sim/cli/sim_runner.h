@@ -24,7 +24,8 @@ struct SimConfig {
   std::string log_path;        // CARMEN log (plain or .gz)
   std::string reference_path;  // *.corrected-poses.txt for a log (ground truth)
   std::string map_yaml;        // ROS map for a log replay (optional)
-  std::string localizer = "odom";
+  // Empty: "mml" when it is registered (the product), else "odom" (pass-through).
+  std::string localizer;
   std::map<std::string, std::string> localizer_options;
   std::uint64_t seed = 1;
   std::size_t steps = 0;       // 0 = all
