@@ -70,6 +70,15 @@ int main(int argc, char** argv) {
     json.add_int("scan_map_nothing_precomp", static_cast<long long>(r.nothing));
     json.add_int("scan_map_below_thres_precomp", static_cast<long long>(r.below_thres));
     json.add("scan_map_mean_iterations_precomp", r.mean_iterations());
+    {
+      MatcherHandle m1;
+      if (!make_matcher(intel, 1, 2, true, &m1, &err)) return fail(err);
+      const ScanMapRun r1 = run_scan_map(intel, m1, scan_params());
+      report("intel precomp 1 thread", r1);
+      json.add("scan_map_ms_p50_1t_precomp", r1.p50());
+      json.add("scan_map_ms_p99_1t_precomp", r1.p99());
+      json.add("speedup_2t_precomp_p50", r1.p50() / r.p50());
+    }
     // Hard contact with the same threshold (Eq. 4.31 vs 4.33).
     fw::pransam::MatchParams hard = scan_params();
     hard.fuzzy = false;
