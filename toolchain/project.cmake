@@ -18,7 +18,9 @@ target_compile_definitions(eigen3 INTERFACE EIGEN_NO_MALLOC EIGEN_DONT_PARALLELI
 add_compile_options(-ffp-contract=off)
 
 if(MMLFW_SANITIZE STREQUAL "address")
-  add_compile_options(-fsanitize=address,undefined -fno-omit-frame-pointer -fno-sanitize-recover=undefined)
+  # -fno-sanitize=vptr: UBSan's vptr check needs typeinfo, which the -fno-rtti firmware/hal libraries
+  # (e.g. hal_sim's polymorphic sources used from RTTI-enabled tests) do not emit: link errors otherwise.
+  add_compile_options(-fsanitize=address,undefined -fno-sanitize=vptr -fno-omit-frame-pointer -fno-sanitize-recover=undefined)
   add_link_options(-fsanitize=address,undefined)
 elseif(MMLFW_SANITIZE STREQUAL "thread")
   add_compile_options(-fsanitize=thread -fno-omit-frame-pointer)

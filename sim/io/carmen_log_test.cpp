@@ -9,6 +9,7 @@
 #include <cmath>
 #include <cstdio>
 #include <fstream>
+#include <random>
 #include <string>
 
 namespace sim {
@@ -195,6 +196,49 @@ TEST(CarmenLog, MalformedLinesAreErrorsNamingFileAndLine) {
     EXPECT_EQ(skipped.scans[1].line, 4u);
     EXPECT_EQ(skipped.scans[1].index, 1u);
   }
+}
+
+// Random byte-level corruption (flips, deletions, insertions, truncation) of a valid log: the reader
+// never crashes or hangs, and either succeeds or names the file and a line that exists.
+TEST(CarmenLog, RandomCorruptionIsAnErrorOrParses) {
+  const std::string good = "# h\nPARAM a 1 0 h 0\nODOM 1 2 3 0 0 0 5.0 h 5.0\n" + flaser_line(10) +
+                           std::string(kRobotLaser) + "RAWLASER1 0 -1 2 0.5 30 0.01 0 2 1 2 1 7 55.5 host 1.5\n" +
+                           flaser_line(12);
+  const size_t good_lines = 7;
+  std::mt19937 rng(12345);
+  const char alphabet[] = " \n\t.-+0123456789eEnaFLSRODMx#\0\xff";
+  size_t failures = 0;
+  for (int iter = 0; iter < 3000; ++iter) {
+    std::string t = good;
+    const int edits = 1 + static_cast<int>(rng() % 4);
+    for (int k = 0; k < edits; ++k) {
+      const size_t pos = rng() % t.size();
+      const char c = alphabet[rng() % (sizeof(alphabet) - 1)];
+      switch (rng() % 4) {
+        case 0: t[pos] = c; break;
+        case 1: t.erase(pos, 1 + rng() % 8); break;
+        case 2: t.insert(pos, 1, c); break;
+        default: t.resize(pos); break;
+      }
+      if (t.empty()) t = "x";
+    }
+    CarmenLog log;
+    std::string err;
+    if (!parse(t, &log, &err)) {
+      ++failures;
+      ASSERT_EQ(err.rfind("mem.clf:", 0), 0u) << err;
+      const size_t line = std::stoul(err.substr(8));
+      ASSERT_GE(line, 1u);
+      ASSERT_LE(line, good_lines + 40) << err;
+    } else {
+      for (const auto& sc : log.scans) {
+        for (float r : sc.ranges) ASSERT_TRUE(std::isfinite(r) && r >= 0.0f);
+      }
+    }
+    CarmenLog skipped;
+    ASSERT_TRUE(parse(t, &skipped, &err, /*skip=*/true)) << err;
+  }
+  EXPECT_GT(failures, 1000u);  // most corruptions are detected
 }
 
 TEST(CarmenLog, MaxScansStopsEarly) {
