@@ -643,6 +643,12 @@ bool run_simulation(const SimConfig& cfg_in, SimResult* out, std::string* err) {
       std::fprintf(stderr, "not localized in %zu steps (%.1f m); localizer '%s'\n", sum.steps, sum.path_length_m,
                    cfg.localizer.c_str());
     }
+    if (cfg.wall_timing) {
+      for (const fw::PerfCounter* pc : {&loop->perf_poll(), &loop->perf_pair(), &loop->perf_step(),
+                                        &loop->perf_publish(), &loop->perf_total()}) {
+        pc->print(stderr);
+      }
+    }
     const std::size_t shown = std::min<std::size_t>(logs->size(), 10);
     for (std::size_t i = logs->size() - shown; i < logs->size(); ++i) {
       std::fprintf(stderr, "firmware: %s\n", logs->line(i).text);

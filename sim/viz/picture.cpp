@@ -256,7 +256,7 @@ bool write_svg(const Picture& pic, const std::string& path, std::string* err) {
   if (!make_layout(pic, &L, err)) return false;
   std::ostringstream s;
   s.precision(6);
-  s << "<svg xmlns=\"http://www.w3.org/2000/svg\" width=\"" << L.width << "\" height=\"" << L.height
+  s << "<svg xmlns=\"http://www.w3.org/2000/svg\" xmlns:xlink=\"http://www.w3.org/1999/xlink\" width=\"" << L.width << "\" height=\"" << L.height
     << "\" viewBox=\"0 0 " << L.width << ' ' << L.height << "\" font-family=\"sans-serif\">\n";
   s << "<rect width=\"100%\" height=\"100%\" fill=\"" << hex(kBackground) << "\"/>\n";
   s << "<text x=\"" << kMargin << "\" y=\"" << kMargin + 14 << "\" font-size=\"16\" font-weight=\"bold\">"
@@ -272,7 +272,7 @@ bool write_svg(const Picture& pic, const std::string& path, std::string* err) {
     const double mx = L.px(g.origin_x), my = L.py(g.origin_y + g.size_y());
     s << "<image x=\"" << mx << "\" y=\"" << my << "\" width=\"" << g.size_x() * L.ppm << "\" height=\""
       << g.size_y() * L.ppm << "\" preserveAspectRatio=\"none\" style=\"image-rendering:pixelated\" "
-      << "href=\"data:image/png;base64," << base64(png) << "\"/>\n";
+      << "xlink:href=\"data:image/png;base64," << base64(png) << "\"/>\n";
   }
   s << "<clipPath id=\"maparea\"><rect x=\"" << kMargin << "\" y=\"" << L.header << "\" width=\"" << L.map_w
     << "\" height=\"" << L.map_h << "\"/></clipPath>\n<g clip-path=\"url(#maparea)\">\n";
