@@ -3,6 +3,9 @@
 #include <cstring>
 #include <vector>
 
+#include <memory>
+
+#include "hal_sim/sim_hal.h"
 #include "hal_sim/sim_log_sink.h"
 #include "hal_sim/sim_sensor_io.h"
 #include "hal_sim/sim_task_runner.h"
@@ -128,6 +131,32 @@ TEST(SimLogSink, FormatsFiltersAndOverwritesOldest) {
   big[sizeof(big) - 1] = 0;
   sink.log(hal::LogLevel::kError, "%s", big);
   EXPECT_EQ(std::strlen(sink.line(sink.size() - 1).text), hal_sim::SimLogLine::kMaxChars - 1);
+}
+
+TEST(SimHal, WiresEveryBackendIntoTheHal) {
+  auto sim = std::make_unique<hal_sim::SimHal>();
+  hal::Hal& h = sim->hal;
+  ASSERT_NE(h.clock, nullptr);
+  sim->clock.set_ns(42);
+  EXPECT_EQ(h.clock->now_ns(), 42u);
+  hal::Odometry o;
+  o.timestamp_ns = 5;
+  ASSERT_TRUE(sim->odometry.push(o));
+  hal::Odometry got;
+  ASSERT_TRUE(h.odometry->poll(&got));
+  EXPECT_EQ(got.timestamp_ns, 5u);
+  hal::PoseEstimate e;
+  e.scan_id = 9;
+  h.pose_sink->publish(e);
+  ASSERT_TRUE(sim->pose_sink.pop(&e));
+  EXPECT_EQ(e.scan_id, 9u);
+  h.log->log(hal::LogLevel::kInfo, "x=%d", 3);
+  EXPECT_STREQ(sim->log.line(0).text, "x=3");
+  std::vector<int> trace;
+  Counter c{&trace, 7};
+  ASSERT_TRUE(h.tasks->add_task("t", &record, &c, 0));
+  h.tasks->run_once();
+  EXPECT_EQ(trace, std::vector<int>{7});
 }
 
 }  // namespace
