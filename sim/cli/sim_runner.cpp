@@ -16,10 +16,7 @@
 #include "firmware/runtime/localization_loop.h"
 #include "hal/hal.h"
 #include "hal_linux/linux_clock.h"
-#include "hal_sim/sim_log_sink.h"
-#include "hal_sim/sim_sensor_io.h"
-#include "hal_sim/sim_task_runner.h"
-#include "hal_sim/stepped_clock.h"
+#include "hal_sim/sim_hal.h"
 #include "sim/io/carmen_log.h"
 #include "sim/io/datasets.h"
 #include "sim/io/reference_trajectory.h"
@@ -451,21 +448,16 @@ bool run_simulation(const SimConfig& cfg_in, SimResult* out, std::string* err) {
   if (!localizer) return false;
 
   // ---- HAL (simulation backend) and the firmware loop ----
-  auto clock = std::make_unique<hal_sim::SteppedClock>();
-  auto laser = std::make_unique<hal_sim::SimLaserSource>();
-  auto odom = std::make_unique<hal_sim::SimOdometrySource>();
-  auto sink = std::make_unique<hal_sim::SimPoseSink>();
-  auto logs = std::make_unique<hal_sim::SimLogSink>(hal::LogLevel::kWarning);
-  auto tasks = std::make_unique<hal_sim::SimTaskRunner>(*clock);
+  auto sim_hal = std::make_unique<hal_sim::SimHal>();
+  hal_sim::SteppedClock* clock = &sim_hal->clock;
+  hal_sim::SimLaserSource* laser = &sim_hal->laser;
+  hal_sim::SimOdometrySource* odom = &sim_hal->odometry;
+  hal_sim::SimPoseSink* sink = &sim_hal->pose_sink;
+  hal_sim::SimLogSink* logs = &sim_hal->log;
+  hal_sim::SimTaskRunner* tasks = &sim_hal->tasks;
+  hal::Hal& hal = sim_hal->hal;
   hal_linux::LinuxClock wall_clock;
   hal_sim::SteppedClock frozen_clock;  // perf clock when timing is off: every duration is 0
-  hal::Hal hal;
-  hal.clock = clock.get();
-  hal.laser = laser.get();
-  hal.odometry = odom.get();
-  hal.pose_sink = sink.get();
-  hal.log = logs.get();
-  hal.tasks = tasks.get();
   auto loop = std::make_unique<fw::LocalizationLoop>();
   fw::LocalizationLoopOptions lo;
   lo.perf_clock = cfg.wall_timing ? static_cast<const hal::Clock*>(&wall_clock) : &frozen_clock;
