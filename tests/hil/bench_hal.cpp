@@ -89,6 +89,8 @@ int main(int argc, char** argv) {
     j.add_int("replay_75hz_scans_processed", static_cast<long long>(r.scans_processed));
     j.add("replay_75hz_processed_rate_hz", r.achieved_rate_hz);
     j.add("static_memory_mib", r.static_memory_mib);
+    j.add_int("replay_75hz_localized", static_cast<long long>(r.localized));
+    j.add_int("replay_75hz_wrong_localized", static_cast<long long>(r.wrong_localized));
     std::map<std::string, double> budget;
     if (mmlfw_hil::read_budget(src + "/firmware/app/budget.txt", &budget, &err)) {
       j.add_int("budget_violations", static_cast<long long>(mmlfw_hil::check_budget(budget, r).size()));

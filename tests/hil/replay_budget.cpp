@@ -22,6 +22,7 @@
 #include "hal_sim/sim_sensor_io.h"
 #include "sim/io/carmen_log.h"
 #include "sim/io/datasets.h"
+#include "sim/io/reference_trajectory.h"
 #include "sim/map/global_maps.h"
 
 namespace mmlfw_hil {
@@ -52,6 +53,16 @@ bool run_replay(const ReplayOptions& o, ReplayResult* r, std::string* error) {
   if (log.scans.size() <= o.first_scan) {
     *error = "log has no scans after " + std::to_string(o.first_scan);
     return false;
+  }
+  std::vector<fw::Se2d> reference;
+  if (!ds->corrected_poses.empty()) {
+    sim::CarmenLog full;
+    std::vector<sim::CorrectedPose> corrected;
+    if (sim::read_carmen_log(sim::data_path(ds->raw_log), sim::CarmenReadOptions{}, &full, error) &&
+        sim::read_corrected_poses(sim::data_path(ds->corrected_poses), &corrected, error)) {
+      reference = sim::reference_at_every_scan(full, corrected);
+    }
+    error->clear();
   }
   const std::string dir = o.map_dir.empty() ? sim::map_cache_dir() : o.map_dir;
   sim::RosMap ros;
@@ -127,7 +138,7 @@ bool run_replay(const ReplayOptions& o, ReplayResult* r, std::string* error) {
   // motion unchanged), odometry records between scans interleaved by their log time.
   const size_t last = std::min(log.scans.size(), o.first_scan + o.num_scans);
   const double log_t0 = log.scans[o.first_scan].ipc_timestamp;
-  const double period = 1.0 / o.rate_hz;
+  const double period = 1.0 / (o.rate_hz > 0 ? o.rate_hz : 75.0);
   auto sensor_ns = [&](double ipc) {
     // Piecewise-linear time warp: scan k of the log is at k * period.
     return ipc;  // replaced below
@@ -157,7 +168,10 @@ bool run_replay(const ReplayOptions& o, ReplayResult* r, std::string* error) {
   while (true) {
     const std::uint64_t now = mono_ns();
     // Push everything due.
-    while (k < scan_t.size() && now >= t0 + static_cast<std::uint64_t>(k * period * 1e9)) {
+    const bool lockstep = o.rate_hz <= 0;
+    while (k < scan_t.size() &&
+           (lockstep ? (laser.pending() == 0 && !loop.scan_pending() && r->scans_processed + r->scans_dropped >= k)
+                     : now >= t0 + static_cast<std::uint64_t>(k * period * 1e9))) {
       const double tk = scan_t[k];
       while (oi < log.odom.size() && log.odom[oi].ipc_timestamp <= tk + 0.5 * (k + 1 < scan_t.size() ? scan_t[k + 1] - tk : 0)) {
         const sim::CarmenOdom& c = log.odom[oi++];
@@ -177,7 +191,18 @@ bool run_replay(const ReplayOptions& o, ReplayResult* r, std::string* error) {
     hal::PoseEstimate e;
     while (sink.pop(&e)) {
       ++r->scans_processed;
-      if (e.status == hal::LocalizationStatus::kLocalized) ++r->localized;
+      if (e.status == hal::LocalizationStatus::kLocalized) {
+        ++r->localized;
+        const size_t idx = e.scan_id;  // to_laser_scan: scan_id = log index
+        if (idx < reference.size()) {
+          const double err = std::hypot(e.x - reference[idx].x, e.y - reference[idx].y);
+          r->mean_err_localized_m += err;
+          if (err > o.localized_bound_m) {
+            ++r->wrong_localized;
+            if (r->wrong_localized_scans.size() < 20) r->wrong_localized_scans.push_back(idx);
+          }
+        }
+      }
     }
     if (k >= scan_t.size() && laser.pending() == 0 && !loop.scan_pending()) break;
     if (mono_ns() > end_ns) break;
@@ -187,6 +212,7 @@ bool run_replay(const ReplayOptions& o, ReplayResult* r, std::string* error) {
     }
   }
   const double wall = static_cast<double>(mono_ns() - t0) * 1e-9;
+  if (r->localized) r->mean_err_localized_m /= static_cast<double>(r->localized);
   pool.stop();
   const fw::PerfStats step = loop.perf_step().stats();
   r->step_p50_ms = step.p50_ms;

@@ -18,7 +18,8 @@ struct ReplayOptions {
   std::string map_dir;          // map cache; empty = sim::map_cache_dir()
   std::string localizer = "mml";
   size_t first_scan = 0, num_scans = 600;
-  double rate_hz = 75.0;
+  double rate_hz = 75.0;         // <= 0: lockstep (each scan processed before the next; deterministic)
+  double localized_bound_m = 1.0;  // a `localized` pose farther from the reference is wrong
   double deadline_ms = 1000.0 / 75.0;
   int workers = 2;
   std::uint64_t seed = 1;
@@ -27,6 +28,9 @@ struct ReplayOptions {
 struct ReplayResult {
   size_t scans_fed = 0, scans_processed = 0, scans_dropped = 0, localized = 0;
   size_t deadline_misses = 0;
+  size_t wrong_localized = 0;     // localized poses farther than localized_bound_m from the reference
+  double mean_err_localized_m = 0;
+  std::vector<size_t> wrong_localized_scans;  // log indices (first 20)
   double step_p50_ms = 0, step_p99_ms = 0, step_max_ms = 0, cycle_p99_ms = 0;
   double achieved_rate_hz = 0;    // processed scans per second of wall time
   double static_memory_mib = 0;   // arena used + static objects
