@@ -28,7 +28,8 @@ struct MatcherConfig {
   fw::ScanMatchingOdometryOptions front;
   int workers = 1;  // >1: RBSM sampling/weighting over a fw::WorkerPool
 };
-// 5 cm cells, 1024-cell (51 m) scrolling window, 1000 particles, points up to 15 m.
+// 5 cm cells, 1024-cell (51 m) scrolling window, 1000 particles, points up to 15 m, at least 3
+// resampling rounds (RbsmOptions::min_iterations; set it to 1 for Alg. 1's stop rule alone).
 MatcherConfig default_matcher_config();
 
 // A matcher with its own arena (host side: the block is one vector allocated at construction).
