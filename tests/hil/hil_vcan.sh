@@ -5,7 +5,9 @@
 #   hil_vcan.sh BUILD_DIR   (results: BUILD_DIR/hil/vcan/results.json)
 # Exit 77 = skipped (no UML, no data); CTest maps it to "Skipped".
 # Environment: HIL_SCANS (FD scenario scans, default 250), HIL_SPEED (replay speed-up, default 2),
-#              HIL_LOCALIZER (mml when the map can be built, else odom), HIL_REQUIRE_LOCALIZED (0/1).
+#              HIL_LOCALIZER (mml when the map can be built, else odom), HIL_REQUIRE_LOCALIZED (0/1),
+#              HIL_ALLOW_WRONG_LOCALIZED=1 (clean scenarios only warn about wrong `localized` poses;
+#              the fault scenario always asserts none).
 set -u
 B=$(cd "$1" && pwd)
 here=$(cd "$(dirname "$0")" && pwd)
@@ -32,15 +34,17 @@ rm -rf "$W"; mkdir -p "$W"
 export MMLFW_DATA_DIR=$DATA
 CANDEV=$B/sim/devices/mml-candev
 
-# The map for MML: built from the corrected log by mml-mapbuild (cached in BUILD_DIR/maps).
+# The map for MML: built from the corrected log by mml-mapbuild, in the shared map cache
+# (MMLFW_MAP_DIR, else <source>/build/maps, as sim::map_cache_dir()).
 LOC=${HIL_LOCALIZER:-}
-MAP=$B/maps/$DS.mmap
+MAPDIR=${MMLFW_MAP_DIR:-$here/../../build/maps}
+MAP=$MAPDIR/$DS.mmap
 if [ -z "$LOC" ]; then
   LOC=odom
   if [ -f "$MAP" ]; then LOC=mml
   elif [ -x "$B/sim/map/mml-mapbuild" ]; then
-    mkdir -p "$B/maps"
-    if timeout 300 "$B/sim/map/mml-mapbuild" --dataset $DS --out "$B/maps" > "$W/mapbuild.log" 2>&1 && [ -f "$MAP" ]; then
+    mkdir -p "$MAPDIR"
+    if timeout 300 "$B/sim/map/mml-mapbuild" --dataset $DS --out "$MAPDIR" > "$W/mapbuild.log" 2>&1 && [ -f "$MAP" ]; then
       LOC=mml
     else
       say "NOTE: mml-mapbuild failed (see $W/mapbuild.log); running with the odometry localizer"
@@ -113,7 +117,12 @@ for s in fd classic fault; do
   check "$s: at least a quarter of the decoded scans processed ($processed >= $ok/4)" test $((processed * 4)) -ge "$ok"
   check "$s: health frames present" test "$(jget "$W/$s/score.json" health)" -ge 1
   check "$s: status frames follow the protocol (0 violations)" test "$(jget "$W/$s/score.json" violations)" = 0
-  check "$s: no wrong 'localized' pose (> 1 m from the reference)" test "$(jget "$W/$s/score.json" wrong_localized)" = 0
+  wrong=$(jget "$W/$s/score.json" wrong_localized)
+  if [ "${HIL_ALLOW_WRONG_LOCALIZED:-0}" = 1 ] && [ "$s" != fault ]; then
+    [ "$wrong" != 0 ] && say "WARNING - $s: $wrong wrong 'localized' poses (> 1 m; allowed by HIL_ALLOW_WRONG_LOCALIZED=1)"
+  else
+    check "$s: no wrong 'localized' pose (> 1 m from the reference; $wrong)" test "$wrong" = 0
+  fi
 done
 # Fault scenario: the counters reach the health frame.
 f=$W/fault
