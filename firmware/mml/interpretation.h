@@ -73,6 +73,10 @@ class Interpreter {
   // interpret(). Sets out->status to outside-map when Ω' collapsed below the option threshold.
   void report_unknown(float omega_prime, std::uint32_t observations, InterpretResult* out);
 
+  // Replaces x_prev of Eq. 5.8 (the localizer refines the published pose against the map).
+  void set_previous_pose(const Se2f& pose) { prev_pose_ = pose; }
+  // Leaves the soft mode of Eq. 5.22: the next `localized` needs the hard criterion again.
+  void drop_soft() { soft_active_ = false; }
   float omega_thres() const { return omega_thres_; }
   const Cluster* clusters() const { return clusters_; }
   std::size_t cluster_count() const { return num_clusters_; }

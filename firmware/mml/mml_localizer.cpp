@@ -96,6 +96,10 @@ void MmlLocalizer::reset() {
   num_scene_ = 0;
   steps_ = 0;
   no_match_steps_ = 0;
+  have_wheel_ = false;
+  tracked_valid_ = false;
+  tracked_bad_steps_ = tracked_unlocalized_steps_ = 0;
+  last_refine_ = RefineResult();
   last_out_ = hal::PoseEstimate();
 }
 
@@ -158,7 +162,9 @@ Status MmlLocalizer::step(const hal::LaserScan& scan, const hal::Odometry& odom,
   {
     ScanPointsResult sr;
     ScanPointsOptions so = config_.front_end.scan;
+    num_scan_pts_ = 0;
     if (scan_to_points(scan, so, scan_pts_, hal::LaserScan::kMaxBeams, &sr).is_ok() && sr.count > 0) {
+      num_scan_pts_ = sr.count;
       Observation ob;
       const std::size_t stride = (sr.count + kUnknownPointsPerObservation - 1) / kUnknownPointsPerObservation;
       for (std::size_t i = 0; i < sr.count && ob.n < kUnknownPointsPerObservation; i += stride) {
@@ -213,8 +219,10 @@ Status MmlLocalizer::step(const hal::LaserScan& scan, const hal::Odometry& odom,
   InterpretInput in;
   in.hypotheses = hyps_;
   in.count = nh;
-  in.have_odom_delta = have_odom_;
-  in.odom_delta = have_odom_ ? prev_odom_.between(local_pose) : Se2f();
+  // x_r of Eq. 5.8 from the wheel odometry (thesis); the RBSM pose can slip in corridors.
+  const Se2f wheel(odom.x, odom.y, odom.theta);
+  in.have_odom_delta = have_wheel_;
+  in.odom_delta = have_wheel_ ? prev_wheel_.between(wheel) : Se2f();
   prev_odom_ = local_pose;
   have_odom_ = true;
   FW_RETURN_IF_ERROR(interp_.interpret(in, &last_));
@@ -232,6 +240,50 @@ Status MmlLocalizer::step(const hal::LaserScan& scan, const hal::Odometry& odom,
       last_.status != hal::LocalizationStatus::kLocalized) {
     last_.status = hal::LocalizationStatus::kOutsideMap;
   }
+
+  // Published pose (pose_refiner.h). Once a `localized` cluster pose is confirmed by refining the
+  // newest scan against the global map, that pose is tracked with the wheel odometry and refined
+  // every step; it replaces x_prev of Eq. 5.8, so a cluster that drifts away from it (a slipping
+  // local map in a corridor) fails Eq. 5.14 instead of dragging the estimate along.
+  if (mo.refine_pose && num_scan_pts_ > 0) {
+    const std::size_t stride = (num_scan_pts_ + mo.refine_points - 1) / mo.refine_points;
+    std::size_t m = 0;
+    for (std::size_t i = 0; i < num_scan_pts_; i += stride) refine_pts_[m++] = scan_pts_[i];
+    const RefineOptions ro;
+    const bool loc = last_.status == hal::LocalizationStatus::kLocalized;
+    if (tracked_valid_ && mo.track_when_localized) {
+      const Se2f pred = tracked_pose_.compose(in.odom_delta);
+      last_refine_ = refine_pose(map_, refine_pts_, m, pred, ro);
+      tracked_pose_ = last_refine_.pose;  // = pred when rejected
+      tracked_bad_steps_ = last_refine_.accepted ? 0 : tracked_bad_steps_ + 1;
+      tracked_unlocalized_steps_ = loc ? 0 : tracked_unlocalized_steps_ + 1;
+      if (tracked_bad_steps_ >= 5 || tracked_unlocalized_steps_ >= 30 ||
+          last_.status == hal::LocalizationStatus::kOutsideMap) {
+        tracked_valid_ = false;
+        // The scans stopped fitting the map around the tracked pose: not sure any more.
+        interp_.drop_soft();
+        if (last_.status == hal::LocalizationStatus::kLocalized) last_.status = hal::LocalizationStatus::kAmbiguous;
+      }
+    }
+    if (!tracked_valid_ && last_.status == hal::LocalizationStatus::kLocalized) {
+      last_refine_ = refine_pose(map_, refine_pts_, m, last_.pose, ro);
+      if (last_refine_.accepted) {
+        tracked_valid_ = true;
+        tracked_pose_ = last_refine_.pose;
+        tracked_bad_steps_ = tracked_unlocalized_steps_ = 0;
+      } else {
+        // The newest scan does not fit the map at the cluster pose: not sure after all.
+        last_.status = hal::LocalizationStatus::kAmbiguous;
+      }
+    }
+    if (tracked_valid_) {
+      interp_.set_previous_pose(tracked_pose_);
+      last_.pose = tracked_pose_;
+      last_.have_pose = true;
+    }
+  }
+  prev_wheel_ = wheel;
+  have_wheel_ = true;
 
   out->status = last_.status;
   if (last_.have_pose) {

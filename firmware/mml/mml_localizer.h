@@ -17,6 +17,7 @@
 #include "firmware/map/global_map.h"
 #include "firmware/mml/interpretation.h"
 #include "firmware/mml/mml_options.h"
+#include "firmware/mml/pose_refiner.h"
 #include "firmware/pransam/matcher.h"
 #include "firmware/rbsm/local_map.h"
 #include "firmware/rbsm/rbsm.h"
@@ -56,6 +57,7 @@ class MmlLocalizer final : public Localizer {
   const Interpreter& interpreter() const { return interp_; }
   const InterpretResult& last() const { return last_; }
   std::size_t local_map_points() const { return num_scene_; }
+  const RefineResult& last_refine() const { return last_refine_; }
   const PerfCounter& match_perf() const { return perf_match_; }
   std::uint32_t front_end_failures() const { return front_end_failures_; }
   bool using_precomputed_table() const { return matcher_.has_precomputed_table(); }
@@ -87,6 +89,7 @@ class MmlLocalizer final : public Localizer {
   };
   RingBuffer<Observation, kMaxUnknownWindow> observations_;
   Point2f scan_pts_[hal::LaserScan::kMaxBeams];
+  std::size_t num_scan_pts_ = 0;
 
   bool have_odom_ = false;
   Se2f prev_odom_;
@@ -95,6 +98,14 @@ class MmlLocalizer final : public Localizer {
   std::uint64_t steps_ = 0;
   std::uint32_t front_end_failures_ = 0;
   std::uint32_t no_match_steps_ = 0;
+  // Published pose tracking (pose_refiner.h).
+  bool have_wheel_ = false;
+  Se2f prev_wheel_;
+  bool tracked_valid_ = false;
+  Se2f tracked_pose_;
+  std::uint32_t tracked_bad_steps_ = 0, tracked_unlocalized_steps_ = 0;
+  Point2f refine_pts_[1081];
+  RefineResult last_refine_;
   hal::PoseEstimate last_out_;
   PerfCounter perf_match_{"mml.pransam"};
 };

@@ -51,6 +51,7 @@ Status MmlOptions::validate() const {
   FW_RETURN_IF_ERROR(check_positive("odom_sigma_rot_floor_rad", odom_sigma_rot_floor_rad));
   FW_RETURN_IF_ERROR(check_positive("hyp_sigma_trans_floor_m", hyp_sigma_trans_floor_m));
   FW_RETURN_IF_ERROR(check_positive("hyp_sigma_rot_floor_rad", hyp_sigma_rot_floor_rad));
+  FW_RETURN_IF_ERROR(check_range("refine_points", refine_points, 3, 1081));
   FW_RETURN_IF_ERROR(check_range("omega_thres0", omega_thres0, 0.0, 1.0));
   FW_RETURN_IF_ERROR(check_range("tau_tr", tau_tr, 1, kMaxThresholdWindow));
   FW_RETURN_IF_ERROR(check_range("bollinger_k", bollinger_k, 0.0, 100.0));

@@ -53,6 +53,13 @@ struct MmlOptions {
   float hyp_sigma_trans_floor_m = 0.10f;
   float hyp_sigma_rot_floor_rad = 0.035f;  // ≈ 2°
 
+  // --- Published pose (extension, see pose_refiner.h): refine the newest scan against the global
+  // map; while localized, propagate the previous published pose with the wheel odometry and refine
+  // that (the clusters keep validating it through Eq. 5.14 and the soft rule).
+  bool refine_pose = true;
+  bool track_when_localized = true;
+  std::uint32_t refine_points = 180;   // scan points used
+
   // --- Matching threshold adaptation (Sec. 5.3.3, Eq. 5.18–5.21).
   bool bollinger = true;
   float omega_thres0 = 0.7f;

@@ -1,0 +1,384 @@
+#include "sim/eval/mml_eval/mml_eval.h"
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <cstdio>
+#include <cstdlib>
+#include <fstream>
+#include <limits>
+#include <sstream>
+
+#include "firmware/base/rng.h"
+#include "firmware/map/map_image.h"
+#include "sim/io/datasets.h"
+#include "sim/io/reference_trajectory.h"
+#include "sim/map/global_maps.h"
+#include "sim/map/map_image_writer.h"
+#include "sim/viz/picture.h"
+
+namespace sim::mmleval {
+
+namespace {
+
+bool fail(std::string* err, const std::string& msg) {
+  if (err) *err = msg;
+  return false;
+}
+
+bool load_image(LoadedDataset* ds, std::string* err) {
+  ds->arena = std::make_unique<fw::StartupArena>();
+  const std::size_t bytes = ds->image.size() + (64u << 20);
+  fw::Status s = ds->arena->init_mapped(bytes, false, "map");
+  if (s.is_ok()) s = fw::load_map_image(ds->image.data(), ds->image.size(), *ds->arena, &ds->map, ds->name.c_str());
+  if (!s.is_ok()) return fail(err, std::string("map image of ") + ds->name + ": " + s.message());
+  return true;
+}
+
+}  // namespace
+
+bool load_dataset(const std::string& name, LoadedDataset* ds, std::string* err) {
+  const Dataset* d = find_dataset(name);
+  if (d == nullptr || d->raw_log.empty()) return fail(err, "mml-eval: unknown dataset or no raw log: '" + name + "'");
+  ds->name = name;
+  ds->key = name;
+  std::replace(ds->key.begin(), ds->key.end(), '-', '_');
+  ds->success_bound_m = name == "mit-killian" ? 1.0 : 0.5;
+  std::string e;
+  if (!read_carmen_log(data_path(d->raw_log), CarmenReadOptions{}, &ds->log, &e)) return fail(err, e);
+  const bool robotlaser = !ds->log.scans.empty() && ds->log.scans[0].type == "ROBOTLASER1";
+  if (!d->corrected_poses.empty()) {
+    std::vector<CorrectedPose> cp;
+    if (!read_corrected_poses(data_path(d->corrected_poses), &cp, &e)) return fail(err, e);
+    ds->reference = reference_at_every_scan(ds->log, cp);
+    ds->reference_note = "corrected poses chained with odometry (sim/io/reference_trajectory.h)";
+  }
+  if (ds->reference.empty()) {
+    // fr-clinic: no corrected log; its global map is built from the raw laser poses, so those are
+    // the reference in the map's own frame.
+    for (const auto& s : ds->log.scans) ds->reference.push_back(s.pose);
+    ds->reference_note = "raw laser poses (the map was built from them; no corrected log exists)";
+  }
+  ds->odometry.clear();
+  ds->travelled.clear();
+  double acc = 0;
+  for (std::size_t i = 0; i < ds->log.scans.size(); ++i) {
+    const auto& s = ds->log.scans[i];
+    // ROBOTLASER1: the laser pose is the map frame's pose (map built from it); FLASER: odometry.
+    const fw::Se2d o = robotlaser ? s.pose : s.odom;
+    if (i > 0) acc += std::hypot(o.x - ds->odometry.back().x, o.y - ds->odometry.back().y);
+    ds->odometry.push_back(o);
+    ds->travelled.push_back(acc);
+  }
+  if (!ensure_global_map(name, -1.0, map_cache_dir(), &ds->ros, &e)) return fail(err, e);
+  if (!ros_map_to_grid(ds->ros, &ds->grid, &e)) return fail(err, e);
+  if (!read_file_bytes(global_map_image_path(name), &ds->image, &e)) return fail(err, e);
+  return load_image(ds, err);
+}
+
+bool erase_region(LoadedDataset* ds, double x0, double y0, double x1, double y1, std::string* err) {
+  const fw::GridGeometry& g = ds->grid.geometry;
+  for (std::uint32_t cy = 0; cy < g.height; ++cy) {
+    for (std::uint32_t cx = 0; cx < g.width; ++cx) {
+      const fw::Point2f c = g.cell_center(static_cast<std::int32_t>(cx), static_cast<std::int32_t>(cy));
+      if (c.x() >= x0 && c.x() <= x1 && c.y() >= y0 && c.y() <= y1) ds->grid.cells[g.index(cx, cy)] = fw::kCellUnknown;
+    }
+  }
+  MapImageWriter w;
+  std::string e;
+  if (!w.set_grid(ds->grid, &e)) return fail(err, e);
+  ds->image = w.bytes();
+  ds->ros = grid_to_ros_map(ds->grid, ds->name + "-erased.pgm");
+  return load_image(ds, err);
+}
+
+std::vector<std::size_t> draw_starts(const LoadedDataset& ds, std::size_t count, std::uint64_t seed,
+                                     const TrialOptions& opt) {
+  // Leave room for the trial: a start needs roughly max_steps·min_move metres of log after it.
+  const double need = std::min(opt.max_metres, static_cast<double>(opt.max_steps) * opt.min_move_m);
+  const double total = ds.travelled.empty() ? 0.0 : ds.travelled.back();
+  std::size_t last = 0;
+  for (std::size_t i = 0; i < ds.travelled.size(); ++i) {
+    if (ds.travelled[i] <= total - need) last = i;
+  }
+  fw::RandomStream rng(seed, 77);
+  std::vector<std::size_t> out;
+  for (std::size_t k = 0; k < count; ++k) out.push_back(last > 0 ? rng.uniform_index(static_cast<std::uint32_t>(last)) : 0);
+  return out;
+}
+
+TrialResult run_trial(fw::Localizer& loc, const LoadedDataset& ds, std::size_t start, const TrialOptions& opt,
+                      const double* region) {
+  TrialResult tr;
+  tr.start = start;
+  loc.reset();
+  static hal::LaserScan scan;
+  fw::Se2d last_used;
+  bool have_last = false;
+  std::size_t localized_run = 0;
+  double err_sum = 0;
+  std::size_t err_n = 0;
+  for (std::size_t i = start; i < ds.log.scans.size() && tr.steps.size() < opt.max_steps; ++i) {
+    const fw::Se2d& od = ds.odometry[i];
+    if (have_last) {
+      const double dm = std::hypot(od.x - last_used.x, od.y - last_used.y);
+      const double dt = std::fabs(fw::wrap_angle(od.theta - last_used.theta));
+      if (dm < opt.min_move_m && dt < opt.min_turn_rad) continue;
+    }
+    const double travelled = ds.travelled[i] - ds.travelled[start];
+    if (travelled > opt.max_metres) break;
+    last_used = od;
+    have_last = true;
+    const std::uint64_t ts = static_cast<std::uint64_t>(std::llround(ds.log.scans[i].ipc_timestamp * 1e9));
+    scan = to_laser_scan(ds.log.scans[i], ts);
+    scan.scan_id = static_cast<std::uint32_t>(i);
+    hal::Odometry o;
+    o.timestamp_ns = ts;
+    o.x = static_cast<float>(od.x);
+    o.y = static_cast<float>(od.y);
+    o.theta = static_cast<float>(od.theta);
+    hal::PoseEstimate est;
+    const auto t0 = std::chrono::steady_clock::now();
+    const fw::Status s = loc.step(scan, o, &est);
+    const auto t1 = std::chrono::steady_clock::now();
+    if (!s.is_ok()) {
+      tr.error = std::string("scan ") + std::to_string(i) + ": " + s.message();
+      break;
+    }
+    StepLog st;
+    st.scan = i;
+    st.travelled = travelled;
+    st.status = est.status;
+    st.mode = est.mode;
+    st.step_ms = std::chrono::duration<double, std::milli>(t1 - t0).count();
+    st.estimate = fw::Se2d(est.x, est.y, est.theta);
+    st.truth = ds.reference[i];
+    st.err_m = std::hypot(est.x - st.truth.x, est.y - st.truth.y);
+    st.err_rad = std::fabs(fw::wrap_angle(static_cast<double>(est.theta) - st.truth.theta));
+    if (region) {
+      st.in_region = st.truth.x >= region[0] && st.truth.x <= region[2] && st.truth.y >= region[1] && st.truth.y <= region[3];
+    }
+    tr.steps.push_back(st);
+    if (std::getenv("MML_EVAL_TRACE")) {
+      std::printf("    step %3zu scan %5zu %-11s %s est (%.2f %.2f %.2f) ref (%.2f %.2f %.2f) err %.2f m %.1f deg  hyp %u cl %u r %.2f %.1f ms\n",
+                  tr.steps.size(), i, hal::status_name(est.status),
+                  est.mode == hal::LocalizationMode::kTracking ? "T" : "G", est.x, est.y, est.theta, st.truth.x,
+                  st.truth.y, st.truth.theta, st.err_m, st.err_rad * 57.2958, est.hypothesis_count, est.cluster_count,
+                  est.rating, st.step_ms);
+    }
+    if (est.status == hal::LocalizationStatus::kLocalized) {
+      const bool ok = st.err_m < ds.success_bound_m && st.err_rad < ds.success_bound_rad;
+      if (!tr.localized) {
+        tr.localized = true;
+        tr.steps_to_localize = tr.steps.size();
+        tr.metres_to_localize = travelled;
+        tr.success = ok;
+      }
+      if (!ok) tr.failure = true;
+      err_sum += st.err_m;
+      ++err_n;
+      ++localized_run;
+      if (opt.stop_after_localized && localized_run >= opt.settle_steps) break;
+    } else {
+      localized_run = 0;
+    }
+  }
+  if (tr.failure) tr.success = false;
+  tr.mean_err_localized = err_n ? err_sum / err_n : std::numeric_limits<double>::quiet_NaN();
+  return tr;
+}
+
+double percentile(std::vector<double> v, double p) {
+  if (v.empty()) return std::numeric_limits<double>::quiet_NaN();
+  std::sort(v.begin(), v.end());
+  const double idx = p / 100.0 * (v.size() - 1);
+  const std::size_t lo = static_cast<std::size_t>(std::floor(idx)), hi = static_cast<std::size_t>(std::ceil(idx));
+  return v[lo] + (v[hi] - v[lo]) * (idx - lo);
+}
+
+SystemSummary summarize(const std::string& dataset, const std::string& system, const std::vector<TrialResult>& trials,
+                        double memory_mib) {
+  SystemSummary s;
+  s.dataset = dataset;
+  s.system = system;
+  s.trials = trials.size();
+  s.memory_mib = memory_mib;
+  std::vector<double> metres, steps, ms, track_err, track_ms;
+  double err_sum = 0;
+  std::size_t err_n = 0, region_n = 0, region_out = 0;
+  for (const auto& t : trials) {
+    if (t.localized) {
+      ++s.localized;
+      metres.push_back(t.metres_to_localize);
+      steps.push_back(static_cast<double>(t.steps_to_localize));
+    }
+    s.successes += t.success;
+    s.failures += t.failure;
+    for (const auto& st : t.steps) {
+      ms.push_back(st.step_ms);
+      if (st.status == hal::LocalizationStatus::kLocalized) {
+        err_sum += st.err_m;
+        ++err_n;
+      }
+      if (st.mode == hal::LocalizationMode::kTracking) {
+        track_err.push_back(st.err_m);
+        track_ms.push_back(st.step_ms);
+      }
+      if (st.in_region) {
+        ++region_n;
+        region_out += st.status == hal::LocalizationStatus::kOutsideMap;
+      }
+    }
+  }
+  const double n = trials.empty() ? 1.0 : static_cast<double>(trials.size());
+  s.success_rate = s.successes / n;
+  s.failure_rate = s.failures / n;
+  s.m_to_localize_median = percentile(metres, 50);
+  s.steps_to_localize_median = percentile(steps, 50);
+  s.mean_err_m = err_n ? err_sum / err_n : std::numeric_limits<double>::quiet_NaN();
+  s.step_ms_p50 = percentile(ms, 50);
+  s.step_ms_p99 = percentile(ms, 99);
+  double m = 0;
+  for (double x : ms) m += x;
+  s.step_ms_mean = ms.empty() ? 0 : m / ms.size();
+  s.outside_map_in_region = region_n ? static_cast<double>(region_out) / region_n : std::numeric_limits<double>::quiet_NaN();
+  s.tracking_err_median_m = percentile(track_err, 50);
+  s.tracking_step_ms_p50 = percentile(track_ms, 50);
+  s.tracking_step_ms_p99 = percentile(track_ms, 99);
+  return s;
+}
+
+std::string markdown_table(const std::vector<SystemSummary>& rows) {
+  std::ostringstream o;
+  o << "| dataset | system | trials | localized | m to localize (median) | success | failure | mean err localized (m) "
+       "| step p50 (ms) | step p99 (ms) | memory (MiB) |\n";
+  o << "|---|---|---|---|---|---|---|---|---|---|---|\n";
+  char buf[512];
+  for (const auto& r : rows) {
+    std::snprintf(buf, sizeof(buf), "| %s | %s | %zu | %zu | %.1f | %.2f | %.2f | %.3f | %.1f | %.1f | %.1f |\n",
+                  r.dataset.c_str(), r.system.c_str(), r.trials, r.localized, r.m_to_localize_median, r.success_rate,
+                  r.failure_rate, r.mean_err_m, r.step_ms_p50, r.step_ms_p99, r.memory_mib);
+    o << buf;
+  }
+  return o.str();
+}
+
+namespace {
+
+const char* status_color(hal::LocalizationStatus s, hal::LocalizationMode m) {
+  if (m == hal::LocalizationMode::kTracking) return "#1f77b4";
+  switch (s) {
+    case hal::LocalizationStatus::kLocalized: return "#2ca02c";
+    case hal::LocalizationStatus::kAmbiguous: return "#ff7f0e";
+    case hal::LocalizationStatus::kOutsideMap: return "#9467bd";
+    case hal::LocalizationStatus::kSearching: return "#aaaaaa";
+    default: return "#d62728";
+  }
+}
+
+}  // namespace
+
+bool write_error_plot(const std::string& path, const std::string& title, const std::vector<TrialResult>& trials,
+                      double bound_m, std::string* err) {
+  const double W = 900, H = 420, L = 60, R = 20, T = 40, B = 50;
+  double xmax = 1;
+  for (const auto& t : trials)
+    for (const auto& s : t.steps) xmax = std::max(xmax, s.travelled);
+  const double ymax = 5.0;
+  auto X = [&](double x) { return L + (W - L - R) * x / xmax; };
+  auto Y = [&](double y) { return H - B - (H - T - B) * std::min(y, ymax) / ymax; };
+  std::ofstream o(path);
+  if (!o) return fail(err, "cannot write " + path);
+  o << "<svg xmlns='http://www.w3.org/2000/svg' width='" << W << "' height='" << H << "' font-family='sans-serif' font-size='12'>\n";
+  o << "<rect width='100%' height='100%' fill='white'/>\n";
+  o << "<text x='" << L << "' y='20' font-size='14'>" << title << "</text>\n";
+  o << "<line x1='" << L << "' y1='" << H - B << "' x2='" << W - R << "' y2='" << H - B << "' stroke='black'/>\n";
+  o << "<line x1='" << L << "' y1='" << T << "' x2='" << L << "' y2='" << H - B << "' stroke='black'/>\n";
+  for (int k = 0; k <= 5; ++k) {
+    o << "<text x='" << L - 8 << "' y='" << Y(k) + 4 << "' text-anchor='end'>" << k << "</text>\n";
+    o << "<line x1='" << L << "' y1='" << Y(k) << "' x2='" << W - R << "' y2='" << Y(k) << "' stroke='#eee'/>\n";
+  }
+  const double step = xmax > 100 ? 20 : (xmax > 40 ? 10 : 5);
+  for (double x = 0; x <= xmax + 1e-9; x += step) {
+    o << "<text x='" << X(x) << "' y='" << H - B + 16 << "' text-anchor='middle'>" << x << "</text>\n";
+  }
+  o << "<text x='" << (L + W - R) / 2 << "' y='" << H - 10 << "' text-anchor='middle'>metres travelled since the kidnapped start</text>\n";
+  o << "<text x='15' y='" << (T + H - B) / 2 << "' transform='rotate(-90 15 " << (T + H - B) / 2
+    << ")' text-anchor='middle'>position error (m, clipped at 5)</text>\n";
+  o << "<line x1='" << L << "' y1='" << Y(bound_m) << "' x2='" << W - R << "' y2='" << Y(bound_m)
+    << "' stroke='#d62728' stroke-dasharray='4 3'/>\n";
+  for (const auto& t : trials) {
+    o << "<polyline fill='none' stroke='#bbb' stroke-width='1' points='";
+    for (const auto& s : t.steps) o << X(s.travelled) << "," << Y(s.err_m) << " ";
+    o << "'/>\n";
+    for (const auto& s : t.steps) {
+      o << "<circle cx='" << X(s.travelled) << "' cy='" << Y(s.err_m) << "' r='2' fill='" << status_color(s.status, s.mode)
+        << "'/>\n";
+    }
+  }
+  const char* names[] = {"searching", "ambiguous", "localized", "outside-map", "tracking (hand-off)"};
+  const char* cols[] = {"#aaaaaa", "#ff7f0e", "#2ca02c", "#9467bd", "#1f77b4"};
+  for (int k = 0; k < 5; ++k) {
+    o << "<circle cx='" << W - 170 << "' cy='" << T + 10 + 16 * k << "' r='4' fill='" << cols[k] << "'/>"
+      << "<text x='" << W - 160 << "' y='" << T + 14 + 16 * k << "'>" << names[k] << "</text>\n";
+  }
+  o << "</svg>\n";
+  return static_cast<bool>(o) || fail(err, "write failed: " + path);
+}
+
+bool write_map_plot(const std::string& path_svg, const std::string& path_png, const LoadedDataset& ds,
+                    const std::string& title, const std::vector<TrialResult>& trials, const double* region,
+                    std::string* err) {
+  Picture pic;
+  pic.title = title;
+  pic.map = &ds.grid;
+  if (region) pic.boxes.push_back({region[0], region[1], region[2], region[3], {200, 60, 200}, "erased from the map"});
+  PointSet loc{{}, {44, 160, 44}, 2.5, "estimate: localized"};
+  PointSet trk{{}, {31, 119, 180}, 2.0, "estimate: tracking"};
+  PointSet amb{{}, {255, 127, 14}, 1.5, "estimate: ambiguous"};
+  PointSet out{{}, {148, 103, 189}, 2.0, "estimate: outside-map"};
+  for (std::size_t k = 0; k < trials.size(); ++k) {
+    const auto& t = trials[k];
+    Polyline pl;
+    pl.color = {220, 40, 40};
+    pl.width_px = 1.5;
+    if (k == 0) pl.label = "true path";
+    for (const auto& s : t.steps) pl.points.push_back({s.truth.x, s.truth.y});
+    pic.lines.push_back(pl);
+    if (!t.steps.empty()) {
+      Marker m;
+      m.x = t.steps[0].truth.x;
+      m.y = t.steps[0].truth.y;
+      m.theta = t.steps[0].truth.theta;
+      m.color = {220, 40, 40};
+      m.text = "start " + std::to_string(k);
+      pic.markers.push_back(m);
+    }
+    for (const auto& s : t.steps) {
+      const PicturePoint p{s.estimate.x, s.estimate.y};
+      if (s.mode == hal::LocalizationMode::kTracking) trk.points.push_back(p);
+      else if (s.status == hal::LocalizationStatus::kLocalized) loc.points.push_back(p);
+      else if (s.status == hal::LocalizationStatus::kOutsideMap) out.points.push_back(p);
+    }
+    if (t.localized) {
+      const auto& s = t.steps[t.steps_to_localize - 1];
+      Marker m;
+      m.x = s.estimate.x;
+      m.y = s.estimate.y;
+      m.theta = s.estimate.theta;
+      m.color = {44, 160, 44};
+      char buf[64];
+      std::snprintf(buf, sizeof(buf), "localized %.0f m", t.metres_to_localize);
+      m.text = buf;
+      pic.markers.push_back(m);
+    }
+  }
+  (void)amb;
+  pic.point_sets = {loc, trk, out};
+  std::string e;
+  if (!write_svg(pic, path_svg, &e)) return fail(err, e);
+  if (!path_png.empty() && !write_png(pic, path_png, &e)) return fail(err, e);
+  return true;
+}
+
+}  // namespace sim::mmleval

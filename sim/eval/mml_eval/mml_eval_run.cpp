@@ -1,0 +1,229 @@
+#include "sim/eval/mml_eval/mml_eval_run.h"
+
+#include <chrono>
+#include <cmath>
+#include <cstdio>
+#include <filesystem>
+#include <fstream>
+#include <limits>
+
+#include "firmware/base/rng.h"
+#include "sim/eval/mml_eval/mml_systems.h"
+
+namespace sim::mmleval {
+
+namespace {
+
+double since(std::chrono::steady_clock::time_point t0) {
+  return std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+}
+
+struct SystemRun {
+  std::string label;
+  std::vector<TrialResult> trials;
+  SystemSummary summary;
+};
+
+SystemRun run_system(OwnedLocalizer& loc, const LoadedDataset& ds, const std::string& label,
+                     const std::vector<std::size_t>& starts, const TrialOptions& opt, bool verbose,
+                     const double* region = nullptr) {
+  SystemRun r;
+  r.label = label;
+  const auto t0 = std::chrono::steady_clock::now();
+  for (std::size_t k = 0; k < starts.size(); ++k) {
+    r.trials.push_back(run_trial(loc, ds, starts[k], opt, region));
+    const TrialResult& t = r.trials.back();
+    if (verbose) {
+      std::printf("  %-12s %-10s trial %zu start %5zu: %s%s after %.1f m (%zu steps), err %.2f m%s%s\n", ds.name.c_str(),
+                  label.c_str(), k, t.start, t.localized ? "localized" : "not localized",
+                  t.failure ? " [FAILURE]" : "", t.metres_to_localize, t.steps_to_localize, t.mean_err_localized,
+                  t.error.empty() ? "" : " error: ", t.error.c_str());
+      std::fflush(stdout);
+    }
+  }
+  r.summary = summarize(ds.name, label, r.trials, loc.static_bytes() / (1024.0 * 1024.0));
+  if (verbose) std::printf("  %-12s %-10s done in %.1f s\n", ds.name.c_str(), label.c_str(), since(t0));
+  return r;
+}
+
+void add_pair(BenchJson* json, const std::string& key, const std::string& sys, const SystemSummary& s) {
+  json->add(key + "_" + sys + "_failure_rate", s.failure_rate);
+  json->add(key + "_" + sys + "_success_rate", s.success_rate);
+  json->add(key + "_" + sys + "_m_to_localize", s.m_to_localize_median);
+  json->add(key + "_" + sys + "_step_ms_p99", s.step_ms_p99);
+  json->add(key + "_" + sys + "_step_ms_p50", s.step_ms_p50);
+  json->add(key + "_" + sys + "_mean_err_m", s.mean_err_m);
+  json->add_int(key + "_" + sys + "_trials", static_cast<long long>(s.trials));
+  json->add_int(key + "_" + sys + "_localized", static_cast<long long>(s.localized));
+}
+
+}  // namespace
+
+bool run_evaluation(const EvalPlan& plan, BenchJson* json, std::string* err) {
+  std::filesystem::create_directories(plan.out_dir);
+  std::vector<SystemSummary> rows;
+  double static_mib = 0;
+  std::vector<double> track_err, track_ms;
+  json->add_int("trials_per_dataset", static_cast<long long>(plan.trials));
+  json->add_int("mcl_trials_per_dataset", static_cast<long long>(plan.mcl_trials ? plan.mcl_trials : plan.trials));
+  json->add_int("max_steps_per_trial", static_cast<long long>(plan.trial.max_steps));
+  json->add_int("seed", static_cast<long long>(plan.seed));
+  for (const std::string& name : plan.datasets) {
+    const auto t0 = std::chrono::steady_clock::now();
+    LoadedDataset ds;
+    if (!load_dataset(name, &ds, err)) return false;
+    if (plan.verbose) {
+      std::printf("dataset %s: %zu scans, %.0f m of path, map %ux%u @ %.2f m, %u points (loaded in %.1f s)\n",
+                  name.c_str(), ds.log.scans.size(), ds.travelled.back(), ds.map.geometry.width, ds.map.geometry.height,
+                  ds.map.geometry.resolution, ds.map.num_points, since(t0));
+    }
+    const bool mit = name == "mit-killian";
+    const TrialOptions& topt = mit ? plan.trial_mit : plan.trial;
+    const std::vector<std::size_t> starts = draw_starts(ds, plan.trials, plan.seed, topt);
+    std::vector<SystemRun> runs;
+
+    // MML (main configuration, then the extra ones side by side).
+    std::vector<int> configs = {plan.mml_config};
+    for (int c : plan.extra_mml_configs)
+      if (c != plan.mml_config) configs.push_back(c);
+    SystemSummary mml_main, mcl_main;
+    for (std::size_t ci = 0; ci < configs.size(); ++ci) {
+      std::string e;
+      const auto ti = std::chrono::steady_clock::now();
+      auto loc = OwnedLocalizer::make_mml(ds.map, ds.image, mml_config(configs[ci], plan.seed), plan.threads, &e);
+      if (!loc) return (*err = e, false);
+      if (plan.verbose) {
+        std::printf("  mml C%d init %.1f s (precomputed table: %s)\n", configs[ci], since(ti),
+                    loc->mml()->using_precomputed_table() ? "yes" : "no");
+      }
+      SystemRun r = run_system(*loc, ds, "mml-C" + std::to_string(configs[ci]), starts, topt, plan.verbose);
+      if (ci == 0) {
+        mml_main = r.summary;
+        static_mib = std::max(static_mib, r.summary.memory_mib + ds.arena->used() / (1024.0 * 1024.0));
+      }
+      rows.push_back(r.summary);
+      runs.push_back(std::move(r));
+    }
+    // MCL baseline.
+    {
+      std::string e;
+      const std::uint32_t particles = mit ? plan.mcl_particles_mit : plan.mcl_particles;
+      auto loc = OwnedLocalizer::make_mcl(ds.map, mcl_baseline_options(particles, plan.seed), plan.threads, &e);
+      if (!loc) return (*err = e, false);
+      std::vector<std::size_t> mstarts = starts;
+      if (plan.mcl_trials && plan.mcl_trials < mstarts.size()) mstarts.resize(plan.mcl_trials);
+      SystemRun r = run_system(*loc, ds, "mcl-" + std::to_string(particles / 1000) + "k", mstarts, topt, plan.verbose);
+      mcl_main = r.summary;
+      rows.push_back(r.summary);
+      runs.push_back(std::move(r));
+    }
+    // Hand-off.
+    if (plan.run_handoff && std::find(plan.handoff_datasets.begin(), plan.handoff_datasets.end(), name) !=
+                                plan.handoff_datasets.end()) {
+      std::string e;
+      auto loc = OwnedLocalizer::make_handoff(ds.map, ds.image, mml_config(plan.mml_config, plan.seed),
+                                              mcl_tracking_options(plan.seed), fw::mml::HandoffOptions(), plan.threads,
+                                              &e);
+      if (!loc) return (*err = e, false);
+      TrialOptions ho = topt;
+      ho.max_steps = topt.max_steps + 100;  // leave time to track after the hand-off
+      SystemRun r = run_system(*loc, ds, "handoff", starts, ho, plan.verbose);
+      for (const auto& t : r.trials)
+        for (const auto& s : t.steps)
+          if (s.mode == hal::LocalizationMode::kTracking) {
+            track_err.push_back(s.err_m);
+            track_ms.push_back(s.step_ms);
+          }
+      if (plan.verbose) {
+        std::printf("  %-12s handoff    tracking median err %.3f m, step p50 %.3f ms, p99 %.3f ms, fallbacks %u\n",
+                    name.c_str(), r.summary.tracking_err_median_m, r.summary.tracking_step_ms_p50,
+                    r.summary.tracking_step_ms_p99, loc->handoff()->fallbacks());
+      }
+      rows.push_back(r.summary);
+      runs.push_back(std::move(r));
+    }
+    add_pair(json, ds.key, "mml", mml_main);
+    add_pair(json, ds.key, "mcl", mcl_main);
+    if (mit) {
+      json->add("mit_killian_mml_speedup_vs_mcl", mcl_main.step_ms_mean / mml_main.step_ms_mean);
+      json->add("mit_killian_mml_speedup_vs_mcl_p50", mcl_main.step_ms_p50 / mml_main.step_ms_p50);
+    }
+    // Plots.
+    for (const auto& r : runs) {
+      const std::string base = plan.out_dir + "/" + ds.key + "_" + r.label;
+      std::string e;
+      if (!write_error_plot(base + "_error.svg", ds.name + " — " + r.label + ": error over metres (kidnapped starts)",
+                            r.trials, ds.success_bound_m, &e) ||
+          !write_map_plot(base + "_map.svg", base + "_map.png", ds, ds.name + " — " + r.label, r.trials, nullptr, &e)) {
+        return (*err = e, false);
+      }
+    }
+    if (plan.verbose) std::printf("dataset %s done in %.1f s\n", name.c_str(), since(t0));
+  }
+
+  // Unknown area: a region around a mid-log pose is erased from the map; trials start 8–30 m
+  // before it, so the robot can localize first and then drive through the erased part.
+  if (plan.run_unknown) {
+    const auto t0 = std::chrono::steady_clock::now();
+    LoadedDataset ds;
+    if (!load_dataset(plan.unknown_dataset, &ds, err)) return false;
+    fw::RandomStream rng(plan.seed, 991);
+    const std::size_t n = ds.log.scans.size();
+    std::size_t c = n / 4 + rng.uniform_index(static_cast<std::uint32_t>(n / 2));
+    const fw::Se2d rc = ds.reference[c];
+    const double half = 4.0;
+    const double region[4] = {rc.x - half, rc.y - half, rc.x + half, rc.y + half};
+    if (!erase_region(&ds, region[0], region[1], region[2], region[3], err)) return false;
+    std::vector<std::size_t> starts;
+    for (std::size_t k = 0; k < plan.unknown_trials; ++k) {
+      const double back = 8.0 + 10.0 * static_cast<double>(k);
+      std::size_t s = c;
+      while (s > 0 && ds.travelled[c] - ds.travelled[s] < back) --s;
+      starts.push_back(s);
+    }
+    TrialOptions uo = plan.trial;
+    uo.max_steps = plan.trial.max_steps + 60;
+    std::string e;
+    auto mml = OwnedLocalizer::make_mml(ds.map, ds.image, mml_config(plan.mml_config, plan.seed), plan.threads, &e);
+    if (!mml) return (*err = e, false);
+    SystemRun rm = run_system(*mml, ds, "mml-unknown", starts, uo, plan.verbose, region);
+    auto mcl = OwnedLocalizer::make_mcl(ds.map, mcl_baseline_options(plan.mcl_particles, plan.seed), plan.threads, &e);
+    if (!mcl) return (*err = e, false);
+    SystemRun rc2 = run_system(*mcl, ds, "mcl-unknown", starts, uo, plan.verbose, region);
+    json->add("unknown_area_mml_failure_rate", rm.summary.failure_rate);
+    json->add("unknown_area_mcl_failure_rate", rc2.summary.failure_rate);
+    json->add("unknown_area_mml_outside_map_fraction", rm.summary.outside_map_in_region);
+    json->add("unknown_area_mcl_success_rate", rc2.summary.success_rate);
+    json->add_int("unknown_area_trials", static_cast<long long>(starts.size()));
+    rows.push_back(rm.summary);
+    rows.push_back(rc2.summary);
+    for (const SystemRun* r : {&rm, &rc2}) {
+      const std::string base = plan.out_dir + "/unknown_" + ds.key + "_" + r->label;
+      if (!write_error_plot(base + "_error.svg", ds.name + " with an erased region — " + r->label, r->trials,
+                            ds.success_bound_m, &e) ||
+          !write_map_plot(base + "_map.svg", base + "_map.png", ds, ds.name + " with an erased region — " + r->label,
+                          r->trials, region, &e)) {
+        return (*err = e, false);
+      }
+    }
+    if (plan.verbose) std::printf("unknown area done in %.1f s\n", since(t0));
+  }
+  json->add("handoff_tracking_err_m", percentile(track_err, 50));
+  json->add("handoff_step_ms_p50", percentile(track_ms, 50));
+  json->add("handoff_step_ms_p99", percentile(track_ms, 99));
+  json->add("static_memory_mib", static_mib);
+
+  std::ofstream md(plan.out_dir + "/summary.md");
+  md << "# MML evaluation\n\nKidnapped starts drawn with seed " << plan.seed << "; " << plan.trials
+     << " trials per dataset (MCL: " << (plan.mcl_trials ? plan.mcl_trials : plan.trials) << "), at most "
+     << plan.trial.max_steps << " steps per trial (mit-killian: " << plan.trial_mit.max_steps
+     << "); a step is a scan after ≥ " << plan.trial.min_move_m << " m or ≥ " << plan.trial.min_turn_rad
+     << " rad of odometry motion. Success: first `localized` within 0.5 m / 20° (1 m at mit-killian) and never "
+        "beyond; failure: any `localized` estimate beyond the bound. Step times are wall-clock on this machine ("
+     << plan.threads << " threads).\n\n";
+  md << markdown_table(rows) << "\n";
+  md << "Plots: `<dataset>_<system>_error.svg` (error over metres, coloured by status) and `_map.svg/.png`.\n";
+  return true;
+}
+
+}  // namespace sim::mmleval

@@ -1,0 +1,104 @@
+// Registry entries for the simulator (sim/cli/localizer_factory.cpp): "mml", "mcl", "handoff".
+// Uses only the registry's header types, so sim_mml does not link the registry (no cycle).
+#include <cstdlib>
+
+#include "sim/cli/localizer_factory.h"
+#include "sim/eval/mml_eval/mml_systems.h"
+
+namespace sim::mmleval {
+
+namespace {
+
+std::string check_keys(const std::string& who, const std::map<std::string, std::string>& options,
+                       const std::vector<std::string>& known) {
+  std::string bad;
+  for (const auto& kv : options) {
+    bool ok = false;
+    for (const auto& k : known) ok = ok || k == kv.first;
+    if (!ok) bad += (bad.empty() ? "" : ", ") + kv.first;
+  }
+  if (bad.empty()) return {};
+  std::string list;
+  for (const auto& k : known) list += (list.empty() ? "" : ", ") + k;
+  return "localizer " + who + ": unknown option(s) " + bad + " (known: " + list + ")";
+}
+
+bool parse_int(const std::map<std::string, std::string>& o, const std::string& key, long lo, long hi, long* v,
+               const std::string& who, std::string* err) {
+  const auto it = o.find(key);
+  if (it == o.end()) return true;
+  char* end = nullptr;
+  const long x = std::strtol(it->second.c_str(), &end, 10);
+  if (end == it->second.c_str() || *end != '\0' || x < lo || x > hi) {
+    *err = "localizer " + who + ": option " + key + "='" + it->second + "' (expected an integer in [" +
+           std::to_string(lo) + ", " + std::to_string(hi) + "])";
+    return false;
+  }
+  *v = x;
+  return true;
+}
+
+std::unique_ptr<fw::Localizer> wrap_hooks(std::unique_ptr<OwnedLocalizer> o, const LocalizerContext& ctx) {
+  if (o && ctx.hooks) {
+    OwnedLocalizer* raw = o.get();
+    ctx.hooks->hypotheses = [raw](std::vector<HypothesisPoint>* out) { raw->hypotheses(out); };
+  }
+  return o;
+}
+
+}  // namespace
+
+std::unique_ptr<fw::Localizer> make_mml_localizer(const LocalizerContext& ctx, std::string* err) {
+  const std::string bad = check_keys("mml", ctx.options, {"config", "iterations"});
+  if (!bad.empty()) { *err = bad; return nullptr; }
+  if (ctx.global_map == nullptr) { *err = "localizer mml: needs a global map"; return nullptr; }
+  long config = 3, iters = 0;
+  if (!parse_int(ctx.options, "config", 1, 4, &config, "mml", err)) return nullptr;
+  if (!parse_int(ctx.options, "iterations", 1000, 10000000, &iters, "mml", err)) return nullptr;
+  auto cfg = mml_config(static_cast<int>(config), ctx.seed);
+  if (iters > 0) cfg.mml.matching_iterations = static_cast<std::uint32_t>(iters);
+  static const std::vector<std::uint8_t> kEmpty;
+  return wrap_hooks(OwnedLocalizer::make_mml(*ctx.global_map, ctx.map_image ? *ctx.map_image : kEmpty, cfg,
+                                             ctx.threads, err),
+                    ctx);
+}
+
+std::unique_ptr<fw::Localizer> make_mcl_localizer(const LocalizerContext& ctx, std::string* err) {
+  const std::string bad = check_keys("mcl", ctx.options, {"particles", "model", "kld", "inject"});
+  if (!bad.empty()) { *err = bad; return nullptr; }
+  if (ctx.global_map == nullptr) { *err = "localizer mcl: needs a global map"; return nullptr; }
+  long particles = 30000, kld = 0, inject = 0;
+  if (!parse_int(ctx.options, "particles", 100, static_cast<long>(fw::mcl::kMaxParticles), &particles, "mcl", err))
+    return nullptr;
+  if (!parse_int(ctx.options, "kld", 0, 1, &kld, "mcl", err)) return nullptr;
+  if (!parse_int(ctx.options, "inject", 0, 1, &inject, "mcl", err)) return nullptr;
+  auto opt = mcl_baseline_options(static_cast<std::uint32_t>(particles), ctx.seed);
+  const auto m = ctx.options.find("model");
+  if (m != ctx.options.end()) {
+    if (m->second == "field") {
+      opt.model = fw::mcl::SensorModel::kLikelihoodField;
+    } else if (m->second != "beam") {
+      *err = "localizer mcl: option model='" + m->second + "' (expected beam or field)";
+      return nullptr;
+    }
+  }
+  opt.kld_sampling = kld != 0;
+  opt.random_injection = inject != 0;
+  return wrap_hooks(OwnedLocalizer::make_mcl(*ctx.global_map, opt, ctx.threads, err), ctx);
+}
+
+std::unique_ptr<fw::Localizer> make_handoff_localizer(const LocalizerContext& ctx, std::string* err) {
+  const std::string bad = check_keys("handoff", ctx.options, {"config"});
+  if (!bad.empty()) { *err = bad; return nullptr; }
+  if (ctx.global_map == nullptr) { *err = "localizer handoff: needs a global map"; return nullptr; }
+  long config = 3;
+  if (!parse_int(ctx.options, "config", 1, 4, &config, "handoff", err)) return nullptr;
+  static const std::vector<std::uint8_t> kEmpty;
+  return wrap_hooks(OwnedLocalizer::make_handoff(*ctx.global_map, ctx.map_image ? *ctx.map_image : kEmpty,
+                                                 mml_config(static_cast<int>(config), ctx.seed),
+                                                 mcl_tracking_options(ctx.seed), fw::mml::HandoffOptions(),
+                                                 ctx.threads, err),
+                    ctx);
+}
+
+}  // namespace sim::mmleval

@@ -1,0 +1,86 @@
+// Host-side construction of the MML / MCL / hand-off localizers for a loaded global map: owns the
+// start-up arena, the worker pool and the (large) localizer objects; used by the evaluation
+// harness (mml-eval, bench_mml) and by the simulator's localizer registry (make_*_localizer).
+#pragma once
+
+#include <cstdint>
+#include <map>
+#include <memory>
+#include <string>
+#include <vector>
+
+#include "firmware/base/arena.h"
+#include "firmware/base/worker_pool.h"
+#include "firmware/map/global_map.h"
+#include "firmware/mcl/mcl_localizer.h"
+#include "firmware/mml/handoff_localizer.h"
+#include "firmware/mml/mml_localizer.h"
+#include "firmware/runtime/localizer.h"
+
+namespace sim {
+struct LocalizerContext;
+struct HypothesisPoint;
+}  // namespace sim
+
+namespace sim::mmleval {
+
+// MML configurations compared (our reading of Tables 5.1–5.4; the thesis's UFLMS/UBB/PRT/MI
+// columns — local map reduction and correction are not implemented):
+//   C1: online relation tables, full local map, Bollinger, 30k iterations
+//   C2: precomputed table, full local map, Bollinger, 30k iterations
+//   C3: precomputed table, fixed local map (last 8 fragments of 2 m), Bollinger, 30k iterations
+//   C4: as C3 with 60k iterations
+fw::mml::MmlLocalizerConfig mml_config(int config, std::uint64_t seed);
+// The thesis's baseline: beam model on 18 beams; `particles` 15k–120k.
+fw::mcl::MclOptions mcl_baseline_options(std::uint32_t particles, std::uint64_t seed);
+// Tracking filter used after the hand-off (few particles, likelihood field, many beams).
+fw::mcl::MclOptions mcl_tracking_options(std::uint64_t seed);
+
+// A localizer together with everything it needs (arena, pool). reset()/step() forward.
+class OwnedLocalizer : public fw::Localizer {
+ public:
+  const char* name() const override { return inner_ ? inner_->name() : "none"; }
+  void reset() override { inner_->reset(); }
+  fw::Status step(const hal::LaserScan& scan, const hal::Odometry& odom, hal::PoseEstimate* out) override {
+    return inner_->step(scan, odom, out);
+  }
+  // Hypotheses (best clusters of the last MML step) for pictures; empty for MCL.
+  void hypotheses(std::vector<HypothesisPoint>* out) const;
+  fw::mml::MmlLocalizer* mml() { return mml_.get(); }
+  fw::mcl::MclLocalizer* mcl() { return mcl_.get(); }
+  fw::mml::HandoffLocalizer* handoff() { return handoff_.get(); }
+  std::size_t arena_bytes() const { return arena_.used(); }
+  // Static memory of the firmware objects + arena (what a robot would reserve), bytes.
+  std::size_t static_bytes() const;
+
+  // Builders. `image` = the compiled map image bytes (for a precomputed relation table section);
+  // may be empty. `threads` ≥ 1.
+  static std::unique_ptr<OwnedLocalizer> make_mml(const fw::GlobalMap& map, const std::vector<std::uint8_t>& image,
+                                                  const fw::mml::MmlLocalizerConfig& cfg, int threads,
+                                                  std::string* err);
+  static std::unique_ptr<OwnedLocalizer> make_mcl(const fw::GlobalMap& map, const fw::mcl::MclOptions& opt,
+                                                  int threads, std::string* err);
+  static std::unique_ptr<OwnedLocalizer> make_handoff(const fw::GlobalMap& map, const std::vector<std::uint8_t>& image,
+                                                      const fw::mml::MmlLocalizerConfig& cfg,
+                                                      const fw::mcl::MclOptions& tracking,
+                                                      const fw::mml::HandoffOptions& ho, int threads,
+                                                      std::string* err);
+
+ private:
+  fw::StartupArena arena_;
+  std::unique_ptr<fw::WorkerPool> pool_;
+  std::unique_ptr<fw::mml::MmlLocalizer> mml_;
+  std::unique_ptr<fw::mcl::MclLocalizer> mcl_;
+  std::unique_ptr<fw::mml::HandoffLocalizer> handoff_;
+  fw::Localizer* inner_ = nullptr;
+  bool start_pool(int threads, std::string* err);
+};
+
+// Simulator registry entries (sim/cli/localizer_factory): "mml", "mcl", "handoff".
+// Options (--opt k=v): mml: config=1..4, iterations=N; mcl: particles=N, model=beam|field,
+// kld=0|1, inject=0|1; handoff: config=1..4.
+std::unique_ptr<fw::Localizer> make_mml_localizer(const LocalizerContext& ctx, std::string* err);
+std::unique_ptr<fw::Localizer> make_mcl_localizer(const LocalizerContext& ctx, std::string* err);
+std::unique_ptr<fw::Localizer> make_handoff_localizer(const LocalizerContext& ctx, std::string* err);
+
+}  // namespace sim::mmleval
