@@ -3,6 +3,7 @@
 #include <algorithm>
 
 #include "firmware/runtime/odometry_localizer.h"
+#include "sim/eval/mml_eval/mml_systems.h"
 
 namespace sim {
 
@@ -45,6 +46,12 @@ std::vector<Entry>& registry() {
   static std::vector<Entry> entries = {
       {"odom", "odometry pass-through (dead reckoning; status always searching); --opt anchor=origin|truth",
        &make_odom},
+      {"mml", "MML global localization (RBSM local map + pRANSAM + Ch. 5 constraints); --opt config=1..4, iterations=N",
+       &mmleval::make_mml_localizer},
+      {"mcl", "MCL baseline (beam model, 18 beams); --opt particles=N, model=beam|field, kld=0|1, inject=0|1",
+       &mmleval::make_mcl_localizer},
+      {"handoff", "MML global localization handing off to MCL tracking; --opt config=1..4",
+       &mmleval::make_handoff_localizer},
   };
   return entries;
 }

@@ -65,7 +65,9 @@ struct SimSummary {
   double mean_err_localized_m = 0, max_err_localized_m = 0, final_err_m = 0;
   std::size_t status_counts[5] = {};
   double step_ms_mean = 0, step_ms_p50 = 0, step_ms_p99 = 0, step_ms_max = 0;
-  double path_length_m = 0, wall_s = 0, scans_per_s = 0;
+  // wall_s / scans_per_s: the run through hal/sim and the localizer (log parsing and map building
+  // excluded: load_s).
+  double path_length_m = 0, wall_s = 0, scans_per_s = 0, load_s = 0;
   std::uint64_t odom_rejected = 0, scans_held = 0, ring_drops = 0, step_errors = 0;
   std::size_t scans_restamped = 0;  // log scans whose time stamp stepped back (re-stamped, see sim_runner.cpp)
 };
