@@ -263,6 +263,46 @@ TEST(Data, ReferenceTrajectoryScoresFarBetterThanOdometry) {
   }
 }
 
+// fr-clinic has no corrected log: its (mutually consistent) relations give the poses at 1316 scans,
+// odometry chaining the rest. The relations then score ≈0 on that reference, and raw odometry does not.
+TEST(Data, FrClinicReferenceFromRelations) {
+  REQUIRE_DATA();
+  const Dataset& d = *find_dataset("fr-clinic");
+  const CarmenLog& raw = log_of(d.raw_log);
+  const auto rel = relations_of(d);
+  std::vector<CorrectedPose> cp;
+  std::string err;
+  ASSERT_TRUE(corrected_poses_from_relations(raw, rel, &cp, &err)) << err;
+  EXPECT_EQ(cp.size(), 1316u);  // README: 1316 distinct relation timestamps, all scans of the log
+  const auto ref = reference_with_bounds(raw, cp);
+  const RelationsMetric mr = evaluate_relations(rel, make_trajectory(raw, reference_at_every_scan(raw, cp)));
+  const RelationsMetric mo = evaluate_relations(rel, odometry_trajectory(raw));
+  const ReferenceGapStats g = reference_gap_stats(raw, cp);
+  std::printf("[ data ] fr-clinic reference from relations: %s\n", to_string(mr).c_str());
+  std::printf("[ data ] fr-clinic gaps %zu mean %.1f max %.0f scans; closure residual mean %.4f m max %.4f m\n", g.gaps,
+              g.mean_gap_scans, g.max_gap_scans, g.mean_closure_m, g.max_closure_m);
+  EXPECT_EQ(mr.used, rel.size());
+  // Not exactly 0: the relations are printed with 6 decimals, rounding accumulates along the tree
+  // (measured max 4.8e-5 m, 1.8e-5 deg).
+  EXPECT_LT(mr.trans_max, 5e-4);
+  EXPECT_LT(mr.rot_max_deg, 5e-3);
+  EXPECT_GT(mo.trans_mean, 0.3);
+  // A relation timestamp that is not a scan is an error naming the log.
+  std::vector<Relation> bad = rel;
+  bad[5].t2 += 0.01;
+  EXPECT_FALSE(corrected_poses_from_relations(raw, bad, &cp, &err));
+  EXPECT_NE(err.find("relation 6"), std::string::npos) << err;
+  // Inconsistent relation sets (intel): spanning-tree relations exact, the metric stays small.
+  const Dataset& di = *find_dataset("intel");
+  const CarmenLog& intel = log_of(di.raw_log);
+  const auto irel = relations_of(di);
+  ASSERT_TRUE(corrected_poses_from_relations(intel, irel, &cp, &err)) << err;
+  EXPECT_EQ(cp.size(), 1791u);
+  const RelationsMetric mi = evaluate_relations(irel, make_trajectory(intel, reference_at_every_scan(intel, cp)));
+  std::printf("[ data ] intel reference from relations (spanning tree): %s\n", to_string(mi).c_str());
+  EXPECT_LT(mi.trans_mean, 0.05);
+}
+
 // Leave-one-out check of the interpolation: drop every other corrected pose, rebuild the reference,
 // and compare it with the dropped (independent) corrected poses.
 TEST(Data, InterpolationReproducesHeldOutCorrectedPoses) {

@@ -1,7 +1,8 @@
 // mml-carmen: command-line access to the sim/io readers and writers.
 //   mml-carmen info LOG [--skip-bad-lines]            record counts, time span, bad lines
 //   mml-carmen convert IN OUT [--skip-bad-lines] [--max-scans N]   re-write as FLASER/ODOM (.gz ok)
-//   mml-carmen trajectory LOG OUT [--reference CORRECTED_POSES]    "t x y theta" at every scan
+//   mml-carmen trajectory LOG OUT [--reference CORRECTED_POSES | --reference-relations RELATIONS]
+//                                                    "t x y theta" at every scan (raw odometry or reference)
 //   mml-carmen eval RELATIONS TRAJECTORY [--tolerance S]           Kümmerle et al. 2009 metric
 //   mml-carmen dataset NAME                          metric of raw odometry and reference (../shared/data)
 // Exit status 0 on success, 1 on bad input (message names the file and line), 2 on usage errors.
@@ -24,7 +25,7 @@ int usage() {
   std::fprintf(stderr,
                "usage: mml-carmen info LOG [--skip-bad-lines]\n"
                "       mml-carmen convert IN OUT [--skip-bad-lines] [--max-scans N]\n"
-               "       mml-carmen trajectory LOG OUT [--reference CORRECTED_POSES]\n"
+               "       mml-carmen trajectory LOG OUT [--reference CORRECTED_POSES | --reference-relations RELATIONS]\n"
                "       mml-carmen eval RELATIONS TRAJECTORY [--tolerance SECONDS]\n"
                "       mml-carmen dataset NAME   (intel, fr079, aces, fr-clinic, mit-killian)\n");
   return 2;
@@ -41,6 +42,7 @@ struct Args {
   size_t max_scans = 0;
   double tolerance = 1e-4;
   std::string reference;
+  std::string reference_relations;
   bool ok = true;
 };
 
@@ -70,6 +72,8 @@ Args parse_args(int argc, char** argv) {
       if (!a.ok || *v == 0 || *end != 0 || !(a.tolerance >= 0)) a.ok = false;
     } else if (s == "--reference") {
       a.reference = value("--reference");
+    } else if (s == "--reference-relations") {
+      a.reference_relations = value("--reference-relations");
     } else if (s.size() > 1 && s[0] == '-') {
       std::fprintf(stderr, "mml-carmen: unknown option %s\n", s.c_str());
       a.ok = false;
@@ -136,11 +140,17 @@ int cmd_trajectory(const Args& a) {
   std::string err;
   if (!load(a.pos[0], a, &log, &err)) return fail(err);
   sim::Trajectory traj;
-  if (a.reference.empty()) {
+  if (a.reference.empty() && a.reference_relations.empty()) {
     traj = sim::odometry_trajectory(log);
   } else {
     std::vector<sim::CorrectedPose> cp;
-    if (!sim::read_corrected_poses(a.reference, &cp, &err)) return fail(err);
+    if (!a.reference.empty()) {
+      if (!sim::read_corrected_poses(a.reference, &cp, &err)) return fail(err);
+    } else {
+      std::vector<sim::Relation> rel;
+      if (!sim::read_relations(a.reference_relations, &rel, &err)) return fail(err);
+      if (!sim::corrected_poses_from_relations(log, rel, &cp, &err)) return fail(a.reference_relations + ": " + err);
+    }
     const auto ref = sim::reference_at_every_scan(log, cp);
     if (ref.empty()) return fail(a.reference + ": no corrected pose indexes a scan of " + a.pos[0]);
     traj = sim::make_trajectory(log, ref);
@@ -175,9 +185,14 @@ int cmd_dataset(const Args& a) {
     if (!sim::read_relations(sim::data_path(d->relations), &rel, &err)) return fail(err);
     std::printf("raw odometry: %s\n", sim::to_string(sim::evaluate_relations(rel, sim::odometry_trajectory(log))).c_str());
   }
-  if (!d->corrected_poses.empty()) {
+  if (!d->corrected_poses.empty() || !rel.empty()) {
     std::vector<sim::CorrectedPose> cp;
-    if (!sim::read_corrected_poses(sim::data_path(d->corrected_poses), &cp, &err)) return fail(err);
+    if (!d->corrected_poses.empty()) {
+      if (!sim::read_corrected_poses(sim::data_path(d->corrected_poses), &cp, &err)) return fail(err);
+    } else {
+      std::printf("(no corrected log: reference poses from the relations' spanning tree)\n");
+      if (!sim::corrected_poses_from_relations(log, rel, &cp, &err)) return fail(err);
+    }
     const auto g = sim::reference_gap_stats(log, cp);
     std::printf("reference: %zu corrected poses, gaps mean %.1f max %.0f scans, closure residual mean %.3f m max %.3f m\n",
                 cp.size(), g.mean_gap_scans, g.max_gap_scans, g.mean_closure_m, g.max_closure_m);

@@ -5,6 +5,8 @@
 #include <cmath>
 #include <cstring>
 #include <limits>
+#include <map>
+#include <cstdio>
 #include <string_view>
 
 namespace sim {
@@ -169,6 +171,76 @@ ReferenceGapStats reference_gap_stats(const CarmenLog& raw, const std::vector<Co
     s.mean_closure_deg /= static_cast<double>(s.gaps);
   }
   return s;
+}
+
+bool corrected_poses_from_relations(const CarmenLog& raw, const std::vector<Relation>& relations,
+                                    std::vector<CorrectedPose>* out, std::string* error) {
+  out->clear();
+  // Timestamp → scan index.
+  std::vector<size_t> order(raw.scans.size());
+  for (size_t i = 0; i < order.size(); ++i) order[i] = i;
+  std::sort(order.begin(), order.end(),
+            [&](size_t a, size_t b) { return raw.scans[a].ipc_timestamp < raw.scans[b].ipc_timestamp; });
+  auto lookup = [&](double t, size_t* idx) {
+    auto it = std::lower_bound(order.begin(), order.end(), t,
+                               [&](size_t i, double v) { return raw.scans[i].ipc_timestamp < v; });
+    double best = 1e-4;
+    bool found = false;
+    for (auto jt : {it, it == order.begin() ? it : it - 1}) {
+      if (jt == order.end()) continue;
+      const double d = std::abs(raw.scans[*jt].ipc_timestamp - t);
+      if (d <= best) {
+        best = d;
+        *idx = *jt;
+        found = true;
+      }
+    }
+    return found;
+  };
+  std::map<size_t, std::vector<std::pair<size_t, size_t>>> adj;  // scan → (relation, other scan)
+  for (size_t r = 0; r < relations.size(); ++r) {
+    size_t a = 0, b = 0;
+    for (double t : {relations[r].t1, relations[r].t2}) {
+      size_t dummy;
+      if (!lookup(t, &dummy)) {
+        char buf[64];
+        std::snprintf(buf, sizeof(buf), "%.6f", t);
+        *error = std::string("relation ") + std::to_string(r + 1) + ": timestamp " + buf + " is not a scan of " + raw.path;
+        return false;
+      }
+    }
+    lookup(relations[r].t1, &a);
+    lookup(relations[r].t2, &b);
+    adj[a].push_back({r, b});
+    adj[b].push_back({r, a});
+  }
+  std::map<size_t, fw::Se2d> placed;
+  for (const auto& [start, unused] : adj) {  // scan order
+    if (placed.count(start)) continue;
+    if (placed.empty()) {
+      placed[start] = fw::Se2d();
+    } else {
+      auto it = placed.lower_bound(start);  // nearest placed scan (before, else after)
+      const size_t p = it == placed.begin() ? it->first : std::prev(it)->first;
+      placed[start] = placed[p].compose(raw.scans[p].odom.between(raw.scans[start].odom));
+    }
+    std::vector<size_t> queue{start};
+    for (size_t q = 0; q < queue.size(); ++q) {
+      const size_t u = queue[q];
+      for (const auto& [r, v] : adj[u]) {
+        if (placed.count(v)) continue;
+        const Relation& rel = relations[r];
+        size_t a = 0;
+        lookup(rel.t1, &a);
+        placed[v] = a == u ? placed[u].compose(rel.delta) : placed[u].compose(rel.delta.inverse());
+        queue.push_back(v);
+      }
+    }
+  }
+  for (const auto& [idx, pose] : placed) {
+    out->push_back({idx, raw.scans[idx].ipc_timestamp, raw.scans[idx].logger_timestamp, pose});
+  }
+  return true;
 }
 
 Trajectory odometry_trajectory(const CarmenLog& raw) {

@@ -65,6 +65,17 @@ struct ReferenceGapStats {
 };
 ReferenceGapStats reference_gap_stats(const CarmenLog& raw, const std::vector<CorrectedPose>& corrected);
 
+// Poses at the relation timestamps laid out along a breadth-first spanning tree of the relation graph
+// (x_{t2} = x_{t1} ⊕ δ), for logs without a corrected log (fr-clinic, whose 2820 relations are
+// mutually consistent up to their 6-decimal print precision: every relation is then satisfied to
+// < 1e-4 m). Each timestamp must be a scan
+// ipc_timestamp of `raw` (within 1e-4 s). Disconnected components are placed, in scan order, by the
+// raw odometry from the nearest already placed scan. The first relation scan is the origin. Feed the
+// result to reference_at_every_scan(). Inconsistent relation sets (intel, fr079, aces) keep the
+// spanning-tree relations exact and leave the loop residuals on the others.
+bool corrected_poses_from_relations(const CarmenLog& raw, const std::vector<Relation>& relations,
+                                    std::vector<CorrectedPose>* out, std::string* error);
+
 // Timestamped trajectories for evaluate_relations (t = ipc_timestamp of each scan).
 Trajectory odometry_trajectory(const CarmenLog& raw);  // raw odometry (CarmenScan::odom)
 Trajectory make_trajectory(const CarmenLog& raw, const std::vector<fw::Se2d>& poses);
