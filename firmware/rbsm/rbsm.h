@@ -42,9 +42,11 @@ struct RbsmOptions {
   float accept_ratio = 0.8f;           // Δ: stop when M_eff ≥ Δ·M (Alg. 1 l. 7)
   float shrink = 0.5f;                 // δ: Σ ← δ·Σ per round (Alg. 1 l. 21), 0 < δ < 1
   std::uint32_t max_iterations = 20;   // cap on resampling rounds
-  // Rounds before the M_eff rule may stop (1 = Alg. 1 exactly). With an accumulated end-point map
-  // the summed weights (Eq. 2.8) are flat enough that M_eff ≥ Δ·M often holds after one round.
-  std::uint32_t min_iterations = 1;
+  // Rounds before the M_eff rule may stop; 1 = Alg. 1's rule alone. On an accumulated end-point
+  // map the summed weights (Eq. 2.8) are so flat that M_eff ≥ Δ·M already holds after round 1
+  // (1.1 rounds/match on average), i.e. the best of one Gaussian cloud; 3 rounds measured on the
+  // real logs: fr079 relations error 0.39 m → 0.06 m, intel 6.7 → 5.6 cm (sim/eval/rbsm).
+  std::uint32_t min_iterations = 3;
   std::uint32_t min_points = 10;       // fewer valid points → status, no match
   float max_range = 0.0f;              // ignore points farther than this (m); 0 = keep all
   bool hill_climbing = false;          // Alg. 1 l. 12 (deterministic local correction)

@@ -83,7 +83,8 @@ TEST(RbsmTest, RecoversKnownDisplacementInSyntheticWorlds) {
     fw::ScanMatchResult r;
     ASSERT_TRUE(h.rbsm->match(cur.data(), cur.size(), c.guess, &r).is_ok()) << c.name;
     EXPECT_FALSE(r.map_was_empty);
-    EXPECT_GE(r.iterations, 1u);
+    EXPECT_GE(r.iterations, 3u);  // min_iterations default
+    EXPECT_LE(r.iterations, 20u);
     // The start error is 4–7 cm and 2.5°: RBSM must land within a cell and half a degree.
     expect_close(r.pose, c.truth, 0.02f, 0.5f * kDeg, c.name);
     EXPECT_GT(r.score, 0.5f) << c.name;
@@ -92,12 +93,15 @@ TEST(RbsmTest, RecoversKnownDisplacementInSyntheticWorlds) {
   }
 }
 
-TEST(RbsmTest, OptionalHillClimbingAndMahalanobisAlsoRecover) {
+TEST(RbsmTest, OptionalHillClimbingMahalanobisAndPlainStopRuleAlsoRecover) {
   const Case c = cases()[2];
-  for (int variant = 0; variant < 2; ++variant) {
+  const char* names[] = {"hill climbing", "mahalanobis", "Alg. 1 stop rule alone"};
+  for (int variant = 0; variant < 3; ++variant) {
     fw::RbsmOptions o = small_options();
     o.num_particles = 300;
-    if (variant == 0) o.hill_climbing = true; else o.mahalanobis = true;
+    if (variant == 0) o.hill_climbing = true;
+    if (variant == 1) o.mahalanobis = true;
+    if (variant == 2) { o.num_particles = 1000; o.min_iterations = 1; }
     RbsmHarness h;
     ASSERT_TRUE(h.init(o).is_ok());
     const auto ref = rbsm_test::cast_scan(c.world, c.reference);
@@ -105,7 +109,7 @@ TEST(RbsmTest, OptionalHillClimbingAndMahalanobisAlsoRecover) {
     ASSERT_TRUE(h.rbsm->integrate(ref.data(), ref.size(), c.reference).is_ok());
     fw::ScanMatchResult r;
     ASSERT_TRUE(h.rbsm->match(cur.data(), cur.size(), c.guess, &r).is_ok());
-    expect_close(r.pose, c.truth, 0.03f, 0.8f * kDeg, variant == 0 ? "hill climbing" : "mahalanobis");
+    expect_close(r.pose, c.truth, 0.03f, 0.8f * kDeg, names[variant]);
   }
 }
 
@@ -217,6 +221,9 @@ TEST(RbsmTest, MalformedInputIsAStatus) {
   bad = small_options();
   bad.accept_ratio = 0.0f;
   EXPECT_FALSE(h2.init(bad).is_ok());
+  bad = small_options();
+  bad.min_iterations = 30;  // > max_iterations
+  EXPECT_NE(std::string(bad.validate().message()).find("min_iterations"), std::string::npos);
 }
 
 TEST(RbsmTest, MatchAndIntegrateAllocateNothing) {

@@ -21,9 +21,7 @@ MatcherConfig default_matcher_config() {
   c.rbsm.grid.size_log2 = 10;
   c.rbsm.num_particles = 1000;
   c.rbsm.max_range = 15.0f;
-  // At least 3 resampling rounds before the M_eff stop rule (Δ = 4/5 unchanged): on accumulated
-  // end-point maps the rule otherwise fires after round 1 (fr079: 39 cm → 6 cm relations error).
-  c.rbsm.min_iterations = 3;
+  c.rbsm.min_iterations = 3;  // the firmware default, explicit here (see RbsmOptions)
   c.icp.grid = c.rbsm.grid;
   c.icp.max_range = 15.0f;
   c.front.scan.max_range = 15.0f;
