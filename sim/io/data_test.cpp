@@ -8,6 +8,7 @@
 
 #include <chrono>
 #include <cmath>
+#include <ctime>
 #include <cstdio>
 #include <deque>
 #include <map>
@@ -425,12 +426,16 @@ TEST(Data, IntelParsesQuickly) {
   REQUIRE_DATA();
   CarmenLog log;
   std::string err;
+  const std::clock_t c0 = std::clock();
   const auto t0 = std::chrono::steady_clock::now();
   ASSERT_TRUE(read_carmen_log(data_path("intel/intel.clf.gz"), {}, &log, &err)) << err;
   const double s = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
-  std::printf("[ data ] intel.clf.gz (16.4 MB decompressed) read in %.3f s\n", s);
+  const double cpu = static_cast<double>(std::clock() - c0) / CLOCKS_PER_SEC;
+  std::printf("[ data ] intel.clf.gz (16.4 MB decompressed) read in %.3f s wall, %.3f s CPU\n", s, cpu);
 #ifdef NDEBUG
-  EXPECT_LT(s, 2.0);  // generous: the machine is shared; typically a fraction of that
+  // CPU time, so that other processes on the shared machine do not make this flaky; measured
+  // ~0.1 s in Release.
+  EXPECT_LT(cpu, 2.0);
 #endif
 }
 
