@@ -1,11 +1,13 @@
 #include "sim/io/carmen_log.h"
 
+#include <sys/stat.h>
 #include <zlib.h>
 
 #include <algorithm>
 #include <charconv>
 #include <cmath>
 #include <cstdio>
+#include <cerrno>
 #include <cstring>
 #include <string_view>
 
@@ -237,6 +239,15 @@ size_t CarmenLog::count(const std::string& type) const {
 
 bool read_file_maybe_gz(const std::string& path, std::string* data, std::string* error) {
   data->clear();
+  struct stat st;
+  if (::stat(path.c_str(), &st) != 0) {
+    *error = path + ": cannot open: " + std::strerror(errno);
+    return false;
+  }
+  if (!S_ISREG(st.st_mode)) {
+    *error = path + ": not a regular file";
+    return false;
+  }
   FILE* probe = std::fopen(path.c_str(), "rb");
   if (!probe) {
     *error = path + ": cannot open: " + std::strerror(errno);

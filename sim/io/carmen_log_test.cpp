@@ -258,6 +258,19 @@ TEST(CarmenLog, MissingFileIsAnError) {
   EXPECT_FALSE(read_carmen_log("/nonexistent/dir/x.clf", {}, &log, &err));
   EXPECT_NE(err.find("/nonexistent/dir/x.clf"), std::string::npos) << err;
   EXPECT_NE(err.find("cannot open"), std::string::npos) << err;
+  const std::string dir = ::testing::TempDir();
+  EXPECT_FALSE(read_carmen_log(dir, {}, &log, &err));
+  EXPECT_NE(err.find("not a regular file"), std::string::npos) << err;
+  // An empty file is a valid, empty log; a bare gzip magic is a corrupt stream.
+  const std::string empty = temp_path("empty.clf"), magic = temp_path("magic.gz");
+  write_text(empty, "");
+  write_text(magic, "\x1f\x8b");
+  EXPECT_TRUE(read_carmen_log(empty, {}, &log, &err)) << err;
+  EXPECT_TRUE(log.scans.empty());
+  EXPECT_FALSE(read_carmen_log(magic, {}, &log, &err));
+  EXPECT_NE(err.find("gzip"), std::string::npos) << err;
+  std::remove(empty.c_str());
+  std::remove(magic.c_str());
 }
 
 TEST(CarmenLog, PlainAndGzipReadAlike) {
