@@ -53,6 +53,7 @@ Status MclOptions::validate() const {
   FW_RETURN_IF_ERROR(check_range("tau", tau, 2, kMaxConstraintWindow));
   FW_RETURN_IF_ERROR(check_range("localized_variance_m2", localized_variance_m2, 0.0, 1e6));
   FW_RETURN_IF_ERROR(check_range("localized_mean_m", localized_mean_m, 0.0, 1e6));
+  FW_RETURN_IF_ERROR(check_range("localized_min_mass", localized_min_mass, 0.0, 1.0));
   FW_RETURN_IF_ERROR(check_range("estimate_radius_m", estimate_radius_m, 1e-3, 1e6));
   return Status::ok();
 }
@@ -316,6 +317,7 @@ void Mcl::estimate(std::size_t best, MclStepResult* out) const {
     ss += w * std::sin(p.theta);
     sc += w * std::cos(p.theta);
   }
+  out->mass_near_best = static_cast<float>(sw);
   if (sw <= 0.0) { out->pose = Se2f(pb.x, pb.y, pb.theta); return; }
   const double mx = sx / sw, my = sy / sw, mt = std::atan2(ss, sc);
   double cxx = 0, cyy = 0, cxy = 0, ctt = 0;
@@ -422,7 +424,8 @@ Status Mcl::step(const hal::LaserScan& scan, const Se2f& odom_delta, bool have_d
     for (std::size_t i = 0; i < best_dist_.size(); ++i) v += (best_dist_[i] - m) * (best_dist_[i] - m);
     v /= best_dist_.size();
     out->best_distance_var = static_cast<float>(v);
-    out->localized = v < options_.localized_variance_m2 && m < options_.localized_mean_m;
+    out->localized = v < options_.localized_variance_m2 && m < options_.localized_mean_m &&
+                     out->mass_near_best >= options_.localized_min_mass;
   }
 
   if (out->neff < options_.resample_neff_ratio * static_cast<float>(n_) || options_.kld_sampling ||

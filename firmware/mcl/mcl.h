@@ -36,6 +36,7 @@ struct MclStepResult {
   float best_distance_var = -1.0f;  // the thesis's constraint value (−1: window not full)
   float mean_beam_log_likelihood = 0.0f;  // weighted mean per-beam log-likelihood (collapse test)
   float neff = 0.0f;
+  float mass_near_best = 0.0f;  // weight fraction within estimate_radius_m of the best particle
   std::uint32_t injected = 0;
 };
 

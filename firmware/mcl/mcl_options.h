@@ -52,6 +52,9 @@ struct MclOptions {
   std::uint32_t tau = 10;
   float localized_variance_m2 = 0.01f;
   float localized_mean_m = 0.5f;     // and its mean (a constant large offset is no convergence)
+  // AMCL-style convergence on top: at least this weight fraction within estimate_radius_m of the
+  // best particle (one mode). 0 = the thesis's constraint alone.
+  float localized_min_mass = 0.9f;
 
   // Output pose: weighted mean of the particles within this radius of the best particle.
   float estimate_radius_m = 1.0f;
