@@ -8,7 +8,7 @@ PACKAGES=(
   libeigen3-dev libgtest-dev libbenchmark-dev zlib1g-dev libpng-dev
   g++-aarch64-linux-gnu g++-arm-linux-gnueabihf qemu-user
   can-utils socat iproute2 kmod busybox-static user-mode-linux
-  binutils file
+  binutils file python3
 )
 
 missing=()
