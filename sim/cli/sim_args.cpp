@@ -71,6 +71,7 @@ run:
   --paced                 pace at the data's real time (default: lockstep, as fast as possible)
   --speed F               pacing speed factor with --paced (default 1)
   --threads N             worker threads offered to the localizer (default 1)
+  --deadline-ms MS        count localizer steps longer than MS as deadline misses (default off)
   --out DIR               output directory (default build/run)
   --timing wall|none      measure step times with the wall clock (default) or not (byte-identical CSV)
   --quiet                 no progress line
@@ -161,6 +162,8 @@ bool parse_sim_args(const std::vector<std::string>& args, SimConfig* cfg, SimArg
         return false;
       }
       cfg->threads = static_cast<int>(n);
+    } else if (a == "--deadline-ms") {
+      if (!value(&v) || !parse_double(a, v, 0, 100000, &cfg->deadline_ms, err)) return false;
     } else if (a == "--out") {
       if (!value(&cfg->out_dir)) return false;
     } else if (a == "--timing") {

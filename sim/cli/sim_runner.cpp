@@ -294,7 +294,8 @@ bool write_summary_json(const std::string& path, const SimSummary& s, std::strin
                num(s.path_length_m).c_str(), num(s.load_s).c_str(), num(s.wall_s).c_str(), num(s.scans_per_s).c_str());
   std::fprintf(f, "  \"scans_dropped\": %zu,\n  \"ring_drops\": %llu,\n  \"odom_rejected\": %llu,\n", s.scans_dropped,
                static_cast<unsigned long long>(s.ring_drops), static_cast<unsigned long long>(s.odom_rejected));
-  std::fprintf(f, "  \"scans_restamped\": %zu,\n", s.scans_restamped);
+  std::fprintf(f, "  \"scans_restamped\": %zu,\n  \"deadline_misses\": %llu,\n", s.scans_restamped,
+               static_cast<unsigned long long>(s.deadline_misses));
   std::fprintf(f, "  \"scans_held\": %llu,\n  \"step_errors\": %llu\n}\n", static_cast<unsigned long long>(s.scans_held),
                static_cast<unsigned long long>(s.step_errors));
   const bool ok = std::fclose(f) == 0;
@@ -462,6 +463,7 @@ bool run_simulation(const SimConfig& cfg_in, SimResult* out, std::string* err) {
   auto loop = std::make_unique<fw::LocalizationLoop>();
   fw::LocalizationLoopOptions lo;
   lo.perf_clock = cfg.wall_timing ? static_cast<const hal::Clock*>(&wall_clock) : &frozen_clock;
+  lo.step_deadline_ns = static_cast<std::uint64_t>(cfg.deadline_ms * 1e6);
   fw::Status s = loop->init(hal, *localizer, lo);
   if (!s.is_ok()) {
     *err = s.message();
@@ -593,6 +595,7 @@ bool run_simulation(const SimConfig& cfg_in, SimResult* out, std::string* err) {
   sum.ring_drops = ring_drops + laser->stats().dropped + odom->stats().dropped;
   sum.odom_rejected = loop->counters().odom_rejected;
   sum.scans_held = loop->counters().scans_held;
+  sum.deadline_misses = loop->health().deadline_misses;
   std::vector<double> ms;
   double err_sum = 0;
   for (const StepRecord& r : out->steps) {

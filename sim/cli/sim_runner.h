@@ -35,6 +35,7 @@ struct SimConfig {
   bool progress = true;        // \r-updated progress line on stderr
   bool pictures = true;
   int threads = 1;
+  double deadline_ms = 0;      // Localizer::step longer than this counts a deadline miss (0 = off)
   std::string out_dir;         // empty: no files
   SyntheticRunOptions synthetic;
   RasterOptions raster;
@@ -69,7 +70,8 @@ struct SimSummary {
   // excluded: load_s).
   double path_length_m = 0, wall_s = 0, scans_per_s = 0, load_s = 0;
   std::uint64_t odom_rejected = 0, scans_held = 0, ring_drops = 0, step_errors = 0;
-  std::size_t scans_restamped = 0;  // log scans whose time stamp stepped back (re-stamped, see sim_runner.cpp)
+  std::size_t scans_restamped = 0;
+  std::uint64_t deadline_misses = 0;  // log scans whose time stamp stepped back (re-stamped, see sim_runner.cpp)
 };
 
 struct SimResult {
