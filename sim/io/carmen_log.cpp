@@ -328,6 +328,7 @@ bool parse_carmen_log(const std::string& name, const char* data, size_t size, co
   CarmenScan scan;
   CarmenOdom odom;
   std::pair<std::string, std::string> kv;
+  size_t scan_records = 0;  // scan lines seen, malformed ones included (so index = flaser_index)
   while (p < end) {
     const char* eol = static_cast<const char*>(std::memchr(p, '\n', static_cast<size_t>(end - p)));
     if (!eol) eol = end;
@@ -388,9 +389,10 @@ bool parse_carmen_log(const std::string& name, const char* data, size_t size, co
       ok = false;
       why = "not a CARMEN message (first field " + show(head) + ")";
     }
+    if (is_scan) ++scan_records;
     if (ok && is_scan) {
       scan.line = line_no;
-      scan.index = out->scans.size();
+      scan.index = scan_records - 1;
       out->scans.push_back(scan);
     }
     if (!ok) {

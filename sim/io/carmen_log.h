@@ -30,7 +30,9 @@ namespace sim {
 
 struct CarmenScan {
   size_t line = 0;   // 1-based line number in the file
-  size_t index = 0;  // 0-based among scan records (= flaser_index of *.corrected-poses.txt)
+  size_t index = 0;  // 0-based among scan records of the file (= flaser_index of *.corrected-poses.txt);
+                     // malformed scan lines dropped by skip_bad_lines still count, so indices of the
+                     // following scans keep matching flaser_index (scans[i].index == i unless lines were dropped)
   std::string type;  // "FLASER", "RLASER", "ROBOTLASER1", "RAWLASER1".."RAWLASER4"
   double ipc_timestamp = 0, logger_timestamp = 0;
   float angle_min = 0, angle_increment = 0, max_range = 0;

@@ -8,8 +8,9 @@
 // time to be ≥ the previous one. Odometry comes from the ODOM records when the log has any, else
 // (fr-clinic, mit-killian) from the pose carried in each scan record (CarmenScan::odom), emitted
 // just before that scan at the same time. At equal times odometry precedes the scan, so the scan's
-// odometry is always available when the scan is polled. hal::LaserScan::scan_id = the scan's index
-// in log.scans (= flaser_index), which maps replay outputs back to scans / reference poses.
+// odometry is always available when the scan is polled. hal::LaserScan::scan_id = CarmenScan::index
+// (= flaser_index; equal to the position in log.scans unless skip_bad_lines dropped scan lines),
+// which maps replay outputs back to scans / reference poses; ReplayEvent::index is the position.
 // The corrected logs' timestamps are unusable (README): replay raw logs.
 #pragma once
 

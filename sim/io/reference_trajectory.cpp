@@ -32,14 +32,29 @@ fw::Se2d blend(const fw::Se2d& a, const fw::Se2d& b, double w) {
                   fw::wrap_angle(a.theta + w * fw::wrap_angle(b.theta - a.theta)));
 }
 
-// Corrected poses usable with this log (index in range), in index order.
-std::vector<const CorrectedPose*> usable(const CarmenLog& raw, const std::vector<CorrectedPose>& corrected) {
-  std::vector<const CorrectedPose*> u;
-  for (const auto& c : corrected) {
-    if (c.flaser_index < raw.scans.size()) u.push_back(&c);
-  }
-  std::stable_sort(u.begin(), u.end(),
+// Corrected poses usable with this log, with the position of their scan in raw.scans (equal to
+// flaser_index unless skip_bad_lines dropped scan lines), in index order. Poses whose scan is not in
+// the log (beyond its end, or dropped as malformed) are left out.
+struct Anchor {
+  size_t pos;
+  const CorrectedPose* c;
+};
+std::vector<Anchor> usable(const CarmenLog& raw, const std::vector<CorrectedPose>& corrected) {
+  std::vector<const CorrectedPose*> sorted;
+  for (const auto& c : corrected) sorted.push_back(&c);
+  std::stable_sort(sorted.begin(), sorted.end(),
                    [](const CorrectedPose* a, const CorrectedPose* b) { return a->flaser_index < b->flaser_index; });
+  std::vector<Anchor> u;
+  for (const CorrectedPose* c : sorted) {
+    size_t pos = c->flaser_index;
+    if (pos >= raw.scans.size() || raw.scans[pos].index != c->flaser_index) {
+      auto it = std::lower_bound(raw.scans.begin(), raw.scans.end(), c->flaser_index,
+                                 [](const CarmenScan& s, size_t v) { return s.index < v; });
+      if (it == raw.scans.end() || it->index != c->flaser_index) continue;
+      pos = static_cast<size_t>(it - raw.scans.begin());
+    }
+    u.push_back({pos, c});
+  }
   return u;
 }
 
@@ -113,29 +128,29 @@ std::vector<ReferencePose> reference_with_bounds(const CarmenLog& raw, const std
   const double inf = std::numeric_limits<double>::infinity();
   auto odo = [&](size_t i) -> const fw::Se2d& { return raw.scans[i].odom; };
   // Before the first corrected pose: backward chain only.
-  for (size_t i = 0; i < u.front()->flaser_index; ++i) {
-    out[i].pose = chain(u.front()->pose, odo(u.front()->flaser_index), odo(i));
+  for (size_t i = 0; i < u.front().pos; ++i) {
+    out[i].pose = chain(u.front().c->pose, odo(u.front().pos), odo(i));
     out[i].bound = inf;
   }
   for (size_t k = 0; k < u.size(); ++k) {
-    const size_t a = u[k]->flaser_index;
-    out[a].pose = u[k]->pose;
+    const size_t a = u[k].pos;
+    out[a].pose = u[k].c->pose;
     out[a].exact = true;
     if (k + 1 == u.size()) {
       for (size_t i = a + 1; i < n; ++i) {
-        out[i].pose = chain(u[k]->pose, odo(a), odo(i));
+        out[i].pose = chain(u[k].c->pose, odo(a), odo(i));
         out[i].bound = inf;
       }
       break;
     }
-    const size_t b = u[k + 1]->flaser_index;
-    const fw::Se2d closure = chain(u[k]->pose, odo(a), odo(b)).between(u[k + 1]->pose);
+    const size_t b = u[k + 1].pos;
+    const fw::Se2d closure = chain(u[k].c->pose, odo(a), odo(b)).between(u[k + 1].c->pose);
     const double r = std::hypot(closure.x, closure.y);
     const double dd = static_cast<double>(b - a);
     for (size_t i = a + 1; i < b; ++i) {
       const double w = static_cast<double>(i - a) / dd;
-      const fw::Se2d f = chain(u[k]->pose, odo(a), odo(i));
-      const fw::Se2d bb = chain(u[k + 1]->pose, odo(b), odo(i));
+      const fw::Se2d f = chain(u[k].c->pose, odo(a), odo(i));
+      const fw::Se2d bb = chain(u[k + 1].c->pose, odo(b), odo(i));
       out[i].pose = blend(f, bb, w);
       out[i].bound = ((1.0 - w) * std::sqrt(w) + w * std::sqrt(1.0 - w)) * r;
     }
@@ -153,8 +168,8 @@ ReferenceGapStats reference_gap_stats(const CarmenLog& raw, const std::vector<Co
   const auto u = usable(raw, corrected);
   ReferenceGapStats s;
   for (size_t k = 0; k + 1 < u.size(); ++k) {
-    const size_t a = u[k]->flaser_index, b = u[k + 1]->flaser_index;
-    const fw::Se2d closure = chain(u[k]->pose, raw.scans[a].odom, raw.scans[b].odom).between(u[k + 1]->pose);
+    const size_t a = u[k].pos, b = u[k + 1].pos;
+    const fw::Se2d closure = chain(u[k].c->pose, raw.scans[a].odom, raw.scans[b].odom).between(u[k + 1].c->pose);
     const double r = std::hypot(closure.x, closure.y);
     const double rd = std::abs(closure.theta) * kRad2Deg;
     ++s.gaps;
@@ -238,7 +253,7 @@ bool corrected_poses_from_relations(const CarmenLog& raw, const std::vector<Rela
     }
   }
   for (const auto& [idx, pose] : placed) {
-    out->push_back({idx, raw.scans[idx].ipc_timestamp, raw.scans[idx].logger_timestamp, pose});
+    out->push_back({raw.scans[idx].index, raw.scans[idx].ipc_timestamp, raw.scans[idx].logger_timestamp, pose});
   }
   return true;
 }

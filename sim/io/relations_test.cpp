@@ -204,6 +204,33 @@ TEST(ReferenceTrajectory, BlendRecoversTruthUnderLinearDrift) {
   EXPECT_GT(g.mean_closure_m, 0.01);
 }
 
+TEST(ReferenceTrajectory, SkippedScanLinesKeepTheIndexMapping) {
+  // Scan 2 of 5 is malformed and skipped: corrected poses keyed by file ordinal still land on the
+  // right scans, and the pose for the dropped scan is simply absent.
+  std::string text;
+  for (int i = 0; i < 5; ++i) {
+    const std::string x = std::to_string(i);
+    text += i == 2 ? "FLASER 2 1 nan 0 0 0 0 0 0 2 h 2\n"
+                   : "FLASER 2 1 1 " + x + " 0 0 " + x + " 0 0 " + x + " h " + x + "\n";
+  }
+  CarmenLog log;
+  std::string err;
+  CarmenReadOptions o;
+  o.skip_bad_lines = true;
+  ASSERT_TRUE(parse_carmen_log("m", text.data(), text.size(), o, &log, &err)) << err;
+  ASSERT_EQ(log.scans.size(), 4u);
+  EXPECT_EQ(log.scans[2].index, 3u);
+  const std::vector<CorrectedPose> cp = {{0, 0, 0, fw::Se2d(10, 0, 0)}, {2, 2, 2, fw::Se2d(99, 99, 0)},
+                                         {4, 4, 4, fw::Se2d(14, 0, 0)}};
+  const auto ref = reference_with_bounds(log, cp);
+  ASSERT_EQ(ref.size(), 4u);
+  EXPECT_TRUE(ref[0].exact);
+  EXPECT_TRUE(ref[3].exact);
+  EXPECT_DOUBLE_EQ(ref[3].pose.x, 14.0);
+  EXPECT_NEAR(ref[1].pose.x, 11.0, 1e-12);  // odometry chained, the dropped scan's pose unused
+  EXPECT_NEAR(ref[2].pose.x, 13.0, 1e-12);
+}
+
 TEST(ReferenceTrajectory, CorruptedPosesFileIsAnError) {
   const struct {
     const char* text;
