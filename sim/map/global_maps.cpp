@@ -101,7 +101,7 @@ bool build_global_map(const std::string& dataset, double resolution, RosMap* out
     std::vector<std::size_t> idx;
     std::vector<fw::Se2d> robot;
     std::string report;
-    if (!relation_graph_trajectory(dataset, &idx, &robot, &report, error)) return false;
+    if (!relation_graph_trajectory(dataset, log, &idx, &robot, &report, error)) return false;
     if (report_out != nullptr) *report_out = report;
     for (std::size_t k = 0; k < idx.size(); ++k) {
       const CarmenScan& s = log.scans[idx[k]];
@@ -140,11 +140,19 @@ bool build_global_map(const std::string& dataset, double resolution, RosMap* out
 bool relation_graph_trajectory(const std::string& dataset, std::vector<std::size_t>* scan_indices,
                                std::vector<fw::Se2d>* robot_poses, std::string* report, std::string* error) {
   const Dataset* d = find_dataset(dataset);
+  if (d == nullptr || d->raw_log.empty()) return fail(error, "dataset '" + dataset + "': no raw log");
+  CarmenLog log;
+  if (!read_carmen_log(data_path(d->raw_log), CarmenReadOptions{}, &log, error)) return false;
+  return relation_graph_trajectory(dataset, log, scan_indices, robot_poses, report, error);
+}
+
+bool relation_graph_trajectory(const std::string& dataset, const CarmenLog& log,
+                               std::vector<std::size_t>* scan_indices, std::vector<fw::Se2d>* robot_poses,
+                               std::string* report, std::string* error) {
+  const Dataset* d = find_dataset(dataset);
   if (d == nullptr || d->relations.empty() || d->raw_log.empty() || !d->relations_match_log) {
     return fail(error, "dataset '" + dataset + "': no relations that match its raw log");
   }
-  CarmenLog log;
-  if (!read_carmen_log(data_path(d->raw_log), CarmenReadOptions{}, &log, error)) return false;
   std::vector<Relation> rel;
   if (!read_relations(data_path(d->relations), &rel, error)) return false;
   // Scan lookup by ipc timestamp (the relation files print the log's 6-decimal timestamps).

@@ -49,6 +49,11 @@ bool ensure_global_map(const std::string& dataset, double resolution, const std:
 // Note: evaluating an estimate against the same relations on THIS trajectory is circular.
 bool relation_graph_trajectory(const std::string& dataset, std::vector<std::size_t>* scan_indices,
                                std::vector<fw::Se2d>* robot_poses, std::string* report, std::string* error);
+// Same, with the dataset's raw log already read (avoids reading it again).
+struct CarmenLog;
+bool relation_graph_trajectory(const std::string& dataset, const CarmenLog& raw_log,
+                               std::vector<std::size_t>* scan_indices, std::vector<fw::Se2d>* robot_poses,
+                               std::string* report, std::string* error);
 
 // Writes a PNG of a ROS map's image (grey levels as in the PGM).
 bool write_map_png(const std::string& path, const RosMap& map, std::string* error);
