@@ -175,7 +175,10 @@ bool write_pictures(const SimConfig& cfg, const SimResult& r, const World* world
     }
   }
   Polyline truth{{}, {0, 160, 60}, 3.0, "ground truth"};
-  Polyline est{{}, {20, 90, 230}, 1.5, "estimate"};
+  // The estimate is drawn as a line only while localized (a global localizer's best guess jumps
+  // around while it searches: those steps are dots coloured by status).
+  Polyline est{{}, {20, 90, 230}, 2.0, "estimate while localized"};
+  std::vector<Polyline> est_runs;
   PointSet by_status[5];
   const char* names[5] = {"searching", "ambiguous", "localized", "outside-map", "fault"};
   for (int i = 0; i < 5; ++i) {
@@ -191,13 +194,22 @@ bool write_pictures(const SimConfig& cfg, const SimResult& r, const World* world
       truth.points.clear();
     }
     if (st.has_truth) truth.points.push_back({st.truth.x, st.truth.y});
-    est.points.push_back({st.estimate.x, st.estimate.y});
+    if (st.estimate.status == hal::LocalizationStatus::kLocalized && !st.kidnapped) {
+      est.points.push_back({st.estimate.x, st.estimate.y});
+    } else if (!est.points.empty()) {
+      est_runs.push_back(est);
+      est.points.clear();
+    }
     const int k = static_cast<int>(st.estimate.status);
     if (k >= 0 && k < 5) by_status[k].points.push_back({st.estimate.x, st.estimate.y});
   }
   for (const auto& l : truth_before) pic.lines.push_back(l);
   pic.lines.push_back(truth);
-  pic.lines.push_back(est);
+  if (!est.points.empty()) est_runs.push_back(est);
+  for (size_t i = 0; i < est_runs.size(); ++i) {
+    if (i > 0) est_runs[i].label.clear();
+    pic.lines.push_back(est_runs[i]);
+  }
   for (auto& ps : by_status) {
     if (!ps.points.empty()) pic.point_sets.push_back(ps);
   }

@@ -281,14 +281,6 @@ bool write_svg(const Picture& pic, const std::string& path, std::string* err) {
       << "\" height=\"" << (b.y1 - b.y0) * L.ppm << "\" fill=\"" << hex(b.color) << "\" fill-opacity=\"0.18\" stroke=\""
       << hex(b.color) << "\" stroke-width=\"2\" stroke-dasharray=\"6 4\"/>\n";
   }
-  for (const auto& ps : pic.point_sets) {
-    s << "<g fill=\"" << hex(ps.color) << "\" fill-opacity=\"0.8\">\n";
-    for (const auto& p : ps.points) {
-      if (!std::isfinite(p.x) || !std::isfinite(p.y)) continue;
-      s << "<circle cx=\"" << L.px(p.x) << "\" cy=\"" << L.py(p.y) << "\" r=\"" << ps.radius_px << "\"/>\n";
-    }
-    s << "</g>\n";
-  }
   for (const auto& l : pic.lines) {
     s << "<polyline fill=\"none\" stroke=\"" << hex(l.color) << "\" stroke-width=\"" << l.width_px
       << "\" stroke-linejoin=\"round\" stroke-opacity=\"0.85\" points=\"";
@@ -297,6 +289,14 @@ bool write_svg(const Picture& pic, const std::string& path, std::string* err) {
       s << L.px(p.x) << ',' << L.py(p.y) << ' ';
     }
     s << "\"/>\n";
+  }
+  for (const auto& ps : pic.point_sets) {
+    s << "<g fill=\"" << hex(ps.color) << "\" fill-opacity=\"0.8\">\n";
+    for (const auto& p : ps.points) {
+      if (!std::isfinite(p.x) || !std::isfinite(p.y)) continue;
+      s << "<circle cx=\"" << L.px(p.x) << "\" cy=\"" << L.py(p.y) << "\" r=\"" << ps.radius_px << "\"/>\n";
+    }
+    s << "</g>\n";
   }
   for (const auto& m : pic.markers) {
     const double cx = L.px(m.x), cy = L.py(m.y);
@@ -381,17 +381,17 @@ bool write_png(const Picture& pic, const std::string& path, std::string* err) {
                 static_cast<int>(L.py(b.y0)), b.color, 0.15);
     c.rect_outline(L.px(b.x0), L.py(b.y1), L.px(b.x1), L.py(b.y0), b.color);
   }
-  for (const auto& ps : pic.point_sets) {
-    for (const auto& p : ps.points) {
-      if (std::isfinite(p.x) && std::isfinite(p.y)) c.disc(L.px(p.x), L.py(p.y), ps.radius_px, ps.color);
-    }
-  }
   for (const auto& l : pic.lines) {
     for (size_t i = 1; i < l.points.size(); ++i) {
       const auto& a = l.points[i - 1];
       const auto& b = l.points[i];
       if (!std::isfinite(a.x) || !std::isfinite(a.y) || !std::isfinite(b.x) || !std::isfinite(b.y)) continue;
       c.line(L.px(a.x), L.py(a.y), L.px(b.x), L.py(b.y), l.width_px, l.color);
+    }
+  }
+  for (const auto& ps : pic.point_sets) {
+    for (const auto& p : ps.points) {
+      if (std::isfinite(p.x) && std::isfinite(p.y)) c.disc(L.px(p.x), L.py(p.y), ps.radius_px, ps.color);
     }
   }
   for (const auto& m : pic.markers) {
