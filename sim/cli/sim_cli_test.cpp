@@ -2,6 +2,7 @@
 
 #include <unistd.h>
 
+#include <algorithm>
 #include <chrono>
 #include <cmath>
 #include <cstdlib>
@@ -231,7 +232,10 @@ TEST(LocalizerFactory, RegisteredLocalizerAndHypothesisHook) {
   ASSERT_TRUE(run_simulation(cfg, &r, &err)) << err;
   ASSERT_EQ(r.last_hypotheses.size(), 3u);
   EXPECT_DOUBLE_EQ(r.last_hypotheses[0].weight, 1.0 / 11);
-  EXPECT_NE(read_all(d + "/run.svg").find("hypotheses (last step)"), std::string::npos);
+  EXPECT_EQ(r.last_hypotheses_step, 9);
+  EXPECT_NE(read_all(d + "/run.svg").find("hypotheses (step 9)"), std::string::npos);
+  const std::string hyps = read_all(d + "/hypotheses.csv");
+  EXPECT_EQ(std::count(hyps.begin(), hyps.end(), '\n'), 1 + 10 * 3);  // header + 3 per step
   std::filesystem::remove_all(d);
 }
 

@@ -214,7 +214,7 @@ bool write_pictures(const SimConfig& cfg, const SimResult& r, const World* world
     if (!ps.points.empty()) pic.point_sets.push_back(ps);
   }
   if (!r.last_hypotheses.empty()) {
-    PointSet h{{}, {230, 30, 30}, 3.0, "hypotheses (last step)"};
+    PointSet h{{}, {230, 30, 30}, 3.0, "hypotheses (step " + std::to_string(r.last_hypotheses_step) + ")"};
     for (const auto& p : r.last_hypotheses) h.points.push_back({p.x, p.y});
     pic.point_sets.push_back(h);
   }
@@ -500,6 +500,18 @@ bool run_simulation(const SimConfig& cfg_in, SimResult* out, std::string* err) {
   hal::LocalizationStatus last_status = hal::LocalizationStatus::kSearching;
   std::uint64_t ring_drops = 0;
 
+  // hypotheses.csv: every hypothesis of every step, when the localizer exposes them.
+  std::vector<HypothesisPoint> step_hyps;
+  std::FILE* hyp_csv = nullptr;
+  if (hooks.hypotheses && !cfg.out_dir.empty()) {
+    const std::string path = cfg.out_dir + "/hypotheses.csv";
+    hyp_csv = std::fopen(path.c_str(), "w");
+    if (hyp_csv == nullptr) {
+      *err = "cannot write '" + path + "'";
+      return false;
+    }
+    std::fprintf(hyp_csv, "step,x,y,theta,weight\n");
+  }
   auto drain = [&]() {
     hal::PoseEstimate e;
     while (sink->pop(&e)) {
@@ -537,8 +549,17 @@ bool run_simulation(const SimConfig& cfg_in, SimResult* out, std::string* err) {
       last_status = e.status;
       out->steps.push_back(r);
       if (hooks.hypotheses) {
-        out->last_hypotheses.clear();
-        hooks.hypotheses(&out->last_hypotheses);
+        step_hyps.clear();
+        hooks.hypotheses(&step_hyps);
+        if (!step_hyps.empty()) {
+          out->last_hypotheses = step_hyps;
+          out->last_hypotheses_step = r.step;
+          if (hyp_csv != nullptr) {
+            for (const HypothesisPoint& h : step_hyps) {
+              std::fprintf(hyp_csv, "%u,%.4f,%.4f,%.5f,%.5f\n", r.step, h.x, h.y, h.theta, h.weight);
+            }
+          }
+        }
       }
     }
   };
@@ -595,6 +616,10 @@ bool run_simulation(const SimConfig& cfg_in, SimResult* out, std::string* err) {
     clock->advance_ns(lo.odom_wait_ns + 1);
     tasks->run_once();
     drain();
+  }
+  if (hyp_csv != nullptr && std::fclose(hyp_csv) != 0) {
+    *err = "error writing '" + cfg.out_dir + "/hypotheses.csv'";
+    return false;
   }
   if (cfg.progress && tty) std::fprintf(stderr, "\n");
   const double wall_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - wall_start).count();

@@ -77,7 +77,9 @@ struct SimSummary {
 struct SimResult {
   std::vector<StepRecord> steps;
   SimSummary summary;
+  // Hypotheses of the last step that had any (from LocalizerHooks::hypotheses) and its step.
   std::vector<HypothesisPoint> last_hypotheses;
+  long last_hypotheses_step = -1;
 };
 
 // Runs the whole simulation; false with *err naming the bad input (world, log, map, localizer).
