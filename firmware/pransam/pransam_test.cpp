@@ -410,6 +410,8 @@ TEST(Matcher3DTest, RecoversKnownTransformBetweenOverlappingTexturedClouds) {
   // The room is nearly symmetric under a 180° turn, and a wrong pose reaches Ω ≈ 0.52 while the
   // true overlap is about 0.6: run the full I_max and keep the best (the "after I_max" stop).
   p.omega_thres = 0.99f;
+  p.refine_iterations = 10;  // polish hypotheses with Ω ≥ 0.45 on the voxel distance field
+  p.refine_min_quality = 0.45f;
   MatchResult<3> res;
   const Status s = m.match(a.data(), a.size(), p, &res);
   ASSERT_TRUE(s.is_ok()) << s.message();

@@ -133,7 +133,7 @@ int main(int argc, char** argv) {
   p.refine_min_quality = std::stof(get(a, "refine-min", "0.6"));
   p.scene_origin_is_sensor = a.count("free-space") != 0;
   p.free_space_margin = std::stof(get(a, "free-margin", "0.3"));
-  p.first_batch = static_cast<std::uint32_t>(std::stoul(get(a, "first-batch", "64")));
+  p.first_batch = static_cast<std::uint32_t>(std::stoul(get(a, "first-batch", "256")));
   p.max_blocked_fraction = std::stof(get(a, "max-blocked", "0.1"));
   const ScanMapRun r = run_scan_map(c, m, p, Criterion(), a.count("verbose") != 0);
   std::printf("%s %s T=%s threads=%s %s: correct %zu wrong %zu nothing %zu of %zu (%.1f %%; %zu returned below "
