@@ -12,6 +12,20 @@ void CanNode::init(hal::CanBus* bus, const hal::Clock* clock, bool fd) {
   start_ns_ = clock_ ? clock_->now_ns() : 0;
 }
 
+std::uint64_t CanNode::map_time(std::uint64_t sender_ns, std::uint64_t rx_ns, bool relax) {
+  if (rx_ns == 0) return sender_ns;  // no receive time (tests without a clock): keep the sender's
+  const std::int64_t sample = static_cast<std::int64_t>(rx_ns) - static_cast<std::int64_t>(sender_ns);
+  constexpr std::int64_t kJump = 10'000'000'000;
+  if (!have_offset_ || sample < offset_ns_ || sample - offset_ns_ > kJump) {
+    offset_ns_ = sample;
+    have_offset_ = true;
+  } else if (relax) {
+    offset_ns_ += (sample - offset_ns_) / 1024;  // slow upward relaxation (clock drift)
+  }
+  const std::int64_t local = static_cast<std::int64_t>(sender_ns) + offset_ns_;
+  return local > 0 ? static_cast<std::uint64_t>(local) : 0;
+}
+
 int CanNode::pump() {
   if (!bus_) return 0;
   int n = 0;
@@ -19,13 +33,19 @@ int CanNode::pump() {
   while (n < kMaxFramesPerPump && bus_->receive(&f)) {
     ++n;
     switch (decoder_.feed(f)) {
-      case Decoded::kScan:
+      case Decoded::kScan: {
         // Keep the newest scans: a late localizer should see the present, not the past.
         if (scans_.push_overwrite(decoder_.scan())) ++scans_overflowed_;
+        hal::LaserScan& s = scans_[scans_.size() - 1];
+        s.timestamp_ns = map_time(s.timestamp_ns, f.timestamp_ns, false);  // includes the scan's own duration
         break;
-      case Decoded::kOdometry:
-        if (odoms_.push_overwrite(decoder_.odometry())) ++odom_overflowed_;
+      }
+      case Decoded::kOdometry: {
+        hal::Odometry o = decoder_.odometry();
+        o.timestamp_ns = map_time(o.timestamp_ns, f.timestamp_ns, true);
+        if (odoms_.push_overwrite(o)) ++odom_overflowed_;
         break;
+      }
       default:
         break;
     }
@@ -51,7 +71,13 @@ void CanNode::send_frames(const hal::CanFrame* frames, std::size_t n) {
 
 void CanNode::Sink::publish(const hal::PoseEstimate& estimate) {
   std::size_t n = 0;
-  if (encode_pose(estimate, node_->pose_tag_++, node_->fd_, node_->tx_, kMaxParts, &n).is_ok()) {
+  // Back to the sender's clock, so the robot can relate the pose to its own sensor data.
+  hal::PoseEstimate e = estimate;
+  if (node_->have_offset_) {
+    const std::int64_t t = static_cast<std::int64_t>(e.timestamp_ns) - node_->offset_ns_;
+    e.timestamp_ns = t > 0 ? static_cast<std::uint64_t>(t) : 0;
+  }
+  if (encode_pose(e, node_->pose_tag_++, node_->fd_, node_->tx_, kMaxParts, &n).is_ok()) {
     node_->send_frames(node_->tx_, n);
     ++node_->poses_sent_;
   }

@@ -341,5 +341,44 @@ TEST(CanNode, DeliversScansAndOdometryAndEncodesPoses) {
   EXPECT_EQ(d.health().deadline_misses, 2);
 }
 
+TEST(CanNode, MapsSenderTimeToTheLocalClock) {
+  static LoopbackBus bus;
+  static CanNode node;
+  node.init(&bus, nullptr, false);
+  hal::CanFrame f[kMaxParts];
+  std::size_t n = 0;
+  // Sender clock at 1 s, received at local 100 s (+2 ms latency), then one with 5 ms latency.
+  for (int k = 0; k < 2; ++k) {
+    hal::Odometry o;
+    o.timestamp_ns = 1'000'000'000ull + k * 100'000'000ull;
+    ASSERT_TRUE(encode_odometry(o, static_cast<std::uint8_t>(k), false, f, kMaxParts, &n).is_ok());
+    for (std::size_t i = 0; i < n; ++i) {
+      f[i].timestamp_ns = 100'002'000'000ull + k * 100'000'000ull + (k ? 3'000'000ull : 0);
+      bus.rx.push_back(f[i]);
+    }
+  }
+  hal::LaserScan sent = make_scan(3, 180);
+  sent.timestamp_ns = 1'200'000'000ull;  // same sender clock; END received 15 ms later
+  auto scan_frames = encode(sent, false);
+  for (auto& g : scan_frames) g.timestamp_ns = 100'217'000'000ull;
+  for (const auto& g : scan_frames) bus.rx.push_back(g);
+  hal::Odometry a, b;
+  ASSERT_TRUE(node.odometry().poll(&a));
+  ASSERT_TRUE(node.odometry().poll(&b));
+  EXPECT_EQ(a.timestamp_ns, 100'002'000'000ull);  // offset = min delay sample
+  EXPECT_NEAR(static_cast<double>(b.timestamp_ns), 100'102'000'000.0, 5e3);
+  static hal::LaserScan s;
+  ASSERT_TRUE(node.laser().poll(&s));
+  EXPECT_NEAR(static_cast<double>(s.timestamp_ns), 100'202'000'000.0, 1e4);
+  // Poses go back out in the sender's clock.
+  hal::PoseEstimate p;
+  p.timestamp_ns = b.timestamp_ns;
+  bus.tx.clear();
+  node.pose_sink().publish(p);
+  Decoder d;
+  for (const auto& g : bus.tx) d.feed(g);
+  EXPECT_NEAR(static_cast<double>(d.pose().timestamp_ns), 1'100'000'000.0, 1e4);
+}
+
 }  // namespace
 }  // namespace hal_can

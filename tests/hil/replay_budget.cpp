@@ -20,6 +20,7 @@
 #include "hal/hal.h"
 #include "hal_linux/linux_clock.h"
 #include "hal_sim/sim_sensor_io.h"
+#include "hal_sim/stepped_clock.h"
 #include "sim/io/carmen_log.h"
 #include "sim/io/datasets.h"
 #include "sim/io/reference_trajectory.h"
@@ -105,17 +106,20 @@ bool run_replay(const ReplayOptions& o, ReplayResult* r, std::string* error) {
   image.close();
 
   static hal_linux::LinuxClock clock;
+  static hal_sim::SteppedClock stepped;  // lockstep: HAL time = time of the newest scan fed
   static hal_sim::SimLaserSource laser;
   static hal_sim::SimOdometrySource odom;
   static hal_sim::SimPoseSink sink;
   hal::Hal hal;
-  hal.clock = &clock;
+  const bool lockstep = o.rate_hz <= 0;
+  hal.clock = lockstep ? static_cast<hal::Clock*>(&stepped) : static_cast<hal::Clock*>(&clock);
   hal.laser = &laser;
   hal.odometry = &odom;
   hal.pose_sink = &sink;
   static fw::LocalizationLoop loop;
   fw::LocalizationLoopOptions lo;
   lo.step_deadline_ns = static_cast<std::uint64_t>(o.deadline_ms * 1e6);
+  lo.perf_clock = &clock;
   st = loop.init(hal, *loc, lo);
   if (!st) { *error = st.message(); pool.stop(); return false; }
   arena.seal();
@@ -146,6 +150,8 @@ bool run_replay(const ReplayOptions& o, ReplayResult* r, std::string* error) {
   (void)sensor_ns;
   std::vector<double> scan_t;  // log times of the scans fed
   for (size_t i = o.first_scan; i < last; ++i) scan_t.push_back(log.scans[i].ipc_timestamp);
+  // Scan times in the HAL clock domain (hal/msg/laser_scan.h): scan k is due at t0 + k * period.
+  const std::uint64_t t0 = mono_ns() + 10'000'000;
   auto warp = [&](double ipc) -> std::uint64_t {
     auto it = std::upper_bound(scan_t.begin(), scan_t.end(), ipc);
     size_t k = static_cast<size_t>(it - scan_t.begin());
@@ -156,21 +162,20 @@ bool run_replay(const ReplayOptions& o, ReplayResult* r, std::string* error) {
       const double a = scan_t[k - 1], b = scan_t[k];
       t = ((k - 1) + (b > a ? (ipc - a) / (b - a) : 0)) * period;
     }
-    return static_cast<std::uint64_t>(1e9 + t * 1e9);
+    return t0 + static_cast<std::uint64_t>(t * 1e9);
   };
   size_t oi = 0;
   while (oi < log.odom.size() && log.odom[oi].ipc_timestamp < log_t0 - 0.5) ++oi;
-  const std::uint64_t t0 = mono_ns() + 10'000'000;
   size_t k = 0;
   const double to_ms = 1e-6;
   (void)to_ms;
-  const std::uint64_t end_ns = t0 + static_cast<std::uint64_t>((last - o.first_scan) * period * 1e9) + 3'000'000'000ull;
+  const std::uint64_t end_ns = t0 + (lockstep ? 600'000'000'000ull : static_cast<std::uint64_t>((last - o.first_scan) * period * 1e9) + 3'000'000'000ull);
   while (true) {
     const std::uint64_t now = mono_ns();
     // Push everything due.
-    const bool lockstep = o.rate_hz <= 0;
     while (k < scan_t.size() &&
-           (lockstep ? (laser.pending() == 0 && !loop.scan_pending() && r->scans_processed + r->scans_dropped >= k)
+           (lockstep ? (laser.pending() == 0 && !loop.scan_pending() &&
+                         loop.health().scans_processed + loop.health().dropped_scans + r->scans_dropped >= k)
                      : now >= t0 + static_cast<std::uint64_t>(k * period * 1e9))) {
       const double tk = scan_t[k];
       while (oi < log.odom.size() && log.odom[oi].ipc_timestamp <= tk + 0.5 * (k + 1 < scan_t.size() ? scan_t[k + 1] - tk : 0)) {
@@ -183,11 +188,14 @@ bool run_replay(const ReplayOptions& o, ReplayResult* r, std::string* error) {
         odom.push(od);
       }
       hal::LaserScan s = sim::to_laser_scan(log.scans[o.first_scan + k], warp(tk));
+      if (lockstep) stepped.set_ns(warp(k + 1 < scan_t.size() ? scan_t[k + 1] : tk));
       if (!laser.push(s)) ++r->scans_dropped;
       ++r->scans_fed;
       ++k;
     }
     loop.spin_once();
+    // Lockstep: a scan waiting for odometry that will never come must see time pass (timeout).
+    if (lockstep && !loop.stepped() && loop.scan_pending()) stepped.advance_ns(50'000'000);
     hal::PoseEstimate e;
     while (sink.pop(&e)) {
       ++r->scans_processed;

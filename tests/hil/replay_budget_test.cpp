@@ -57,8 +57,8 @@ TEST(ReplayBudget, DISABLED_LockstepAcesNoWrongLocalized) {
   mmlfw_hil::ReplayResult r;
   std::string err;
   ASSERT_TRUE(mmlfw_hil::run_replay(o, &r, &err)) << err;
-  std::printf("lockstep: processed %zu, localized %zu, wrong %zu, mean error while localized %.3f m; wrong at:",
-              r.scans_processed, r.localized, r.wrong_localized, r.mean_err_localized_m);
+  std::printf("lockstep: fed %zu, processed %zu, dropped %zu, localized %zu, wrong %zu, mean error while localized %.3f m; wrong at:",
+              r.scans_fed, r.scans_processed, r.scans_dropped, r.localized, r.wrong_localized, r.mean_err_localized_m);
   for (size_t i : r.wrong_localized_scans) std::printf(" %zu", i);
   std::printf("\n");
   EXPECT_EQ(r.wrong_localized, 0u);

@@ -34,6 +34,8 @@ class CanNode {
   hal::PoseSink& pose_sink() { return sink_; }
 
   const DecoderStats& decoder_stats() const { return decoder_.stats(); }
+  // Current estimate of (local monotonic ns − sender ns), see map_time().
+  std::int64_t clock_offset_ns() const { return offset_ns_; }
   std::uint32_t scans_overflowed() const { return scans_overflowed_; }
   std::uint32_t odometry_overflowed() const { return odom_overflowed_; }
   std::uint32_t tx_failed() const { return tx_failed_; }
@@ -63,6 +65,13 @@ class CanNode {
     CanNode* node_;
   };
   void send_frames(const hal::CanFrame* frames, std::size_t n);
+  // The frames carry the sender's clock; the firmware's messages use the local monotonic clock
+  // (hal/msg/laser_scan.h). One-way synchronisation by minimum delay: offset = min over records
+  // of (kernel receive time − sender time), relaxed slowly upwards by odometry samples (short
+  // records) to follow drift, and reset when the sender's clock jumps (restart) by more than 10 s.
+  std::uint64_t map_time(std::uint64_t sender_ns, std::uint64_t rx_ns, bool relax);
+  bool have_offset_ = false;
+  std::int64_t offset_ns_ = 0;
 
   hal::CanBus* bus_ = nullptr;
   const hal::Clock* clock_ = nullptr;
