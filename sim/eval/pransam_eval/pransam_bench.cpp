@@ -191,7 +191,7 @@ int main(int argc, char** argv) {
   }
   // ---------------------------------------------------------------- 3-D
   {
-    const ThreeDRun r = run_3d(10, 2, 200000, &err, 10, 0.45f);  // best after I_max, hypotheses Ω ≥ 0.45 refined
+    const ThreeDRun r = run_3d(20, 2, 200000, &err, 10, 0.45f);  // best after I_max, hypotheses Ω ≥ 0.45 refined
     if (r.trials == 0) return fail(err);
     std::printf("3d: success %zu/%zu p50 %.1f ms\n", r.success, r.trials, r.p50());
     json.add("pransam3d_success", static_cast<double>(r.success) / static_cast<double>(r.trials));
