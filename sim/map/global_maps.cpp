@@ -221,10 +221,10 @@ bool relation_graph_trajectory(const std::string& dataset, const CarmenLog& log,
     char buf[512];
     std::snprintf(buf, sizeof(buf),
                   "%s: pose graph of %zu relation scans, %zu relations (%zu links from odometry); chi2 %.4g -> %.4g in "
-                  "%d GN iterations; relation error of the result: %.4f m / %.3f deg mean (max %.3f m / %.2f deg); "
+                  "%d GN iterations (last solve %d CG iterations); relation error of the result: %.4f m / %.3f deg mean (max %.3f m / %.2f deg); "
                   "raw odometry: %.4f m / %.3f deg",
                   dataset.c_str(), n, edges.size(), odometry_links, pg.initial_chi2, pg.final_chi2, pg.iterations,
-                  m.trans_mean, m.rot_mean_deg, m.trans_max, m.rot_max_deg, mo.trans_mean, mo.rot_mean_deg);
+                  pg.cg_iterations_last, m.trans_mean, m.rot_mean_deg, m.trans_max, m.rot_max_deg, mo.trans_mean, mo.rot_mean_deg);
     *report = buf;
   }
   *scan_indices = std::move(idx);

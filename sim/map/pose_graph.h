@@ -23,9 +23,9 @@ struct PoseGraphEdge {
 
 struct PoseGraphOptions {
   int max_iterations = 30;
-  double stop_relative_chi2_change = 1e-9;
+  double stop_relative_chi2_change = 1e-6;
   int cg_max_iterations = 20000;
-  double cg_relative_tolerance = 1e-10;
+  double cg_relative_tolerance = 1e-8;
 };
 
 struct PoseGraphResult {
