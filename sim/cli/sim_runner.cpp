@@ -56,8 +56,9 @@ struct FrameInfo {
 // scan's own odometry triple (FLASER/RLASER/ROBOTLASER1) at the scan time.
 bool load_log_frames(const SimConfig& cfg, std::vector<Frame>* frames, std::size_t* restamped, std::string* err) {
   CarmenLog log;
+  // The whole log is read even with --steps: the reference is chained from corrected poses that
+  // may lie beyond the first N scans (aces: the first corrected pose is not at scan 0).
   CarmenReadOptions ro;
-  ro.max_scans = cfg.steps;
   if (!read_carmen_log(cfg.log_path, ro, &log, err)) return false;
   if (log.scans.empty()) {
     *err = "log '" + cfg.log_path + "' contains no laser scans";
@@ -78,7 +79,8 @@ bool load_log_frames(const SimConfig& cfg, std::vector<Frame>* frames, std::size
   size_t next_odom = 0;
   double travelled = 0;
   fw::Se2d prev;
-  for (size_t i = 0; i < log.scans.size(); ++i) {
+  const size_t n_scans = cfg.steps > 0 ? std::min(cfg.steps, log.scans.size()) : log.scans.size();
+  for (size_t i = 0; i < n_scans; ++i) {
     const CarmenScan& s = log.scans[i];
     Frame f;
     f.index = static_cast<std::uint32_t>(i);
