@@ -36,8 +36,7 @@ TEST(ReplayBudget, Aces75HzWithinBudget) {
   std::printf("localized %zu, wrong (> %.1f m) %zu, mean error while localized %.3f m\n", r.localized,
               o.localized_bound_m, r.wrong_localized, r.mean_err_localized_m);
   if (r.wrong_localized) {
-    // Not a budget item; reported for the localizer owners (lockstep replays of the same scans
-    // have none: it appears when scans are skipped because steps overrun the 13.3 ms period).
+    // Not a budget item; reported for the localizer owners (the HIL test asserts it).
     std::printf("NOTE: wrong localized poses at log scans:");
     for (size_t i : r.wrong_localized_scans) std::printf(" %zu", i);
     std::printf("\n");
