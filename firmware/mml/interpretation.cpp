@@ -332,7 +332,7 @@ Status Interpreter::interpret(const InterpretInput& in, InterpretResult* out) {
   h.pose = Se2f(cb.x, cb.y, cb.theta);
   h.cov = cluster_cov(cb);
   out->best_rating = cb.rating;
-  out->c_rating = cb.rating > options_.delta_r;
+  out->c_rating = cb.rating > options_.delta_r && cb.size() >= options_.min_cluster_hypotheses;
 
   // Eq. 5.11–5.14.
   if (can_predict) {

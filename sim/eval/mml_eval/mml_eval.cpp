@@ -278,6 +278,9 @@ const char* status_color(hal::LocalizationStatus s, hal::LocalizationMode m) {
 
 }  // namespace
 
+bool write_error_plot_png(const std::string& path, const std::vector<TrialResult>& trials, double bound_m,
+                          std::string* err);
+
 bool write_error_plot(const std::string& path, const std::string& title, const std::vector<TrialResult>& trials,
                       double bound_m, std::string* err) {
   const double W = 900, H = 420, L = 60, R = 20, T = 40, B = 50;
@@ -323,6 +326,47 @@ bool write_error_plot(const std::string& path, const std::string& title, const s
       << "<text x='" << W - 160 << "' y='" << T + 14 + 16 * k << "'>" << names[k] << "</text>\n";
   }
   o << "</svg>\n";
+  o.close();
+  if (!o) return fail(err, "write failed: " + path);
+  // A raster twin (x: metres 0..max, y: error 0..5 m; same colours) for quick viewing.
+  std::string png = path;
+  if (png.size() > 4 && png.compare(png.size() - 4, 4, ".svg") == 0) png.replace(png.size() - 4, 4, ".png");
+  return png == path || write_error_plot_png(png, trials, bound_m, err);
+}
+
+bool write_error_plot_png(const std::string& path, const std::vector<TrialResult>& trials, double bound_m,
+                          std::string* err) {
+  const int W = 900, H = 420, L = 60, R = 20, T = 40, B = 50;
+  std::vector<std::uint8_t> rgb(static_cast<std::size_t>(W) * H * 3, 255);
+  double xmax = 1;
+  for (const auto& t : trials)
+    for (const auto& s : t.steps) xmax = std::max(xmax, s.travelled);
+  auto X = [&](double x) { return static_cast<int>(L + (W - L - R) * x / xmax); };
+  auto Y = [&](double y) { return static_cast<int>(H - B - (H - T - B) * std::min(y, 5.0) / 5.0); };
+  auto put = [&](int x, int y, Rgb c) {
+    if (x < 0 || y < 0 || x >= W || y >= H) return;
+    std::uint8_t* p = &rgb[(static_cast<std::size_t>(y) * W + x) * 3];
+    p[0] = c.r; p[1] = c.g; p[2] = c.b;
+  };
+  for (int k = 0; k <= 5; ++k)
+    for (int x = L; x < W - R; ++x) put(x, Y(k), k == 0 ? Rgb{0, 0, 0} : Rgb{230, 230, 230});
+  for (int y = T; y <= H - B; ++y) put(L, y, {0, 0, 0});
+  for (int x = L; x < W - R; x += 4) put(x, Y(bound_m), {214, 39, 40});
+  for (const auto& t : trials) {
+    for (const auto& s : t.steps) {
+      Rgb c{170, 170, 170};
+      if (s.mode == hal::LocalizationMode::kTracking) c = {31, 119, 180};
+      else if (s.status == hal::LocalizationStatus::kLocalized) c = {44, 160, 44};
+      else if (s.status == hal::LocalizationStatus::kAmbiguous) c = {255, 127, 14};
+      else if (s.status == hal::LocalizationStatus::kOutsideMap) c = {148, 103, 189};
+      for (int dy = -2; dy <= 2; ++dy)
+        for (int dx = -2; dx <= 2; ++dx) put(X(s.travelled) + dx, Y(s.err_m) + dy, c);
+    }
+  }
+  std::vector<std::uint8_t> png;
+  if (!encode_png_rgb(W, H, rgb, &png, err)) return false;
+  std::ofstream o(path, std::ios::binary);
+  o.write(reinterpret_cast<const char*>(png.data()), static_cast<std::streamsize>(png.size()));
   return static_cast<bool>(o) || fail(err, "write failed: " + path);
 }
 

@@ -50,6 +50,7 @@ int main(int argc, char** argv) {
     else if (a == "--mcl-particles") plan.mcl_particles = next(100, 131072);
     else if (a == "--mcl-particles-mit") plan.mcl_particles_mit = next(100, 131072);
     else if (a == "--no-handoff") plan.run_handoff = false;
+    else if (a == "--no-mcl") plan.run_mcl = false;
     else if (a == "--no-unknown") plan.run_unknown = false;
     else if (a == "--out" && i + 1 < argc) plan.out_dir = argv[++i];
     else return usage(("unknown argument '" + a + "'").c_str());

@@ -105,13 +105,14 @@ bool run_evaluation(const EvalPlan& plan, BenchJson* json, std::string* err) {
       runs.push_back(std::move(r));
     }
     // MCL baseline.
-    {
+    if (plan.run_mcl) {
       std::string e;
       const std::uint32_t particles = mit ? plan.mcl_particles_mit : plan.mcl_particles;
       auto loc = OwnedLocalizer::make_mcl(ds.map, mcl_baseline_options(particles, plan.seed), plan.threads, &e);
       if (!loc) return (*err = e, false);
       std::vector<std::size_t> mstarts = starts;
-      if (plan.mcl_trials && plan.mcl_trials < mstarts.size()) mstarts.resize(plan.mcl_trials);
+      const std::size_t mt = (mit && plan.mcl_trials_mit) ? plan.mcl_trials_mit : plan.mcl_trials;
+      if (mt && mt < mstarts.size()) mstarts.resize(mt);
       SystemRun r = run_system(*loc, ds, "mcl-" + std::to_string(particles / 1000) + "k", mstarts, topt, plan.verbose);
       mcl_main = r.summary;
       rows.push_back(r.summary);
@@ -152,9 +153,9 @@ bool run_evaluation(const EvalPlan& plan, BenchJson* json, std::string* err) {
     for (const auto& r : runs) {
       const std::string base = plan.out_dir + "/" + ds.key + "_" + r.label;
       std::string e;
-      if (!write_error_plot(base + "_error.svg", ds.name + " — " + r.label + ": error over metres (kidnapped starts)",
+      if (!write_error_plot(base + "_error.svg", ds.name + " - " + r.label + ": error over metres (kidnapped starts)",
                             r.trials, ds.success_bound_m, &e) ||
-          !write_map_plot(base + "_map.svg", base + "_map.png", ds, ds.name + " — " + r.label, r.trials, nullptr, &e)) {
+          !write_map_plot(base + "_map.svg", base + "_map.png", ds, ds.name + " - " + r.label, r.trials, nullptr, &e)) {
         return (*err = e, false);
       }
     }
@@ -199,9 +200,9 @@ bool run_evaluation(const EvalPlan& plan, BenchJson* json, std::string* err) {
     rows.push_back(rc2.summary);
     for (const SystemRun* r : {&rm, &rc2}) {
       const std::string base = plan.out_dir + "/unknown_" + ds.key + "_" + r->label;
-      if (!write_error_plot(base + "_error.svg", ds.name + " with an erased region — " + r->label, r->trials,
+      if (!write_error_plot(base + "_error.svg", ds.name + " with an erased region - " + r->label, r->trials,
                             ds.success_bound_m, &e) ||
-          !write_map_plot(base + "_map.svg", base + "_map.png", ds, ds.name + " with an erased region — " + r->label,
+          !write_map_plot(base + "_map.svg", base + "_map.png", ds, ds.name + " with an erased region - " + r->label,
                           r->trials, region, &e)) {
         return (*err = e, false);
       }

@@ -22,6 +22,8 @@ struct EvalPlan {
   std::uint32_t mcl_particles = 30000;
   std::uint32_t mcl_particles_mit = 120000;
   std::size_t mcl_trials = 0;     // 0 = same as trials (MCL is the slow one)
+  std::size_t mcl_trials_mit = 0; // 0 = mcl_trials (120k particles on mit-killian are slower still)
+  bool run_mcl = true;
   bool run_handoff = true;
   std::vector<std::string> handoff_datasets = {"intel", "aces"};
   bool run_unknown = true;

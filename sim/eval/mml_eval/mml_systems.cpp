@@ -1,5 +1,6 @@
 #include "sim/eval/mml_eval/mml_systems.h"
 
+#include <algorithm>
 #include <cstdlib>
 
 #include "firmware/map/map_image.h"
@@ -57,6 +58,20 @@ bool OwnedLocalizer::start_pool(int threads, std::string* err) {
 }
 
 namespace {
+// The contact field (pRANSAM's Ω) covers the whole global map: its cell size follows the map's
+// (never finer than 5 cm) and its capacity the map's extent (fr-clinic: 440 × 241 m at 0.10 m).
+fw::mml::MmlLocalizerConfig adapt_to_map(fw::mml::MmlLocalizerConfig cfg, const fw::GlobalMap& map) {
+  const float res = std::max(0.05f, map.geometry.resolution);
+  auto& f = cfg.matcher.field;
+  f.resolution = res;
+  f.eps_hard = 2.0f * res;
+  f.eps_soft = 4.0f * res;
+  const float sx = map.geometry.size_x() / res + 64.0f, sy = map.geometry.size_y() / res + 64.0f;
+  f.max_axis = static_cast<std::uint32_t>(std::max(sx, sy)) + 1;
+  f.max_cells = static_cast<std::size_t>(sx + 1) * static_cast<std::size_t>(sy + 1);
+  return cfg;
+}
+
 const std::uint8_t* table_section(const std::vector<std::uint8_t>& image, std::size_t* len) {
   *len = 0;
   if (image.empty()) return nullptr;
@@ -69,12 +84,12 @@ std::unique_ptr<OwnedLocalizer> OwnedLocalizer::make_mml(const fw::GlobalMap& ma
                                                          std::string* err) {
   auto o = std::unique_ptr<OwnedLocalizer>(new OwnedLocalizer());
   if (!o->start_pool(threads, err)) return nullptr;
-  fw::Status s = o->arena_.init_mapped(160u << 20, false, "mml");
+  fw::Status s = o->arena_.init_mapped(400u << 20, false, "mml");
   if (s.is_ok()) {
     o->mml_ = std::make_unique<fw::mml::MmlLocalizer>();
     std::size_t len = 0;
     const std::uint8_t* sec = table_section(image, &len);
-    s = o->mml_->init(cfg, map, sec, len, o->arena_, o->pool_.get());
+    s = o->mml_->init(adapt_to_map(cfg, map), map, sec, len, o->arena_, o->pool_.get());
   }
   if (!s.is_ok()) {
     *err = std::string("localizer mml: ") + s.message();
@@ -107,12 +122,12 @@ std::unique_ptr<OwnedLocalizer> OwnedLocalizer::make_handoff(const fw::GlobalMap
                                                              std::string* err) {
   auto o = std::unique_ptr<OwnedLocalizer>(new OwnedLocalizer());
   if (!o->start_pool(threads, err)) return nullptr;
-  fw::Status s = o->arena_.init_mapped(160u << 20, false, "handoff");
+  fw::Status s = o->arena_.init_mapped(400u << 20, false, "handoff");
   if (s.is_ok()) {
     o->mml_ = std::make_unique<fw::mml::MmlLocalizer>();
     std::size_t len = 0;
     const std::uint8_t* sec = table_section(image, &len);
-    s = o->mml_->init(cfg, map, sec, len, o->arena_, o->pool_.get());
+    s = o->mml_->init(adapt_to_map(cfg, map), map, sec, len, o->arena_, o->pool_.get());
   }
   if (s.is_ok()) {
     o->mcl_ = std::make_unique<fw::mcl::MclLocalizer>();
