@@ -79,6 +79,11 @@ TEST(GlobalMapsDataTest, FrClinicRelationGraphTrajectory) {
   const Dataset* d = find_dataset("fr-clinic");
   ASSERT_NE(d, nullptr);
   if (!have_data(d->raw_log) || !have_data(d->relations)) GTEST_SKIP() << "data not found: " << data_path(d->raw_log);
+#if !defined(NDEBUG) || defined(__SANITIZE_ADDRESS__) || defined(__SANITIZE_THREAD__)
+  // ~9000 CG iterations of 3x3 Eigen blocks: 4 s optimized, 400 s in a Debug+ASan build (measured;
+  // that run was clean). The optimized builds run it.
+  GTEST_SKIP() << "fr-clinic pose-graph data test runs only in optimized, unsanitized builds (400 s under Debug+ASan)";
+#endif
   std::vector<std::size_t> idx;
   std::vector<fw::Se2d> robot;
   std::string report, err;
