@@ -1,7 +1,7 @@
 // bench_mml: the issue-6 figures within ~20 minutes on a 2-core machine (scripts/bench.sh mml).
-// Budget: 5 kidnapped starts per dataset for MML, 3 for MCL (the slow one; 1 at mit-killian with
-// 120k particles), ≤ 120 steps per trial (mit-killian: ≤ 250), hand-off on intel and aces, unknown
-// area on intel (3 runs).
+// Budget (≈ 12 min measured): 10 kidnapped starts per dataset for MML and the hand-off, the first 3
+// of them for MCL (the slow one; 1 at mit-killian with 120k particles), ≤ 200 steps per trial
+// (mit-killian: ≤ 250), hand-off on intel and aces, unknown area on intel (3 runs).
 // The full evaluation (≥ 10 trials, all configurations) is `mml-eval --trials 10 --all-configs`.
 #include <cstdio>
 #include <string>
@@ -14,10 +14,10 @@ int main(int argc, char** argv) {
     return 2;
   }
   sim::mmleval::EvalPlan plan;
-  plan.trials = 5;
+  plan.trials = 10;
   plan.mcl_trials = 3;
   plan.mcl_trials_mit = 1;
-  plan.trial.max_steps = 120;
+  plan.trial.max_steps = 200;
   plan.trial_mit = plan.trial;
   plan.trial_mit.max_steps = 250;
   plan.unknown_trials = 3;
