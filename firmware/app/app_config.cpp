@@ -102,6 +102,9 @@ Status parse_app_config(const char* name, const char* text, std::size_t len, App
       if (std::strcmp(v, "odom") && std::strcmp(v, "mml"))
         return CFG_ERR("'%s' unknown (odom, mml)", v);
       copy(out->localizer, sizeof(out->localizer), v);
+    } else if (!std::strcmp(key, "mml_preset")) {
+      if (!parse_int(v, 1, 4, &x)) return CFG_ERR("'%s' is not a configuration 1..4 (Tables 5.1-5.4)", v);
+      out->mml_preset = static_cast<int>(x);
     } else if (!std::strcmp(key, "map")) {
       if (!copy(out->map, sizeof(out->map), v)) return CFG_ERR("path longer than %zu characters", sizeof(out->map) - 1);
     } else if (!std::strcmp(key, "workers")) {

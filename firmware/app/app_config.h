@@ -5,6 +5,7 @@
 //   output           socketcan:IFACE | log               [laser's interface when socketcan, else log]
 //   can_fd           auto | true | false                 [auto: FD when the interface MTU is 72]
 //   localizer        odom | mml                          [odom]
+//   mml_preset       1..4 MML configuration C1..C4 (firmware/mml/mml_presets.h)  [3]
 //   map              path of the compiled map image (mml-mapc / mml-mapbuild)   (required for mml)
 //   workers          1..16 worker threads, created once  [2]
 //   cores            comma list of CPU ids for worker i  [0,1,...]; pinned to (core mod online CPUs)
@@ -30,6 +31,7 @@ struct AppConfig {
   char output[128] = {0};
   int can_fd = -1;           // -1 auto, 0 classic, 1 FD required
   char localizer[16] = "odom";
+  int mml_preset = 3;
   char map[256] = {0};
   int workers = 2;
   int cores[kMaxCores] = {0};

@@ -15,7 +15,7 @@ TEST(AppConfig, ParsesAllKeys) {
   Status s = parse(
       "# robot\nlaser = socketcan:vcan0\nodometry=socketcan:vcan0\noutput = socketcan:vcan0  # same bus\n"
       "can_fd = true\nlocalizer = mml\nmap = /tmp/aces.mmap\nworkers = 3\ncores = 0, 1 ,2\nrealtime = false\n"
-      "arena_mib = 64\nstep_deadline_ms = 13.3\nhealth_period_ms = 100\nseed = 7\nlog_level = warning\n",
+      "arena_mib = 64\nstep_deadline_ms = 13.3\nhealth_period_ms = 100\nseed = 7\nlog_level = warning\nmml_preset = 2\n",
       &c);
   ASSERT_TRUE(s.is_ok()) << s.message();
   EXPECT_STREQ(c.laser, "socketcan:vcan0");
@@ -28,6 +28,7 @@ TEST(AppConfig, ParsesAllKeys) {
   EXPECT_NEAR(c.step_deadline_ms, 13.3, 1e-9);
   EXPECT_EQ(c.seed, 7u);
   EXPECT_EQ(c.log_level, 2);
+  EXPECT_EQ(c.mml_preset, 2);
 }
 
 TEST(AppConfig, ErrorsNameTheKey) {
@@ -42,6 +43,7 @@ TEST(AppConfig, ErrorsNameTheKey) {
       {"laser = socketcan:vcan0\ncan_fd = maybe\n", "key 'can_fd'"},
       {"laser = socketcan:vcan0\nlocalizer = magic\n", "key 'localizer'"},
       {"laser = socketcan:vcan0\nlocalizer = mml\n", "key 'map' is required"},
+      {"laser = socketcan:vcan0\nmml_preset = 5\n", "line 2: key 'mml_preset'"},
       {"laser = socketcan:vcan0\nfrobnicate = 1\n", "unknown key 'frobnicate'"},
       {"laser = socketcan:vcan0\nstep_deadline_ms = nan\n", "key 'step_deadline_ms'"},
       {"laser = socketcan:vcan0\ncores = 0,x\n", "key 'cores'"},

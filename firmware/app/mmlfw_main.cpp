@@ -20,6 +20,7 @@
 #include "firmware/map/map_image.h"
 #include "firmware/map/map_image_file.h"
 #include "firmware/mml/mml_localizer.h"
+#include "firmware/mml/mml_presets.h"
 #include "firmware/runtime/localization_loop.h"
 #include "firmware/runtime/odometry_localizer.h"
 #include "hal_linux/board.h"
@@ -126,9 +127,12 @@ int main(int argc, char** argv) {
 
   fw::Localizer* localizer = nullptr;
   if (!std::strcmp(c.localizer, "mml")) {
-    fw::mml::MmlLocalizerConfig mc = fw::mml::default_mml_config();
-    mc.mml.seed = c.seed;
-    if (!table) mc.mml.precomputed_table = false;
+    // The configuration measured by mml-sim / mml-eval / bench_mml, fitted to this map.
+    fw::mml::MmlLocalizerConfig mc = fw::mml::fit_contact_field_to_map(fw::mml::mml_preset(c.mml_preset, c.seed), map);
+    // Without a relation table section in the image the localizer fills R_B once here, at start-up
+    // (Sec. 5.5.2; ~1-3 s); filling it online per step (configuration C1) rarely localizes.
+    if (!table && mc.mml.precomputed_table)
+      hal.log->log(hal::LogLevel::kInfo, "mmlfw: map image has no relation table; filling it at start-up");
     st = g_mml.init(mc, map, table, table_len, g_arena, &g_pool);
     if (!st) return fail("localizer mml", st);
     localizer = &g_mml;

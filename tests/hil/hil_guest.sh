@@ -24,7 +24,14 @@ while read -r name iface config replay; do
   cpid=$!
   "$B/firmware/app/mmlfw" --config "$config" > "$d/mmlfw.out" 2> "$d/mmlfw.log" &
   fpid=$!
-  for i in $(seq 1 100); do grep -q "mmlfw: running" "$d/mmlfw.log" 2>/dev/null && break; kill -0 $fpid 2>/dev/null || break; sleep 0.1; done
+  # Start-up includes loading the map image (and filling the relation table when the image has none).
+  for i in $(seq 1 600); do grep -q "mmlfw: running" "$d/mmlfw.log" 2>/dev/null && break; kill -0 $fpid 2>/dev/null || break; sleep 0.1; done
+  echo "hil-guest: $name: mmlfw start-up took $((i / 10)).$((i % 10)) s"
+  if ! grep -q "mmlfw: running" "$d/mmlfw.log" 2>/dev/null; then
+    echo "hil-guest: $name: mmlfw not running after 60 s:"; cat "$d/mmlfw.log"; rc=1
+    kill $fpid $cpid 2>/dev/null; wait $fpid $cpid 2>/dev/null
+    continue
+  fi
   if ! kill -0 $fpid 2>/dev/null; then
     echo "hil-guest: $name: mmlfw exited at start-up:"; cat "$d/mmlfw.log"; rc=1
     kill $cpid 2>/dev/null; wait $cpid 2>/dev/null

@@ -5,21 +5,12 @@
 
 #include "firmware/map/map_image.h"
 #include "firmware/mcl/global_map_view.h"
+#include "firmware/mml/mml_presets.h"
 #include "sim/cli/localizer_factory.h"  // HypothesisPoint (header only)
 
 namespace sim::mmleval {
 
-fw::mml::MmlLocalizerConfig mml_config(int config, std::uint64_t seed) {
-  fw::mml::MmlLocalizerConfig c = fw::mml::default_mml_config();
-  c.mml.seed = seed;
-  c.rbsm.seed = seed;
-  c.mml.bollinger = true;
-  c.mml.matching_iterations = 30000;
-  c.mml.precomputed_table = config != 1;
-  c.local_map.keep_last = (config == 3 || config == 4) ? 8 : 0;
-  if (config == 4) c.mml.matching_iterations = 60000;
-  return c;
-}
+fw::mml::MmlLocalizerConfig mml_config(int config, std::uint64_t seed) { return fw::mml::mml_preset(config, seed); }
 
 fw::mcl::MclOptions mcl_baseline_options(std::uint32_t particles, std::uint64_t seed) {
   fw::mcl::MclOptions o;
@@ -58,18 +49,8 @@ bool OwnedLocalizer::start_pool(int threads, std::string* err) {
 }
 
 namespace {
-// The contact field (pRANSAM's Ω) covers the whole global map: its cell size follows the map's
-// (never finer than 5 cm) and its capacity the map's extent (fr-clinic: 440 × 241 m at 0.10 m).
-fw::mml::MmlLocalizerConfig adapt_to_map(fw::mml::MmlLocalizerConfig cfg, const fw::GlobalMap& map) {
-  const float res = std::max(0.05f, map.geometry.resolution);
-  auto& f = cfg.matcher.field;
-  f.resolution = res;
-  f.eps_hard = 2.0f * res;
-  f.eps_soft = 4.0f * res;
-  const float sx = map.geometry.size_x() / res + 64.0f, sy = map.geometry.size_y() / res + 64.0f;
-  f.max_axis = static_cast<std::uint32_t>(std::max(sx, sy)) + 1;
-  f.max_cells = static_cast<std::size_t>(sx + 1) * static_cast<std::size_t>(sy + 1);
-  return cfg;
+fw::mml::MmlLocalizerConfig adapt_to_map(const fw::mml::MmlLocalizerConfig& cfg, const fw::GlobalMap& map) {
+  return fw::mml::fit_contact_field_to_map(cfg, map);
 }
 
 const std::uint8_t* table_section(const std::vector<std::uint8_t>& image, std::size_t* len) {

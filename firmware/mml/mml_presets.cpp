@@ -1,0 +1,33 @@
+#include "firmware/mml/mml_presets.h"
+
+#include <algorithm>
+
+namespace fw {
+namespace mml {
+
+MmlLocalizerConfig mml_preset(int preset, std::uint64_t seed) {
+  if (preset < 1 || preset > 4) preset = kDefaultMmlPreset;
+  MmlLocalizerConfig c = default_mml_config();
+  c.mml.seed = seed;
+  c.rbsm.seed = seed;
+  c.mml.bollinger = true;
+  c.mml.matching_iterations = preset == 4 ? 60000 : 30000;
+  c.mml.precomputed_table = preset != 1;
+  c.local_map.keep_last = preset >= 3 ? 8 : 0;
+  return c;
+}
+
+MmlLocalizerConfig fit_contact_field_to_map(MmlLocalizerConfig config, const GlobalMap& map) {
+  const float res = std::max(0.05f, map.geometry.resolution);
+  auto& f = config.matcher.field;
+  f.resolution = res;
+  f.eps_hard = 2.0f * res;
+  f.eps_soft = 4.0f * res;
+  const float sx = map.geometry.size_x() / res + 64.0f, sy = map.geometry.size_y() / res + 64.0f;
+  f.max_axis = static_cast<std::uint32_t>(std::max(sx, sy)) + 1;
+  f.max_cells = static_cast<std::size_t>(sx + 1) * static_cast<std::size_t>(sy + 1);
+  return config;
+}
+
+}  // namespace mml
+}  // namespace fw
