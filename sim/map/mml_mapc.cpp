@@ -1,7 +1,12 @@
 // mml-mapc: compile a ROS map (PGM+YAML) into the firmware's map image, or inspect an image.
-//   mml-mapc MAP.yaml OUT.mmap      compile (and verify by loading it with the firmware loader)
+//   mml-mapc [--relation-table [--seed N] [--preset C]] MAP.yaml OUT.mmap
+//                                   compile (and verify by loading it with the firmware loader);
+//                                   --relation-table appends pRANSAM's precomputed global table
+//                                   (Sec. 5.5.2) for mmlfw's `seed`/`mml_preset`, so the robot
+//                                   skips filling it at start-up
 //   mml-mapc --info IMAGE.mmap      validate with the firmware loader and print the section table
 #include <cstdio>
+#include <cstdlib>
 #include <cstring>
 #include <string>
 #include <vector>
@@ -9,12 +14,13 @@
 #include "firmware/base/arena.h"
 #include "firmware/map/map_image.h"
 #include "sim/map/map_image_writer.h"
+#include "sim/map/relation_table_builder.h"
 
 namespace {
 
 int usage() {
   std::fprintf(stderr,
-               "usage: mml-mapc MAP.yaml OUT.mmap\n"
+               "usage: mml-mapc [--relation-table [--seed N] [--preset 1..4]] MAP.yaml OUT.mmap\n"
                "       mml-mapc --info IMAGE.mmap\n");
   return 2;
 }
@@ -51,10 +57,17 @@ int check_and_print(const std::string& path, const std::vector<std::uint8_t>& by
 
 }  // namespace
 
+bool parse_u64(const char* text, std::uint64_t lo, std::uint64_t hi, std::uint64_t* out) {
+  char* end = nullptr;
+  const unsigned long long v = std::strtoull(text, &end, 10);
+  if (end == text || *end != '\0' || text[0] == '-' || v < lo || v > hi) return false;
+  *out = v;
+  return true;
+}
+
 int main(int argc, char** argv) {
-  if (argc != 3) return usage();
   std::string err;
-  if (std::strcmp(argv[1], "--info") == 0) {
+  if (argc == 3 && std::strcmp(argv[1], "--info") == 0) {
     std::vector<std::uint8_t> bytes;
     if (!sim::read_file_bytes(argv[2], &bytes, &err)) {
       std::fprintf(stderr, "mml-mapc: %s\n", err.c_str());
@@ -62,15 +75,55 @@ int main(int argc, char** argv) {
     }
     return check_and_print(argv[2], bytes);
   }
+  bool table = false;
+  sim::RelationTableBuild build;
+  std::vector<std::string> files;
+  for (int i = 1; i < argc; ++i) {
+    const std::string a = argv[i];
+    std::uint64_t v = 0;
+    if (a == "--relation-table") {
+      table = true;
+    } else if (a == "--seed" || a == "--preset") {
+      if (i + 1 >= argc) {
+        std::fprintf(stderr, "mml-mapc: %s needs a value\n", a.c_str());
+        return usage();
+      }
+      const bool ok = a == "--seed" ? parse_u64(argv[i + 1], 0, 0x7FFFFFFF, &v) : parse_u64(argv[i + 1], 1, 4, &v);
+      if (!ok) {
+        std::fprintf(stderr, "mml-mapc: %s '%s' is not %s\n", a.c_str(), argv[i + 1],
+                     a == "--seed" ? "a non-negative integer" : "a configuration 1..4");
+        return 2;
+      }
+      if (a == "--seed") build.seed = v; else build.preset = static_cast<int>(v);
+      ++i;
+    } else if (!a.empty() && a[0] == '-') {
+      std::fprintf(stderr, "mml-mapc: unknown option '%s'\n", a.c_str());
+      return usage();
+    } else {
+      files.push_back(a);
+    }
+  }
+  if (files.size() != 2) return usage();
   sim::RosMap map;
-  if (!sim::read_ros_map(argv[1], &map, &err)) {
+  sim::MapImageWriter writer;
+  if (!sim::read_ros_map(files[0], &map, &err) || !writer.set_map(map, &err)) {
     std::fprintf(stderr, "mml-mapc: %s\n", err.c_str());
     return 1;
   }
-  std::vector<std::uint8_t> bytes;
-  if (!sim::compile_map_image(map, &bytes, &err) || !sim::write_file_bytes(argv[2], bytes, &err)) {
+  if (table) {
+    sim::RelationTableBuildReport rep;
+    if (!sim::add_relation_table(&writer, build, files[0], &rep, &err)) {
+      std::fprintf(stderr, "mml-mapc: %s\n", err.c_str());
+      return 1;
+    }
+    std::printf("relation table: %llu triples over %u points (seed %llu, C%d) in %.2f s, %zu bytes\n",
+                static_cast<unsigned long long>(rep.triples), rep.map_points,
+                static_cast<unsigned long long>(build.seed), build.preset, rep.seconds, rep.section_bytes);
+  }
+  const std::vector<std::uint8_t> bytes = writer.bytes();
+  if (!sim::write_file_bytes(files[1], bytes, &err)) {
     std::fprintf(stderr, "mml-mapc: %s\n", err.c_str());
     return 1;
   }
-  return check_and_print(argv[2], bytes);
+  return check_and_print(files[1], bytes);
 }

@@ -52,13 +52,23 @@ if [ -z "$LOC" ]; then
   fi
 fi
 say "localizer $LOC (map $MAP)"
+# The FD scenario runs on an image with the precomputed relation table (mml-mapc --relation-table,
+# Sec. 5.5.2); the others on the plain image, where mmlfw fills the table at start-up.
+TABLE_MAP=$MAP
+if [ "$LOC" = mml ]; then
+  if "$B/sim/map/mml-mapc" --relation-table "${MAP%.mmap}.yaml" "$W/$DS-table.mmap" > "$W/mapc.log" 2>&1; then
+    TABLE_MAP=$W/$DS-table.mmap
+  else
+    say "FAIL: mml-mapc --relation-table (see $W/mapc.log)"; fail=1
+  fi
+fi
 
-write_config() {  # write_config FILE IFACE FD
+write_config() {  # write_config FILE IFACE FD [MAP]
   {
     echo "laser = socketcan:$2"
     echo "can_fd = $3"
     echo "localizer = $LOC"
-    [ "$LOC" != odom ] && echo "map = $MAP"
+    [ "$LOC" != odom ] && echo "map = ${4:-$MAP}"
     echo "workers = 2"          # inside UML: 1 CPU, pinning degrades to core 0 with a warning
     echo "arena_mib = 96"
     echo "health_period_ms = 200"
@@ -68,7 +78,7 @@ write_config() {  # write_config FILE IFACE FD
 # Scenario fd: CAN FD on vcan0, clean. classic: classic CAN on vcan1. fault: FD with corrupt,
 # missing and duplicated segments and a bus-off burst (error frames with CAN_ERR_FLAG|CAN_ERR_BUSOFF:
 # vcan has no controller, so bus-off is injected as the error frames a controller would report).
-write_config "$W/fd.conf" vcan0 true
+write_config "$W/fd.conf" vcan0 true "$TABLE_MAP"
 write_config "$W/classic.conf" vcan1 false
 write_config "$W/fault.conf" vcan0 true
 "$CANDEV" log2can --dataset $DS --count "$SCANS" --fd --speed "$SPEED" --out "$W/fd.replay" > "$W/fd.sent.json" || exit 1
@@ -135,6 +145,10 @@ check "fault: health frame reports bus-off" test "$(jget $f/score.json health_bu
 check "fault: health frame reports CRC errors" test "$(jget $f/score.json health_crc_errors)" = "$(jget $W/fault.sent.json scans_corrupted)"
 check "classic: runs on a classic-only bus (no FD frames in the capture)" bash -c "! grep -q '##' '$W/classic/capture.log'"
 check "fd: pose frames are CAN FD" grep -q '520##' "$W/fd/capture.log"
+if [ "$LOC" = mml ]; then
+  check "fd: mmlfw used the image's precomputed relation table" grep -q "precomputed relation table" "$W/fd/mmlfw.log"
+  check "classic: mmlfw filled the relation table at start-up" grep -q "filling it at start-up" "$W/classic/mmlfw.log"
+fi
 
 LOCALIZED=$(jget "$W/fd/score.json" localized)
 if [ "$LOC" = mml ]; then
