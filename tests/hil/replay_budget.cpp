@@ -15,6 +15,7 @@
 #include "firmware/map/map_image.h"
 #include "firmware/map/map_image_file.h"
 #include "firmware/mml/mml_localizer.h"
+#include "firmware/mml/mml_presets.h"
 #include "firmware/runtime/localization_loop.h"
 #include "firmware/runtime/odometry_localizer.h"
 #include "hal/hal.h"
@@ -96,14 +97,16 @@ bool run_replay(const ReplayOptions& o, ReplayResult* r, std::string* error) {
   static fw::OdometryLocalizer odom_loc;
   fw::Localizer* loc = &odom_loc;
   if (o.localizer == "mml") {
-    fw::mml::MmlLocalizerConfig mc = fw::mml::default_mml_config();
-    mc.mml.seed = o.seed;
-    if (!table) mc.mml.precomputed_table = false;
+    // The configuration mmlfw runs (firmware/app/mmlfw_main.cpp): preset C3 fitted to the map; the
+    // relation table is the image's section or filled at start-up.
+    fw::mml::MmlLocalizerConfig mc =
+        fw::mml::fit_contact_field_to_map(fw::mml::mml_preset(fw::mml::kDefaultMmlPreset, o.seed), map);
     st = g_mml.init(mc, map, table, table_len, arena, &pool);
     if (!st) { *error = std::string("mml: ") + st.message(); pool.stop(); return false; }
     loc = &g_mml;
   }
-  image.close();
+  // A table section in use is read in place: keep the image mapped (as mmlfw does).
+  if (!(loc == &g_mml && table != nullptr && g_mml.using_precomputed_table())) image.close();
 
   static hal_linux::LinuxClock clock;
   static hal_sim::SteppedClock stepped;  // lockstep: HAL time = time of the newest scan fed
