@@ -1,5 +1,7 @@
 #include "firmware/rbsm/endpoint_grid.h"
 
+#include "firmware/base/memory_report.h"
+
 #include <cmath>
 #include <cstring>
 
@@ -62,6 +64,7 @@ Status EndpointGrid::init(const EndpointGridOptions& options, StartupArena& aren
   lookup_ = static_cast<std::uint8_t*>(*lut);
   std::memset(occupancy_, 0, cells);
   std::memset(lookup_, 0, subs + 64);
+  FW_RETURN_IF_ERROR(MemoryReport::instance().add({"rbsm", "end-point grid + likelihood lookup", cells + subs + 64, cells, nullptr}));
   // Eq. 2.9 in cells: δ = exp(−d²) for d ≤ ξ, else 0; quantised to 1/255.
   const float xi2 = options.xi_cells * options.xi_cells;
   for (int dy = -1; dy <= 1; ++dy) {

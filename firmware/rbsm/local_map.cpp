@@ -1,5 +1,7 @@
 #include "firmware/rbsm/local_map.h"
 
+#include "firmware/base/memory_report.h"
+
 #include <cmath>
 
 namespace fw {
@@ -25,6 +27,8 @@ Status LocalMap::init(const LocalMapOptions& options, StartupArena& arena) {
   if (!r) return r.status();
   points_ = *r;
   capacity_ = options.point_capacity;
+  FW_RETURN_IF_ERROR(MemoryReport::instance().add(
+      {"rbsm", "local map fragments' points", capacity_ * sizeof(Point2f), capacity_, nullptr}));
   reset();
   return Status::ok();
 }

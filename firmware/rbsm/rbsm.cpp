@@ -1,5 +1,7 @@
 #include "firmware/rbsm/rbsm.h"
 
+#include "firmware/base/memory_report.h"
+
 #include <cmath>
 
 namespace fw {
@@ -62,6 +64,8 @@ Status Rbsm::init(const RbsmOptions& options, StartupArena& arena, WorkerPool* p
   Result<void*> r = arena.allocate(m * sizeof(std::uint32_t), 64, "rbsm weights");
   if (!r) return r.status();
   w_ = static_cast<std::uint32_t*>(*r);
+  FW_RETURN_IF_ERROR(MemoryReport::instance().add(
+      {"rbsm", "particles (SoA) + weights", m * (8 * sizeof(float) + sizeof(std::uint32_t)), m, nullptr}));
   initialized_ = true;
   reset();
   return Status::ok();
