@@ -1,5 +1,7 @@
 #include "sim/eval/mml_eval/mml_eval.h"
 
+#include "sim/viz/font5x7.h"
+
 #include <algorithm>
 #include <chrono>
 #include <cmath>
@@ -278,8 +280,8 @@ const char* status_color(hal::LocalizationStatus s, hal::LocalizationMode m) {
 
 }  // namespace
 
-bool write_error_plot_png(const std::string& path, const std::vector<TrialResult>& trials, double bound_m,
-                          std::string* err);
+bool write_error_plot_png(const std::string& path, const std::string& title, const std::vector<TrialResult>& trials,
+                          double bound_m, std::string* err);
 
 bool write_error_plot(const std::string& path, const std::string& title, const std::vector<TrialResult>& trials,
                       double bound_m, std::string* err) {
@@ -331,11 +333,11 @@ bool write_error_plot(const std::string& path, const std::string& title, const s
   // A raster twin (x: metres 0..max, y: error 0..5 m; same colours) for quick viewing.
   std::string png = path;
   if (png.size() > 4 && png.compare(png.size() - 4, 4, ".svg") == 0) png.replace(png.size() - 4, 4, ".png");
-  return png == path || write_error_plot_png(png, trials, bound_m, err);
+  return png == path || write_error_plot_png(png, title, trials, bound_m, err);
 }
 
-bool write_error_plot_png(const std::string& path, const std::vector<TrialResult>& trials, double bound_m,
-                          std::string* err) {
+bool write_error_plot_png(const std::string& path, const std::string& title, const std::vector<TrialResult>& trials,
+                          double bound_m, std::string* err) {
   const int W = 900, H = 420, L = 60, R = 20, T = 40, B = 50;
   std::vector<std::uint8_t> rgb(static_cast<std::size_t>(W) * H * 3, 255);
   double xmax = 1;
@@ -348,6 +350,35 @@ bool write_error_plot_png(const std::string& path, const std::vector<TrialResult
     std::uint8_t* p = &rgb[(static_cast<std::size_t>(y) * W + x) * 3];
     p[0] = c.r; p[1] = c.g; p[2] = c.b;
   };
+  // Text with the pictures' 5×7 font (scale 1 or 2), so the PNG reads like the SVG.
+  auto text = [&](int x, int y, const std::string& str, int scale, Rgb c) {
+    for (char ch : str) {
+      const std::uint8_t* g = font5x7_glyph(ch);
+      for (int col = 0; col < 5; ++col)
+        for (int row = 0; row < 7; ++row)
+          if (g[col] & (1u << row))
+            for (int sy = 0; sy < scale; ++sy)
+              for (int sx = 0; sx < scale; ++sx) put(x + col * scale + sx, y + row * scale + sy, c);
+      x += 6 * scale;
+    }
+  };
+  const Rgb black{0, 0, 0};
+  text(L, 8, title, 2, black);
+  for (int k = 0; k <= 5; ++k) text(L - 14, Y(k) - 3, std::to_string(k), 1, black);
+  const double tick = xmax > 100 ? 20 : (xmax > 40 ? 10 : 5);
+  for (double x = 0; x <= xmax + 1e-9; x += tick) {
+    const std::string lab = std::to_string(static_cast<int>(x));
+    text(X(x) - 3 * static_cast<int>(lab.size()), H - B + 6, lab, 1, black);
+  }
+  text(L + 180, H - 18, "metres travelled since the kidnapped start", 1, black);
+  text(4, T - 12, "error (m, clipped at 5)", 1, black);
+  const char* names[] = {"searching", "ambiguous", "localized", "outside-map", "tracking (hand-off)"};
+  const Rgb cols[] = {{170, 170, 170}, {255, 127, 14}, {44, 160, 44}, {148, 103, 189}, {31, 119, 180}};
+  for (int k = 0; k < 5; ++k) {
+    for (int dy = -3; dy <= 3; ++dy)
+      for (int dx = -3; dx <= 3; ++dx) put(W - 170 + dx, T + 10 + 14 * k + dy, cols[k]);
+    text(W - 160, T + 7 + 14 * k, names[k], 1, black);
+  }
   for (int k = 0; k <= 5; ++k)
     for (int x = L; x < W - R; ++x) put(x, Y(k), k == 0 ? Rgb{0, 0, 0} : Rgb{230, 230, 230});
   for (int y = T; y <= H - B; ++y) put(L, y, {0, 0, 0});
