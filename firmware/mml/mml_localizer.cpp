@@ -79,6 +79,16 @@ Status MmlLocalizer::init(const MmlLocalizerConfig& config, const GlobalMap& map
   Result<Hypothesis*> hp = arena.allocate_array<Hypothesis>(kMaxHypotheses, "mml hypotheses");
   if (!hp) return hp.status();
   hyps_ = *hp;
+  rule_ = ReductionRule(config.mml);
+  if (config.mml.reduce_observations) {
+    const std::size_t per = config.mml.reduction_observation_points;
+    const std::size_t slots = config.mml.reduction_max_observations + 2;
+    Result<Point2f*> rp = arena.allocate_array<Point2f>(slots * per, "mml reduced observations");
+    if (!rp) return rp.status();
+    for (std::size_t i = 0; i < config.mml.reduction_max_observations; ++i) red_[i].pts = *rp + i * per;
+    pending_prev_.pts = *rp + (slots - 2) * per;
+    pending_cur_.pts = *rp + (slots - 1) * per;
+  }
   FW_RETURN_IF_ERROR(MemoryReport::instance().add({"mml", "interpreter", sizeof(Interpreter), kMaxHypotheses, nullptr}));
   FW_RETURN_IF_ERROR(MemoryReport::instance().add({"mml", "observations", sizeof(observations_), kMaxUnknownWindow, nullptr}));
   initialized_ = true;
@@ -101,6 +111,123 @@ void MmlLocalizer::reset() {
   tracked_bad_steps_ = tracked_unlocalized_steps_ = 0;
   last_refine_ = RefineResult();
   last_out_ = hal::PoseEstimate();
+  have_newest_ = false;
+  corrections_applied_ = 0;
+  last_correction_ = CorrectionResult();
+  rule_.reset();
+  red_head_ = red_count_ = 0;
+  have_prev_obs_ = have_cur_obs_ = false;
+  observations_accepted_ = 0;
+}
+
+// The robot pose in the corrected local map: the newest fragment's correction T_N as a transform
+// of the local map, C_N = (F_N ⊕ T_N) ⊖ F_N, applied to the RBSM pose.
+Se2f MmlLocalizer::corrected_pose(const Se2f& rbsm_pose) const {
+  if (local_map_.num_fragments() == 0) return rbsm_pose;
+  const FragmentView v = local_map_.fragment(local_map_.num_fragments() - 1);
+  return v.frame.compose(v.scan_matcher_frame.inverse()).compose(rbsm_pose);
+}
+
+void MmlLocalizer::capture_observation(const Se2f& rbsm_pose) {
+  have_cur_obs_ = false;
+  if (num_scan_pts_ == 0 || local_map_.num_fragments() == 0) return;
+  const FragmentView v = local_map_.fragment(local_map_.num_fragments() - 1);
+  // Stored in the newest fragment's (scan-matcher) frame, like the fragment's own points, so a
+  // correction of that fragment moves the observation with it.
+  const Se2f frag_from_sensor = v.scan_matcher_frame.inverse().compose(rbsm_pose);
+  const std::size_t cap = config_.mml.reduction_observation_points;
+  const std::size_t stride = (num_scan_pts_ + cap - 1) / cap;
+  pending_cur_.fragment_id = v.id;
+  pending_cur_.n = 0;
+  for (std::size_t i = 0; i < num_scan_pts_ && pending_cur_.n < cap; i += stride) {
+    pending_cur_.pts[pending_cur_.n++] = frag_from_sensor.transform_point(scan_pts_[i]);
+  }
+  have_cur_obs_ = pending_cur_.n > 0;
+}
+
+void MmlLocalizer::accept_observation(const ReducedObservation& ob) {
+  const std::size_t cap = config_.mml.reduction_max_observations;
+  if (red_count_ == cap) {  // full: the oldest accepted observation goes
+    red_head_ = (red_head_ + 1) % cap;
+    --red_count_;
+  }
+  ReducedObservation& dst = red_[(red_head_ + red_count_) % cap];
+  dst.fragment_id = ob.fragment_id;
+  dst.n = ob.n;
+  for (std::uint32_t i = 0; i < ob.n; ++i) dst.pts[i] = ob.pts[i];
+  ++red_count_;
+  ++observations_accepted_;
+}
+
+void MmlLocalizer::append_observation(const ReducedObservation& ob, std::size_t stride, std::size_t* k) {
+  std::size_t fi = 0;
+  if (!local_map_.find_fragment(ob.fragment_id, &fi)) return;  // its fragment was dropped (keep_last)
+  const Se2f frame = local_map_.fragment(fi).frame;
+  for (std::uint32_t i = 0; i < ob.n; ++i, ++*k) {
+    if (*k % stride != 0 || num_scene_ >= scene_capacity_) continue;
+    scene_[num_scene_++] = frame.transform_point(ob.pts[i]);
+  }
+}
+
+// Eq. 5.28–5.30: the reduced local map = accepted observations + the undecided t−1 and t.
+Status MmlLocalizer::gather_reduced_map() {
+  const std::size_t cap = config_.mml.reduction_max_observations;
+  // Observations of dropped fragments are gone for good (ids grow along the ring).
+  while (red_count_ > 0) {
+    std::size_t fi = 0;
+    if (local_map_.find_fragment(red_[red_head_].fragment_id, &fi)) break;
+    red_head_ = (red_head_ + 1) % cap;
+    --red_count_;
+  }
+  std::size_t total = 0;
+  for (std::size_t i = 0; i < red_count_; ++i) total += red_[(red_head_ + i) % cap].n;
+  if (have_prev_obs_) total += pending_prev_.n;
+  if (have_cur_obs_) total += pending_cur_.n;
+  const std::size_t stride = total > scene_capacity_ ? (total + scene_capacity_ - 1) / scene_capacity_ : 1;
+  num_scene_ = 0;
+  std::size_t k = 0;
+  for (std::size_t i = 0; i < red_count_; ++i) append_observation(red_[(red_head_ + i) % cap], stride, &k);
+  if (have_prev_obs_) append_observation(pending_prev_, stride, &k);
+  if (have_cur_obs_) append_observation(pending_cur_, stride, &k);
+  return Status::ok();
+}
+
+// Eq. 5.23–5.27: move the newest fragments onto the global map under H_best. Only while the best
+// cluster passes the rating test (r > δ_r, ≥ min_cluster_hypotheses members), so an ambiguous or
+// wrong hypothesis cannot bend the local map; H_best is the best-quality hypothesis of that cluster.
+void MmlLocalizer::correct_local_map(const Se2f& mml_pose) {
+  const MmlOptions& mo = config_.mml;
+  if (!last_.c_rating || interp_.cluster_count() == 0 || local_map_.num_fragments() == 0) return;
+  const Cluster* cl = interp_.clusters();
+  std::size_t best = 0;
+  for (std::size_t i = 1; i < interp_.cluster_count(); ++i)
+    if (cl[i].rating > cl[best].rating) best = i;
+  if (cl[best].end <= cl[best].begin) return;
+  const Hypothesis* hy = interp_.hypotheses();
+  std::uint32_t bh = cl[best].begin;
+  for (std::uint32_t i = cl[best].begin; i < cl[best].end; ++i)
+    if (hy[i].quality > hy[bh].quality) bh = i;
+  // Hypotheses are robot poses H ⊕ x_local, so H_best = robot ⊖ x_local.
+  const Se2f h_best = Se2f(hy[bh].x, hy[bh].y, hy[bh].theta).compose(mml_pose.inverse());
+  CorrectionParams cp;
+  cp.iterations = mo.correction_iterations;
+  cp.step = mo.correction_step;
+  cp.clip_m = mo.correction_clip_m;
+  cp.max_shift_m = mo.correction_max_shift_m;
+  cp.max_rotation_rad = mo.correction_max_rotation_rad;
+  const std::size_t nf = local_map_.num_fragments();
+  const std::size_t first = nf > mo.correction_fragments ? nf - mo.correction_fragments : 0;
+  for (std::size_t f = first; f < nf; ++f) {
+    const FragmentView v = local_map_.fragment(f);
+    if (v.size() < mo.correction_min_points) continue;
+    const std::size_t stride = (v.size() + mo.correction_points - 1) / mo.correction_points;
+    std::size_t m = 0;
+    for (std::size_t i = 0; i < v.size() && m < mo.correction_points; i += stride) corr_pts_[m++] = v[i];
+    last_correction_ = correct_fragment(map_, h_best.compose(v.frame), corr_pts_, m, cp);
+    if (last_correction_.applied) {
+      if (local_map_.set_correction(f, v.correction.compose(last_correction_.delta)).is_ok()) ++corrections_applied_;
+    }
+  }
 }
 
 Status MmlLocalizer::gather_local_map() {
@@ -157,6 +284,21 @@ Status MmlLocalizer::step(const hal::LaserScan& scan, const hal::Odometry& odom,
     return Status::ok();
   }
   ++steps_;
+  const Se2f rbsm_pose = local_pose;
+  if (config_.mml.correct_local_map && local_map_.num_fragments() > 0) {
+    // A new fragment inherits its predecessor's correction (as a local-map transform): RBSM's
+    // drift is continuous, so the new fragment starts where the corrected map continues.
+    const std::size_t nf = local_map_.num_fragments();
+    const FragmentView v = local_map_.fragment(nf - 1);
+    if ((!have_newest_ || v.id != newest_id_) && nf >= 2) {
+      const FragmentView p = local_map_.fragment(nf - 2);
+      const Se2f c_prev = p.frame.compose(p.scan_matcher_frame.inverse());
+      FW_RETURN_IF_ERROR(local_map_.set_correction(nf - 1, v.scan_matcher_frame.inverse().compose(c_prev).compose(v.scan_matcher_frame)));
+    }
+    have_newest_ = true;
+    newest_id_ = v.id;
+    local_pose = corrected_pose(rbsm_pose);
+  }
 
   // Remember a subsample of this observation (local frame) for Eq. 5.37.
   {
@@ -180,7 +322,20 @@ Status MmlLocalizer::step(const hal::LaserScan& scan, const hal::Odometry& odom,
   out->scan_id = scan.scan_id;
   out->mode = hal::LocalizationMode::kGlobal;
 
-  FW_RETURN_IF_ERROR(gather_local_map());
+  const bool reduce = config_.mml.reduce_observations;
+  if (reduce) {
+    capture_observation(rbsm_pose);
+    if (local_map_.total_points() < config_.mml.min_local_map_points) {
+      // Before matching starts (t = 0 of Fig. 5.5) every observation is kept: the first one is
+      // needed to rule out hypotheses the later, informative ones leave open.
+      if (have_cur_obs_) accept_observation(pending_cur_);
+      have_cur_obs_ = have_prev_obs_ = false;
+      rule_.reset();
+    }
+    FW_RETURN_IF_ERROR(gather_reduced_map());
+  } else {
+    FW_RETURN_IF_ERROR(gather_local_map());
+  }
   if (local_map_.total_points() < config_.mml.min_local_map_points || num_scene_ < 3) {
     out->status = hal::LocalizationStatus::kSearching;
     last_out_ = *out;
@@ -226,6 +381,16 @@ Status MmlLocalizer::step(const hal::LaserScan& scan, const hal::Odometry& odom,
   prev_odom_ = local_pose;
   have_odom_ = true;
   FW_RETURN_IF_ERROR(interp_.interpret(in, &last_));
+  if (reduce) {
+    // Eq. 5.29 on f(t) = |C(t)|: a crossing accepts observation t−1; t becomes the undecided t−1.
+    if (rule_.push(last_.cluster_count) && have_prev_obs_) accept_observation(pending_prev_);
+    Point2f* const spare = pending_prev_.pts;
+    pending_prev_ = pending_cur_;
+    pending_cur_.pts = spare;
+    pending_cur_.n = 0;
+    have_prev_obs_ = have_cur_obs_;
+    have_cur_obs_ = false;
+  }
   if (have_h_) {
     interp_.report_unknown(unknown_contact(last_h_), static_cast<std::uint32_t>(observations_.size()), &last_);
   }
@@ -284,6 +449,7 @@ Status MmlLocalizer::step(const hal::LaserScan& scan, const hal::Odometry& odom,
   }
   prev_wheel_ = wheel;
   have_wheel_ = true;
+  if (mo.correct_local_map) correct_local_map(local_pose);
 
   out->status = last_.status;
   if (last_.have_pose) {

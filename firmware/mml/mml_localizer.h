@@ -4,6 +4,12 @@
 // hypotheses become robot poses in the map (H ⊕ x_local) → Interpreter (filter, clustering,
 // rating, constraints, Bollinger) → unknown-region test Ω' over the last τ_up observations
 // (Eq. 5.37) → PoseEstimate (searching / ambiguous / localized / outside-map).
+// Options: local map correction (Eq. 5.23–5.27, local_map_correction.h) moves the newest fragments
+// onto the global map while the best cluster passes the rating test; the corrections live in the
+// LocalMap's fragments (T_i), RBSM keeps tracking in its own uncorrected frame, and MML uses the
+// robot pose in the corrected local map (C_N ⊕ RBSM pose, C_N the newest fragment's correction as
+// a local-map transform). Local map reduction (Eq. 5.28–5.30, observation_reduction.h) matches only
+// accepted observations plus the two newest instead of the fragments' points.
 // All storage comes from the StartupArena given to init() or is a fixed member; step() allocates
 // nothing. Place the object in static storage (it holds the interpreter's fixed arrays).
 #pragma once
@@ -16,7 +22,9 @@
 #include "firmware/base/worker_pool.h"
 #include "firmware/map/global_map.h"
 #include "firmware/mml/interpretation.h"
+#include "firmware/mml/local_map_correction.h"
 #include "firmware/mml/mml_options.h"
+#include "firmware/mml/observation_reduction.h"
 #include "firmware/mml/pose_refiner.h"
 #include "firmware/pransam/matcher.h"
 #include "firmware/rbsm/local_map.h"
@@ -61,9 +69,28 @@ class MmlLocalizer final : public Localizer {
   const PerfCounter& match_perf() const { return perf_match_; }
   std::uint32_t front_end_failures() const { return front_end_failures_; }
   bool using_precomputed_table() const { return matcher_.has_precomputed_table(); }
+  const LocalMap& local_map() const { return local_map_; }
+  // Local map correction: fragment corrections applied since reset, the last attempt.
+  std::uint32_t corrections_applied() const { return corrections_applied_; }
+  const CorrectionResult& last_correction() const { return last_correction_; }
+  // Local map reduction: observations accepted since reset / currently kept.
+  std::uint32_t observations_accepted() const { return observations_accepted_; }
+  std::size_t observations_kept() const { return red_count_; }
 
  private:
   Status gather_local_map();
+  Status gather_reduced_map();
+  // Reduction storage: a ring of accepted observations, each in its fragment's frame.
+  struct ReducedObservation {
+    std::uint32_t fragment_id = 0;
+    std::uint32_t n = 0;
+    Point2f* pts = nullptr;  // arena, reduction_observation_points
+  };
+  void capture_observation(const Se2f& rbsm_pose);
+  void accept_observation(const ReducedObservation& ob);
+  void append_observation(const ReducedObservation& ob, std::size_t stride, std::size_t* k);
+  void correct_local_map(const Se2f& mml_pose);
+  Se2f corrected_pose(const Se2f& rbsm_pose) const;
   float unknown_contact(const Se2f& h_map_from_local) const;
 
   MmlLocalizerConfig config_;
@@ -108,6 +135,21 @@ class MmlLocalizer final : public Localizer {
   RefineResult last_refine_;
   hal::PoseEstimate last_out_;
   PerfCounter perf_match_{"mml.pransam"};
+
+  // Local map correction (Eq. 5.23–5.27).
+  Point2f corr_pts_[kMaxCorrectionPoints];
+  bool have_newest_ = false;
+  std::uint32_t newest_id_ = 0;
+  std::uint32_t corrections_applied_ = 0;
+  CorrectionResult last_correction_;
+
+  // Local map reduction (Eq. 5.28–5.30).
+  ReductionRule rule_{2.0f, 4.0f, 20};
+  ReducedObservation red_[kMaxReducedObservations];
+  std::size_t red_head_ = 0, red_count_ = 0;
+  ReducedObservation pending_prev_, pending_cur_;  // observations t−1 and t (decided one step later)
+  bool have_prev_obs_ = false, have_cur_obs_ = false;
+  std::uint32_t observations_accepted_ = 0;
 };
 
 }  // namespace mml

@@ -75,21 +75,22 @@ Status MmlOptions::validate() const {
   FW_RETURN_IF_ERROR(check_range("outside_map_no_match_steps", outside_map_no_match_steps, 0, 100000));
   FW_RETURN_IF_ERROR(check_range("local_map_fragments", local_map_fragments, 0, 100000));
   FW_RETURN_IF_ERROR(check_range("reduction_min_jump", reduction_min_jump, 0.0, 1e6));
+  FW_RETURN_IF_ERROR(check_range("reduction_delta_max", reduction_delta_max, reduction_min_jump, 1e6));
+  FW_RETURN_IF_ERROR(check_range("reduction_clusters_max", reduction_clusters_max, 1, kMaxClusters));
+  FW_RETURN_IF_ERROR(check_range("reduction_observation_points", reduction_observation_points, 3, 1081));
+  FW_RETURN_IF_ERROR(check_range("reduction_max_observations", reduction_max_observations, 1, kMaxReducedObservations));
   FW_RETURN_IF_ERROR(check_range("correction_iterations", correction_iterations, 0, 10000));
+  FW_RETURN_IF_ERROR(check_positive("correction_step", correction_step));
   FW_RETURN_IF_ERROR(check_range("correction_step", correction_step, 0.0, 1.0));
+  FW_RETURN_IF_ERROR(check_range("correction_fragments", correction_fragments, 1, kMaxCorrectedFragments));
+  FW_RETURN_IF_ERROR(check_range("correction_points", correction_points, 3, kMaxCorrectionPoints));
+  FW_RETURN_IF_ERROR(check_range("correction_min_points", correction_min_points, 3, correction_points));
+  FW_RETURN_IF_ERROR(check_positive("correction_clip_m", correction_clip_m));
+  FW_RETURN_IF_ERROR(check_positive("correction_max_shift_m", correction_max_shift_m));
+  FW_RETURN_IF_ERROR(check_range("correction_max_rotation_rad", correction_max_rotation_rad, 1e-6, 3.1416));
   FW_RETURN_IF_ERROR(check_range("min_local_map_points", min_local_map_points, 3, 1000000));
   FW_RETURN_IF_ERROR(check_range("table_triples", static_cast<double>(table_triples), 1, 1e9));
   FW_RETURN_IF_ERROR(check_range("table_extent_m", table_extent_m, 0.5, 1000.0));
-  if (reduce_observations) {
-    return Status::error(Errc::kUnsupported,
-                         "MmlOptions.reduce_observations: local map reduction (Eq. 5.28-5.30) is not implemented in "
-                         "this build");
-  }
-  if (correct_local_map) {
-    return Status::error(Errc::kUnsupported,
-                         "MmlOptions.correct_local_map: gradient-descent local map correction (Eq. 5.23-5.27) "
-                         "is not implemented in this build");
-  }
   FW_RETURN_IF_ERROR(check_range("matching_iterations", matching_iterations, 1, 100000000));
   FW_RETURN_IF_ERROR(check_range("max_local_map_points", max_local_map_points, 3, 1000000));
   FW_RETURN_IF_ERROR(check_range("max_hypotheses", max_hypotheses, 1, kMaxHypotheses));

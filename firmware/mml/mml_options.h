@@ -18,6 +18,9 @@ constexpr std::size_t kMaxClusters = 512;      // clusters per step
 constexpr std::size_t kMaxMedianWindow = 64;   // τ_m
 constexpr std::size_t kMaxThresholdWindow = 64;  // τ_tr
 constexpr std::size_t kMaxUnknownWindow = 64;  // τ_up
+constexpr std::size_t kMaxReducedObservations = 256;  // reduction_max_observations
+constexpr std::size_t kMaxCorrectedFragments = 16;    // correction_fragments
+constexpr std::size_t kMaxCorrectionPoints = 2048;    // correction_points
 
 struct MmlOptions {
   // --- Hypothesis filter (Eq. 5.3): max rotation about x (roll) and y (pitch) of a 3-D frame
@@ -86,11 +89,26 @@ struct MmlOptions {
 
   // --- Local map (Sec. 5.4–5.5).
   std::uint32_t local_map_fragments = 0;   // keep only the last m fragments (0 = all that fit)
-  bool reduce_observations = false;        // Eq. 5.28–5.30: keep information-rich observations
-  float reduction_min_jump = 2.0f;         // Δ(|C(t)|)
-  bool correct_local_map = false;          // Eq. 5.23–5.27 / App. D
-  std::uint32_t correction_iterations = 20;
-  float correction_step = 0.05f;
+  // Local map reduction (Sec. 5.5.1, Eq. 5.28–5.30, observation_reduction.h): match only the
+  // observations (scans) at which the number of clusters f(t) collapsed, plus the two newest.
+  bool reduce_observations = false;
+  float reduction_min_jump = 2.0f;         // Δ(|C(t)|) for |C(t)| → 0: the constant 2 of Eq. 5.30
+  float reduction_delta_max = 4.0f;        // Δ_max of Eq. 5.30 (≥ reduction_min_jump)
+  std::uint32_t reduction_clusters_max = 20;  // |C|_max of Eq. 5.30
+  std::uint32_t reduction_observation_points = 180;  // scan points kept per accepted observation
+  std::uint32_t reduction_max_observations = 64;     // accepted observations kept (oldest evicted)
+  // Local map correction (Sec. 5.4, Eq. 5.23–5.27, App. D, local_map_correction.h): gradient
+  // descent of the newest fragments onto the global map under H_best, only while the best cluster
+  // passes the rating test (r > δ_r with ≥ min_cluster_hypotheses members).
+  bool correct_local_map = false;
+  std::uint32_t correction_iterations = 20;  // gradient steps per fragment and MML step
+  float correction_step = 0.05f;             // α(0) of Eq. 5.27 (adapted: ×2 on success, ½ on failure)
+  std::uint32_t correction_fragments = 2;    // newest fragments corrected per step
+  std::uint32_t correction_points = 300;     // fragment points used (subsampled)
+  std::uint32_t correction_min_points = 30;  // fewer fragment points: not corrected
+  float correction_clip_m = 0.30f;           // points farther from the map do not pull (outliers)
+  float correction_max_shift_m = 0.30f;      // a per-step correction beyond these is rejected
+  float correction_max_rotation_rad = 0.10f;
   std::uint32_t min_local_map_points = 150;  // no matching below (status searching)
 
   // --- Matching (pRANSAM collect-all).

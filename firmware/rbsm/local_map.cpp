@@ -75,6 +75,7 @@ Status LocalMap::update_pose(const Se2f& pose) {
   Fragment& f = fragments_[(head_ + count_) % LocalMapOptions::kMaxFragments];
   f.id = next_id_++;
   f.frame = pose;
+  f.correction = Se2f();
   f.path_length = 0.0f;
   f.start = (points_head_ + points_used_) % capacity_;
   f.count = 0;
@@ -123,7 +124,9 @@ FragmentView LocalMap::fragment(std::size_t i) const {
   }
   const Fragment& f = fragments_[(head_ + i) % LocalMapOptions::kMaxFragments];
   v.id = f.id;
-  v.frame = f.frame;
+  v.scan_matcher_frame = f.frame;
+  v.correction = f.correction;
+  v.frame = f.frame.compose(f.correction);
   v.path_length = f.path_length;
   const std::uint32_t until_end = capacity_ - f.start;
   v.first = points_ + f.start;
@@ -131,6 +134,25 @@ FragmentView LocalMap::fragment(std::size_t i) const {
   v.second = points_;
   v.second_count = f.count - v.first_count;
   return v;
+}
+
+Status LocalMap::set_correction(std::size_t i, const Se2f& correction) {
+  if (i >= count_) {
+    return Status::error(Errc::kInvalidArgument, "local map: correction for fragment %zu of %u", i, count_);
+  }
+  if (!std::isfinite(correction.x) || !std::isfinite(correction.y) || !std::isfinite(correction.theta)) {
+    return Status::error(Errc::kInvalidArgument, "local map: non-finite correction for fragment %zu", i);
+  }
+  fragments_[(head_ + i) % LocalMapOptions::kMaxFragments].correction = correction;
+  return Status::ok();
+}
+
+bool LocalMap::find_fragment(std::uint32_t id, std::size_t* index) const {
+  if (count_ == 0) return false;
+  const std::uint32_t oldest = fragments_[head_].id;  // ids are consecutive in the ring
+  if (id < oldest || id - oldest >= count_) return false;
+  *index = id - oldest;
+  return true;
 }
 
 }  // namespace fw

@@ -5,6 +5,10 @@
 // (advance two ring tails) and never fragments memory. keep_last = m keeps only the last m
 // fragments (Sec. 5.4). A full point ring is a status (kCapacityExceeded naming the sizes) unless
 // drop_oldest_when_full allows evicting older fragments.
+// Each fragment also carries a correction T_i (identity unless a consumer sets one; MML's local
+// map correction, Eq. 5.23–5.27): its points lie at F_i ⊕ T_i ⊕ x in the local map. Points keep
+// being stored with F_i (the scan matcher's frame), so the scan matcher never sees the correction
+// and later points of a corrected fragment get the same correction as the earlier ones.
 #pragma once
 
 #include <cstddef>
@@ -30,7 +34,9 @@ struct LocalMapOptions {
 // Points of one fragment: up to two contiguous spans (the ring may wrap), in the fragment frame.
 struct FragmentView {
   std::uint32_t id = 0;     // running fragment number since reset
-  Se2f frame;               // F_i in the world (scan-matcher) frame
+  Se2f frame;               // F_i ⊕ T_i: where the points lie in the local map (corrected)
+  Se2f scan_matcher_frame;  // F_i in the world (scan-matcher) frame
+  Se2f correction;          // T_i (fragment frame)
   float path_length = 0.0f; // path travelled inside this fragment (m)
   const Point2f* first = nullptr;
   std::size_t first_count = 0;
@@ -59,11 +65,16 @@ class LocalMap {
   std::uint32_t dropped_fragments() const { return dropped_; }
   // Drops the oldest fragment in O(1); false when empty.
   bool drop_oldest();
+  // Sets T_i of fragment i (0 = oldest kept); non-finite values are rejected.
+  Status set_correction(std::size_t i, const Se2f& correction);
+  // Index of the kept fragment with running number `id`; false when dropped or not yet opened.
+  bool find_fragment(std::uint32_t id, std::size_t* index) const;
 
  private:
   struct Fragment {
     std::uint32_t id;
     Se2f frame;
+    Se2f correction;
     float path_length;
     std::uint32_t start;  // ring index of the first point
     std::uint32_t count;
