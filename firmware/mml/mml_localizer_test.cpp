@@ -84,6 +84,71 @@ TEST(MmlLocalizerTest, UniqueRoomLocalizes) {
   EXPECT_GT(count(rec, hal::LocalizationStatus::kLocalized), static_cast<int>(rec.size()) / 3);
 }
 
+struct OptionRun {
+  std::vector<testing::StepRecord> rec;
+  int first = -1, localized = 0, wrong = 0;
+  double mean_points = 0.0;  // local map points matched per step (after matching started)
+};
+
+OptionRun run_unique_room(const MmlLocalizerConfig& cfg, Rig* rig) {
+  static GridWorld g = mcl::testing::unique_room();
+  static OwnedGlobalMap gm(g);
+  OptionRun o;
+  EXPECT_TRUE(rig->init(gm.map, cfg).is_ok());
+  const auto path = testing::waypoint_path({{1.5f, 1.5f}, {1.5f, 6.5f}, {4.5f, 6.5f}, {4.5f, 2.0f}, {10.5f, 3.5f}}, 0.1f);
+  std::size_t sum = 0, n = 0;
+  const MmlLocalizer* loc = rig->loc.get();
+  auto hook = note_hook(loc);
+  o.rec = testing::drive(rig->loc.get(), g, path, 1, [&](testing::StepRecord* r) {
+    hook(r);
+    if (loc->local_map_points() > 0) { sum += loc->local_map_points(); ++n; }
+  });
+  for (std::size_t i = 0; i < o.rec.size(); ++i) {
+    const auto& r = o.rec[i];
+    EXPECT_NE(r.est.status, hal::LocalizationStatus::kFault) << i << ": " << r.error;
+    if (r.est.status != hal::LocalizationStatus::kLocalized) continue;
+    if (o.first < 0) o.first = static_cast<int>(i);
+    ++o.localized;
+    o.wrong += std::hypot(r.est.x - r.truth.x, r.est.y - r.truth.y) > 0.3f;
+  }
+  o.mean_points = n ? static_cast<double>(sum) / n : 0.0;
+  return o;
+}
+
+// Local map correction (Eq. 5.23–5.27) on: still localizes, never wrong, and corrections happen.
+TEST(MmlLocalizerTest, UniqueRoomLocalizesWithLocalMapCorrection) {
+  MmlLocalizerConfig c = test_config();
+  c.mml.correct_local_map = true;
+  Rig rig;
+  const OptionRun o = run_unique_room(c, &rig);
+  std::printf("correction: first localized at step %d, %d localized, %u fragment corrections\n", o.first,
+              o.localized, rig.loc->corrections_applied());
+  EXPECT_GE(o.first, 0) << "never localized";
+  EXPECT_EQ(o.wrong, 0);
+  EXPECT_GT(o.localized, static_cast<int>(o.rec.size()) / 3);
+  EXPECT_GT(rig.loc->corrections_applied(), 0u);
+  if (::testing::Test::HasFailure() || std::getenv("MML_TRACE")) print_trace(o.rec);
+}
+
+// Local map reduction (Eq. 5.28–5.30) on: still localizes, never wrong, and matches fewer points
+// than the whole local map.
+TEST(MmlLocalizerTest, UniqueRoomLocalizesWithReducedLocalMap) {
+  MmlLocalizerConfig c = test_config();
+  c.mml.reduce_observations = true;
+  Rig rig, full_rig;
+  const OptionRun o = run_unique_room(c, &rig);
+  const OptionRun full = run_unique_room(test_config(), &full_rig);
+  std::printf("reduction: first localized at step %d (full map: %d), %d localized, %u observations accepted, "
+              "%.0f points matched per step (full map: %.0f)\n",
+              o.first, full.first, o.localized, rig.loc->observations_accepted(), o.mean_points, full.mean_points);
+  EXPECT_GE(o.first, 0) << "never localized";
+  EXPECT_EQ(o.wrong, 0);
+  EXPECT_GT(o.localized, static_cast<int>(o.rec.size()) / 3);
+  EXPECT_GT(rig.loc->observations_accepted(), 1u);
+  EXPECT_LT(o.mean_points, full.mean_points);
+  if (::testing::Test::HasFailure() || std::getenv("MML_TRACE")) print_trace(o.rec);
+}
+
 // A featureless corridor with both ends alike: the position along it (and the direction) cannot
 // be isolated ⇒ never localized.
 TEST(MmlLocalizerTest, SymmetricCorridorStaysAmbiguous) {

@@ -122,6 +122,37 @@ TEST(MmlZeroHeapTest, MmlMclAndHandoffStepsAllocateNothing) {
   EXPECT_GT(s.mml->last().hypotheses_valid, 0u);
 }
 
+// The same with local map correction (Eq. 5.23–5.27) and reduction (Eq. 5.28–5.30) both on: their
+// storage comes from the arena in init(), nothing from the heap per step.
+TEST(MmlZeroHeapTest, CorrectionAndReductionAllocateNothing) {
+  if (!AllocCounter::available()) GTEST_SKIP() << "allocation counter unavailable under sanitizers";
+  static GridWorld g = mcl::testing::unique_room();
+  static OwnedGlobalMap gm(g);
+  StartupArena arena;
+  ASSERT_TRUE(arena.init_mapped(192u << 20, false, "mml-options-test").is_ok());
+  auto mml = std::make_unique<MmlLocalizer>();
+  MmlLocalizerConfig c = small_config();
+  c.mml.correct_local_map = true;
+  c.mml.reduce_observations = true;
+  c.mml.reduction_max_observations = 4;  // small ring: eviction is exercised too
+  const Status st = mml->init(c, gm.map, nullptr, 0, arena, nullptr);
+  ASSERT_TRUE(st.is_ok()) << st.message();
+  arena.seal();
+  const Inputs in = make_inputs(g, testing::waypoint_path({{1.5f, 1.5f}, {1.5f, 6.5f}, {4.5f, 6.5f}, {4.5f, 2.0f}}, 0.1f));
+  hal::PoseEstimate est;
+  int localized = 0;
+  AllocCounter::begin();
+  for (std::size_t i = 0; i < in.scans.size(); ++i) {
+    if (!mml->step(in.scans[i], in.odom[i], &est).is_ok()) break;
+    localized += est.status == hal::LocalizationStatus::kLocalized;
+  }
+  const long allocs = AllocCounter::end();
+  EXPECT_EQ(allocs, 0) << "heap allocations after init";
+  EXPECT_GT(localized, 10);
+  EXPECT_GT(mml->corrections_applied(), 0u);
+  EXPECT_GT(mml->observations_accepted(), 0u);
+}
+
 // Hand-off: MML localizes, MCL tracks with small error; a kidnap (teleport) collapses the
 // likelihood, MML takes over again and re-localizes at the new place.
 TEST(HandoffTest, TracksAndRecoversFromKidnap) {

@@ -89,4 +89,35 @@ TEST_F(LocalMapFixture, FullIsAClearStatusWhenEvictionIsOff) {
   EXPECT_EQ(fresh.update_pose(fw::Se2f()).code(), fw::Errc::kNotInitialized);
 }
 
+// A fragment correction T_i moves its points (F_i ⊕ T_i ⊕ x) without touching how later points
+// are stored (F_i, the scan matcher's frame); fragments are found by id until dropped.
+TEST_F(LocalMapFixture, CorrectionMovesFragmentPointsAndIdsAreFound) {
+  fw::LocalMapOptions o;
+  o.fragment_length_m = 1.0f;
+  o.keep_last = 2;
+  o.point_capacity = 1000;
+  make(o);
+  ASSERT_TRUE(map.update_pose(fw::Se2f(0.0f, 0.0f, 0.0f)).is_ok());
+  const fw::Point2f w(2.0f, 1.0f);
+  ASSERT_TRUE(map.add_points(&w, 1).is_ok());
+  ASSERT_TRUE(map.set_correction(0, fw::Se2f(0.1f, 0.0f, 0.0f)).is_ok());
+  const fw::Point2f w2(3.0f, 1.0f);
+  ASSERT_TRUE(map.add_points(&w2, 1).is_ok());  // added after the correction: corrected as well
+  const fw::FragmentView v = map.fragment(0);
+  EXPECT_NEAR(v.frame.transform_point(v[0]).x(), 2.1f, 1e-5f);
+  EXPECT_NEAR(v.frame.transform_point(v[1]).x(), 3.1f, 1e-5f);
+  EXPECT_NEAR(v.scan_matcher_frame.transform_point(v[1]).x(), 3.0f, 1e-5f);
+  EXPECT_FALSE(map.set_correction(0, fw::Se2f(NAN, 0.0f, 0.0f)).is_ok());
+  EXPECT_FALSE(map.set_correction(5, fw::Se2f()).is_ok());
+  std::size_t idx = 99;
+  EXPECT_TRUE(map.find_fragment(0, &idx));
+  EXPECT_EQ(idx, 0u);
+  for (int k = 1; k <= 3; ++k) ASSERT_TRUE(map.update_pose(fw::Se2f(1.5f * k, 0.0f, 0.0f)).is_ok());
+  EXPECT_FALSE(map.find_fragment(0, &idx));  // dropped (keep_last = 2)
+  EXPECT_TRUE(map.find_fragment(3, &idx));
+  EXPECT_EQ(idx, 1u);
+  EXPECT_FALSE(map.find_fragment(4, &idx));  // not opened yet
+  EXPECT_EQ(map.fragment(1).correction.x, 0.0f);  // new fragments start uncorrected
+}
+
 }  // namespace
