@@ -138,6 +138,19 @@ TEST(ReductionRuleTest, ThresholdGrowsWithClusterCount) {
   EXPECT_FALSE(few.push(5));  // no history after reset
 }
 
+// f = 1, 1, 0, 1 satisfies Eq. 5.29 (f'' = −1, 2; jump 3 > Δ(1) = 2) but the "collapse" is a step
+// without any cluster: not accepted (extension, see observation_reduction.h).
+TEST(ReductionRuleTest, CollapseToNoClusterIsNotInformation) {
+  ReductionRule r(2.0f, 4.0f, 20);
+  bool acc = false;
+  for (std::uint32_t v : {1u, 1u, 1u, 0u, 1u}) acc = r.push(v) || acc;
+  EXPECT_FALSE(acc);
+  ReductionRule r2(2.0f, 4.0f, 20);
+  acc = false;
+  for (std::uint32_t v : {2u, 2u, 2u, 1u, 2u}) acc = r2.push(v) || acc;  // same shape, one cluster left
+  EXPECT_TRUE(acc);
+}
+
 std::string check(const MmlOptions& o) {
   const Status s = o.validate();
   return s.is_ok() ? std::string() : std::string(s.message());

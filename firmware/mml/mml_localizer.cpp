@@ -118,6 +118,7 @@ void MmlLocalizer::reset() {
   red_head_ = red_count_ = 0;
   have_prev_obs_ = have_cur_obs_ = false;
   observations_accepted_ = 0;
+  localized_prev_ = localized_before_prev_ = false;
 }
 
 // The robot pose in the corrected local map: the newest fragment's correction T_N as a transform
@@ -284,6 +285,7 @@ Status MmlLocalizer::step(const hal::LaserScan& scan, const hal::Odometry& odom,
     return Status::ok();
   }
   ++steps_;
+  matched_points_ = 0;
   const Se2f rbsm_pose = local_pose;
   if (config_.mml.correct_local_map && local_map_.num_fragments() > 0) {
     // A new fragment inherits its predecessor's correction (as a local-map transform): RBSM's
@@ -349,6 +351,7 @@ Status MmlLocalizer::step(const hal::LaserScan& scan, const hal::Odometry& odom,
   mp.omega_thres = interp_.omega_thres();
   mp.seed = config_.mml.seed * 1000003ull + steps_;
   pransam::MatchResult<2> mr;
+  matched_points_ = num_scene_;
   const Status ms = matcher_.match(scene_, num_scene_, mp, &mr);
   std::size_t nh = 0;
   if (ms.is_ok()) {
@@ -383,7 +386,12 @@ Status MmlLocalizer::step(const hal::LaserScan& scan, const hal::Odometry& odom,
   FW_RETURN_IF_ERROR(interp_.interpret(in, &last_));
   if (reduce) {
     // Eq. 5.29 on f(t) = |C(t)|: a crossing accepts observation t−1; t becomes the undecided t−1.
-    if (rule_.push(last_.cluster_count) && have_prev_obs_) accept_observation(pending_prev_);
+    // Extension: nothing is accepted while localized (the pose was known before observation t−1
+    // arrived, so it cannot be information-rich about which pose it is); f(t) keeps feeding the rule.
+    const bool accept = rule_.push(last_.cluster_count);
+    if (accept && have_prev_obs_ && !localized_before_prev_) {
+      accept_observation(pending_prev_);
+    }
     Point2f* const spare = pending_prev_.pts;
     pending_prev_ = pending_cur_;
     pending_cur_.pts = spare;
@@ -451,6 +459,8 @@ Status MmlLocalizer::step(const hal::LaserScan& scan, const hal::Odometry& odom,
   have_wheel_ = true;
   if (mo.correct_local_map) correct_local_map(local_pose);
 
+  localized_before_prev_ = localized_prev_;
+  localized_prev_ = last_.status == hal::LocalizationStatus::kLocalized;
   out->status = last_.status;
   if (last_.have_pose) {
     out->x = last_.pose.x;

@@ -65,6 +65,8 @@ class MmlLocalizer final : public Localizer {
   const Interpreter& interpreter() const { return interp_; }
   const InterpretResult& last() const { return last_; }
   std::size_t local_map_points() const { return num_scene_; }
+  // Points handed to pRANSAM in the last step (0 when it did not match).
+  std::size_t matched_points() const { return matched_points_; }
   const RefineResult& last_refine() const { return last_refine_; }
   const PerfCounter& match_perf() const { return perf_match_; }
   std::uint32_t front_end_failures() const { return front_end_failures_; }
@@ -106,6 +108,7 @@ class MmlLocalizer final : public Localizer {
 
   Point2f* scene_ = nullptr;  // local map points in the local (scan-matcher) frame, arena
   std::size_t num_scene_ = 0;
+  std::size_t matched_points_ = 0;
   std::size_t scene_capacity_ = 0;
   Hypothesis* hyps_ = nullptr;  // arena, kMaxHypotheses
 
@@ -150,6 +153,7 @@ class MmlLocalizer final : public Localizer {
   ReducedObservation pending_prev_, pending_cur_;  // observations t−1 and t (decided one step later)
   bool have_prev_obs_ = false, have_cur_obs_ = false;
   std::uint32_t observations_accepted_ = 0;
+  bool localized_prev_ = false, localized_before_prev_ = false;  // published status at t−1, t−2
 };
 
 }  // namespace mml

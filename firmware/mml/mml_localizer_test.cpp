@@ -144,7 +144,7 @@ TEST(MmlLocalizerTest, UniqueRoomLocalizesWithReducedLocalMap) {
   EXPECT_GE(o.first, 0) << "never localized";
   EXPECT_EQ(o.wrong, 0);
   EXPECT_GT(o.localized, static_cast<int>(o.rec.size()) / 3);
-  EXPECT_GT(rig.loc->observations_accepted(), 1u);
+  EXPECT_GE(rig.loc->observations_accepted(), 1u);  // at least the first (t = 0) observation
   EXPECT_LT(o.mean_points, full.mean_points);
   if (::testing::Test::HasFailure() || std::getenv("MML_TRACE")) print_trace(o.rec);
 }

@@ -19,7 +19,7 @@ bool ReductionRule::push(std::uint32_t clusters) {
   d2_prev_ = d2_;
   d2_ = n_ >= 3 ? static_cast<float>(f_[0] - 2 * f_[1] + f_[2]) : 0.0f;
   if (n_ < 4) return false;  // f''(t−1) needs f(t−3)
-  return d2_prev_ < 0.0f && d2_ > 0.0f && d2_ - d2_prev_ > delta(clusters);
+  return f_[1] >= 1 && d2_prev_ < 0.0f && d2_ > 0.0f && d2_ - d2_prev_ > delta(clusters);
 }
 
 }  // namespace mml

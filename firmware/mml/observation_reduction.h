@@ -8,6 +8,10 @@
 // Which observation: the crossing between t−1 and t marks the collapse of f at t−1 (Fig. 5.5: the
 // crossing between t = 5 and t = 6 keeps the observation of t = 5), so push(f(t)) accepts the
 // observation of step t−1. The caller keeps the first observations (t = 0) unconditionally.
+// Extension: the accepted observation must have left at least one cluster (f(t−1) ≥ 1). On real
+// logs f(t) flickers between 0 and 2 once the pose is unique (a step without any hypothesis above
+// the threshold), and 1, 1, 0, 1 would pass Eq. 5.29 (jump 3 > Δ(1) = 2): a match that produced
+// nothing is a failed match, not an information-rich observation.
 #pragma once
 
 #include <cstdint>

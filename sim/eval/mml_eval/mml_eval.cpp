@@ -110,7 +110,7 @@ std::vector<std::size_t> draw_starts(const LoadedDataset& ds, std::size_t count,
 }
 
 TrialResult run_trial(fw::Localizer& loc, const LoadedDataset& ds, std::size_t start, const TrialOptions& opt,
-                      const double* region) {
+                      const double* region, const std::function<std::size_t()>& matched_points) {
   TrialResult tr;
   tr.start = start;
   loc.reset();
@@ -149,6 +149,7 @@ TrialResult run_trial(fw::Localizer& loc, const LoadedDataset& ds, std::size_t s
     }
     StepLog st;
     st.scan = i;
+    if (matched_points) st.matched_points = matched_points();
     st.travelled = travelled;
     st.status = est.status;
     st.mode = est.mode;
@@ -207,7 +208,8 @@ SystemSummary summarize(const std::string& dataset, const std::string& system, c
   s.memory_mib = memory_mib;
   std::vector<double> metres, steps, ms, track_err, track_ms;
   double err_sum = 0;
-  std::size_t err_n = 0, region_n = 0, region_out = 0;
+  std::size_t err_n = 0, region_n = 0, region_out = 0, matched_n = 0;
+  double matched_sum = 0;
   for (const auto& t : trials) {
     if (t.localized) {
       ++s.localized;
@@ -218,6 +220,10 @@ SystemSummary summarize(const std::string& dataset, const std::string& system, c
     s.failures += t.failure;
     for (const auto& st : t.steps) {
       ms.push_back(st.step_ms);
+      if (st.matched_points > 0) {
+        matched_sum += static_cast<double>(st.matched_points);
+        ++matched_n;
+      }
       if (st.status == hal::LocalizationStatus::kLocalized) {
         err_sum += st.err_m;
         ++err_n;
@@ -244,6 +250,7 @@ SystemSummary summarize(const std::string& dataset, const std::string& system, c
   for (double x : ms) m += x;
   s.step_ms_mean = ms.empty() ? 0 : m / ms.size();
   s.outside_map_in_region = region_n ? static_cast<double>(region_out) / region_n : std::numeric_limits<double>::quiet_NaN();
+  s.matched_points_mean = matched_n ? matched_sum / matched_n : std::numeric_limits<double>::quiet_NaN();
   s.tracking_err_median_m = percentile(track_err, 50);
   s.tracking_step_ms_p50 = percentile(track_ms, 50);
   s.tracking_step_ms_p99 = percentile(track_ms, 99);
@@ -253,13 +260,13 @@ SystemSummary summarize(const std::string& dataset, const std::string& system, c
 std::string markdown_table(const std::vector<SystemSummary>& rows) {
   std::ostringstream o;
   o << "| dataset | system | trials | localized | m to localize (median) | success | failure | mean err localized (m) "
-       "| step p50 (ms) | step p99 (ms) | memory (MiB) |\n";
-  o << "|---|---|---|---|---|---|---|---|---|---|---|\n";
+       "| step p50 (ms) | step p99 (ms) | memory (MiB) | matched points (mean) |\n";
+  o << "|---|---|---|---|---|---|---|---|---|---|---|---|\n";
   char buf[512];
   for (const auto& r : rows) {
-    std::snprintf(buf, sizeof(buf), "| %s | %s | %zu | %zu | %.1f | %.2f | %.2f | %.3f | %.1f | %.1f | %.1f |\n",
+    std::snprintf(buf, sizeof(buf), "| %s | %s | %zu | %zu | %.1f | %.2f | %.2f | %.3f | %.1f | %.1f | %.1f | %.0f |\n",
                   r.dataset.c_str(), r.system.c_str(), r.trials, r.localized, r.m_to_localize_median, r.success_rate,
-                  r.failure_rate, r.mean_err_m, r.step_ms_p50, r.step_ms_p99, r.memory_mib);
+                  r.failure_rate, r.mean_err_m, r.step_ms_p50, r.step_ms_p99, r.memory_mib, r.matched_points_mean);
     o << buf;
   }
   return o.str();

@@ -5,6 +5,7 @@
 #pragma once
 
 #include <cstdint>
+#include <functional>
 #include <memory>
 #include <string>
 #include <vector>
@@ -60,6 +61,7 @@ struct StepLog {
   double step_ms = 0;
   fw::Se2d estimate, truth;
   bool in_region = false;  // inside the erased region (unknown-area runs)
+  std::size_t matched_points = 0;  // MML: local map points handed to pRANSAM (0: not matched / not MML)
 };
 
 struct TrialResult {
@@ -75,8 +77,9 @@ struct TrialResult {
 };
 
 // Drives `loc` (reset first) from scan `start` on. `region` (optional) marks steps inside it.
+// `matched_points` (optional) reports the local map points matched in the last step (MML).
 TrialResult run_trial(fw::Localizer& loc, const LoadedDataset& ds, std::size_t start, const TrialOptions& opt,
-                      const double* region = nullptr);
+                      const double* region = nullptr, const std::function<std::size_t()>& matched_points = nullptr);
 
 // Kidnapped starts from a seed: uniform over scans with enough log left for the trial.
 std::vector<std::size_t> draw_starts(const LoadedDataset& ds, std::size_t count, std::uint64_t seed,
@@ -94,6 +97,7 @@ struct SystemSummary {
   double outside_map_in_region = 0;  // unknown-area runs: fraction of in-region steps reporting outside-map
   double tracking_err_median_m = 0;  // steps in tracking mode (hand-off)
   double tracking_step_ms_p50 = 0, tracking_step_ms_p99 = 0;
+  double matched_points_mean = 0;    // MML: mean local map points matched per matching step (NaN: none)
 };
 
 SystemSummary summarize(const std::string& dataset, const std::string& system, const std::vector<TrialResult>& trials,

@@ -5,6 +5,7 @@
 #include <cstdio>
 #include <filesystem>
 #include <fstream>
+#include <functional>
 #include <limits>
 
 #include "firmware/base/rng.h"
@@ -31,7 +32,9 @@ SystemRun run_system(OwnedLocalizer& loc, const LoadedDataset& ds, const std::st
   r.label = label;
   const auto t0 = std::chrono::steady_clock::now();
   for (std::size_t k = 0; k < starts.size(); ++k) {
-    r.trials.push_back(run_trial(loc, ds, starts[k], opt, region));
+    std::function<std::size_t()> probe;
+    if (loc.mml() != nullptr && loc.handoff() == nullptr) probe = [&loc] { return loc.mml()->matched_points(); };
+    r.trials.push_back(run_trial(loc, ds, starts[k], opt, region, probe));
     const TrialResult& t = r.trials.back();
     if (verbose) {
       std::printf("  %-12s %-10s trial %zu start %5zu: %s%s after %.1f m (%zu steps), err %.2f m%s%s\n", ds.name.c_str(),
@@ -44,6 +47,22 @@ SystemRun run_system(OwnedLocalizer& loc, const LoadedDataset& ds, const std::st
   r.summary = summarize(ds.name, label, r.trials, loc.static_bytes() / (1024.0 * 1024.0));
   if (verbose) std::printf("  %-12s %-10s done in %.1f s\n", ds.name.c_str(), label.c_str(), since(t0));
   return r;
+}
+
+// Configuration C`config` with the plan's local map options (plus `correct` / `reduce`).
+struct MmlVariant {
+  std::string label;
+  fw::mml::MmlLocalizerConfig cfg;
+};
+MmlVariant mml_variant(const EvalPlan& plan, int config, bool correct, bool reduce) {
+  MmlVariant v;
+  v.cfg = mml_config(config, plan.seed);
+  v.cfg.mml.correct_local_map = correct || plan.mml_correct;
+  v.cfg.mml.reduce_observations = reduce || plan.mml_reduce;
+  v.label = "mml-C" + std::to_string(config);
+  if (v.cfg.mml.correct_local_map) v.label += "+corr";
+  if (v.cfg.mml.reduce_observations) v.label += "+red";
+  return v;
 }
 
 void add_pair(BenchJson* json, const std::string& key, const std::string& sys, const SystemSummary& s) {
@@ -83,20 +102,36 @@ bool run_evaluation(const EvalPlan& plan, BenchJson* json, std::string* err) {
     std::vector<SystemRun> runs;
 
     // MML (main configuration, then the extra ones side by side).
-    std::vector<int> configs = {plan.mml_config};
+    std::vector<MmlVariant> configs = {mml_variant(plan, plan.mml_config, false, false)};
     for (int c : plan.extra_mml_configs)
-      if (c != plan.mml_config) configs.push_back(c);
+      if (c != plan.mml_config) configs.push_back(mml_variant(plan, c, false, false));
+    if (plan.compare_local_map_options) {
+      if (!plan.mml_correct) configs.push_back(mml_variant(plan, plan.mml_config, true, false));
+      if (!plan.mml_reduce) configs.push_back(mml_variant(plan, plan.mml_config, false, true));
+    }
     SystemSummary mml_main, mcl_main;
     for (std::size_t ci = 0; ci < configs.size(); ++ci) {
       std::string e;
       const auto ti = std::chrono::steady_clock::now();
-      auto loc = OwnedLocalizer::make_mml(ds.map, ds.image, mml_config(configs[ci], plan.seed), plan.threads, &e);
+      auto loc = OwnedLocalizer::make_mml(ds.map, ds.image, configs[ci].cfg, plan.threads, &e);
       if (!loc) return (*err = e, false);
       if (plan.verbose) {
-        std::printf("  mml C%d init %.1f s (precomputed table: %s)\n", configs[ci], since(ti),
+        std::printf("  %s init %.1f s (precomputed table: %s)\n", configs[ci].label.c_str(), since(ti),
                     loc->mml()->using_precomputed_table() ? "yes" : "no");
       }
-      SystemRun r = run_system(*loc, ds, "mml-C" + std::to_string(configs[ci]), starts, topt, plan.verbose);
+      SystemRun r = run_system(*loc, ds, configs[ci].label, starts, topt, plan.verbose);
+      if (plan.verbose) {
+        std::printf("  %-12s %-10s matched points per step %.0f, corrections %u, observations accepted %u (last trial)\n",
+                    ds.name.c_str(), configs[ci].label.c_str(), r.summary.matched_points_mean,
+                    loc->mml()->corrections_applied(), loc->mml()->observations_accepted());
+      }
+      if (ci > 0 && (configs[ci].cfg.mml.correct_local_map || configs[ci].cfg.mml.reduce_observations)) {
+        std::string key = "mml_c" + std::to_string(plan.mml_config);
+        if (configs[ci].cfg.mml.correct_local_map) key += "_corr";
+        if (configs[ci].cfg.mml.reduce_observations) key += "_red";
+        add_pair(json, ds.key, key, r.summary);
+        json->add(ds.key + "_" + key + "_matched_points_mean", r.summary.matched_points_mean);
+      }
       if (ci == 0) {
         mml_main = r.summary;
         static_mib = std::max(static_mib, r.summary.memory_mib + ds.arena->used() / (1024.0 * 1024.0));
@@ -122,7 +157,7 @@ bool run_evaluation(const EvalPlan& plan, BenchJson* json, std::string* err) {
     if (plan.run_handoff && std::find(plan.handoff_datasets.begin(), plan.handoff_datasets.end(), name) !=
                                 plan.handoff_datasets.end()) {
       std::string e;
-      auto loc = OwnedLocalizer::make_handoff(ds.map, ds.image, mml_config(plan.mml_config, plan.seed),
+      auto loc = OwnedLocalizer::make_handoff(ds.map, ds.image, mml_variant(plan, plan.mml_config, false, false).cfg,
                                               mcl_tracking_options(plan.seed), fw::mml::HandoffOptions(), plan.threads,
                                               &e);
       if (!loc) return (*err = e, false);
@@ -185,7 +220,7 @@ bool run_evaluation(const EvalPlan& plan, BenchJson* json, std::string* err) {
     TrialOptions uo = plan.trial;
     uo.max_steps = plan.trial.max_steps + 60;
     std::string e;
-    auto mml = OwnedLocalizer::make_mml(ds.map, ds.image, mml_config(plan.mml_config, plan.seed), plan.threads, &e);
+    auto mml = OwnedLocalizer::make_mml(ds.map, ds.image, mml_variant(plan, plan.mml_config, false, false).cfg, plan.threads, &e);
     if (!mml) return (*err = e, false);
     SystemRun rm = run_system(*mml, ds, "mml-unknown", starts, uo, plan.verbose, region);
     auto mcl = OwnedLocalizer::make_mcl(ds.map, mcl_baseline_options(plan.mcl_particles, plan.seed), plan.threads, &e);

@@ -19,6 +19,11 @@ struct EvalPlan {
   TrialOptions trial_mit;         // mit-killian: longer corridors
   int mml_config = 3;
   std::vector<int> extra_mml_configs;  // C1..C4 besides the main one (side by side)
+  // Local map correction (Eq. 5.23–5.27) / reduction (Eq. 5.28–5.30) on in every MML run.
+  bool mml_correct = false;
+  bool mml_reduce = false;
+  // Also run the main configuration with correction and with reduction side by side.
+  bool compare_local_map_options = false;
   std::uint32_t mcl_particles = 30000;
   std::uint32_t mcl_particles_mit = 120000;
   std::size_t mcl_trials = 0;     // 0 = same as trials (MCL is the slow one)

@@ -38,6 +38,17 @@ bool parse_int(const std::map<std::string, std::string>& o, const std::string& k
   return true;
 }
 
+// correct=0|1 / reduce=0|1: local map correction (Eq. 5.23–5.27) / reduction (Eq. 5.28–5.30).
+bool apply_local_map_options(const std::map<std::string, std::string>& o, const std::string& who,
+                             fw::mml::MmlLocalizerConfig* cfg, std::string* err) {
+  long correct = cfg->mml.correct_local_map ? 1 : 0, reduce = cfg->mml.reduce_observations ? 1 : 0;
+  if (!parse_int(o, "correct", 0, 1, &correct, who, err)) return false;
+  if (!parse_int(o, "reduce", 0, 1, &reduce, who, err)) return false;
+  cfg->mml.correct_local_map = correct != 0;
+  cfg->mml.reduce_observations = reduce != 0;
+  return true;
+}
+
 std::unique_ptr<fw::Localizer> wrap_hooks(std::unique_ptr<OwnedLocalizer> o, const LocalizerContext& ctx) {
   if (o && ctx.hooks) {
     OwnedLocalizer* raw = o.get();
@@ -49,7 +60,7 @@ std::unique_ptr<fw::Localizer> wrap_hooks(std::unique_ptr<OwnedLocalizer> o, con
 }  // namespace
 
 std::unique_ptr<fw::Localizer> make_mml_localizer(const LocalizerContext& ctx, std::string* err) {
-  const std::string bad = check_keys("mml", ctx.options, {"config", "iterations"});
+  const std::string bad = check_keys("mml", ctx.options, {"config", "iterations", "correct", "reduce"});
   if (!bad.empty()) { *err = bad; return nullptr; }
   if (ctx.global_map == nullptr) { *err = "localizer mml: needs a global map"; return nullptr; }
   long config = 3, iters = 0;
@@ -57,6 +68,7 @@ std::unique_ptr<fw::Localizer> make_mml_localizer(const LocalizerContext& ctx, s
   if (!parse_int(ctx.options, "iterations", 1000, 10000000, &iters, "mml", err)) return nullptr;
   auto cfg = mml_config(static_cast<int>(config), ctx.seed);
   if (iters > 0) cfg.mml.matching_iterations = static_cast<std::uint32_t>(iters);
+  if (!apply_local_map_options(ctx.options, "mml", &cfg, err)) return nullptr;
   static const std::vector<std::uint8_t> kEmpty;
   return wrap_hooks(OwnedLocalizer::make_mml(*ctx.global_map, ctx.map_image ? *ctx.map_image : kEmpty, cfg,
                                              ctx.threads, err),
@@ -88,14 +100,15 @@ std::unique_ptr<fw::Localizer> make_mcl_localizer(const LocalizerContext& ctx, s
 }
 
 std::unique_ptr<fw::Localizer> make_handoff_localizer(const LocalizerContext& ctx, std::string* err) {
-  const std::string bad = check_keys("handoff", ctx.options, {"config"});
+  const std::string bad = check_keys("handoff", ctx.options, {"config", "correct", "reduce"});
   if (!bad.empty()) { *err = bad; return nullptr; }
   if (ctx.global_map == nullptr) { *err = "localizer handoff: needs a global map"; return nullptr; }
   long config = 3;
   if (!parse_int(ctx.options, "config", 1, 4, &config, "handoff", err)) return nullptr;
+  auto cfg = mml_config(static_cast<int>(config), ctx.seed);
+  if (!apply_local_map_options(ctx.options, "handoff", &cfg, err)) return nullptr;
   static const std::vector<std::uint8_t> kEmpty;
-  return wrap_hooks(OwnedLocalizer::make_handoff(*ctx.global_map, ctx.map_image ? *ctx.map_image : kEmpty,
-                                                 mml_config(static_cast<int>(config), ctx.seed),
+  return wrap_hooks(OwnedLocalizer::make_handoff(*ctx.global_map, ctx.map_image ? *ctx.map_image : kEmpty, cfg,
                                                  mcl_tracking_options(ctx.seed), fw::mml::HandoffOptions(),
                                                  ctx.threads, err),
                     ctx);

@@ -25,7 +25,8 @@ struct HypothesisPoint;
 namespace sim::mmleval {
 
 // MML configurations compared (our reading of Tables 5.1–5.4; the thesis's UFLMS/UBB/PRT/MI
-// columns — local map reduction and correction are not implemented):
+// columns; local map correction and reduction are separate switches, MmlOptions.correct_local_map
+// and reduce_observations, off in C1–C4):
 //   C1: online relation tables, full local map, Bollinger, 30k iterations
 //   C2: precomputed table, full local map, Bollinger, 30k iterations
 //   C3: precomputed table, fixed local map (last 8 fragments of 2 m), Bollinger, 30k iterations
@@ -77,8 +78,9 @@ class OwnedLocalizer : public fw::Localizer {
 };
 
 // Simulator registry entries (sim/cli/localizer_factory): "mml", "mcl", "handoff".
-// Options (--opt k=v): mml: config=1..4, iterations=N; mcl: particles=N, model=beam|field,
-// kld=0|1, inject=0|1; handoff: config=1..4.
+// Options (--opt k=v): mml: config=1..4, iterations=N, correct=0|1 (local map correction,
+// Eq. 5.23–5.27), reduce=0|1 (local map reduction, Eq. 5.28–5.30); mcl: particles=N,
+// model=beam|field, kld=0|1, inject=0|1; handoff: config=1..4, correct=0|1, reduce=0|1.
 std::unique_ptr<fw::Localizer> make_mml_localizer(const LocalizerContext& ctx, std::string* err);
 std::unique_ptr<fw::Localizer> make_mcl_localizer(const LocalizerContext& ctx, std::string* err);
 std::unique_ptr<fw::Localizer> make_handoff_localizer(const LocalizerContext& ctx, std::string* err);
