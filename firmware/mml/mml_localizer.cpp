@@ -193,12 +193,18 @@ Status MmlLocalizer::gather_reduced_map() {
   return Status::ok();
 }
 
-// Eq. 5.23–5.27: move the newest fragments onto the global map under H_best. Only while the best
-// cluster passes the rating test (r > δ_r, ≥ min_cluster_hypotheses members), so an ambiguous or
-// wrong hypothesis cannot bend the local map; H_best is the best-quality hypothesis of that cluster.
+// Eq. 5.23–5.27: move the newest fragments onto the global map under H_best. Only in a step that
+// ends `localized` (all checks of this step passed, including the pose refiner's) and whose best
+// cluster passes the rating test (r > δ_r, ≥ min_cluster_hypotheses members): a correction under
+// a merely well-rated cluster made wrong clusters self-consistent on fr-clinic (a false
+// `localized` 108 m off), so the correction keeps a confirmed pose's local map consistent and
+// never takes part in deciding which pose it is. H_best = the best-quality hypothesis of that cluster.
 void MmlLocalizer::correct_local_map(const Se2f& mml_pose) {
   const MmlOptions& mo = config_.mml;
-  if (!last_.c_rating || interp_.cluster_count() == 0 || local_map_.num_fragments() == 0) return;
+  if (last_.status != hal::LocalizationStatus::kLocalized || !last_.c_rating || interp_.cluster_count() == 0 ||
+      local_map_.num_fragments() == 0) {
+    return;
+  }
   const Cluster* cl = interp_.clusters();
   std::size_t best = 0;
   for (std::size_t i = 1; i < interp_.cluster_count(); ++i)

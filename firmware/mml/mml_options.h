@@ -98,8 +98,8 @@ struct MmlOptions {
   std::uint32_t reduction_observation_points = 180;  // scan points kept per accepted observation
   std::uint32_t reduction_max_observations = 64;     // accepted observations kept (oldest evicted)
   // Local map correction (Sec. 5.4, Eq. 5.23–5.27, App. D, local_map_correction.h): gradient
-  // descent of the newest fragments onto the global map under H_best, only while the best cluster
-  // passes the rating test (r > δ_r with ≥ min_cluster_hypotheses members).
+  // descent of the newest fragments onto the global map under H_best, only in steps that end
+  // `localized` with the best cluster passing the rating test (r > δ_r, ≥ min_cluster_hypotheses).
   bool correct_local_map = false;
   std::uint32_t correction_iterations = 20;  // gradient steps per fragment and MML step
   float correction_step = 0.05f;             // α(0) of Eq. 5.27 (adapted: ×2 on success, ½ on failure)
