@@ -42,6 +42,7 @@ void Interpreter::reset() {
   omega_thres_ = options_.omega_thres0;
   soft_active_ = false;
   blind_steps_ = 0;
+  consistent_streak_ = 0;
 }
 
 float Interpreter::circular_mean(const float* angles, std::size_t n) {
@@ -314,6 +315,7 @@ Status Interpreter::interpret(const InterpretInput& in, InterpretResult* out) {
       return Status::ok();
     }
     soft_active_ = false;
+    consistent_streak_ = 0;
     if (can_predict) {  // keep x_prev moving with the robot so the next d² is meaningful
       prev_pose_ = pred.pose;
       prev_cov_ = pred.cov;
@@ -359,7 +361,12 @@ Status Interpreter::interpret(const InterpretInput& in, InterpretResult* out) {
     out->c_median = out->sigma_med < options_.xi_med;
   }
   const bool hard = out->c_rating && out->c_mahalanobis && out->c_median;  // Eq. 5.17
-  bool localized = hard;
+  consistent_streak_ = out->c_mahalanobis && out->c_median ? consistent_streak_ + 1 : 0;
+  // Extension: entering `localized` (not in soft mode) needs the consistency part of Eq. 5.17
+  // (d² and σ_med) in `confirm_steps` consecutive steps, the rating in the last one. σ_med
+  // (Eq. 5.16) is a median: right after a jump, a wrong cluster tracked for half of the τ_m window
+  // passes it, and one lucky rating localized it (aces: 3.6 m off along a corridor).
+  bool localized = hard && (soft_active_ || consistent_streak_ >= options_.confirm_steps);
   if (!hard && soft_active_) {  // Eq. 5.22
     localized = out->c_rating || (out->c_mahalanobis && out->c_median);
     out->soft = localized;

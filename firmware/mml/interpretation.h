@@ -117,6 +117,7 @@ class Interpreter {
   float omega_thres_ = 0.7f;
   bool soft_active_ = false;
   std::uint32_t blind_steps_ = 0;
+  std::uint32_t consistent_streak_ = 0;  // consecutive steps meeting d² and σ_med (entry confirmation)
 };
 
 }  // namespace mml

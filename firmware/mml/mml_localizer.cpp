@@ -121,11 +121,18 @@ void MmlLocalizer::reset() {
   localized_prev_ = localized_before_prev_ = false;
 }
 
+namespace {
+bool is_identity(const Se2f& t) { return t.x == 0.0f && t.y == 0.0f && t.theta == 0.0f; }
+}  // namespace
+
 // The robot pose in the corrected local map: the newest fragment's correction T_N as a transform
 // of the local map, C_N = (F_N ⊕ T_N) ⊖ F_N, applied to the RBSM pose.
 Se2f MmlLocalizer::corrected_pose(const Se2f& rbsm_pose) const {
   if (local_map_.num_fragments() == 0) return rbsm_pose;
   const FragmentView v = local_map_.fragment(local_map_.num_fragments() - 1);
+  // Uncorrected: exactly the RBSM pose (no rounding, so MML behaves bit-identically until the
+  // first correction).
+  if (is_identity(v.correction)) return rbsm_pose;
   return v.frame.compose(v.scan_matcher_frame.inverse()).compose(rbsm_pose);
 }
 
@@ -298,7 +305,7 @@ Status MmlLocalizer::step(const hal::LaserScan& scan, const hal::Odometry& odom,
     // drift is continuous, so the new fragment starts where the corrected map continues.
     const std::size_t nf = local_map_.num_fragments();
     const FragmentView v = local_map_.fragment(nf - 1);
-    if ((!have_newest_ || v.id != newest_id_) && nf >= 2) {
+    if ((!have_newest_ || v.id != newest_id_) && nf >= 2 && !is_identity(local_map_.fragment(nf - 2).correction)) {
       const FragmentView p = local_map_.fragment(nf - 2);
       const Se2f c_prev = p.frame.compose(p.scan_matcher_frame.inverse());
       FW_RETURN_IF_ERROR(local_map_.set_correction(nf - 1, v.scan_matcher_frame.inverse().compose(c_prev).compose(v.scan_matcher_frame)));

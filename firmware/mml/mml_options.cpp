@@ -45,6 +45,7 @@ Status MmlOptions::validate() const {
   FW_RETURN_IF_ERROR(check_range("tau_m", tau_m, 1, kMaxMedianWindow));
   FW_RETURN_IF_ERROR(check_range("med_min_samples", med_min_samples, 1, tau_m));
   FW_RETURN_IF_ERROR(check_range("soft_max_blind_steps", soft_max_blind_steps, 0, 1000));
+  FW_RETURN_IF_ERROR(check_range("confirm_steps", confirm_steps, 1, 100));
   FW_RETURN_IF_ERROR(check_range("odom_sigma_trans_per_m", odom_sigma_trans_per_m, 0.0, 10.0));
   FW_RETURN_IF_ERROR(check_range("odom_sigma_rot_per_rad", odom_sigma_rot_per_rad, 0.0, 10.0));
   FW_RETURN_IF_ERROR(check_range("odom_sigma_rot_per_m", odom_sigma_rot_per_m, 0.0, 10.0));

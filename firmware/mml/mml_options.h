@@ -48,6 +48,9 @@ struct MmlOptions {
   std::uint32_t med_min_samples = 5;  // d² samples needed before σ_med is trusted
   bool soft_rule = true;        // Eq. 5.22
   std::uint32_t soft_max_blind_steps = 3;  // steps without any hypothesis tolerated in soft mode
+  // Extension: consecutive steps meeting d² < ξ_r² and σ_med < ξ_med before the first `localized`
+  // (1 = Eq. 5.17 alone).
+  std::uint32_t confirm_steps = 2;
 
   // Covariances for Eq. 5.9–5.13: odometry noise per step (P_r) and a floor added to cluster
   // covariances (P_prev, P_h) — a one-hypothesis cluster has zero spread but is not exact.
