@@ -160,6 +160,34 @@ TEST(InterpreterTest, JumpingClusterFailsMahalanobis) {
   }
 }
 
+// After jumps, σ_med (a median) passes as soon as half of the τ_m window is consistent; with
+// confirm_steps = 2 the first `localized` waits until d² and σ_med held in two consecutive steps.
+int first_localized_after_jumps(std::uint32_t confirm_steps) {
+  static Interpreter it;
+  MmlOptions o;
+  o.confirm_steps = confirm_steps;
+  EXPECT_TRUE(it.init(o).is_ok());
+  RandomStream rng(8, 0);
+  Se2f truth(2, 3, 0.3f);
+  const Se2f step(0.3f, 0.0f, 0.05f);
+  for (int t = 0; t < 30; ++t) {
+    const float jump = (t < 6 && t % 2 == 1) ? 6.0f : 0.0f;  // a wrong place every other step
+    auto h = blob(truth.x + jump, truth.y, truth.theta, 60, 0.02f, 0.9f, &rng);
+    const InterpretResult r = run(&it, h, step, t > 0);
+    if (r.status == hal::LocalizationStatus::kLocalized) return t;
+    truth = truth.compose(step);
+  }
+  return -1;
+}
+
+TEST(InterpreterTest, ConfirmStepsDelaysEntryAfterJumps) {
+  const int first1 = first_localized_after_jumps(1);
+  const int first2 = first_localized_after_jumps(2);
+  ASSERT_GE(first1, 0);
+  ASSERT_GE(first2, 0);
+  EXPECT_GT(first2, first1);
+}
+
 TEST(InterpreterTest, BollingerWalksThresholdDownWithoutHypotheses) {
   static Interpreter it;
   MmlOptions o;
