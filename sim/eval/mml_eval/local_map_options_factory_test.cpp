@@ -1,0 +1,89 @@
+// mml-sim's registry entry "mml" (and "handoff") reach MML's local map options: --opt correct=0|1,
+// reduce=0|1; bad values and unknown keys are refused naming the option.
+#include <gtest/gtest.h>
+
+#include "firmware/base/arena.h"
+#include "firmware/map/map_image.h"
+#include "sim/cli/localizer_factory.h"
+#include "sim/eval/mml_eval/mml_systems.h"
+#include "sim/map/map_image_writer.h"
+#include "sim/world/builtin_worlds.h"
+#include "sim/world/raster.h"
+#include "sim/world/synthetic_run.h"
+
+namespace {
+
+struct SmallOffice {
+  sim::World world;
+  std::vector<std::uint8_t> image;
+  fw::StartupArena arena;
+  fw::GlobalMap map;
+  std::string err;
+  bool load() {
+    sim::OccupancyGrid grid;
+    if (!sim::make_builtin_world("small-office", &world, &err) || !sim::rasterize_world(world, sim::RasterOptions(), &grid, &err))
+      return false;
+    sim::MapImageWriter w;
+    if (!w.set_grid(grid, &err)) return false;
+    image = w.bytes();
+    return arena.init_mapped(image.size() + (4u << 20), false, "test map").is_ok() &&
+           fw::load_map_image(image.data(), image.size(), arena, &map, "small-office").is_ok();
+  }
+};
+
+TEST(LocalMapOptionsFactory, OptionsReachTheLocalizer) {
+  SmallOffice so;
+  ASSERT_TRUE(so.load()) << so.err;
+  sim::LocalizerContext ctx;
+  ctx.global_map = &so.map;
+  ctx.map_image = &so.image;
+  ctx.options = {{"correct", "1"}, {"reduce", "1"}};
+  std::string err;
+  auto loc = sim::mmleval::make_mml_localizer(ctx, &err);
+  ASSERT_NE(loc, nullptr) << err;
+  auto* owned = static_cast<sim::mmleval::OwnedLocalizer*>(loc.get());
+  sim::SyntheticRun run;
+  sim::SyntheticRunOptions ro;
+  ro.seed = 3;
+  ro.max_scans = 20;
+  ASSERT_TRUE(run.init(so.world, ro, &err)) << err;
+  sim::SyntheticFrame f;
+  while (run.next(&f)) {
+    hal::PoseEstimate est{};
+    ASSERT_TRUE(loc->step(f.scan, f.odometry.back(), &est).is_ok());
+  }
+  // Reduction on: at least the first observation was kept (0 when the option did not arrive).
+  EXPECT_GE(owned->mml()->observations_accepted(), 1u);
+
+  ctx.options = {{"reduce", "0"}};
+  auto plain = sim::mmleval::make_mml_localizer(ctx, &err);
+  ASSERT_NE(plain, nullptr) << err;
+  sim::SyntheticRun run2;
+  ASSERT_TRUE(run2.init(so.world, ro, &err)) << err;
+  while (run2.next(&f)) {
+    hal::PoseEstimate est{};
+    ASSERT_TRUE(plain->step(f.scan, f.odometry.back(), &est).is_ok());
+  }
+  EXPECT_EQ(static_cast<sim::mmleval::OwnedLocalizer*>(plain.get())->mml()->observations_accepted(), 0u);
+}
+
+TEST(LocalMapOptionsFactory, BadValuesAreRefused) {
+  SmallOffice so;
+  ASSERT_TRUE(so.load()) << so.err;
+  sim::LocalizerContext ctx;
+  ctx.global_map = &so.map;
+  ctx.map_image = &so.image;
+  std::string err;
+  ctx.options = {{"correct", "yes"}};
+  EXPECT_EQ(sim::mmleval::make_mml_localizer(ctx, &err), nullptr);
+  EXPECT_NE(err.find("correct='yes'"), std::string::npos) << err;
+  ctx.options = {{"reduce", "2"}};
+  EXPECT_EQ(sim::mmleval::make_handoff_localizer(ctx, &err), nullptr);
+  EXPECT_NE(err.find("reduce='2'"), std::string::npos) << err;
+  ctx.options = {{"corect", "1"}};
+  EXPECT_EQ(sim::mmleval::make_mml_localizer(ctx, &err), nullptr);
+  EXPECT_NE(err.find("unknown option(s) corect"), std::string::npos) << err;
+  EXPECT_NE(err.find("correct, reduce"), std::string::npos) << err;
+}
+
+}  // namespace
