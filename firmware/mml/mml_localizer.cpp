@@ -88,6 +88,8 @@ Status MmlLocalizer::init(const MmlLocalizerConfig& config, const GlobalMap& map
     for (std::size_t i = 0; i < config.mml.reduction_max_observations; ++i) red_[i].pts = *rp + i * per;
     pending_prev_.pts = *rp + (slots - 2) * per;
     pending_cur_.pts = *rp + (slots - 1) * per;
+    FW_RETURN_IF_ERROR(MemoryReport::instance().add(
+        {"mml", "reduced observations (Eq. 5.28-5.30)", slots * per * sizeof(Point2f), slots, nullptr}));
   }
   FW_RETURN_IF_ERROR(MemoryReport::instance().add({"mml", "interpreter", sizeof(Interpreter), kMaxHypotheses, nullptr}));
   FW_RETURN_IF_ERROR(MemoryReport::instance().add({"mml", "observations", sizeof(observations_), kMaxUnknownWindow, nullptr}));
