@@ -289,9 +289,11 @@ std::string markdown_table(const std::vector<SystemSummary>& rows) {
   o << "|---|---|---|---|---|---|---|---|---|---|---|---|\n";
   char buf[512];
   for (const auto& r : rows) {
-    std::snprintf(buf, sizeof(buf), "| %s | %s | %zu | %zu | %.1f | %.2f | %.2f | %.3f | %.1f | %.1f | %.1f | %.0f |\n",
+    char matched[32] = "-";  // MCL matches no local map
+    if (std::isfinite(r.matched_points_mean)) std::snprintf(matched, sizeof(matched), "%.0f", r.matched_points_mean);
+    std::snprintf(buf, sizeof(buf), "| %s | %s | %zu | %zu | %.1f | %.2f | %.2f | %.3f | %.1f | %.1f | %.1f | %s |\n",
                   r.dataset.c_str(), r.system.c_str(), r.trials, r.localized, r.m_to_localize_median, r.success_rate,
-                  r.failure_rate, r.mean_err_m, r.step_ms_p50, r.step_ms_p99, r.memory_mib, r.matched_points_mean);
+                  r.failure_rate, r.mean_err_m, r.step_ms_p50, r.step_ms_p99, r.memory_mib, matched);
     o << buf;
   }
   return o.str();
