@@ -2,29 +2,10 @@
 
 #include <cmath>
 
+#include "firmware/map/distance_sample.h"
+
 namespace fw {
 namespace mml {
-namespace {
-
-// Bilinear distance between cell centres and its gradient, in double (the finite-difference check
-// of the gradient needs more than float resolution). False off the grid.
-bool sample(const GlobalMap& m, double x, double y, double* d, double* gx, double* gy) {
-  const GridGeometry& g = m.geometry;
-  const double fx = (x - g.origin_x) / g.resolution - 0.5, fy = (y - g.origin_y) / g.resolution - 0.5;
-  if (!(fx >= 0.0 && fy >= 0.0 && fx < static_cast<double>(g.width) - 1.0 && fy < static_cast<double>(g.height) - 1.0)) {
-    return false;
-  }
-  const std::int32_t ix = static_cast<std::int32_t>(fx), iy = static_cast<std::int32_t>(fy);
-  const double ax = fx - ix, ay = fy - iy;
-  const double d00 = m.distance_m[g.index(ix, iy)], d10 = m.distance_m[g.index(ix + 1, iy)];
-  const double d01 = m.distance_m[g.index(ix, iy + 1)], d11 = m.distance_m[g.index(ix + 1, iy + 1)];
-  *d = (1 - ax) * (1 - ay) * d00 + ax * (1 - ay) * d10 + (1 - ax) * ay * d01 + ax * ay * d11;
-  *gx = ((1 - ay) * (d10 - d00) + ay * (d11 - d01)) / g.resolution;
-  *gy = ((1 - ax) * (d01 - d00) + ax * (d11 - d10)) / g.resolution;
-  return true;
-}
-
-}  // namespace
 
 double correction_error(const GlobalMap& map, const Se2f& a, const Point2f* pts, std::size_t n, float clip_m,
                         const double delta[3], double grad[3], std::uint32_t* inliers) {
@@ -39,7 +20,7 @@ double correction_error(const GlobalMap& map, const Se2f& a, const Point2f* pts,
     const double ux = cd * xl - sd * yl + delta[0], uy = sd * xl + cd * yl + delta[1];
     const double px = a.x + cb * ux - sb * uy, py = a.y + sb * ux + cb * uy;
     double d = 0.0, gx = 0.0, gy = 0.0;
-    if (!sample(map, px, py, &d, &gx, &gy) || d >= clip) {
+    if (!sample_distance<double>(map, px, py, &d, &gx, &gy) || d >= clip) {
       e += clip2;  // truncated: constant, no pull
       continue;
     }

@@ -3,28 +3,10 @@
 #include <Eigen/Cholesky>
 #include <cmath>
 
+#include "firmware/map/distance_sample.h"
+
 namespace fw {
 namespace mml {
-namespace {
-
-// Bilinear distance and its gradient (metres, per metre); false off the grid.
-bool sample(const GlobalMap& m, float x, float y, float* d, float* gx, float* gy) {
-  const GridGeometry& g = m.geometry;
-  const float fx = (x - g.origin_x) / g.resolution - 0.5f, fy = (y - g.origin_y) / g.resolution - 0.5f;
-  if (!(fx >= 0.0f && fy >= 0.0f && fx < static_cast<float>(g.width) - 1.0f && fy < static_cast<float>(g.height) - 1.0f)) {
-    return false;
-  }
-  const std::int32_t ix = static_cast<std::int32_t>(fx), iy = static_cast<std::int32_t>(fy);
-  const float ax = fx - static_cast<float>(ix), ay = fy - static_cast<float>(iy);
-  const float d00 = m.distance_m[g.index(ix, iy)], d10 = m.distance_m[g.index(ix + 1, iy)];
-  const float d01 = m.distance_m[g.index(ix, iy + 1)], d11 = m.distance_m[g.index(ix + 1, iy + 1)];
-  *d = (1 - ax) * (1 - ay) * d00 + ax * (1 - ay) * d10 + (1 - ax) * ay * d01 + ax * ay * d11;
-  *gx = ((1 - ay) * (d10 - d00) + ay * (d11 - d01)) / g.resolution;
-  *gy = ((1 - ax) * (d01 - d00) + ax * (d11 - d10)) / g.resolution;
-  return true;
-}
-
-}  // namespace
 
 RefineResult refine_pose(const GlobalMap& map, const Point2f* points, std::size_t n, const Se2f& initial,
                          const RefineOptions& o) {
@@ -46,7 +28,7 @@ RefineResult refine_pose(const GlobalMap& map, const Point2f* points, std::size_
       const float px = points[i].x(), py = points[i].y();
       const float qx = t.x + c * px - s * py, qy = t.y + s * px + c * py;
       float d, gx, gy;
-      if (!sample(map, qx, qy, &d, &gx, &gy) || d > clip) continue;
+      if (!sample_distance<float>(map, qx, qy, &d, &gx, &gy) || d > clip) continue;
       ++inl;
       sq += static_cast<double>(d) * d;
       const Eigen::Vector3d j(gx, gy, gx * (-s * px - c * py) + gy * (c * px - s * py));
