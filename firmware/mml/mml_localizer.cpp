@@ -40,6 +40,11 @@ MmlLocalizerConfig default_mml_config() {
   return c;
 }
 
+Status fill_global_relation_table(const MmlLocalizerConfig& config, pransam::Matcher<2>* matcher) {
+  return matcher->fill_model_table(config.mml.seed ^ 0x5eedull, config.mml.table_triples, config.mml.table_extent_m,
+                                   config.match.min_height_ratio);
+}
+
 Status MmlLocalizer::init(const MmlLocalizerConfig& config, const GlobalMap& map, const std::uint8_t* table_section,
                           std::size_t table_len, StartupArena& arena, WorkerPool* pool) {
   FW_RETURN_IF_ERROR(config.validate());
@@ -66,8 +71,7 @@ Status MmlLocalizer::init(const MmlLocalizerConfig& config, const GlobalMap& map
       FW_RETURN_IF_ERROR(matcher_.use_precomputed_table(sec.slots, sec.extent, "map image relation table"));
     } else {
       // No offline table in the image: fill R_B once at start-up (Theorem 2, h triples).
-      FW_RETURN_IF_ERROR(matcher_.fill_model_table(config.mml.seed ^ 0x5eedull, config.mml.table_triples,
-                                                   config.mml.table_extent_m, config.match.min_height_ratio));
+      FW_RETURN_IF_ERROR(fill_global_relation_table(config, &matcher_));
       const pransam::RelationTable& t = matcher_.model_table();
       FW_RETURN_IF_ERROR(matcher_.use_precomputed_table(t.data(), config.mml.table_extent_m, "start-up relation table"));
     }

@@ -48,6 +48,11 @@ struct MmlLocalizerConfig {
 // Defaults for a SICK-class 2-D laser and a 5 cm global map.
 MmlLocalizerConfig default_mml_config();
 
+// Fills the matcher's global relation table R_B as MML does when the map image has none (Theorem 2,
+// h = config.mml.table_triples). The one definition of that fill: mml-mapc --relation-table calls it
+// too, so an offline table equals the start-up one.
+Status fill_global_relation_table(const MmlLocalizerConfig& config, pransam::Matcher<2>* matcher);
+
 // Observation points kept per step for Eq. 5.37.
 constexpr std::size_t kUnknownPointsPerObservation = 48;
 

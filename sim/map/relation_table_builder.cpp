@@ -42,10 +42,7 @@ bool add_relation_table(MapImageWriter* writer, const RelationTableBuild& build,
   if (s.is_ok()) s = matcher.init(mo, arena, nullptr);
   if (s.is_ok()) s = matcher.set_model(map.points, map.num_points, name.c_str());
   const auto t0 = std::chrono::steady_clock::now();
-  // Same call as MmlLocalizer::init without a section (firmware/mml/mml_localizer.cpp).
-  if (s.is_ok())
-    s = matcher.fill_model_table(cfg.mml.seed ^ 0x5eedull, cfg.mml.table_triples, cfg.mml.table_extent_m,
-                                 cfg.match.min_height_ratio);
+  if (s.is_ok()) s = fw::mml::fill_global_relation_table(cfg, &matcher);
   const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
   std::vector<std::uint8_t> section(fw::pransam::relation_table_section_bytes());
   if (s.is_ok())

@@ -13,7 +13,7 @@
 namespace sim {
 
 struct RelationTableBuild {
-  std::uint64_t seed = 1;  // the firmware's `seed` (mmlfw config); the fill stream is seed ^ 0x5eed
+  std::uint64_t seed = 1;  // the firmware's `seed` (mmlfw config)
   int preset = 3;          // MML configuration C1..C4 (firmware/mml/mml_presets.h)
 };
 
