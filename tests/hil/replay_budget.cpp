@@ -178,7 +178,8 @@ bool run_replay(const ReplayOptions& o, ReplayResult* r, std::string* error) {
     // Push everything due.
     while (k < scan_t.size() &&
            (lockstep ? (laser.pending() == 0 && !loop.scan_pending() &&
-                         loop.health().scans_processed + loop.health().dropped_scans + r->scans_dropped >= k)
+                         loop.health().scans_processed + loop.health().dropped_scans + r->scans_dropped +
+                                 r->scans_lost >= k)
                      : now >= t0 + static_cast<std::uint64_t>(k * period * 1e9))) {
       const double tk = scan_t[k];
       while (oi < log.odom.size() && log.odom[oi].ipc_timestamp <= tk + 0.5 * (k + 1 < scan_t.size() ? scan_t[k + 1] - tk : 0)) {
@@ -192,7 +193,11 @@ bool run_replay(const ReplayOptions& o, ReplayResult* r, std::string* error) {
       }
       hal::LaserScan s = sim::to_laser_scan(log.scans[o.first_scan + k], warp(tk));
       if (lockstep) stepped.set_ns(warp(k + 1 < scan_t.size() ? scan_t[k + 1] : tk));
-      if (!laser.push(s)) ++r->scans_dropped;
+      if (o.lose_every > 0 && k % o.lose_every == o.lose_every - 1) {
+        ++r->scans_lost;
+      } else if (!laser.push(s)) {
+        ++r->scans_dropped;
+      }
       ++r->scans_fed;
       ++k;
     }

@@ -23,10 +23,11 @@ struct ReplayOptions {
   double deadline_ms = 1000.0 / 75.0;
   int workers = 2;
   std::uint64_t seed = 1;
+  size_t lose_every = 0;          // > 0: every n-th scan is lost on the way (never reaches the firmware)
 };
 
 struct ReplayResult {
-  size_t scans_fed = 0, scans_processed = 0, scans_dropped = 0, localized = 0;
+  size_t scans_fed = 0, scans_processed = 0, scans_dropped = 0, scans_lost = 0, localized = 0;
   size_t deadline_misses = 0;
   size_t wrong_localized = 0;     // localized poses farther than localized_bound_m from the reference
   double mean_err_localized_m = 0;

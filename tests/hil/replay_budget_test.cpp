@@ -47,7 +47,9 @@ TEST(ReplayBudget, Aces75HzWithinBudget) {
 
 // Deterministic check of the firmware's MML configuration (not part of the budget): aces scans
 // 0..249 in lockstep (no scan skipped, so timing cannot matter); MML must localize and never be
-// confidently wrong. Prints every wrong `localized` pose. MMLFW_REPLAY_SEED picks another seed.
+// confidently wrong. Prints every wrong `localized` pose. For diagnosis, MMLFW_REPLAY_SEED,
+// MMLFW_REPLAY_FIRST, MMLFW_REPLAY_COUNT and MMLFW_REPLAY_LOSE_EVERY (every n-th scan lost) replay
+// another seed or stretch of the log (the asserted bounds are for the default run).
 TEST(ReplayBudget, LockstepAcesLocalizesNeverWrong) {
   const sim::Dataset* ds = sim::find_dataset("aces");
   if (!ds || std::fopen(sim::data_path(ds->raw_log).c_str(), "rb") == nullptr) {
@@ -57,6 +59,9 @@ TEST(ReplayBudget, LockstepAcesLocalizesNeverWrong) {
   o.num_scans = 250;
   o.rate_hz = 0;
   if (const char* seed = std::getenv("MMLFW_REPLAY_SEED")) o.seed = std::strtoull(seed, nullptr, 10);
+  if (const char* v = std::getenv("MMLFW_REPLAY_FIRST")) o.first_scan = std::strtoull(v, nullptr, 10);
+  if (const char* v = std::getenv("MMLFW_REPLAY_COUNT")) o.num_scans = std::strtoull(v, nullptr, 10);
+  if (const char* v = std::getenv("MMLFW_REPLAY_LOSE_EVERY")) o.lose_every = std::strtoull(v, nullptr, 10);
   mmlfw_hil::ReplayResult r;
   std::string err;
   ASSERT_TRUE(mmlfw_hil::run_replay(o, &r, &err)) << err;
