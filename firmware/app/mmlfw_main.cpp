@@ -51,6 +51,28 @@ int fail(const char* stage, const fw::Status& s) {
 
 }  // namespace
 
+namespace {
+// log_level = debug: one line per processed scan with the odometry it was paired with and, for MML,
+// the interpreter's view (Eq. 5.7, 5.14, 5.16) — what a field engineer needs to replay a bad run.
+void trace_step(hal::Hal& hal, bool mml) {
+  const hal::PoseEstimate& e = g_loop.last_estimate();
+  const hal::Odometry& od = g_loop.last_odometry();
+  if (!mml) {
+    hal.log->log(hal::LogLevel::kDebug, "step scan %u t %llu odom %.4f %.4f %.4f status %s pose %.3f %.3f %.3f", e.scan_id,
+                 static_cast<unsigned long long>(e.timestamp_ns), od.x, od.y, od.theta, hal::status_name(e.status), e.x, e.y,
+                 e.theta);
+    return;
+  }
+  const fw::mml::InterpretResult& r = g_mml.last();
+  hal.log->log(hal::LogLevel::kDebug,
+               "step scan %u t %llu odom %.4f %.4f %.4f status %s pose %.3f %.3f %.3f hyps %u/%u clusters %u r %.3f "
+               "d2 %.2f smed %.2f c %d%d%d soft %d thres %.3f",
+               e.scan_id, static_cast<unsigned long long>(e.timestamp_ns), od.x, od.y, od.theta, hal::status_name(e.status),
+               e.x, e.y, e.theta, r.hypotheses_valid, r.hypotheses_in, r.cluster_count, r.best_rating, r.d2, r.sigma_med,
+               r.c_rating, r.c_mahalanobis, r.c_median, r.soft, r.omega_thres_next);
+}
+}  // namespace
+
 int main(int argc, char** argv) {
   const char* config_path = nullptr;
   bool memory_report = false;
@@ -204,6 +226,7 @@ int main(int argc, char** argv) {
       if (!g_loop.stepped()) break;
       ++scans;
       last_health = hal.clock->now_ns();  // the loop published health with the pose
+      if (c.log_level == static_cast<int>(hal::LogLevel::kDebug)) trace_step(hal, localizer == &g_mml);
       if (max_scans > 0 && static_cast<long>(scans) >= max_scans) g_stop = 1;
     }
     const std::uint64_t now = hal.clock->now_ns();

@@ -116,6 +116,7 @@ void MmlLocalizer::reset() {
   tracked_valid_ = false;
   tracked_bad_steps_ = tracked_unlocalized_steps_ = 0;
   last_refine_ = RefineResult();
+  last_unique_ = UniquenessResult();
   last_out_ = hal::PoseEstimate();
   have_newest_ = false;
   corrections_applied_ = 0;
@@ -459,13 +460,26 @@ Status MmlLocalizer::step(const hal::LaserScan& scan, const hal::Odometry& odom,
     }
     if (!tracked_valid_ && last_.status == hal::LocalizationStatus::kLocalized) {
       last_refine_ = refine_pose(map_, refine_pts_, m, last_.pose, ro);
-      if (last_refine_.accepted) {
+      bool unique = true;
+      if (last_refine_.accepted && mo.unique_check) {
+        UniquenessOptions uo;
+        uo.clip_m = ro.clip_m;
+        uo.max_shift_m = mo.unique_max_shift_m;
+        uo.shift_step_m = mo.unique_shift_step_m;
+        uo.margin = mo.unique_margin;
+        last_unique_ = check_pose_uniqueness(map_, refine_pts_, m, last_refine_.pose, uo);
+        unique = last_unique_.unique;
+        if (!unique) ++unique_rejections_;
+      }
+      if (last_refine_.accepted && unique) {
         tracked_valid_ = true;
         tracked_pose_ = last_refine_.pose;
         tracked_bad_steps_ = tracked_unlocalized_steps_ = 0;
       } else {
-        // The newest scan does not fit the map at the cluster pose: not sure after all.
+        // The newest scan does not fit the map at the cluster pose, or fits a rival pose along the
+        // corridor as well: not sure after all (and no soft rule on the strength of this step).
         last_.status = hal::LocalizationStatus::kAmbiguous;
+        interp_.drop_soft();
       }
     }
     if (tracked_valid_) {

@@ -26,6 +26,7 @@
 #include "firmware/mml/mml_options.h"
 #include "firmware/mml/observation_reduction.h"
 #include "firmware/mml/pose_refiner.h"
+#include "firmware/mml/pose_uniqueness.h"
 #include "firmware/pransam/matcher.h"
 #include "firmware/rbsm/local_map.h"
 #include "firmware/rbsm/rbsm.h"
@@ -73,6 +74,9 @@ class MmlLocalizer final : public Localizer {
   // Points handed to pRANSAM in the last step (0 when it did not match).
   std::size_t matched_points() const { return matched_points_; }
   const RefineResult& last_refine() const { return last_refine_; }
+  // Uniqueness test of the last step that would have entered `localized` (pose_uniqueness.h).
+  const UniquenessResult& last_uniqueness() const { return last_unique_; }
+  std::uint32_t uniqueness_rejections() const { return unique_rejections_; }
   const PerfCounter& match_perf() const { return perf_match_; }
   std::uint32_t front_end_failures() const { return front_end_failures_; }
   bool using_precomputed_table() const { return matcher_.has_precomputed_table(); }
@@ -141,6 +145,8 @@ class MmlLocalizer final : public Localizer {
   std::uint32_t tracked_bad_steps_ = 0, tracked_unlocalized_steps_ = 0;
   Point2f refine_pts_[1081];
   RefineResult last_refine_;
+  UniquenessResult last_unique_;
+  std::uint32_t unique_rejections_ = 0;
   hal::PoseEstimate last_out_;
   PerfCounter perf_match_{"mml.pransam"};
 

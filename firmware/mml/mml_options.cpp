@@ -54,6 +54,13 @@ Status MmlOptions::validate() const {
   FW_RETURN_IF_ERROR(check_positive("hyp_sigma_trans_floor_m", hyp_sigma_trans_floor_m));
   FW_RETURN_IF_ERROR(check_positive("hyp_sigma_rot_floor_rad", hyp_sigma_rot_floor_rad));
   FW_RETURN_IF_ERROR(check_range("refine_points", refine_points, 3, 1081));
+  if (!(unique_shift_step_m > 0.0f) || !(unique_max_shift_m >= unique_shift_step_m) || unique_max_shift_m > 20.0f) {
+    return Status::error(Errc::kInvalidArgument, "MmlOptions: need 0 < unique_shift_step_m (%g) <= unique_max_shift_m (%g) <= 20",
+                         static_cast<double>(unique_shift_step_m), static_cast<double>(unique_max_shift_m));
+  }
+  if (!(unique_margin >= 0.0f && unique_margin < 1.0f)) {
+    return Status::error(Errc::kInvalidArgument, "MmlOptions: unique_margin %g outside [0, 1)", static_cast<double>(unique_margin));
+  }
   FW_RETURN_IF_ERROR(check_range("omega_thres0", omega_thres0, 0.0, 1.0));
   FW_RETURN_IF_ERROR(check_range("tau_tr", tau_tr, 1, kMaxThresholdWindow));
   FW_RETURN_IF_ERROR(check_range("bollinger_k", bollinger_k, 0.0, 100.0));

@@ -68,6 +68,12 @@ struct MmlOptions {
   bool refine_pose = true;
   bool track_when_localized = true;
   std::uint32_t refine_points = 180;   // scan points used
+  // Extension (pose_uniqueness.h): entering `localized` also needs the refined pose to be the best
+  // fit of the newest scan among rivals seeded along its principal axes (corridor aliases).
+  bool unique_check = true;
+  float unique_max_shift_m = 3.0f;
+  float unique_shift_step_m = 0.4f;
+  float unique_margin = 0.0f;        // in units of clip² of the truncated scan cost
 
   // --- Matching threshold adaptation (Sec. 5.3.3, Eq. 5.18–5.21).
   bool bollinger = true;

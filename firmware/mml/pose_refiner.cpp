@@ -1,6 +1,7 @@
 #include "firmware/mml/pose_refiner.h"
 
 #include <Eigen/Cholesky>
+#include <Eigen/Eigenvalues>
 #include <cmath>
 
 #include "firmware/map/distance_sample.h"
@@ -35,7 +36,17 @@ RefineResult refine_pose(const GlobalMap& map, const Point2f* points, std::size_
       h += wd * (j * j.transpose());
       b += wd * static_cast<double>(d) * j;
     }
-    if (it == o.iterations || inl < 3) break;
+    if (it == o.iterations || inl < 3) {
+      if (inl >= 3) {
+        const Eigen::Matrix3d hu = h / wd;
+        Eigen::Matrix2d ht = hu.topLeftCorner<2, 2>();
+        if (hu(2, 2) > 1e-9) ht -= hu.topRightCorner<2, 1>() * hu.bottomLeftCorner<1, 2>() / hu(2, 2);
+        const Eigen::SelfAdjointEigenSolver<Eigen::Matrix2d> es(ht, Eigen::EigenvaluesOnly);
+        r.weak_axis_points = static_cast<float>(es.eigenvalues()(0));
+        r.strong_axis_points = static_cast<float>(es.eigenvalues()(1));
+      }
+      break;
+    }
     // Prior N(initial, diag(σ_xy², σ_xy², σ_θ²)).
     const double pxy = 1.0 / (static_cast<double>(o.prior_sigma_xy_m) * o.prior_sigma_xy_m);
     const double pth = 1.0 / (static_cast<double>(o.prior_sigma_theta_rad) * o.prior_sigma_theta_rad);

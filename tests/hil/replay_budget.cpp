@@ -3,6 +3,7 @@
 #include <time.h>
 
 #include <algorithm>
+#include <random>
 #include <cmath>
 #include <fstream>
 #include <memory>
@@ -170,6 +171,8 @@ bool run_replay(const ReplayOptions& o, ReplayResult* r, std::string* error) {
   size_t oi = 0;
   while (oi < log.odom.size() && log.odom[oi].ipc_timestamp < log_t0 - 0.5) ++oi;
   size_t k = 0;
+  std::mt19937_64 lose_rng(o.lose_seed);
+  std::uniform_real_distribution<double> lose_draw(0.0, 1.0);
   const double to_ms = 1e-6;
   (void)to_ms;
   const std::uint64_t end_ns = t0 + (lockstep ? 600'000'000'000ull : static_cast<std::uint64_t>((last - o.first_scan) * period * 1e9) + 3'000'000'000ull);
@@ -191,9 +194,13 @@ bool run_replay(const ReplayOptions& o, ReplayResult* r, std::string* error) {
         od.theta = static_cast<float>(c.pose.theta);
         odom.push(od);
       }
-      hal::LaserScan s = sim::to_laser_scan(log.scans[o.first_scan + k], warp(tk));
+      std::int64_t jitter_ns = 0;
+      if (o.scan_time_jitter_ms > 0) jitter_ns = static_cast<std::int64_t>((2.0 * lose_draw(lose_rng) - 1.0) * o.scan_time_jitter_ms * 1e6);
+      hal::LaserScan s = sim::to_laser_scan(log.scans[o.first_scan + k], warp(tk) + jitter_ns);
       if (lockstep) stepped.set_ns(warp(k + 1 < scan_t.size() ? scan_t[k + 1] : tk));
-      if (o.lose_every > 0 && k % o.lose_every == o.lose_every - 1) {
+      const bool lost_random = (o.lose_prob > 0 && lose_draw(lose_rng) < o.lose_prob) ||
+                               std::find(o.lose_list.begin(), o.lose_list.end(), o.first_scan + k) != o.lose_list.end();
+      if ((o.lose_every > 0 && k % o.lose_every == o.lose_every - 1) || lost_random) {
         ++r->scans_lost;
       } else if (!laser.push(s)) {
         ++r->scans_dropped;
@@ -207,6 +214,16 @@ bool run_replay(const ReplayOptions& o, ReplayResult* r, std::string* error) {
     hal::PoseEstimate e;
     while (sink.pop(&e)) {
       ++r->scans_processed;
+      if (o.trace && loc == &g_mml && e.scan_id < reference.size()) {
+        const fw::mml::InterpretResult& ir = g_mml.last();
+        const fw::Se2d& ref = reference[e.scan_id];
+        std::printf("trace %u %-10s err %6.3f pose %8.3f %8.3f %6.3f ref %8.3f %8.3f hyps %4u cl %3u r %.3f d2 %8.2f smed %6.2f c %d%d%d soft %d weak %.1f inl %.2f uq %d %.3f/%.3f\n",
+                    e.scan_id, hal::status_name(e.status), std::hypot(e.x - ref.x, e.y - ref.y), e.x, e.y, e.theta, ref.x,
+                    ref.y, ir.hypotheses_valid, ir.cluster_count, ir.best_rating, ir.d2, ir.sigma_med, ir.c_rating,
+                    ir.c_mahalanobis, ir.c_median, ir.soft, g_mml.last_refine().weak_axis_points,
+                    g_mml.last_refine().inlier_ratio, g_mml.last_uniqueness().unique, g_mml.last_uniqueness().cost,
+                    g_mml.last_uniqueness().rival_cost);
+      }
       if (e.status == hal::LocalizationStatus::kLocalized) {
         ++r->localized;
         const size_t idx = e.scan_id;  // to_laser_scan: scan_id = log index

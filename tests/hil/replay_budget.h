@@ -24,6 +24,14 @@ struct ReplayOptions {
   int workers = 2;
   std::uint64_t seed = 1;
   size_t lose_every = 0;          // > 0: every n-th scan is lost on the way (never reaches the firmware)
+  double lose_prob = 0;           // > 0: each scan is also lost with this probability (drawn from lose_seed),
+  std::uint64_t lose_seed = 1;    // as a real-time firmware that skips to the newest scan would see them
+  std::vector<size_t> lose_list;  // log indices of scans lost on the way (e.g. read off a HIL trace)
+  // > 0: each scan's timestamp is shifted by a uniform draw in ±this (ms, from lose_seed) against the
+  // odometry, the pairing jitter of a CAN link whose sender clock is mapped by a min-delay offset
+  // (HIL runs of one log differ by 1-2 cm in the paired odometry).
+  double scan_time_jitter_ms = 0;
+  bool trace = false;             // one line per processed scan on stdout (interpreter state, error)
 };
 
 struct ReplayResult {

@@ -47,9 +47,11 @@ TEST(ReplayBudget, Aces75HzWithinBudget) {
 
 // Deterministic check of the firmware's MML configuration (not part of the budget): aces scans
 // 0..249 in lockstep (no scan skipped, so timing cannot matter); MML must localize and never be
-// confidently wrong. Prints every wrong `localized` pose. For diagnosis, MMLFW_REPLAY_SEED,
-// MMLFW_REPLAY_FIRST, MMLFW_REPLAY_COUNT and MMLFW_REPLAY_LOSE_EVERY (every n-th scan lost) replay
-// another seed or stretch of the log (the asserted bounds are for the default run).
+// confidently wrong. Prints every wrong `localized` pose. For diagnosis (the asserted bounds are
+// for the default run), environment variables replay another run: MMLFW_REPLAY_SEED, _FIRST,
+// _COUNT; scans lost on the way: _LOSE_EVERY (every n-th), _LOSE_PROB with _LOSE_SEED (at random,
+// as a real-time firmware skipping to the newest scan), _LOSE_LIST (comma-separated log indices);
+// _JITTER_MS (scan/odometry pairing jitter, drawn from _LOSE_SEED); _TRACE=1 prints every step.
 TEST(ReplayBudget, LockstepAcesLocalizesNeverWrong) {
   const sim::Dataset* ds = sim::find_dataset("aces");
   if (!ds || std::fopen(sim::data_path(ds->raw_log).c_str(), "rb") == nullptr) {
@@ -62,6 +64,19 @@ TEST(ReplayBudget, LockstepAcesLocalizesNeverWrong) {
   if (const char* v = std::getenv("MMLFW_REPLAY_FIRST")) o.first_scan = std::strtoull(v, nullptr, 10);
   if (const char* v = std::getenv("MMLFW_REPLAY_COUNT")) o.num_scans = std::strtoull(v, nullptr, 10);
   if (const char* v = std::getenv("MMLFW_REPLAY_LOSE_EVERY")) o.lose_every = std::strtoull(v, nullptr, 10);
+  if (const char* v = std::getenv("MMLFW_REPLAY_LOSE_PROB")) o.lose_prob = std::strtod(v, nullptr);
+  if (const char* v = std::getenv("MMLFW_REPLAY_LOSE_SEED")) o.lose_seed = std::strtoull(v, nullptr, 10);
+  o.trace = std::getenv("MMLFW_REPLAY_TRACE") != nullptr;
+  if (const char* v = std::getenv("MMLFW_REPLAY_JITTER_MS")) o.scan_time_jitter_ms = std::strtod(v, nullptr);
+  if (const char* v = std::getenv("MMLFW_REPLAY_LOSE_LIST")) {  // comma-separated log indices
+    for (const char* q = v; *q;) {
+      char* end = nullptr;
+      const unsigned long long i = std::strtoull(q, &end, 10);
+      if (end == q) break;
+      o.lose_list.push_back(static_cast<size_t>(i));
+      q = *end == ',' ? end + 1 : end;
+    }
+  }
   mmlfw_hil::ReplayResult r;
   std::string err;
   ASSERT_TRUE(mmlfw_hil::run_replay(o, &r, &err)) << err;

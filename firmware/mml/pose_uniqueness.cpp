@@ -1,0 +1,82 @@
+#include "firmware/mml/pose_uniqueness.h"
+
+#include <Eigen/Eigenvalues>
+#include <cmath>
+
+#include "firmware/map/distance_sample.h"
+#include "firmware/mml/pose_refiner.h"
+
+namespace fw {
+namespace mml {
+
+float truncated_scan_cost(const GlobalMap& map, const Point2f* points, std::size_t n, const Se2f& pose, float clip_m) {
+  if (n == 0) return 1.0f;
+  const float c = std::cos(pose.theta), s = std::sin(pose.theta);
+  const double clip2 = static_cast<double>(clip_m) * clip_m;
+  double sum = 0.0;
+  for (std::size_t i = 0; i < n; ++i) {
+    const float px = points[i].x(), py = points[i].y();
+    float d, gx, gy;
+    if (!sample_distance<float>(map, pose.x + c * px - s * py, pose.y + s * px + c * py, &d, &gx, &gy) || d > clip_m) {
+      sum += 1.0;
+      continue;
+    }
+    sum += static_cast<double>(d) * d / clip2;
+  }
+  return static_cast<float>(sum / static_cast<double>(n));
+}
+
+namespace {
+
+// Principal axes of the translational information Σ ∇D ∇Dᵀ of the inliers at `pose` (columns,
+// weak axis first). Falls back to the map axes when too few points are in contact.
+Eigen::Matrix2f principal_axes(const GlobalMap& map, const Point2f* points, std::size_t n, const Se2f& pose, float clip_m) {
+  const float c = std::cos(pose.theta), s = std::sin(pose.theta);
+  Eigen::Matrix2f h = Eigen::Matrix2f::Zero();
+  std::size_t inl = 0;
+  for (std::size_t i = 0; i < n; ++i) {
+    const float px = points[i].x(), py = points[i].y();
+    float d, gx, gy;
+    if (!sample_distance<float>(map, pose.x + c * px - s * py, pose.y + s * px + c * py, &d, &gx, &gy) || d > clip_m) continue;
+    const Eigen::Vector2f g(gx, gy);
+    h += g * g.transpose();
+    ++inl;
+  }
+  if (inl < 3) return Eigen::Matrix2f::Identity();
+  const Eigen::SelfAdjointEigenSolver<Eigen::Matrix2f> es(h);
+  return es.eigenvectors();  // eigenvalues ascending: column 0 = weak axis
+}
+
+}  // namespace
+
+UniquenessResult check_pose_uniqueness(const GlobalMap& map, const Point2f* points, std::size_t n, const Se2f& pose,
+                                       const UniquenessOptions& o) {
+  UniquenessResult r;
+  r.cost = truncated_scan_cost(map, points, n, pose, o.clip_m);
+  r.rival = pose;
+  if (n == 0 || !map.valid() || o.shift_step_m <= 0.0f) return r;
+  const Eigen::Matrix2f axes = principal_axes(map, points, n, pose, o.clip_m);
+  RefineOptions ro;
+  ro.clip_m = o.clip_m;
+  ro.max_shift_m = o.shift_step_m;  // a rival stays near its seed: the seeds cover the line
+  for (int a = 0; a < 2; ++a) {
+    for (float step = o.shift_step_m; step <= o.max_shift_m + 1e-4f; step += o.shift_step_m) {
+      for (int sign = -1; sign <= 1; sign += 2) {
+        const Se2f seed(pose.x + sign * step * axes(0, a), pose.y + sign * step * axes(1, a), pose.theta);
+        const RefineResult rr = refine_pose(map, points, n, seed, ro);
+        ++r.rivals_tried;
+        if (std::hypot(rr.pose.x - pose.x, rr.pose.y - pose.y) < o.min_separation_m) continue;
+        const float cost = truncated_scan_cost(map, points, n, rr.pose, o.clip_m);
+        if (cost < r.rival_cost) {
+          r.rival_cost = cost;
+          r.rival = rr.pose;
+        }
+      }
+    }
+  }
+  r.unique = r.rival_cost > r.cost + o.margin;
+  return r;
+}
+
+}  // namespace mml
+}  // namespace fw
