@@ -73,7 +73,7 @@ struct MmlOptions {
   bool unique_check = true;
   float unique_max_shift_m = 3.0f;
   float unique_shift_step_m = 0.4f;
-  float unique_margin = 0.0f;        // in units of clip² of the truncated scan cost
+  float unique_margin = 0.01f;       // in units of clip² of the truncated scan cost: a near-tie is no proof
 
   // --- Matching threshold adaptation (Sec. 5.3.3, Eq. 5.18–5.21).
   bool bollinger = true;

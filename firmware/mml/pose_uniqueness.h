@@ -21,7 +21,7 @@ struct UniquenessOptions {
   float max_shift_m = 3.0f;        // rivals are seeded up to this far along each axis
   float shift_step_m = 0.4f;       // spacing of the seeds
   float min_separation_m = 0.4f;   // a refined rival closer than this is the candidate itself
-  float margin = 0.0f;             // unique when every rival's cost exceeds the candidate's by more
+  float margin = 0.01f;            // unique when every rival's cost exceeds the candidate's by more
 };
 
 struct UniquenessResult {

@@ -1,0 +1,89 @@
+#include "firmware/mml/pose_uniqueness.h"
+
+#include <gtest/gtest.h>
+
+#include <cmath>
+
+#include "firmware/mml/mml_test_util.h"
+#include "firmware/scan/scan_points.h"
+
+namespace fw {
+namespace mml {
+namespace {
+
+using mcl::testing::GridWorld;
+
+// A 40 m corridor, 2 m wide, with a pillar every 3 m on one wall: seen through an 8 m laser, every
+// 3 m shift of the robot looks the same (the aliasing of a real office corridor).
+GridWorld periodic_corridor() {
+  GridWorld g;
+  g.w = 800; g.h = 60;
+  g.occ.assign(g.w * g.h, 0);
+  g.box(0.5f, 0.5f, 39.5f, 2.5f);
+  for (float x = 3.0f; x < 39.0f; x += 3.0f) g.box(x, 0.5f, x + 0.3f, 0.8f);
+  g.finish();
+  return g;
+}
+
+std::size_t scan_points_at(const GridWorld& g, const Se2f& pose, Point2f* pts) {
+  static hal::LaserScan scan;
+  mcl::testing::simulate_scan(g.view(), pose.x, pose.y, pose.theta, &scan);
+  ScanPointsResult sr;
+  EXPECT_TRUE(scan_to_points(scan, {}, pts, 1081, &sr).is_ok());
+  return sr.count;
+}
+
+TEST(PoseUniquenessTest, UniqueRoomPoseIsUnique) {
+  static GridWorld g = mcl::testing::unique_room();
+  static testing::OwnedGlobalMap gm(g);
+  static Point2f pts[1081];
+  for (const Se2f truth : {Se2f(2.5f, 6.5f, 0.0f), Se2f(4.5f, 2.8f, -1.57f), Se2f(7.0f, 3.0f, 0.7f)}) {
+    const std::size_t n = scan_points_at(g, truth, pts);
+    const UniquenessResult r = check_pose_uniqueness(gm.map, pts, n, truth, UniquenessOptions());
+    EXPECT_TRUE(r.unique) << truth.x << "," << truth.y << ": cost " << r.cost << " rival " << r.rival_cost << " at "
+                          << r.rival.x << "," << r.rival.y;
+    EXPECT_LT(r.cost, 0.05f);
+    EXPECT_EQ(r.rivals_tried, 2u * 2u * 7u);  // 2 axes × 2 signs × 7 steps of 0.4 m up to 3 m
+  }
+}
+
+TEST(PoseUniquenessTest, OffsetPoseLosesToTheTruePose) {
+  // The candidate is 1.2 m off (a wrong cluster); the rival seeded near the truth fits better.
+  static GridWorld g = mcl::testing::unique_room();
+  static testing::OwnedGlobalMap gm(g);
+  static Point2f pts[1081];
+  const Se2f truth(4.5f, 2.8f, 0.0f);
+  const std::size_t n = scan_points_at(g, truth, pts);
+  const Se2f wrong(truth.x + 1.2f, truth.y, truth.theta);
+  const UniquenessResult r = check_pose_uniqueness(gm.map, pts, n, wrong, UniquenessOptions());
+  EXPECT_FALSE(r.unique) << "cost " << r.cost << " rival " << r.rival_cost;
+  EXPECT_LT(r.rival_cost, r.cost);
+  EXPECT_LT(std::hypot(r.rival.x - truth.x, r.rival.y - truth.y), 0.2f) << r.rival.x << "," << r.rival.y;
+}
+
+TEST(PoseUniquenessTest, PeriodicCorridorIsNotUnique) {
+  static GridWorld g = periodic_corridor();
+  static testing::OwnedGlobalMap gm(g);
+  static Point2f pts[1081];
+  for (const Se2f truth : {Se2f(18.1f, 1.5f, 0.0f), Se2f(20.0f, 1.7f, 3.14159f), Se2f(21.0f, 1.4f, 0.3f)}) {
+    const std::size_t n = scan_points_at(g, truth, pts);
+    const UniquenessResult r = check_pose_uniqueness(gm.map, pts, n, truth, UniquenessOptions());
+    EXPECT_FALSE(r.unique) << truth.x << ": cost " << r.cost << " rival " << r.rival_cost << " at " << r.rival.x;
+    // The rival is an alias along the corridor (x), one pillar period away, not across it.
+    EXPECT_NEAR(std::fabs(r.rival.x - truth.x), 3.0f, 0.2f);
+    EXPECT_NEAR(r.rival.y, truth.y, 0.1f);
+  }
+}
+
+TEST(PoseUniquenessTest, EmptyInputIsHandled) {
+  static GridWorld g = mcl::testing::unique_room();
+  static testing::OwnedGlobalMap gm(g);
+  const UniquenessResult r = check_pose_uniqueness(gm.map, nullptr, 0, Se2f(1.0f, 1.0f, 0.0f), UniquenessOptions());
+  EXPECT_TRUE(r.unique);
+  EXPECT_EQ(r.rivals_tried, 0u);
+  EXPECT_FLOAT_EQ(truncated_scan_cost(gm.map, nullptr, 0, Se2f(), 0.15f), 1.0f);
+}
+
+}  // namespace
+}  // namespace mml
+}  // namespace fw
