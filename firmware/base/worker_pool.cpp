@@ -7,10 +7,44 @@
 #include <cstdarg>
 #include <cstdio>
 #include <cstring>
+#include <ctime>
 
 #include "firmware/base/fault.h"
 
 namespace fw {
+namespace {
+
+inline void cpu_relax() {
+#if defined(__x86_64__) || defined(__i386__)
+  __builtin_ia32_pause();
+#elif defined(__aarch64__) || defined(__arm__)
+  asm volatile("yield" ::: "memory");
+#endif
+}
+
+std::uint64_t monotonic_ns() {
+  timespec ts;
+  clock_gettime(CLOCK_MONOTONIC, &ts);
+  return static_cast<std::uint64_t>(ts.tv_sec) * 1000000000ull + static_cast<std::uint64_t>(ts.tv_nsec);
+}
+
+// Polls done() for up to spin_us microseconds (yielding now and then, so a thread sharing the core
+// can run); true when it became true.
+template <typename Done>
+bool spin_until(Done done, int spin_us) {
+  if (spin_us <= 0) return done();
+  const std::uint64_t end = monotonic_ns() + static_cast<std::uint64_t>(spin_us) * 1000ull;
+  for (std::uint32_t i = 1;; ++i) {
+    if (done()) return true;
+    cpu_relax();
+    if ((i & 63u) == 0) {
+      if (monotonic_ns() >= end) return done();
+      sched_yield();
+    }
+  }
+}
+
+}  // namespace
 
 void WorkerPool::warn(const char* fmt, ...) {
   va_list args;
@@ -31,7 +65,8 @@ Status WorkerPool::start(const WorkerPoolOptions& options) {
   if (online < 1) online = 1;
   num_workers_ = options.num_workers;
   stopping_ = false;
-  generation_ = 0;
+  generation_.store(0);
+  spin_us_ = options.spin_us < 0 ? 0 : options.spin_us;
   for (int i = 0; i < num_workers_; ++i) {
     int core = options.cores[i] >= 0 ? options.cores[i] : i;
     if (core >= online) {
@@ -79,7 +114,7 @@ void WorkerPool::stop() {
   if (!started_) return;
   pthread_mutex_lock(&mutex_);
   stopping_ = true;
-  ++generation_;
+  generation_.fetch_add(1);
   pthread_cond_broadcast(&start_cv_);
   pthread_mutex_unlock(&mutex_);
   for (int i = 0; i < num_workers_; ++i) pthread_join(threads_[i], nullptr);
@@ -96,9 +131,10 @@ void* WorkerPool::thread_main(void* arg) {
 void WorkerPool::worker_loop(int index) {
   std::uint64_t seen = 0;
   for (;;) {
+    spin_until([&] { return generation_.load(std::memory_order_acquire) != seen; }, spin_us_);
     pthread_mutex_lock(&mutex_);
-    while (generation_ == seen) pthread_cond_wait(&start_cv_, &mutex_);
-    seen = generation_;
+    while (generation_.load() == seen) pthread_cond_wait(&start_cv_, &mutex_);
+    seen = generation_.load();
     if (stopping_) {
       pthread_mutex_unlock(&mutex_);
       return;
@@ -110,9 +146,13 @@ void WorkerPool::worker_loop(int index) {
 
     fn(ctx, index, n);
 
-    pthread_mutex_lock(&mutex_);
-    if (--remaining_ == 0) pthread_cond_signal(&done_cv_);
-    pthread_mutex_unlock(&mutex_);
+    // The last worker wakes run(); run() re-checks remaining_ under mutex_ before it sleeps, so
+    // signalling under the mutex cannot be lost.
+    if (remaining_.fetch_sub(1, std::memory_order_acq_rel) == 1) {
+      pthread_mutex_lock(&mutex_);
+      pthread_cond_signal(&done_cv_);
+      pthread_mutex_unlock(&mutex_);
+    }
   }
 }
 
@@ -130,10 +170,14 @@ void WorkerPool::run(JobFn fn, void* context) {
   pthread_mutex_lock(&mutex_);
   job_ = fn;
   job_context_ = context;
-  remaining_ = num_workers_;
-  ++generation_;
+  remaining_.store(num_workers_);
+  generation_.fetch_add(1);  // seq_cst: job_, job_context_ and remaining_ are visible with it
   pthread_cond_broadcast(&start_cv_);
-  while (remaining_ > 0) pthread_cond_wait(&done_cv_, &mutex_);
+  pthread_mutex_unlock(&mutex_);
+  // The caller only waits (the workers own the cores): spin briefly for short jobs, then sleep.
+  spin_until([&] { return remaining_.load(std::memory_order_acquire) == 0; }, spin_us_);
+  pthread_mutex_lock(&mutex_);
+  while (remaining_.load() > 0) pthread_cond_wait(&done_cv_, &mutex_);
   pthread_mutex_unlock(&mutex_);
   in_run_.store(false);
 }

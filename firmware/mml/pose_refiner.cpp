@@ -1,9 +1,9 @@
 #include "firmware/mml/pose_refiner.h"
 
 #include <Eigen/Cholesky>
-#include <Eigen/Eigenvalues>
 #include <cmath>
 
+#include "firmware/base/sym2_eigen.h"
 #include "firmware/map/distance_sample.h"
 
 namespace fw {
@@ -41,9 +41,9 @@ RefineResult refine_pose(const GlobalMap& map, const Point2f* points, std::size_
         const Eigen::Matrix3d hu = h / wd;
         Eigen::Matrix2d ht = hu.topLeftCorner<2, 2>();
         if (hu(2, 2) > 1e-9) ht -= hu.topRightCorner<2, 1>() * hu.bottomLeftCorner<1, 2>() / hu(2, 2);
-        const Eigen::SelfAdjointEigenSolver<Eigen::Matrix2d> es(ht, Eigen::EigenvaluesOnly);
-        r.weak_axis_points = static_cast<float>(es.eigenvalues()(0));
-        r.strong_axis_points = static_cast<float>(es.eigenvalues()(1));
+        const Sym2Eigen es = sym2_eigen(ht(0, 0), ht(0, 1), ht(1, 1));
+        r.weak_axis_points = es.lambda_min;
+        r.strong_axis_points = es.lambda_max;
       }
       break;
     }

@@ -1,8 +1,8 @@
 #include "firmware/mml/pose_uniqueness.h"
 
-#include <Eigen/Eigenvalues>
 #include <cmath>
 
+#include "firmware/base/sym2_eigen.h"
 #include "firmware/map/distance_sample.h"
 #include "firmware/mml/pose_refiner.h"
 
@@ -43,8 +43,10 @@ Eigen::Matrix2f principal_axes(const GlobalMap& map, const Point2f* points, std:
     ++inl;
   }
   if (inl < 3) return Eigen::Matrix2f::Identity();
-  const Eigen::SelfAdjointEigenSolver<Eigen::Matrix2f> es(h);
-  return es.eigenvectors();  // eigenvalues ascending: column 0 = weak axis
+  const Sym2Eigen es = sym2_eigen(h(0, 0), h(0, 1), h(1, 1));
+  Eigen::Matrix2f axes;
+  axes << es.vmin_x, -es.vmin_y, es.vmin_y, es.vmin_x;  // column 0 = weak axis, column 1 its normal
+  return axes;
 }
 
 }  // namespace

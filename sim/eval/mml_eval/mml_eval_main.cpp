@@ -3,7 +3,7 @@
 //   mml-eval [--datasets intel,aces] [--trials 10] [--mcl-trials N] [--steps 150] [--mit-steps 300]
 //            [--seed 1] [--threads 2] [--config 3] [--all-configs] [--mcl-particles 30000]
 //            [--mcl-particles-mit 120000] [--no-handoff] [--no-mcl] [--no-unknown] [--out build/eval/mml]
-//            [--correct] [--reduce] [--compare-local-map-options]
+//            [--correct] [--reduce] [--no-unique] [--compare-local-map-options]
 //   --correct / --reduce: local map correction (Eq. 5.23–5.27) / reduction (Eq. 5.28–5.30) on in
 //   every MML run (labels mml-C3+corr, +red); --compare-local-map-options: the main configuration
 //   also with correction and with reduction, side by side (JSON keys <dataset>_mml_c3_corr_*, _red_*).
@@ -58,6 +58,7 @@ int main(int argc, char** argv) {
     else if (a == "--no-unknown") plan.run_unknown = false;
     else if (a == "--correct") plan.mml_correct = true;
     else if (a == "--reduce") plan.mml_reduce = true;
+    else if (a == "--no-unique") plan.mml_unique = false;
     else if (a == "--compare-local-map-options") plan.compare_local_map_options = true;
     else if (a == "--out" && i + 1 < argc) plan.out_dir = argv[++i];
     else return usage(("unknown argument '" + a + "'").c_str());

@@ -59,6 +59,7 @@ MmlVariant mml_variant(const EvalPlan& plan, int config, bool correct, bool redu
   v.cfg = mml_config(config, plan.seed);
   v.cfg.mml.correct_local_map = correct || plan.mml_correct;
   v.cfg.mml.reduce_observations = reduce || plan.mml_reduce;
+  v.cfg.mml.unique_check = plan.mml_unique;
   v.label = "mml-C" + std::to_string(config);
   if (v.cfg.mml.correct_local_map) v.label += "+corr";
   if (v.cfg.mml.reduce_observations) v.label += "+red";

@@ -22,6 +22,7 @@ struct EvalPlan {
   // Local map correction (Eq. 5.23–5.27) / reduction (Eq. 5.28–5.30) on in every MML run.
   bool mml_correct = false;
   bool mml_reduce = false;
+  bool mml_unique = true;   // --no-unique: MmlOptions::unique_check off (pose_uniqueness.h)
   // Also run the main configuration with correction and with reduction side by side.
   bool compare_local_map_options = false;
   std::uint32_t mcl_particles = 30000;
