@@ -66,10 +66,10 @@ void trace_step(hal::Hal& hal, bool mml) {
   const fw::mml::InterpretResult& r = g_mml.last();
   hal.log->log(hal::LogLevel::kDebug,
                "step scan %u t %llu odom %.4f %.4f %.4f status %s pose %.3f %.3f %.3f hyps %u/%u clusters %u r %.3f "
-               "d2 %.2f smed %.2f c %d%d%d soft %d thres %.3f",
+               "d2 %.2f smed %.2f c %d%d%d soft %d thres %.3f unique-rejections %u",
                e.scan_id, static_cast<unsigned long long>(e.timestamp_ns), od.x, od.y, od.theta, hal::status_name(e.status),
                e.x, e.y, e.theta, r.hypotheses_valid, r.hypotheses_in, r.cluster_count, r.best_rating, r.d2, r.sigma_med,
-               r.c_rating, r.c_mahalanobis, r.c_median, r.soft, r.omega_thres_next);
+               r.c_rating, r.c_mahalanobis, r.c_median, r.soft, r.omega_thres_next, g_mml.uniqueness_rejections());
 }
 }  // namespace
 
