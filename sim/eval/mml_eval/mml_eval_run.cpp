@@ -36,11 +36,13 @@ SystemRun run_system(OwnedLocalizer& loc, const LoadedDataset& ds, const std::st
     if (loc.mml() != nullptr && loc.handoff() == nullptr) probe = [&loc] { return loc.mml()->matched_points(); };
     r.trials.push_back(run_trial(loc, ds, starts[k], opt, region, probe));
     const TrialResult& t = r.trials.back();
-    if (verbose) {
-      std::printf("  %-12s %-10s trial %zu start %5zu: %s%s after %.1f m (%zu steps), err %.2f m%s%s\n", ds.name.c_str(),
-                  label.c_str(), k, t.start, t.localized ? "localized" : "not localized",
-                  t.failure ? " [FAILURE]" : "", t.metres_to_localize, t.steps_to_localize, t.mean_err_localized,
-                  t.error.empty() ? "" : " error: ", t.error.c_str());
+    if (verbose && t.localized) {
+      std::printf("  %-12s %-10s trial %zu start %5zu: localized%s after %.1f m (%zu steps), err %.2f m%s%s\n", ds.name.c_str(),
+                  label.c_str(), k, t.start, t.failure ? " [FAILURE]" : "", t.metres_to_localize, t.steps_to_localize,
+                  t.mean_err_localized, t.error.empty() ? "" : " error: ", t.error.c_str());
+    } else if (verbose) {
+      std::printf("  %-12s %-10s trial %zu start %5zu: not localized in %zu steps%s%s\n", ds.name.c_str(), label.c_str(), k,
+                  t.start, t.steps.size(), t.error.empty() ? "" : " error: ", t.error.c_str());
       std::fflush(stdout);
     }
   }
