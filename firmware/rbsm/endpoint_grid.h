@@ -29,10 +29,7 @@ struct EndpointGridOptions {
   std::uint32_t size_log2 = 10;    // window side = 2^size_log2 cells (1024 × 5 cm = 51.2 m)
   std::uint32_t subcell_log2 = 2;  // lookup sub-cells per cell side = 2^subcell_log2
   float xi_cells = 1.41421356f;    // ξ: bound of the nearest-neighbour distance (Eq. 2.9), ≤ 1.5
-  // Re-centre when the robot is this fraction of the side off-centre. Small, so the window scrolls
-  // a few strips often: at 0.25 (256 strips of 1024 cells at once, every 12.8 m) the scroll cost
-  // 11-22 ms in one RBSM step, the 1 % tail of the MML step time.
-  float recenter_fraction = 1.0f / 64.0f;
+  float recenter_fraction = 0.25f; // re-centre when the robot is this fraction of the side off-centre
 
   Status validate() const;
 };

@@ -49,7 +49,6 @@ TEST_F(GridFixture, LikelihoodFollowsEq29) {
 TEST_F(GridFixture, ScrollingDropsCellsThatLeaveTheWindow) {
   fw::EndpointGridOptions o;
   o.size_log2 = 6;  // 64 cells = 3.2 m
-  o.recenter_fraction = 0.25f;  // re-centre margin 16 cells = 0.8 m
   make(o);
   grid.center_on(0, 0);
   ASSERT_TRUE(grid.insert(-1.0f, 0.0f));
