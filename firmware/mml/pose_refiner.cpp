@@ -3,7 +3,6 @@
 #include <Eigen/Cholesky>
 #include <cmath>
 
-#include "firmware/base/sym2_eigen.h"
 #include "firmware/map/distance_sample.h"
 
 namespace fw {
@@ -36,17 +35,7 @@ RefineResult refine_pose(const GlobalMap& map, const Point2f* points, std::size_
       h += wd * (j * j.transpose());
       b += wd * static_cast<double>(d) * j;
     }
-    if (it == o.iterations || inl < 3) {
-      if (inl >= 3) {
-        const Eigen::Matrix3d hu = h / wd;
-        Eigen::Matrix2d ht = hu.topLeftCorner<2, 2>();
-        if (hu(2, 2) > 1e-9) ht -= hu.topRightCorner<2, 1>() * hu.bottomLeftCorner<1, 2>() / hu(2, 2);
-        const Sym2Eigen es = sym2_eigen(ht(0, 0), ht(0, 1), ht(1, 1));
-        r.weak_axis_points = es.lambda_min;
-        r.strong_axis_points = es.lambda_max;
-      }
-      break;
-    }
+    if (it == o.iterations || inl < 3) break;
     // Prior N(initial, diag(σ_xy², σ_xy², σ_θ²)).
     const double pxy = 1.0 / (static_cast<double>(o.prior_sigma_xy_m) * o.prior_sigma_xy_m);
     const double pth = 1.0 / (static_cast<double>(o.prior_sigma_theta_rad) * o.prior_sigma_theta_rad);

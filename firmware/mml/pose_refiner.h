@@ -31,12 +31,6 @@ struct RefineResult {
   Se2f pose;
   float inlier_ratio = 0.0f;
   float rms_m = 0.0f;
-  // Observability of the translation at the final pose: the smallest eigenvalue of the inliers'
-  // translational information (Schur complement of θ in Σ JᵀJ, unit-weight) — how many points'
-  // worth of map gradient pin the weakest direction. ≈ 0 along a corridor whose walls are all the
-  // scan sees: the match slides along it.
-  float weak_axis_points = 0.0f;
-  float strong_axis_points = 0.0f;
   bool accepted = false;
 };
 

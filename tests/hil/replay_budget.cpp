@@ -217,11 +217,10 @@ bool run_replay(const ReplayOptions& o, ReplayResult* r, std::string* error) {
       if (o.trace && loc == &g_mml && e.scan_id < reference.size()) {
         const fw::mml::InterpretResult& ir = g_mml.last();
         const fw::Se2d& ref = reference[e.scan_id];
-        std::printf("trace %u %-10s err %6.3f pose %8.3f %8.3f %6.3f ref %8.3f %8.3f hyps %4u cl %3u r %.3f d2 %8.2f smed %6.2f c %d%d%d soft %d weak %.1f inl %.2f uq %d %.3f/%.3f\n",
+        std::printf("trace %u %-10s err %6.3f pose %8.3f %8.3f %6.3f ref %8.3f %8.3f hyps %4u cl %3u r %.3f d2 %8.2f smed %6.2f c %d%d%d soft %d inl %.2f uq %d %.3f/%.3f\n",
                     e.scan_id, hal::status_name(e.status), std::hypot(e.x - ref.x, e.y - ref.y), e.x, e.y, e.theta, ref.x,
                     ref.y, ir.hypotheses_valid, ir.cluster_count, ir.best_rating, ir.d2, ir.sigma_med, ir.c_rating,
-                    ir.c_mahalanobis, ir.c_median, ir.soft, g_mml.last_refine().weak_axis_points,
-                    g_mml.last_refine().inlier_ratio, g_mml.last_uniqueness().unique, g_mml.last_uniqueness().cost,
+                    ir.c_mahalanobis, ir.c_median, ir.soft, g_mml.last_refine().inlier_ratio, g_mml.last_uniqueness().unique, g_mml.last_uniqueness().cost,
                     g_mml.last_uniqueness().rival_cost);
       }
       if (e.status == hal::LocalizationStatus::kLocalized) {
