@@ -173,10 +173,8 @@ void WorkerPool::run(JobFn fn, void* context) {
   remaining_.store(num_workers_);
   generation_.fetch_add(1);  // seq_cst: job_, job_context_ and remaining_ are visible with it
   pthread_cond_broadcast(&start_cv_);
-  pthread_mutex_unlock(&mutex_);
   // The caller only waits: it sleeps at once and leaves the cores to the pinned workers (its
   // spinning would steal a worker's core on a 2-core board); the workers spin between jobs.
-  pthread_mutex_lock(&mutex_);
   while (remaining_.load() > 0) pthread_cond_wait(&done_cv_, &mutex_);
   pthread_mutex_unlock(&mutex_);
   in_run_.store(false);
