@@ -16,7 +16,7 @@ enum class LocalizationStatus : std::uint8_t {
 
 enum class LocalizationMode : std::uint8_t {
   kGlobal = 0,    // MML global localization
-  kTracking = 1,  // MCL tracking after hand-off
+  kTracking = 1,  // tracking against the global map after a fix (mml-track: scan-to-map; handoff: MCL)
 };
 
 const char* status_name(LocalizationStatus s);
@@ -31,6 +31,13 @@ struct PoseEstimate {
   std::uint16_t hypothesis_count = 0;
   std::uint16_t cluster_count = 0;
   float rating = 0.0f;  // normalised rating r of the best cluster (Eq. 5.7)
+  // Protection level (RAIM style, firmware/track/protection_level.h): the true horizontal error
+  // exceeds protection_xy_m, or the heading error protection_theta_rad, in at most 1 of 1000
+  // `localized` steps. 0 = no bound (status not localized, or a localizer without integrity monitor).
+  float protection_xy_m = 0.0f;
+  float protection_theta_rad = 0.0f;
+  // Consecutive scans since a scan last confirmed the pose (0 = this scan did).
+  std::uint16_t unsupported_steps = 0;
 };
 
 inline const char* status_name(LocalizationStatus s) {

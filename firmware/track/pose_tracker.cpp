@@ -1,0 +1,174 @@
+#include "firmware/track/pose_tracker.h"
+
+#include <Eigen/Cholesky>
+#include <Eigen/LU>
+#include <cmath>
+
+namespace fw {
+namespace track {
+
+const char* verdict_name(ScanVerdict v) {
+  switch (v) {
+    case ScanVerdict::kSupported: return "supported";
+    case ScanVerdict::kUninformative: return "uninformative";
+    case ScanVerdict::kContradicting: return "contradicting";
+    case ScanVerdict::kOutsideMap: return "outside-map";
+  }
+  return "unknown";
+}
+
+Status PoseTracker::init(const TrackOptions& options, const GlobalMap& map) {
+  FW_RETURN_IF_ERROR(options.validate());
+  if (!map.valid()) return Status::error(Errc::kInvalidArgument, "PoseTracker: global map is empty");
+  options_ = options;
+  map_ = map;
+  k_ = ProtectionFactors::for_risk(options.integrity_risk);
+  initialized_ = true;
+  reset();
+  return Status::ok();
+}
+
+void PoseTracker::reset() {
+  active_ = false;
+  pose_ = Se2f();
+  cov_.setZero();
+  prev_odom_ = odom_at_fuse_ = Se2f();
+  fused_once_ = false;
+  bias_xy_m_ = map_.geometry.resolution;
+  bias_theta_rad_ = 0.0f;
+  unsupported_ = faulty_ = outside_ = 0;
+  last_ = TrackStep();
+}
+
+void PoseTracker::start(const Se2f& pose, const Eigen::Matrix3f& cov, const Se2f& odom) {
+  reset();
+  active_ = initialized_;
+  pose_ = pose;
+  cov_ = cov * options_.init_cov_scale;
+  const float fxy = options_.init_sigma_xy_floor_m * options_.init_sigma_xy_floor_m;
+  const float ft = options_.init_sigma_theta_floor_rad * options_.init_sigma_theta_floor_rad;
+  if (!cov_.allFinite()) cov_.setZero();
+  cov_ = 0.5f * (cov_ + cov_.transpose()).eval();
+  if (cov_(0, 0) < fxy) cov_(0, 0) = fxy;
+  if (cov_(1, 1) < fxy) cov_(1, 1) = fxy;
+  if (cov_(2, 2) < ft) cov_(2, 2) = ft;
+  prev_odom_ = odom;
+  odom_at_fuse_ = odom;
+}
+
+// x⁻ = x ⊕ Δ, P⁻ = F P Fᵀ + G Q Gᵀ with Q diagonal in the robot frame of the increment.
+void PoseTracker::predict_to(const Se2f& odom) {
+  const Se2f delta = prev_odom_.between(odom);
+  prev_odom_ = odom;
+  const float ds = std::hypot(delta.x, delta.y), da = std::fabs(delta.theta);
+  const float st = options_.odom_trans_per_m * ds + options_.odom_trans_per_rad * da;
+  const float sr = options_.odom_rot_per_rad * da + options_.odom_rot_per_m * ds;
+  Eigen::Matrix3f q = Eigen::Matrix3f::Zero();
+  q(0, 0) = q(1, 1) = st * st;
+  q(2, 2) = sr * sr;
+  const Eigen::Matrix3f f = pose_.jacobian_compose_first(delta);
+  const Eigen::Matrix3f g = pose_.jacobian_compose_second();
+  pose_ = pose_.compose(delta);
+  cov_ = f * cov_ * f.transpose() + g * q * g.transpose();
+  cov_ = 0.5f * (cov_ + cov_.transpose()).eval();
+}
+
+TrackStep PoseTracker::step(const Point2f* points, std::size_t n, const Se2f& odom, bool predict) {
+  TrackStep out;
+  if (!active_) {
+    out.lost = true;
+    last_ = out;
+    return out;
+  }
+  const TrackOptions& o = options_;
+  bool odom_jump = false;
+  if (predict) {
+    const Se2f d = prev_odom_.between(odom);
+    odom_jump = !(std::hypot(d.x, d.y) <= o.max_odom_step_m && std::fabs(d.theta) <= o.max_odom_step_rad);
+    predict_to(odom);
+  }
+  const Se2f pred = pose_;
+  out.alignment = align_scan(map_, points, n, pred, o.align);
+  const ScanAlignment& a = out.alignment;
+
+  // Verdict of this scan on the pose (fault detection).
+  ScanVerdict v = ScanVerdict::kSupported;
+  Eigen::Matrix3f p_post = cov_;
+  Eigen::Vector3f e = Eigen::Vector3f::Zero();
+  if (odom_jump) {
+    v = ScanVerdict::kContradicting;  // the pose cannot be carried across a non-physical increment
+  } else if (a.points > 0 && a.unknown_fraction() > o.outside_map_fraction) {
+    v = ScanVerdict::kOutsideMap;
+  } else if (a.inliers + a.contradicting < o.min_points) {
+    v = ScanVerdict::kUninformative;
+  } else if (a.inlier_fraction() < o.min_inlier_fraction) {
+    v = ScanVerdict::kContradicting;
+  } else {
+    // Innovation of the scan fix against the prediction: d² = eᵀ S⁻¹ e with S = P⁻ + H⁻¹, computed as
+    // S⁻¹ = H − H P⁺ H (P⁺ = (P⁻⁻¹ + H)⁻¹), which stays finite where H is singular (corridor axis).
+    e = Eigen::Vector3f(a.pose.x - pred.x, a.pose.y - pred.y, wrap_angle(a.pose.theta - pred.theta));
+    const Eigen::Matrix3d pinv = cov_.cast<double>().inverse();
+    const Eigen::Matrix3d hd = a.information.cast<double>();
+    const Eigen::Matrix3d post = (pinv + hd).inverse();
+    const Eigen::Matrix3d sinv = hd - hd * post * hd;
+    const Eigen::Vector3d ed = e.cast<double>();
+    out.innovation_chi2 = static_cast<float>(ed.dot(sinv * ed));
+    if (!std::isfinite(out.innovation_chi2) || !post.allFinite()) {
+      v = ScanVerdict::kContradicting;
+    } else if (out.innovation_chi2 > o.innovation_chi2) {
+      v = ScanVerdict::kContradicting;
+    } else {
+      p_post = post.cast<float>();
+    }
+  }
+  out.verdict = v;
+
+  if (v == ScanVerdict::kSupported) {
+    const Se2f since = odom_at_fuse_.between(odom);
+    const bool moved = !fused_once_ || !predict || std::hypot(since.x, since.y) >= o.update_min_d_m ||
+                       std::fabs(since.theta) >= o.update_min_a_rad;
+    if (moved) {
+      // x = x⁻ + P⁺ H e (information-form Kalman update, linearised at the scan fix).
+      const Eigen::Vector3f dx = p_post * (a.information * e);
+      if (dx.allFinite()) {
+        pose_ = Se2f(pred.x + dx(0), pred.y + dx(1), wrap_angle(pred.theta + dx(2)));
+        cov_ = 0.5f * (p_post + p_post.transpose());
+        odom_at_fuse_ = odom;
+        fused_once_ = true;
+        out.fused = true;
+      }
+    }
+    bias_xy_m_ = std::fmax(map_.geometry.resolution, a.rms_m);
+    bias_theta_rad_ = bias_xy_m_ / std::fmax(a.lever_m, 1.0f);
+    unsupported_ = 0;
+    faulty_ = 0;
+    outside_ = 0;
+  } else {
+    ++unsupported_;
+    if (v == ScanVerdict::kContradicting) ++faulty_; else faulty_ = 0;
+    if (v == ScanVerdict::kOutsideMap) ++outside_; else outside_ = 0;
+  }
+
+  out.pose = pose_;
+  out.cov = cov_;
+  out.pl = protection_level(cov_, k_, bias_xy_m_, bias_theta_rad_);
+  out.unsupported_steps = unsupported_;
+  out.faulty_steps = faulty_;
+  out.outside_steps = outside_;
+  const bool within = out.pl.xy_m <= o.alert_limit_m && out.pl.theta_rad <= o.alert_limit_rad;
+  if (v == ScanVerdict::kOutsideMap) {
+    out.status = hal::LocalizationStatus::kOutsideMap;
+  } else if (v != ScanVerdict::kContradicting && faulty_ == 0 && within) {
+    out.status = hal::LocalizationStatus::kLocalized;
+  } else {
+    out.status = hal::LocalizationStatus::kAmbiguous;
+  }
+  out.lost = faulty_ >= o.max_faulty_steps || outside_ >= o.max_outside_steps || !(out.pl.xy_m <= o.lost_limit_m) ||
+             !pose_.vector().allFinite();
+  if (out.lost) active_ = false;
+  last_ = out;
+  return out;
+}
+
+}  // namespace track
+}  // namespace fw

@@ -1,0 +1,86 @@
+// PoseTracker: tracking against the global map after a global fix, with an integrity monitor and a
+// protection level (extension of the dissertation; its Sec. 5.8 names tracking after MML as future
+// work). Per scan:
+//   predict   x⁻ = x ⊕ Δodom, P⁻ = F P Fᵀ + G Q(Δ) Gᵀ (odometry noise grows with the motion);
+//   align     the scan on the distance field from x⁻ (scan_alignment.h) → x_s, information H;
+//   check     fault detection on the residuals: too few end-points explained by the map, or a scan
+//             fix that disagrees with the prediction (χ² of the innovation), contradicts the pose;
+//             most end-points in unknown space means outside the map; too few points says nothing;
+//   update    only on a consistent scan, and only after the robot moved a little (no re-counting of
+//             the same map error while standing still): P = (P⁻⁻¹ + H)⁻¹, x = x⁻ + P H (x_s − x⁻);
+//   publish   the protection level (protection_level.h) and a status: `localized` only when this
+//             scan does not contradict the pose, no contradiction is pending and PL ≤ alert limits.
+// A scan that says nothing leaves the pose on the prediction and the PL grows with the odometry
+// noise until the status drops; contradicting or outside-map scans drop it at once; persistent
+// contradiction, persistent outside-map or a PL beyond the lost limit end the track (`lost`), and
+// the owner goes back to global localization. Never allocates; deterministic.
+#pragma once
+
+#include <Eigen/Core>
+#include <cstdint>
+
+#include "firmware/base/se2.h"
+#include "firmware/base/status.h"
+#include "firmware/map/global_map.h"
+#include "firmware/track/protection_level.h"
+#include "firmware/track/scan_alignment.h"
+#include "firmware/track/track_options.h"
+#include "hal/msg/pose_estimate.h"
+
+namespace fw {
+namespace track {
+
+enum class ScanVerdict : std::uint8_t {
+  kSupported = 0,      // consistent with the pose (fused, or checked while standing still)
+  kUninformative = 1,  // too few end-points on the map to say anything
+  kContradicting = 2,  // poor fit or inconsistent with the odometry prediction
+  kOutsideMap = 3,     // most end-points in unknown space
+};
+const char* verdict_name(ScanVerdict v);
+
+struct TrackStep {
+  Se2f pose;
+  Eigen::Matrix3f cov = Eigen::Matrix3f::Zero();
+  ProtectionLevel pl;
+  hal::LocalizationStatus status = hal::LocalizationStatus::kSearching;
+  ScanVerdict verdict = ScanVerdict::kUninformative;
+  bool fused = false;
+  bool lost = false;            // the track is given up: go back to global localization
+  std::uint32_t unsupported_steps = 0, faulty_steps = 0, outside_steps = 0;
+  float innovation_chi2 = 0.0f;
+  ScanAlignment alignment;
+};
+
+class PoseTracker {
+ public:
+  Status init(const TrackOptions& options, const GlobalMap& map);
+  void reset();
+  bool active() const { return active_; }
+  // Starts a track at a global fix (`cov` = the fix's covariance, inflated and floored per options).
+  void start(const Se2f& pose, const Eigen::Matrix3f& cov, const Se2f& odom);
+  // One scan: `points` in the sensor frame (beam order), `odom` the wheel odometry pose at the scan.
+  // `predict` = false checks/fuses the scan at the current pose without an odometry step (the scan
+  // the track was started on). Returns the published view; `lost` ends the track (active() false).
+  TrackStep step(const Point2f* points, std::size_t n, const Se2f& odom, bool predict = true);
+  const TrackStep& last() const { return last_; }
+  const TrackOptions& options() const { return options_; }
+
+ private:
+  void predict_to(const Se2f& odom);
+  TrackOptions options_;
+  GlobalMap map_;
+  ProtectionFactors k_;
+  bool initialized_ = false;
+  bool active_ = false;
+  Se2f pose_;
+  Eigen::Matrix3f cov_ = Eigen::Matrix3f::Zero();
+  Se2f prev_odom_;
+  Se2f odom_at_fuse_;      // odometry at the last fused scan (update thresholds)
+  bool fused_once_ = false;
+  float bias_xy_m_ = 0.0f, bias_theta_rad_ = 0.0f;  // of the last supported scan
+  std::uint32_t unsupported_ = 0, faulty_ = 0, outside_ = 0;
+  TrackStep last_;
+};
+
+}  // namespace track
+}  // namespace fw

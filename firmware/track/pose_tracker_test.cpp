@@ -1,0 +1,210 @@
+#include "firmware/track/pose_tracker.h"
+
+#include <gtest/gtest.h>
+
+#include <cmath>
+
+#include "firmware/track/track_test_util.h"
+
+namespace fw {
+namespace track {
+namespace {
+
+using testing::GridWorld;
+using testing::OwnedGlobalMap;
+
+const GridWorld& room() {
+  static GridWorld g = mcl::testing::unique_room();
+  return g;
+}
+const OwnedGlobalMap& room_map() {
+  static OwnedGlobalMap m(room());
+  return m;
+}
+
+Eigen::Matrix3f small_cov() {
+  Eigen::Matrix3f c = Eigen::Matrix3f::Zero();
+  c(0, 0) = c(1, 1) = 0.0025f;
+  c(2, 2) = 0.0004f;
+  return c;
+}
+
+float err_xy(const Se2f& a, const Se2f& b) { return std::hypot(a.x - b.x, a.y - b.y); }
+
+// Drives along a path with noisy odometry: every `localized` pose is inside its protection level and
+// the tracking error stays at the centimetre level.
+TEST(PoseTrackerTest, TracksWithinProtectionLevel) {
+  PoseTracker t;
+  ASSERT_TRUE(t.init(TrackOptions(), room_map().map).is_ok());
+  const auto path = mml::testing::waypoint_path({{1.5f, 1.5f}, {1.5f, 6.5f}, {4.5f, 6.5f}, {4.5f, 2.0f}, {10.5f, 3.5f}}, 0.1f);
+  RandomStream rng(3, 0);
+  Se2f odom(0, 0, 0);
+  t.start(path[0], small_cov(), odom);
+  int localized = 0;
+  float worst = 0.0f;
+  for (std::size_t i = 0; i < path.size(); ++i) {
+    if (i > 0) {
+      Se2f d = path[i - 1].between(path[i]);
+      d.x *= 1.0f + 0.05f * static_cast<float>(rng.gaussian());
+      d.theta = d.theta * (1.0f + 0.05f * static_cast<float>(rng.gaussian())) + 0.005f * static_cast<float>(rng.gaussian());
+      odom = odom.compose(d);
+    }
+    const auto pts = testing::scan_at(room(), path[i], &rng);
+    const TrackStep s = t.step(pts.data(), pts.size(), odom, i > 0);
+    ASSERT_FALSE(s.lost) << "step " << i << " " << verdict_name(s.verdict);
+    if (s.status != hal::LocalizationStatus::kLocalized) continue;
+    ++localized;
+    const float e = err_xy(s.pose, path[i]);
+    worst = std::fmax(worst, e);
+    EXPECT_LT(e, s.pl.xy_m) << "step " << i;
+    EXPECT_LT(std::fabs(wrap_angle(s.pose.theta - path[i].theta)), s.pl.theta_rad) << "step " << i;
+    EXPECT_LE(s.pl.xy_m, 0.5f);
+  }
+  EXPECT_GE(localized, static_cast<int>(path.size()) * 95 / 100);
+  EXPECT_LT(worst, 0.05f);
+}
+
+// Kidnapped (carried to another place, wheels still): the scans contradict the pose at once, the
+// status drops on the first such scan and the track is given up within max_faulty_steps.
+TEST(PoseTrackerTest, KidnapDropsStatusAtOnceAndLosesTrack) {
+  PoseTracker t;
+  TrackOptions o;
+  ASSERT_TRUE(t.init(o, room_map().map).is_ok());
+  RandomStream rng(5, 0);
+  const Se2f a(1.5f, 1.5f, 0.3f), b(10.0f, 6.0f, 2.5f);
+  t.start(a, small_cov(), Se2f());
+  for (int i = 0; i < 3; ++i) {
+    const auto pts = testing::scan_at(room(), a, &rng);
+    EXPECT_EQ(t.step(pts.data(), pts.size(), Se2f()).status, hal::LocalizationStatus::kLocalized);
+  }
+  bool lost = false;
+  for (std::uint32_t i = 0; i < o.max_faulty_steps && !lost; ++i) {
+    const auto pts = testing::scan_at(room(), b, &rng);
+    const TrackStep s = t.step(pts.data(), pts.size(), Se2f());
+    EXPECT_NE(s.status, hal::LocalizationStatus::kLocalized) << "kidnapped scan " << i;
+    EXPECT_EQ(s.verdict, ScanVerdict::kContradicting);
+    lost = s.lost;
+  }
+  EXPECT_TRUE(lost);
+  EXPECT_FALSE(t.active());
+}
+
+// Scans that say nothing (laser blinded: no returns) leave the pose on the odometry; the protection
+// level grows with every such step until the status drops — never `localized` with a stale bound.
+TEST(PoseTrackerTest, UninformativeScansGrowProtectionLevelUntilStatusDrops) {
+  PoseTracker t;
+  ASSERT_TRUE(t.init(TrackOptions(), room_map().map).is_ok());
+  RandomStream rng(9, 0);
+  Se2f truth(1.5f, 1.5f, 1.5707963f), odom;
+  t.start(truth, small_cov(), odom);
+  const auto pts = testing::scan_at(room(), truth, &rng);
+  t.step(pts.data(), pts.size(), odom, false);
+  float prev_pl = t.last().pl.xy_m;
+  bool dropped = false;
+  for (int i = 0; i < 200 && !dropped; ++i) {
+    const Se2f d(0.1f, 0.0f, 0.0f);
+    odom = odom.compose(d);
+    truth = truth.compose(Se2f(0.1f * 1.1f, 0.0f, 0.0f));  // odometry under-reads by 10 %
+    const TrackStep s = t.step(nullptr, 0, odom);
+    EXPECT_EQ(s.verdict, ScanVerdict::kUninformative);
+    EXPECT_GT(s.pl.xy_m, prev_pl);
+    EXPECT_EQ(s.unsupported_steps, static_cast<std::uint32_t>(i + 1));
+    prev_pl = s.pl.xy_m;
+    if (s.status == hal::LocalizationStatus::kLocalized) {
+      EXPECT_LT(err_xy(s.pose, truth), s.pl.xy_m) << "step " << i;
+    } else {
+      dropped = true;
+    }
+  }
+  EXPECT_TRUE(dropped);
+}
+
+// Standing still: the same scan 300 times neither moves the pose nor shrinks the covariance below
+// what one scan supports (the same map error is not counted again).
+TEST(PoseTrackerTest, StandingStillNeitherDriftsNorBecomesOverconfident) {
+  PoseTracker t;
+  ASSERT_TRUE(t.init(TrackOptions(), room_map().map).is_ok());
+  RandomStream rng(11, 0);
+  const Se2f truth(6.0f, 2.5f, 0.7f);
+  t.start(truth, small_cov(), Se2f());
+  const auto first = testing::scan_at(room(), truth, &rng);
+  const TrackStep s0 = t.step(first.data(), first.size(), Se2f(), false);
+  int fused = 0;
+  TrackStep s;
+  for (int i = 0; i < 300; ++i) {
+    const auto pts = testing::scan_at(room(), truth, &rng);
+    s = t.step(pts.data(), pts.size(), Se2f());
+    fused += s.fused;
+    EXPECT_EQ(s.status, hal::LocalizationStatus::kLocalized);
+  }
+  EXPECT_EQ(fused, 0);
+  EXPECT_LT(err_xy(s.pose, truth), 0.02f);
+  EXPECT_FLOAT_EQ(s.cov(0, 0), s0.cov(0, 0));
+}
+
+// Walking into space the map does not know: outside-map at once, the track ends after a few scans.
+TEST(PoseTrackerTest, UnmappedSpaceIsOutsideMap) {
+  // The world has a second room east of the mapped one; the map has only the first.
+  static GridWorld world, mapped;
+  for (GridWorld* g : {&world, &mapped}) {
+    g->w = 480; g->h = 160;
+    g->occ.assign(g->w * g->h, 0);
+  }
+  world.box(0.2f, 0.2f, 23.8f, 7.8f);
+  world.wall(12.0f, 0.2f, 12.0f, 3.0f);
+  world.wall(12.0f, 5.0f, 12.0f, 7.8f);
+  world.wall(18.0f, 2.0f, 20.0f, 2.0f);
+  world.finish();
+  mapped.box(0.2f, 0.2f, 12.0f, 7.8f);
+  for (std::uint32_t y = 0; y < mapped.h; ++y)
+    for (std::uint32_t x = 0; x < mapped.w; ++x)
+      if (x * mapped.res > 12.1f) mapped.occ[y * mapped.w + x] = kCellUnknown;
+  mapped.finish();
+  static OwnedGlobalMap m(mapped);
+  PoseTracker t;
+  TrackOptions o;
+  ASSERT_TRUE(t.init(o, m.map).is_ok());
+  RandomStream rng(13, 0);
+  const Se2f inside(14.0f, 4.0f, 0.0f);  // east room, looking further east
+  t.start(inside, small_cov(), Se2f());
+  int outside = 0;
+  bool lost = false;
+  for (std::uint32_t i = 0; i < o.max_outside_steps && !lost; ++i) {
+    const auto pts = testing::scan_at(world, inside, &rng);
+    const TrackStep s = t.step(pts.data(), pts.size(), Se2f(), i > 0);
+    EXPECT_NE(s.status, hal::LocalizationStatus::kLocalized);
+    outside += s.status == hal::LocalizationStatus::kOutsideMap;
+    lost = s.lost;
+  }
+  EXPECT_GE(outside, 1);
+  EXPECT_TRUE(lost);
+}
+
+// An odometry increment no robot can make between two scans cannot carry the pose.
+TEST(PoseTrackerTest, OdometryJumpContradicts) {
+  PoseTracker t;
+  ASSERT_TRUE(t.init(TrackOptions(), room_map().map).is_ok());
+  RandomStream rng(17, 0);
+  const Se2f truth(1.5f, 1.5f, 0.0f);
+  t.start(truth, small_cov(), Se2f());
+  const auto pts = testing::scan_at(room(), truth, &rng);
+  t.step(pts.data(), pts.size(), Se2f(), false);
+  const TrackStep s = t.step(pts.data(), pts.size(), Se2f(30.0f, 0.0f, 0.0f));
+  EXPECT_EQ(s.verdict, ScanVerdict::kContradicting);
+  EXPECT_NE(s.status, hal::LocalizationStatus::kLocalized);
+}
+
+TEST(PoseTrackerTest, BadOptionsNameTheField) {
+  TrackOptions o;
+  o.alert_limit_m = -1.0f;
+  const Status s = o.validate();
+  EXPECT_FALSE(s.is_ok());
+  EXPECT_NE(std::string(s.message()).find("alert_limit_m"), std::string::npos);
+  o = TrackOptions();
+  o.align.max_points = 5;
+  EXPECT_NE(std::string(o.validate().message()).find("max_points"), std::string::npos);
+}
+
+}  // namespace
+}  // namespace track
+}  // namespace fw

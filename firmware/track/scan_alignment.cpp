@@ -1,0 +1,111 @@
+#include "firmware/track/scan_alignment.h"
+
+#include <Eigen/Cholesky>
+#include <cmath>
+
+#include "firmware/map/distance_sample.h"
+
+namespace fw {
+namespace track {
+
+namespace {
+
+enum class PointClass : std::uint8_t { kInlier, kContradicting, kUnknown };
+
+// Where the map has no say (unknown cell, off the grid) a far end-point is not evidence against
+// the pose; on a known free cell it is.
+PointClass classify(const GlobalMap& map, float qx, float qy, bool sampled, float d, float outlier) {
+  if (sampled && d <= outlier) return PointClass::kInlier;
+  std::int32_t cx = 0, cy = 0;
+  if (!map.geometry.world_to_cell(qx, qy, &cx, &cy)) return PointClass::kUnknown;
+  return map.cell(cx, cy) == kCellUnknown ? PointClass::kUnknown : PointClass::kContradicting;
+}
+
+}  // namespace
+
+ScanAlignment align_scan(const GlobalMap& map, const Point2f* points, std::size_t n, const Se2f& seed,
+                         const ScanAlignOptions& o) {
+  ScanAlignment r;
+  r.pose = seed;
+  r.points = static_cast<std::uint32_t>(n);
+  if (!map.valid() || n == 0) return r;
+  // Levenberg regularisation towards the seed: tiny against what a scan constrains, it keeps the
+  // directions a scan does not see (along a corridor) at the seed instead of letting noise move them.
+  const double reg_xy = 1.0 / (1.0 * 1.0), reg_th = 1.0 / (0.5 * 0.5);
+  Se2f t = seed;
+  for (std::uint32_t it = 0; it < o.iterations; ++it) {
+    const float outlier = (it < o.iterations / 2) ? 2.0f * o.outlier_m : o.outlier_m;
+    const float c = std::cos(t.theta), s = std::sin(t.theta);
+    Eigen::Matrix3d h = Eigen::Matrix3d::Zero();
+    Eigen::Vector3d b = Eigen::Vector3d::Zero();
+    std::uint32_t used = 0;
+    for (std::size_t i = 0; i < n; ++i) {
+      const float px = points[i].x(), py = points[i].y();
+      const float qx = t.x + c * px - s * py, qy = t.y + s * px + c * py;
+      float d = 0.0f, gx = 0.0f, gy = 0.0f;
+      if (!sample_distance<float>(map, qx, qy, &d, &gx, &gy) || d > outlier) continue;
+      ++used;
+      const double w = d <= o.huber_m ? 1.0 : static_cast<double>(o.huber_m) / d;  // Huber IRLS weight
+      const Eigen::Vector3d j(gx, gy, gx * (-s * px - c * py) + gy * (c * px - s * py));
+      h += w * (j * j.transpose());
+      b += w * static_cast<double>(d) * j;
+    }
+    if (used < 3) break;
+    h(0, 0) += reg_xy;
+    h(1, 1) += reg_xy;
+    h(2, 2) += reg_th;
+    b(0) += reg_xy * (t.x - seed.x);
+    b(1) += reg_xy * (t.y - seed.y);
+    b(2) += reg_th * wrap_angle(t.theta - seed.theta);
+    const Eigen::Vector3d dx = -h.ldlt().solve(b);
+    if (!dx.allFinite()) break;
+    t = Se2f(t.x + static_cast<float>(dx(0)), t.y + static_cast<float>(dx(1)),
+             wrap_angle(t.theta + static_cast<float>(dx(2))));
+    if (it >= o.iterations / 2 && dx.head<2>().norm() < 1e-4 && std::fabs(dx(2)) < 1e-5) break;
+  }
+  r.pose = t;
+
+  // Statistics and information at the optimum, with the final outlier threshold.
+  const float c = std::cos(t.theta), s = std::sin(t.theta);
+  Eigen::Matrix3d h = Eigen::Matrix3d::Zero();
+  double sq = 0.0, lever = 0.0;
+  const float cell = o.correlation_length_m;
+  bool have_prev_cell = false;
+  std::int32_t prev_cx = 0, prev_cy = 0;
+  for (std::size_t i = 0; i < n; ++i) {
+    const float px = points[i].x(), py = points[i].y();
+    const float qx = t.x + c * px - s * py, qy = t.y + s * px + c * py;
+    float d = 0.0f, gx = 0.0f, gy = 0.0f;
+    const bool ok = sample_distance<float>(map, qx, qy, &d, &gx, &gy);
+    const PointClass pc = classify(map, qx, qy, ok, d, o.outlier_m);
+    if (pc == PointClass::kUnknown) { ++r.unknown; continue; }
+    if (pc == PointClass::kContradicting) { ++r.contradicting; continue; }
+    ++r.inliers;
+    sq += static_cast<double>(d) * d;
+    lever += static_cast<double>(px) * px + static_cast<double>(py) * py;
+    const double w = d <= o.huber_m ? 1.0 : static_cast<double>(o.huber_m) / d;
+    const Eigen::Vector3d j(gx, gy, gx * (-s * px - c * py) + gy * (c * px - s * py));
+    h += w * (j * j.transpose());
+    // Beams arrive in angular order: a new correlation cell starts when the end-point leaves the
+    // previous one (a wall seen again after a gap counts again, which is conservative enough).
+    const std::int32_t cx = static_cast<std::int32_t>(std::floor(qx / cell));
+    const std::int32_t cy = static_cast<std::int32_t>(std::floor(qy / cell));
+    if (!have_prev_cell || cx != prev_cx || cy != prev_cy) ++r.independent;
+    have_prev_cell = true;
+    prev_cx = cx;
+    prev_cy = cy;
+  }
+  if (r.inliers > 0) {
+    r.rms_m = static_cast<float>(std::sqrt(sq / r.inliers));
+    r.lever_m = static_cast<float>(std::sqrt(lever / r.inliers));
+    r.sigma_m = r.rms_m > o.min_sigma_m ? r.rms_m : o.min_sigma_m;
+    // Σ w JᵀJ / σ² counts every inlier as independent; only `independent` of them are.
+    const double scale = static_cast<double>(r.independent) / static_cast<double>(r.inliers) /
+                         (static_cast<double>(r.sigma_m) * r.sigma_m);
+    r.information = (h * scale).cast<float>();
+  }
+  return r;
+}
+
+}  // namespace track
+}  // namespace fw

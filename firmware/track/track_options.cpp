@@ -1,0 +1,64 @@
+#include "firmware/track/track_options.h"
+
+#include <cmath>
+
+namespace fw {
+namespace track {
+
+namespace {
+Status check_range(const char* name, float v, float lo, float hi) {
+  if (!std::isfinite(v) || v < lo || v > hi) {
+    return Status::error(Errc::kInvalidArgument, "TrackOptions.%s = %g out of range [%g, %g]", name,
+                         static_cast<double>(v), static_cast<double>(lo), static_cast<double>(hi));
+  }
+  return Status::ok();
+}
+}  // namespace
+
+Status ScanAlignOptions::validate() const {
+  if (max_points < 10 || max_points > 1081) {
+    return Status::error(Errc::kInvalidArgument, "TrackOptions.align.max_points = %u out of range [10, 1081]", max_points);
+  }
+  if (iterations < 1 || iterations > 100) {
+    return Status::error(Errc::kInvalidArgument, "TrackOptions.align.iterations = %u out of range [1, 100]", iterations);
+  }
+  FW_RETURN_IF_ERROR(check_range("align.max_range_m", max_range_m, 0.5f, 1000.0f));
+  FW_RETURN_IF_ERROR(check_range("align.outlier_m", outlier_m, 0.01f, 5.0f));
+  FW_RETURN_IF_ERROR(check_range("align.huber_m", huber_m, 0.001f, 5.0f));
+  FW_RETURN_IF_ERROR(check_range("align.correlation_length_m", correlation_length_m, 0.001f, 10.0f));
+  FW_RETURN_IF_ERROR(check_range("align.min_sigma_m", min_sigma_m, 0.0001f, 1.0f));
+  return Status::ok();
+}
+
+Status TrackOptions::validate() const {
+  FW_RETURN_IF_ERROR(align.validate());
+  FW_RETURN_IF_ERROR(check_range("odom_trans_per_m", odom_trans_per_m, 0.0f, 10.0f));
+  FW_RETURN_IF_ERROR(check_range("odom_trans_per_rad", odom_trans_per_rad, 0.0f, 10.0f));
+  FW_RETURN_IF_ERROR(check_range("odom_rot_per_rad", odom_rot_per_rad, 0.0f, 10.0f));
+  FW_RETURN_IF_ERROR(check_range("odom_rot_per_m", odom_rot_per_m, 0.0f, 10.0f));
+  FW_RETURN_IF_ERROR(check_range("max_odom_step_m", max_odom_step_m, 0.01f, 100.0f));
+  FW_RETURN_IF_ERROR(check_range("max_odom_step_rad", max_odom_step_rad, 0.01f, 6.3f));
+  FW_RETURN_IF_ERROR(check_range("update_min_d_m", update_min_d_m, 0.0f, 10.0f));
+  FW_RETURN_IF_ERROR(check_range("update_min_a_rad", update_min_a_rad, 0.0f, 3.2f));
+  if (min_points < 3 || min_points > 1081) {
+    return Status::error(Errc::kInvalidArgument, "TrackOptions.min_points = %u out of range [3, 1081]", min_points);
+  }
+  FW_RETURN_IF_ERROR(check_range("min_inlier_fraction", min_inlier_fraction, 0.0f, 1.0f));
+  FW_RETURN_IF_ERROR(check_range("innovation_chi2", innovation_chi2, 0.1f, 1e6f));
+  FW_RETURN_IF_ERROR(check_range("outside_map_fraction", outside_map_fraction, 0.0f, 1.0f));
+  if (max_faulty_steps < 1 || max_faulty_steps > 10000 || max_outside_steps < 1 || max_outside_steps > 10000) {
+    return Status::error(Errc::kInvalidArgument, "TrackOptions: max_faulty_steps %u / max_outside_steps %u out of range [1, 10000]",
+                         max_faulty_steps, max_outside_steps);
+  }
+  FW_RETURN_IF_ERROR(check_range("integrity_risk", integrity_risk, 1e-9f, 0.5f));
+  FW_RETURN_IF_ERROR(check_range("alert_limit_m", alert_limit_m, 0.001f, 100.0f));
+  FW_RETURN_IF_ERROR(check_range("alert_limit_rad", alert_limit_rad, 0.0001f, 3.2f));
+  FW_RETURN_IF_ERROR(check_range("lost_limit_m", lost_limit_m, alert_limit_m, 1000.0f));
+  FW_RETURN_IF_ERROR(check_range("init_cov_scale", init_cov_scale, 0.01f, 1e4f));
+  FW_RETURN_IF_ERROR(check_range("init_sigma_xy_floor_m", init_sigma_xy_floor_m, 0.0f, 100.0f));
+  FW_RETURN_IF_ERROR(check_range("init_sigma_theta_floor_rad", init_sigma_theta_floor_rad, 0.0f, 3.2f));
+  return Status::ok();
+}
+
+}  // namespace track
+}  // namespace fw

@@ -1,0 +1,65 @@
+// Options of the pose tracker and its integrity monitor (pose_tracker.h): one plain struct,
+// validated once at start-up (Cartographer style). Defaults are stated in physical terms — a SICK
+// class laser, wheel odometry of a differential-drive robot, a 5 cm map — not fitted to a log.
+#pragma once
+
+#include <cstdint>
+
+#include "firmware/base/status.h"
+
+namespace fw {
+namespace track {
+
+struct ScanAlignOptions {
+  std::uint32_t max_points = 360;    // scan end-points used per alignment (evenly subsampled)
+  float max_range_m = 30.0f;         // beams beyond this are not used (range noise grows with range)
+  std::uint32_t iterations = 12;     // Gauss-Newton iterations
+  // A point farther than this from every mapped wall is not explained by the map. The first half
+  // of the iterations uses twice the value to pull in from a poor prediction.
+  float outlier_m = 0.30f;
+  float huber_m = 0.05f;             // Huber loss: residuals beyond this weigh less (robust)
+  // Map errors of neighbouring end-points are correlated (same wall, same map cells): one
+  // independent observation is counted per cell of this side that holds inliers (consecutive
+  // beams in one cell count once), so the information does not grow with the beam density.
+  float correlation_length_m = 0.25f;
+  float min_sigma_m = 0.02f;         // floor of the per-point noise estimated from the residuals
+  Status validate() const;
+};
+
+struct TrackOptions {
+  ScanAlignOptions align;
+  // Odometry noise (as AMCL's α1..α4): σ_trans = a_tt·|Δs| + a_tr·|Δθ|, σ_rot = a_rr·|Δθ| + a_rt·|Δs|.
+  float odom_trans_per_m = 0.10f;
+  float odom_trans_per_rad = 0.05f;
+  float odom_rot_per_rad = 0.10f;
+  float odom_rot_per_m = 0.05f;
+  // Odometry increments beyond these between two scans are not physical (a jump, a reset of the
+  // wheel counters): the pose cannot be carried across them.
+  float max_odom_step_m = 2.0f;
+  float max_odom_step_rad = 1.5f;
+  // Scans are fused only after the robot moved this far or turned this much since the last fused
+  // scan (LaMa / AMCL update thresholds): standing still neither drifts nor shrinks the covariance
+  // by re-counting the same map error. Every scan is still checked against the map.
+  float update_min_d_m = 0.05f;
+  float update_min_a_rad = 0.05f;
+  // Integrity monitor (fault detection on the residuals, RAIM style).
+  std::uint32_t min_points = 30;          // fewer in-map points: the scan is uninformative
+  float min_inlier_fraction = 0.5f;       // of the points on mapped (known) cells
+  float innovation_chi2 = 16.27f;         // χ²(3) at 1 − 1e-3: scan fix vs odometry prediction
+  float outside_map_fraction = 0.5f;      // end-points in unknown space beyond this: outside the map
+  std::uint32_t max_faulty_steps = 5;     // consecutive contradicting scans → back to global mode
+  std::uint32_t max_outside_steps = 5;    // consecutive outside-map scans → back to global mode
+  // Protection level (protection_level.h): integrity risk per `localized` step and alert limits.
+  float integrity_risk = 1e-3f;
+  float alert_limit_m = 0.5f;             // PL beyond → not `localized` (the product's 0.5 m bound)
+  float alert_limit_rad = 0.0872665f;     // 5°
+  float lost_limit_m = 2.0f;              // PL beyond → the track is given up, global search
+  // Start of tracking from a global fix: its covariance inflated by this factor, then floored.
+  float init_cov_scale = 4.0f;
+  float init_sigma_xy_floor_m = 0.10f;
+  float init_sigma_theta_floor_rad = 0.05f;
+  Status validate() const;
+};
+
+}  // namespace track
+}  // namespace fw

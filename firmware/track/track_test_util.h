@@ -1,0 +1,35 @@
+// Shared by the tracking tests: a synthetic room, its global map and scans at known poses.
+#pragma once
+
+#include <vector>
+
+#include "firmware/mcl/mcl_test_world.h"
+#include "firmware/mml/mml_test_util.h"
+#include "firmware/scan/scan_points.h"
+#include "firmware/track/pose_tracker.h"
+
+namespace fw {
+namespace track {
+namespace testing {
+
+using mcl::testing::GridWorld;
+using mml::testing::OwnedGlobalMap;
+
+// Scan end-points (sensor frame) of a simulated scan at `pose` in `world`, with range noise.
+inline std::vector<Point2f> scan_at(const GridWorld& world, const Se2f& pose, RandomStream* rng, float noise = 0.01f,
+                                    float maxr = 8.0f) {
+  static hal::LaserScan scan;
+  mcl::testing::simulate_scan(world.view(), pose.x, pose.y, pose.theta, &scan, maxr);
+  for (std::uint32_t b = 0; b < scan.beam_count; ++b)
+    if (scan.ranges[b] < scan.range_max) scan.ranges[b] += noise * static_cast<float>(rng->gaussian());
+  std::vector<Point2f> pts(hal::LaserScan::kMaxBeams);
+  ScanPointsResult r;
+  ScanPointsOptions so;
+  if (!scan_to_points(scan, so, pts.data(), pts.size(), &r).is_ok()) r.count = 0;
+  pts.resize(r.count);
+  return pts;
+}
+
+}  // namespace testing
+}  // namespace track
+}  // namespace fw

@@ -1,0 +1,105 @@
+#include "firmware/track/tracked_localizer.h"
+
+#include <cmath>
+
+#include "firmware/scan/scan_points.h"
+
+namespace fw {
+namespace track {
+
+Status TrackedLocalizer::init(const TrackOptions& options, const GlobalMap& map, mml::MmlLocalizer* global) {
+  if (global == nullptr) return Status::error(Errc::kInvalidArgument, "TrackedLocalizer: null global localizer");
+  FW_RETURN_IF_ERROR(tracker_.init(options, map));
+  mml_ = global;
+  reset();
+  return Status::ok();
+}
+
+void TrackedLocalizer::reset() {
+  tracker_.reset();
+  if (mml_ != nullptr) mml_->reset();
+  fixes_ = fix_rejections_ = tracks_lost_ = 0;
+}
+
+// End-points within the tracker's range, evenly subsampled to at most align.max_points (beam order kept).
+std::size_t TrackedLocalizer::scan_points(const hal::LaserScan& scan) {
+  ScanPointsOptions so;
+  so.max_range = tracker_.options().align.max_range_m;
+  ScanPointsResult sr;
+  if (!scan_to_points(scan, so, all_pts_, hal::LaserScan::kMaxBeams, &sr).is_ok()) return 0;
+  const std::size_t cap = tracker_.options().align.max_points;
+  if (sr.count <= cap) {
+    for (std::size_t i = 0; i < sr.count; ++i) pts_[i] = all_pts_[i];
+    return sr.count;
+  }
+  std::size_t m = 0;
+  for (std::size_t k = 0; k < cap; ++k) pts_[m++] = all_pts_[k * sr.count / cap];
+  return m;
+}
+
+void TrackedLocalizer::publish_track(const TrackStep& ts, hal::PoseEstimate* out) const {
+  out->x = ts.pose.x;
+  out->y = ts.pose.y;
+  out->theta = ts.pose.theta;
+  for (int r = 0; r < 3; ++r)
+    for (int c = 0; c < 3; ++c) out->cov[r * 3 + c] = ts.cov(r, c);
+  out->status = ts.status;
+  out->mode = hal::LocalizationMode::kTracking;
+  out->hypothesis_count = 1;
+  out->cluster_count = 1;
+  out->rating = ts.alignment.inlier_fraction();
+  out->protection_xy_m = ts.pl.xy_m;
+  out->protection_theta_rad = ts.pl.theta_rad;
+  out->unsupported_steps = static_cast<std::uint16_t>(ts.unsupported_steps > 65535 ? 65535 : ts.unsupported_steps);
+}
+
+Status TrackedLocalizer::step(const hal::LaserScan& scan, const hal::Odometry& odom, hal::PoseEstimate* out) {
+  if (mml_ == nullptr) return Status::error(Errc::kNotInitialized, "TrackedLocalizer: step() before init()");
+  if (out == nullptr) return Status::error(Errc::kInvalidArgument, "TrackedLocalizer: null output");
+  if (!std::isfinite(odom.x) || !std::isfinite(odom.y) || !std::isfinite(odom.theta)) {
+    return Status::error(Errc::kInvalidArgument, "TrackedLocalizer: non-finite odometry at scan %u", scan.scan_id);
+  }
+  const Se2f wheel(odom.x, odom.y, odom.theta);
+  const std::size_t n = scan_points(scan);
+  if (tracker_.active()) {
+    const TrackStep ts = tracker_.step(pts_, n, wheel);
+    *out = hal::PoseEstimate();
+    out->timestamp_ns = scan.timestamp_ns;
+    out->scan_id = scan.scan_id;
+    publish_track(ts, out);
+    if (ts.lost) {
+      // The track is given up: global localization from a fresh local map, starting with this scan.
+      ++tracks_lost_;
+      mml_->reset();
+      hal::PoseEstimate g;
+      FW_RETURN_IF_ERROR(mml_->step(scan, odom, &g));
+      out->status = ts.verdict == ScanVerdict::kOutsideMap ? hal::LocalizationStatus::kOutsideMap
+                                                           : hal::LocalizationStatus::kSearching;
+      out->mode = hal::LocalizationMode::kGlobal;
+      out->protection_xy_m = out->protection_theta_rad = 0.0f;
+    }
+    return Status::ok();
+  }
+  FW_RETURN_IF_ERROR(mml_->step(scan, odom, out));
+  out->mode = hal::LocalizationMode::kGlobal;
+  out->protection_xy_m = out->protection_theta_rad = 0.0f;
+  if (out->status != hal::LocalizationStatus::kLocalized) return Status::ok();
+  // MML says the pose is isolated: the tracker must confirm it on this scan before it is published.
+  Eigen::Matrix3f cov;
+  for (int r = 0; r < 3; ++r)
+    for (int c = 0; c < 3; ++c) cov(r, c) = out->cov[r * 3 + c];
+  tracker_.start(Se2f(out->x, out->y, out->theta), cov, wheel);
+  const TrackStep ts = tracker_.step(pts_, n, wheel, /*predict=*/false);
+  if (ts.status == hal::LocalizationStatus::kLocalized && !ts.lost) {
+    ++fixes_;
+    publish_track(ts, out);
+    return Status::ok();
+  }
+  ++fix_rejections_;
+  tracker_.reset();
+  out->status = hal::LocalizationStatus::kAmbiguous;
+  return Status::ok();
+}
+
+}  // namespace track
+}  // namespace fw
