@@ -1,5 +1,7 @@
 #include "firmware/app/app_config.h"
 
+#include "firmware/app/localizer_names.h"
+
 #include <errno.h>
 #include <fcntl.h>
 #include <string.h>
@@ -99,8 +101,7 @@ Status parse_app_config(const char* name, const char* text, std::size_t len, App
       else if (parse_bool(v, &b)) out->can_fd = b ? 1 : 0;
       else return CFG_ERR("'%s' is not auto, true or false", v);
     } else if (!std::strcmp(key, "localizer")) {
-      if (std::strcmp(v, "odom") && std::strcmp(v, "mml"))
-        return CFG_ERR("'%s' unknown (odom, mml)", v);
+      if (!is_known_localizer(v)) return CFG_ERR("'%s' unknown (%s)", v, kKnownLocalizers);
       copy(out->localizer, sizeof(out->localizer), v);
     } else if (!std::strcmp(key, "mml_preset")) {
       if (!parse_int(v, 1, 4, &x)) return CFG_ERR("'%s' is not a configuration 1..4 (Tables 5.1-5.4)", v);
@@ -152,13 +153,13 @@ Status parse_app_config(const char* name, const char* text, std::size_t len, App
     }
   }
   if (!seen_laser) return Status::error(Errc::kInvalidArgument, "config '%s': key 'laser' is required", name);
-  if (std::strcmp(out->localizer, "odom") && !out->map[0]) {
-    return Status::error(Errc::kInvalidArgument, "config '%s': key 'map' is required for localizer '%s'", name,
-                         out->localizer);
-  }
   if (out->num_cores > 0 && out->num_cores < out->workers) {
     return Status::error(Errc::kInvalidArgument, "config '%s': key 'cores' lists %d CPUs for %d workers", name,
                          out->num_cores, out->workers);
+  }
+  if (std::strcmp(out->localizer, "odom") && !out->map[0]) {
+    return Status::error(Errc::kInvalidArgument, "config '%s': key 'map' is required for localizer '%s' (localizer = odom runs without a map)", name,
+                         out->localizer);
   }
   return Status::ok();
 }

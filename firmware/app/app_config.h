@@ -4,7 +4,7 @@
 //   odometry         socketcan:IFACE | none              [laser's interface when socketcan, else none]
 //   output           socketcan:IFACE | log               [laser's interface when socketcan, else log]
 //   can_fd           auto | true | false                 [auto: FD when the interface MTU is 72]
-//   localizer        odom | mml                          [odom]
+//   localizer        mml-track | mml | handoff | mcl | odom   [mml-track] (firmware/app/system.h)
 //   mml_preset       1..4 MML configuration C1..C4 (firmware/mml/mml_presets.h)  [3]
 //   map              path of the compiled map image (mml-mapc / mml-mapbuild)   (required for mml)
 //   workers          1..16 worker threads, created once  [2]
@@ -30,7 +30,7 @@ struct AppConfig {
   char odometry[128] = {0};  // empty = default
   char output[128] = {0};
   int can_fd = -1;           // -1 auto, 0 classic, 1 FD required
-  char localizer[16] = "odom";
+  char localizer[16] = "mml-track";
   int mml_preset = 3;
   char map[256] = {0};
   int workers = 2;

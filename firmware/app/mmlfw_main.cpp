@@ -13,16 +13,14 @@
 #include <cstring>
 
 #include "firmware/app/app_config.h"
+#include "firmware/app/system.h"
 #include "firmware/base/arena.h"
 #include "firmware/base/memory_report.h"
 #include "firmware/base/worker_pool.h"
 #include "firmware/map/global_map.h"
 #include "firmware/map/map_image.h"
 #include "firmware/map/map_image_file.h"
-#include "firmware/mml/mml_localizer.h"
-#include "firmware/mml/mml_presets.h"
 #include "firmware/runtime/localization_loop.h"
-#include "firmware/runtime/odometry_localizer.h"
 #include "hal_linux/board.h"
 
 namespace {
@@ -31,8 +29,7 @@ namespace {
 hal_linux::Board g_board;
 fw::StartupArena g_arena;
 fw::WorkerPool g_pool;
-fw::OdometryLocalizer g_odom;
-fw::mml::MmlLocalizer g_mml;
+fw::LocalizationSystem g_system;  // the localizer objects themselves live in the arena
 fw::LocalizationLoop g_loop;
 fw::AppConfig g_config;
 volatile sig_atomic_t g_stop = 0;
@@ -54,22 +51,34 @@ int fail(const char* stage, const fw::Status& s) {
 namespace {
 // log_level = debug: one line per processed scan with the odometry it was paired with and, for MML,
 // the interpreter's view (Eq. 5.7, 5.14, 5.16) — what a field engineer needs to replay a bad run.
-void trace_step(hal::Hal& hal, bool mml) {
+void trace_step(hal::Hal& hal) {
   const hal::PoseEstimate& e = g_loop.last_estimate();
   const hal::Odometry& od = g_loop.last_odometry();
-  if (!mml) {
+  const fw::mml::MmlLocalizer* mml = g_system.mml();
+  if (e.mode == hal::LocalizationMode::kTracking && g_system.tracked() != nullptr) {
+    const fw::track::TrackStep& t = g_system.tracked()->tracker().last();
+    hal.log->log(hal::LogLevel::kDebug,
+                 "step scan %u t %llu odom %.4f %.4f %.4f status %s pose %.3f %.3f %.3f track %s inliers %u/%u "
+                 "unknown %u chi2 %.2f pl %.3f m %.4f rad unsupported %u",
+                 e.scan_id, static_cast<unsigned long long>(e.timestamp_ns), od.x, od.y, od.theta,
+                 hal::status_name(e.status), e.x, e.y, e.theta, fw::track::verdict_name(t.verdict), t.alignment.inliers,
+                 t.alignment.inliers + t.alignment.contradicting, t.alignment.unknown, t.innovation_chi2,
+                 e.protection_xy_m, e.protection_theta_rad, e.unsupported_steps);
+    return;
+  }
+  if (mml == nullptr) {
     hal.log->log(hal::LogLevel::kDebug, "step scan %u t %llu odom %.4f %.4f %.4f status %s pose %.3f %.3f %.3f", e.scan_id,
                  static_cast<unsigned long long>(e.timestamp_ns), od.x, od.y, od.theta, hal::status_name(e.status), e.x, e.y,
                  e.theta);
     return;
   }
-  const fw::mml::InterpretResult& r = g_mml.last();
+  const fw::mml::InterpretResult& r = mml->last();
   hal.log->log(hal::LogLevel::kDebug,
                "step scan %u t %llu odom %.4f %.4f %.4f status %s pose %.3f %.3f %.3f hyps %u/%u clusters %u r %.3f "
                "d2 %.2f smed %.2f c %d%d%d soft %d thres %.3f unique-rejections %u",
                e.scan_id, static_cast<unsigned long long>(e.timestamp_ns), od.x, od.y, od.theta, hal::status_name(e.status),
                e.x, e.y, e.theta, r.hypotheses_valid, r.hypotheses_in, r.cluster_count, r.best_rating, r.d2, r.sigma_med,
-               r.c_rating, r.c_mahalanobis, r.c_median, r.soft, r.omega_thres_next, g_mml.uniqueness_rejections());
+               r.c_rating, r.c_mahalanobis, r.c_median, r.soft, r.omega_thres_next, mml->uniqueness_rejections());
 }
 }  // namespace
 
@@ -147,27 +156,19 @@ int main(int argc, char** argv) {
                  g_pool.warning());
   }
 
-  fw::Localizer* localizer = nullptr;
-  if (!std::strcmp(c.localizer, "mml")) {
-    // The configuration measured by mml-sim / mml-eval / bench_mml, fitted to this map.
-    fw::mml::MmlLocalizerConfig mc = fw::mml::fit_contact_field_to_map(fw::mml::mml_preset(c.mml_preset, c.seed), map);
-    // Without a relation table section in the image the localizer fills R_B once here, at start-up
-    // (Sec. 5.5.2; ~1-3 s); filling it online per step (configuration C1) rarely localizes.
-    if (!table && mc.mml.precomputed_table)
-      hal.log->log(hal::LogLevel::kInfo, "mmlfw: map image has no relation table; filling it at start-up");
-    st = g_mml.init(mc, map, table, table_len, g_arena, &g_pool);
-    if (!st) return fail("localizer mml", st);
-    localizer = &g_mml;
-  } else {
-    fw::OdometryLocalizerOptions oo;
-    st = oo.validate();
-    if (!st) return fail("localizer odom", st);
-    g_odom = fw::OdometryLocalizer(oo);
-    localizer = &g_odom;
-  }
+  // The one start-up builder (firmware/app/system.h), as mml-sim, mml-eval and the replays use it.
+  if (!table && c.map[0] && std::strcmp(c.localizer, "odom") && std::strcmp(c.localizer, "mcl") && c.mml_preset != 1)
+    hal.log->log(hal::LogLevel::kInfo, "mmlfw: map image has no relation table; filling it at start-up");
+  fw::SystemSpec sys;
+  sys.localizer = c.localizer;
+  sys.mml_preset = c.mml_preset;
+  sys.seed = c.seed;
+  st = g_system.build(sys, map, table, table_len, g_arena, &g_pool);
+  if (!st) return fail("localizer", st);
+  fw::Localizer* localizer = &g_system.localizer();
   // The map now lives in the arena; a relation table section in use is read in place from the
   // mapped image (read-only, like flash), so the image stays mapped while the loop runs.
-  const bool table_in_use = localizer == &g_mml && table != nullptr && g_mml.using_precomputed_table();
+  const bool table_in_use = table != nullptr && g_system.table_in_use();
   if (!table_in_use) image.close();
 
   fw::LocalizationLoopOptions lo;
@@ -181,12 +182,7 @@ int main(int argc, char** argv) {
   mr.add({"hal", "board (sockets, CAN node rings, SICK parser)", sizeof(g_board), 0, nullptr});
   mr.add({"runtime", "localization loop (odometry ring, pending scan, perf)", sizeof(g_loop), 0, nullptr});
   mr.add({"runtime", "worker pool", sizeof(g_pool), static_cast<std::size_t>(c.workers), nullptr});
-  if (localizer == &g_mml) {
-    mr.add({"mml", "MmlLocalizer object (static)", sizeof(g_mml), 0, nullptr});
-    if (table_in_use) mr.add({"map", "relation table (mapped image)", table_len, 0, nullptr});
-  } else {
-    mr.add({"runtime", "OdometryLocalizer object (static)", sizeof(g_odom), 0, nullptr});
-  }
+  if (table_in_use) mr.add({"map", "relation table (mapped image)", table_len, 0, nullptr});
   g_arena.seal();
   if (memory_report) {
     std::printf("mmlfw memory report (config '%s', localizer %s, arena used %zu of %zu bytes)\n", config_path,
@@ -194,8 +190,8 @@ int main(int argc, char** argv) {
     mr.print(stdout);
     // The map/pransam/mml regions above are carved from the arena (listed for the breakdown), so
     // the footprint is the arena plus the static objects.
-    const std::size_t statics = sizeof(g_board) + sizeof(g_loop) + sizeof(g_pool) +
-                                (localizer == &g_mml ? sizeof(g_mml) : sizeof(g_odom));
+    // (The localizer objects are in the arena: system.h.)
+    const std::size_t statics = sizeof(g_board) + sizeof(g_loop) + sizeof(g_pool) + sizeof(g_system);
     const std::size_t mapped = table_in_use ? table_len : 0;
     std::printf("footprint: arena reserved %.3f MiB (used %.3f MiB) + static objects %.3f MiB + mapped table "
                 "%.3f MiB = %.3f MiB (%.3f MiB with the arena trimmed to its use)\n",
@@ -226,7 +222,7 @@ int main(int argc, char** argv) {
       if (!g_loop.stepped()) break;
       ++scans;
       last_health = hal.clock->now_ns();  // the loop published health with the pose
-      if (c.log_level == static_cast<int>(hal::LogLevel::kDebug)) trace_step(hal, localizer == &g_mml);
+      if (c.log_level == static_cast<int>(hal::LogLevel::kDebug)) trace_step(hal);
       if (max_scans > 0 && static_cast<long>(scans) >= max_scans) g_stop = 1;
     }
     const std::uint64_t now = hal.clock->now_ns();

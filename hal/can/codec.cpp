@@ -2,6 +2,7 @@
 
 #include <cmath>
 #include <cstring>
+#include <limits>
 
 namespace hal_can {
 namespace {
@@ -11,7 +12,7 @@ using fw::Status;
 
 constexpr std::size_t kStartPayload = kScanStartParts * kPartBytes;  // 28
 constexpr std::size_t kOdomPayload = kOdomParts * kPartBytes;        // 28
-constexpr std::size_t kPosePayload = kPoseParts * kPartBytes;        // 35
+constexpr std::size_t kPosePayload = kPoseParts * kPartBytes;        // 42
 constexpr std::size_t kHealthPayload = kHealthParts * kPartBytes;    // 35
 
 struct Crc32Table {
@@ -92,6 +93,27 @@ std::uint8_t fd_length_for(std::size_t n) {
     if (n <= l) return l;
   }
   return 64;
+}
+
+std::uint16_t protection_code(float bound, double lsb_per_unit) {
+  // NaN, negative and 0 all mean "no bound": an unusable bound must never reach the robot as a
+  // number. +inf and anything beyond the range saturate (the receiver reads "at least the max").
+  if (!(bound > 0.0f)) return 0;
+  // Round up: the published bound must hold, so it may grow by < 1 LSB but never shrink. The
+  // 1e-6 relative slack absorbs the float representation error of the input (0.1f m is
+  // 100.0000015 mm and should stay 100 mm, not become 101 mm); it shrinks no bound by more than
+  // 1e-6 of itself. Codes start at 1: a tiny positive bound is 1 LSB, not "no bound".
+  const double c = std::ceil(static_cast<double>(bound) * lsb_per_unit * (1.0 - 1e-6));
+  if (!(c < kProtectionSaturated)) return kProtectionSaturated;  // also +inf
+  return static_cast<std::uint16_t>(c < 1.0 ? 1.0 : c);
+}
+
+float protection_value(std::uint16_t code, double lsb_per_unit) {
+  if (code == 0) return 0.0f;
+  // Saturated: the true bound is at least the largest code, so report no finite bound rather
+  // than a smaller number that would not hold.
+  if (code == kProtectionSaturated) return std::numeric_limits<float>::infinity();
+  return static_cast<float>(code / lsb_per_unit);
 }
 
 std::uint32_t crc32_update(std::uint32_t crc, const std::uint8_t* data, std::size_t len) {
@@ -207,6 +229,12 @@ Status encode_pose(const hal::PoseEstimate& pose, std::uint8_t tag, bool fd, hal
   put_u32(p + 21, static_cast<std::uint32_t>(clamp_i32(static_cast<double>(pose.theta) * 1e6)));
   put_u16(p + 25, clamp_u16(sigma(pose.cov[8]) * 1e4));
   put_u48(p + 28, pose.timestamp_ns / 1000);
+  p[kPoseLayoutOffset] = kPoseLayout;
+  // Part 5 (layout 1): protection level (RAIM-style bound, hal/msg/pose_estimate.h) and the
+  // number of scans since one last confirmed the pose. p[41] is reserved (0).
+  put_u16(p + 35, protection_code(pose.protection_xy_m, kProtectionXyPerMetre));
+  put_u16(p + 37, protection_code(pose.protection_theta_rad, kProtectionThetaPerRad));
+  put_u16(p + 39, pose.unsupported_steps);
   return emit_record(kPoseId, kPoseParts, tag, p, fd, out, capacity, count, "pose");
 }
 
@@ -441,8 +469,16 @@ Decoded Decoder::feed(const hal::CanFrame& f) {
     return scan_end(f) ? Decoded::kScan : Decoded::kNothing;
   }
   if (id >= kPoseId && id < kPoseId + kPoseParts) {
-    const bool done = fd_id ? (id == kPoseId && feed_fd_record(&pose_rec_, kPoseParts, f))
-                            : feed_part(&pose_rec_, kPoseParts, id - kPoseId, f);
+    // FD: both layouts travel in a 48-byte frame (layout 0 padded with zeros), so the 6-part
+    // length check accepts either.
+    bool done = fd_id ? (id == kPoseId && feed_fd_record(&pose_rec_, kPoseParts, f))
+                      : feed_part(&pose_rec_, kPoseParts, id - kPoseId, f);
+    if (!done && !fd_id && id - kPoseId + 1 == kPoseLegacyParts && pose_rec_.active &&
+        pose_rec_.next == kPoseLegacyParts && pose_rec_.bytes[kPoseLayoutOffset] == 0) {
+      // Part 4 of a layout-0 sender (no protection part) completes its record.
+      pose_rec_.active = false;
+      done = true;
+    }
     if (!done) return Decoded::kNothing;
     p = pose_rec_.bytes;
     pose_ = hal::PoseEstimate{};
@@ -466,6 +502,11 @@ Decoded Decoder::feed(const hal::CanFrame& f) {
     pose_.cov[8] = static_cast<float>(st * st);
     pose_time_us_ = get_u48(p + 28);
     pose_.timestamp_ns = pose_time_us_ * 1000;
+    if (p[kPoseLayoutOffset] != 0) {  // layouts only append: any layout >= 1 has part 5
+      pose_.protection_xy_m = protection_value(get_u16(p + 35), kProtectionXyPerMetre);
+      pose_.protection_theta_rad = protection_value(get_u16(p + 37), kProtectionThetaPerRad);
+      pose_.unsupported_steps = get_u16(p + 39);
+    }
     ++stats_.poses_ok;
     return Decoded::kPose;
   }

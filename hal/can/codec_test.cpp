@@ -5,6 +5,7 @@
 #include <cmath>
 #include <cstring>
 #include <deque>
+#include <limits>
 #include <random>
 #include <vector>
 
@@ -243,6 +244,10 @@ TEST(RecordCodec, OdometryPoseHealthRoundTrip) {
     EXPECT_NEAR(d.pose().cov[4], 0.04, 1e-4);
     EXPECT_EQ(d.pose().hypothesis_count, 300);
     EXPECT_EQ(d.pose().timestamp_ns, 42'000'000u);
+    // Defaults: no protection bound, confirmed by this scan.
+    EXPECT_EQ(d.pose().protection_xy_m, 0.0f);
+    EXPECT_EQ(d.pose().protection_theta_rad, 0.0f);
+    EXPECT_EQ(d.pose().unsupported_steps, 0);
 
     HealthRecord h;
     h.uptime_ms = 123456;
@@ -262,6 +267,163 @@ TEST(RecordCodec, OdometryPoseHealthRoundTrip) {
     EXPECT_EQ(d.health().fault_bits, 0x10u);
     EXPECT_EQ(d.health().scans_processed, 1000u);
   }
+}
+
+hal::PoseEstimate pose_with_protection(float xy, float theta, std::uint16_t unsupported) {
+  hal::PoseEstimate p;
+  p.timestamp_ns = 7'000'000;
+  p.scan_id = 901;
+  p.x = 1.5f;
+  p.status = hal::LocalizationStatus::kLocalized;
+  p.protection_xy_m = xy;
+  p.protection_theta_rad = theta;
+  p.unsupported_steps = unsupported;
+  return p;
+}
+
+// Encodes and decodes one pose; fails the test if the decoder does not deliver it.
+hal::PoseEstimate round_trip(const hal::PoseEstimate& p, bool fd, std::size_t* frames = nullptr) {
+  hal::CanFrame f[kMaxParts];
+  std::size_t n = 0;
+  EXPECT_TRUE(encode_pose(p, 11, fd, f, kMaxParts, &n).is_ok());
+  if (frames) *frames = n;
+  Decoder d;
+  Decoded last = Decoded::kNothing;
+  for (std::size_t i = 0; i < n; ++i) last = d.feed(f[i]);
+  EXPECT_EQ(last, Decoded::kPose);
+  EXPECT_EQ(d.stats().malformed + d.stats().broken_records + d.stats().unknown_ids, 0u);
+  return d.pose();
+}
+
+TEST(PoseProtection, RoundTripClassicAndFd) {
+  for (bool fd : {false, true}) {
+    std::size_t n = 0;
+    const hal::PoseEstimate got = round_trip(pose_with_protection(0.75f, 0.0523f, 17), fd, &n);
+    EXPECT_EQ(n, fd ? 1u : 6u);  // classic: parts 0x120..0x125
+    EXPECT_NEAR(got.protection_xy_m, 0.75, 1e-6);
+    EXPECT_NEAR(got.protection_theta_rad, 0.0523, 1e-6);
+    EXPECT_EQ(got.unsupported_steps, 17);
+    EXPECT_EQ(got.scan_id, 901u);
+    EXPECT_NEAR(got.x, 1.5, 1e-3);
+    EXPECT_EQ(round_trip(pose_with_protection(1.0f, 0.1f, 65535), fd).unsupported_steps, 65535);
+  }
+  hal::CanFrame f[kMaxParts];
+  std::size_t n = 0;
+  ASSERT_TRUE(encode_pose(pose_with_protection(1, 1, 1), 0, true, f, kMaxParts, &n).is_ok());
+  EXPECT_EQ(f[0].len, 48);  // 1 + 42 bytes: the FD frame length did not change
+  ASSERT_TRUE(encode_pose(pose_with_protection(1, 1, 1), 0, false, f, kMaxParts, &n).is_ok());
+  EXPECT_EQ(f[5].id, 0x125u);
+  EXPECT_EQ(f[5].len, 8);
+}
+
+TEST(PoseProtection, RoundsUpNeverDown) {
+  // The published bound must hold: it may grow by less than one LSB, never shrink.
+  for (float xy : {0.0004f, 0.0011f, 0.1f, 0.2345f, 1.0f, 12.3456f, 65.0f}) {
+    const float got = round_trip(pose_with_protection(xy, 0.0f, 0), false).protection_xy_m;
+    EXPECT_GE(got, xy * (1 - 1e-6f)) << xy;
+    EXPECT_LT(got, xy + 0.001f) << xy;
+  }
+  for (float th : {0.00001f, 0.01f, 0.017453292f, 0.5f, 3.1415927f, 6.5f}) {
+    const float got = round_trip(pose_with_protection(0.0f, th, 0), true).protection_theta_rad;
+    EXPECT_GE(got, th * (1 - 1e-6f)) << th;
+    EXPECT_LT(got, th + 1e-4f) << th;
+  }
+  // Exact decimal inputs keep their code (float noise does not add an LSB).
+  EXPECT_EQ(protection_code(0.1f, kProtectionXyPerMetre), 100);
+  EXPECT_EQ(protection_code(0.3f, kProtectionXyPerMetre), 300);
+  EXPECT_EQ(protection_code(0.0523f, kProtectionThetaPerRad), 523);
+  EXPECT_EQ(protection_code(0.0001f, kProtectionXyPerMetre), 1);  // tiny bound: 1 LSB, not "no bound"
+  EXPECT_EQ(protection_code(0.1001f, kProtectionXyPerMetre), 101);
+}
+
+TEST(PoseProtection, HugeValuesSaturateAndDecodeAsNoFiniteBound) {
+  const float inf = std::numeric_limits<float>::infinity();
+  for (bool fd : {false, true}) {
+    for (float xy : {65.535f, 70.0f, 1e6f, 3e38f, inf}) {
+      EXPECT_EQ(protection_code(xy, kProtectionXyPerMetre), kProtectionSaturated) << xy;
+      EXPECT_EQ(round_trip(pose_with_protection(xy, 0.1f, 0), fd).protection_xy_m, inf) << xy;
+    }
+    for (float th : {6.6f, 100.0f, 3e38f, inf}) {
+      EXPECT_EQ(protection_code(th, kProtectionThetaPerRad), kProtectionSaturated) << th;
+      EXPECT_EQ(round_trip(pose_with_protection(0.5f, th, 0), fd).protection_theta_rad, inf) << th;
+    }
+  }
+  // Just below saturation stays a finite bound: 65.534 m and 6.5534 rad are the largest.
+  EXPECT_EQ(protection_code(65.534f, kProtectionXyPerMetre), 65534);
+  EXPECT_NEAR(protection_value(65534, kProtectionXyPerMetre), 65.534, 1e-4);
+  EXPECT_EQ(protection_code(6.5534f, kProtectionThetaPerRad), 65534);
+}
+
+TEST(PoseProtection, ZeroNanAndNegativeMeanNoBound) {
+  const float nan = std::numeric_limits<float>::quiet_NaN();
+  const float inf = std::numeric_limits<float>::infinity();
+  for (bool fd : {false, true}) {
+    for (float bad : {0.0f, -0.0f, -1.0f, -1e30f, -inf, nan}) {
+      const hal::PoseEstimate got = round_trip(pose_with_protection(bad, bad, 3), fd);
+      EXPECT_EQ(got.protection_xy_m, 0.0f) << bad;
+      EXPECT_EQ(got.protection_theta_rad, 0.0f) << bad;
+      EXPECT_EQ(got.unsupported_steps, 3);
+    }
+  }
+  EXPECT_EQ(protection_code(nan, kProtectionXyPerMetre), 0);
+  EXPECT_EQ(protection_value(0, kProtectionXyPerMetre), 0.0f);
+}
+
+TEST(PoseProtection, DecodesLayoutZeroSenders) {
+  // A sender from before protection levels: 5 classic parts with byte 34 (frame 0x124, byte 7)
+  // = 0, or a 48-byte FD frame with zero padding. Both decode, with "no bound".
+  for (bool fd : {false, true}) {
+    hal::CanFrame f[kMaxParts];
+    std::size_t n = 0;
+    ASSERT_TRUE(encode_pose(pose_with_protection(0.5f, 0.05f, 9), 4, fd, f, kMaxParts, &n).is_ok());
+    if (fd) {
+      f[0].data[1 + kPoseLayoutOffset] = 0;
+      for (std::size_t i = 1 + kPoseLegacyParts * kPartBytes; i < f[0].len; ++i) f[0].data[i] = 0;
+    } else {
+      f[4].data[7] = 0;
+      n = kPoseLegacyParts;
+    }
+    Decoder d;
+    // A layout-1 pose first, so stale bytes of a previous record cannot leak into the old one.
+    hal::CanFrame g[kMaxParts];
+    std::size_t m = 0;
+    ASSERT_TRUE(encode_pose(pose_with_protection(2.0f, 0.2f, 5), 3, fd, g, kMaxParts, &m).is_ok());
+    for (std::size_t i = 0; i < m; ++i) d.feed(g[i]);
+    ASSERT_EQ(d.pose().unsupported_steps, 5);
+    Decoded last = Decoded::kNothing;
+    for (std::size_t i = 0; i < n; ++i) last = d.feed(f[i]);
+    ASSERT_EQ(last, Decoded::kPose) << "fd=" << fd;
+    EXPECT_EQ(d.pose().scan_id, 901u);
+    EXPECT_EQ(d.pose().protection_xy_m, 0.0f);
+    EXPECT_EQ(d.pose().protection_theta_rad, 0.0f);
+    EXPECT_EQ(d.pose().unsupported_steps, 0);
+    EXPECT_EQ(d.stats().poses_ok, 2u);
+    EXPECT_EQ(d.stats().broken_records, 0u);
+  }
+}
+
+TEST(PoseProtection, MissingProtectionPartDropsThePose) {
+  // Layout 1 announces part 5: without it the pose is not delivered (and never delivered with
+  // a made-up bound); the next complete pose is fine again.
+  Decoder d;
+  hal::CanFrame f[kMaxParts];
+  std::size_t n = 0;
+  ASSERT_TRUE(encode_pose(pose_with_protection(0.5f, 0.05f, 9), 1, false, f, kMaxParts, &n).is_ok());
+  for (std::size_t i = 0; i + 1 < n; ++i) EXPECT_EQ(d.feed(f[i]), Decoded::kNothing);
+  ASSERT_TRUE(encode_pose(pose_with_protection(0.25f, 0.05f, 2), 2, false, f, kMaxParts, &n).is_ok());
+  Decoded last = Decoded::kNothing;
+  for (std::size_t i = 0; i < n; ++i) last = d.feed(f[i]);
+  ASSERT_EQ(last, Decoded::kPose);
+  EXPECT_NEAR(d.pose().protection_xy_m, 0.25, 1e-6);
+  EXPECT_EQ(d.stats().poses_ok, 1u);
+  EXPECT_EQ(d.stats().broken_records, 1u);
+  // Part 5 of another record (wrong tag) is not accepted either.
+  hal::CanFrame g[kMaxParts];
+  ASSERT_TRUE(encode_pose(pose_with_protection(9.0f, 0.05f, 2), 7, false, g, kMaxParts, &n).is_ok());
+  ASSERT_TRUE(encode_pose(pose_with_protection(0.5f, 0.05f, 2), 8, false, f, kMaxParts, &n).is_ok());
+  for (std::size_t i = 0; i + 1 < n; ++i) d.feed(f[i]);
+  EXPECT_EQ(d.feed(g[5]), Decoded::kNothing);
+  EXPECT_EQ(d.stats().poses_ok, 1u);
 }
 
 TEST(RecordCodec, PartsOfDifferentRecordsAreNotMixed) {

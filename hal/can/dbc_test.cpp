@@ -84,7 +84,7 @@ double sig(const std::map<std::uint32_t, Message>& dbc, const hal::CanFrame* fra
 
 TEST(Dbc, DescribesEveryFrameTheEncoderProduces) {
   const auto dbc = load_dbc();
-  ASSERT_GE(dbc.size(), 25u);
+  ASSERT_GE(dbc.size(), 26u);
   for (bool fd : {false, true}) {
     hal::CanFrame f[kMaxParts];
     std::size_t n = 0;
@@ -98,10 +98,18 @@ TEST(Dbc, DescribesEveryFrameTheEncoderProduces) {
     p.cov[0] = 0.04f;
     p.hypothesis_count = 17;
     p.timestamp_ns = 123456789000ull;
+    p.protection_xy_m = 0.75f;
+    p.protection_theta_rad = 0.0523f;
+    p.unsupported_steps = 1234;
     ASSERT_TRUE(encode_pose(p, 5, fd, f, kMaxParts, &n).is_ok());
+    EXPECT_EQ(n, fd ? 1u : kPoseParts);
     for (std::size_t i = 0; i < n; ++i) {
       ASSERT_TRUE(dbc.count(f[i].id)) << std::hex << f[i].id;
       EXPECT_LE(f[i].len, dbc.at(f[i].id).dlc);
+      // Every signal the DBC puts in this frame lies inside the bytes the encoder sends.
+      for (const auto& [name, s] : dbc.at(f[i].id).signals) {
+        EXPECT_LE(s.start + s.bits, 8 * f[i].len) << dbc.at(f[i].id).name << "." << name;
+      }
     }
     EXPECT_EQ(sig(dbc, f, n, "ScanId"), 4242);
     EXPECT_NEAR(sig(dbc, f, n, "X"), -12.5, 1e-9);
@@ -112,6 +120,16 @@ TEST(Dbc, DescribesEveryFrameTheEncoderProduces) {
     EXPECT_NEAR(sig(dbc, f, n, "SigmaX"), 0.2, 1e-3);
     EXPECT_EQ(sig(dbc, f, n, "HypothesisCount"), 17);
     EXPECT_EQ(sig(dbc, f, n, "TimeUs"), 123456789);
+    EXPECT_EQ(sig(dbc, f, n, "PoseLayout"), kPoseLayout);
+    EXPECT_NEAR(sig(dbc, f, n, "ProtectionXY"), 0.75, 1e-9);
+    EXPECT_NEAR(sig(dbc, f, n, "ProtectionTheta"), 0.0523, 1e-9);
+    EXPECT_EQ(sig(dbc, f, n, "UnsupportedSteps"), 1234);
+    // The DBC factors are the codec's: a saturated bound reads as the DBC's maximum.
+    p.protection_xy_m = 1e6f;
+    p.protection_theta_rad = 100.0f;
+    ASSERT_TRUE(encode_pose(p, 6, fd, f, kMaxParts, &n).is_ok());
+    EXPECT_NEAR(sig(dbc, f, n, "ProtectionXY"), 65535 / kProtectionXyPerMetre, 1e-9);
+    EXPECT_NEAR(sig(dbc, f, n, "ProtectionTheta"), 65535 / kProtectionThetaPerRad, 1e-9);
 
     hal::Odometry o;
     o.x = 1.5f;

@@ -44,6 +44,10 @@ std::unique_ptr<fw::Localizer> make_odom(const LocalizerContext& ctx, std::strin
 // The built-in table. Owners: add your localizer here ({"mml", "...", &make_mml}).
 std::vector<Entry>& registry() {
   static std::vector<Entry> entries = {
+      {"mml-track",
+       "MML global fix, confirmed and tracked on the global map at every scan with a protection level (firmware "
+       "default); --opt config=1..4, alert=M",
+       &mmleval::make_track_localizer},
       {"odom", "odometry pass-through (dead reckoning; status always searching); --opt anchor=origin|truth",
        &make_odom},
       {"mml", "MML global localization (RBSM local map + pRANSAM + Ch. 5 constraints); --opt config=1..4, iterations=N",

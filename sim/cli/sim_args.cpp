@@ -64,7 +64,7 @@ source:
   --reference FILE        *.corrected-poses.txt: ground truth for the log's scans
   --map FILE.yaml         ROS map_server map for the log (the localizer's global map)
 run:
-  --localizer NAME        localizer (default mml when built in, else odom; --list shows all)
+  --localizer NAME        localizer (default mml-track, the firmware's; --list shows all)
   --opt KEY=VALUE         localizer option (repeatable), e.g. --opt anchor=truth for odom
   --seed N                random seed (route, people, noise; default 1)
   --steps N               stop after N scans (default: the whole route / log)

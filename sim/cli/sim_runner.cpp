@@ -1,5 +1,7 @@
 #include "sim/cli/sim_runner.h"
 
+#include "firmware/app/localizer_names.h"
+
 #include <unistd.h>
 
 #include <algorithm>
@@ -370,7 +372,7 @@ bool run_simulation(const SimConfig& cfg_in, SimResult* out, std::string* err) {
   if (cfg.localizer.empty()) {
     cfg.localizer = "odom";
     for (const LocalizerInfo& l : localizer_names()) {
-      if (l.name == "mml") cfg.localizer = "mml";
+      if (l.name == fw::kDefaultLocalizer) cfg.localizer = fw::kDefaultLocalizer;  // the firmware's default
     }
   }
   if (cfg.custom_world != nullptr) {

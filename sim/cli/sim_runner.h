@@ -24,7 +24,7 @@ struct SimConfig {
   std::string log_path;        // CARMEN log (plain or .gz)
   std::string reference_path;  // *.corrected-poses.txt for a log (ground truth)
   std::string map_yaml;        // ROS map for a log replay (optional)
-  // Empty: "mml" when it is registered (the product), else "odom" (pass-through).
+  // Empty: "mml-track" when it is registered (the product, firmware/app/system.h), else "odom".
   std::string localizer;
   std::map<std::string, std::string> localizer_options;
   std::uint64_t seed = 1;

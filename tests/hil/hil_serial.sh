@@ -19,7 +19,7 @@ sp=$!
 trap 'kill $sp 2>/dev/null; wait $sp 2>/dev/null' EXIT
 for i in $(seq 1 100); do [ -e "$W/ttyA" ] && [ -e "$W/ttyB" ] && break; sleep 0.05; done
 [ -e "$W/ttyB" ] || { say "FAIL: socat made no pty pair"; cat "$W/socat.log"; exit 1; }
-printf 'laser = serial:%s@500000\nodometry = none\noutput = log\nworkers = 1\narena_mib = 16\nlog_level = warning\n' \
+printf 'localizer = odom\nlaser = serial:%s@500000\nodometry = none\noutput = log\nworkers = 1\narena_mib = 16\nlog_level = warning\n' \
   "$W/ttyB" > "$W/serial.conf"
 "$B/sim/devices/mml-sickdev" --device "$W/ttyA" --dataset aces --count "$N" --rate 75 --corrupt-every 25 \
   --garbage-every 40 --wait 10 > "$W/sent.json" 2> "$W/sickdev.err" &

@@ -1,4 +1,4 @@
-// Registry entries for the simulator (sim/cli/localizer_factory.cpp): "mml", "mcl", "handoff".
+// Registry entries for the simulator (sim/cli/localizer_factory.cpp): "mml-track", "mml", "mcl", "handoff".
 // Uses only the registry's header types, so sim_mml does not link the registry (no cycle).
 #include <cstdlib>
 
@@ -111,6 +111,38 @@ std::unique_ptr<fw::Localizer> make_handoff_localizer(const LocalizerContext& ct
   return wrap_hooks(OwnedLocalizer::make_handoff(*ctx.global_map, ctx.map_image ? *ctx.map_image : kEmpty, cfg,
                                                  mcl_tracking_options(ctx.seed), fw::mml::HandoffOptions(),
                                                  ctx.threads, err),
+                    ctx);
+}
+
+}  // namespace sim::mmleval
+
+namespace sim::mmleval {
+
+// The product's system (firmware default): MML fix confirmed and tracked with a protection level.
+// Options: config=1..4, correct=0|1, reduce=0|1 (MML part); alert=M (alert limit, metres).
+std::unique_ptr<fw::Localizer> make_track_localizer(const LocalizerContext& ctx, std::string* err) {
+  const std::string bad = check_keys("mml-track", ctx.options, {"config", "correct", "reduce", "alert"});
+  if (!bad.empty()) { *err = bad; return nullptr; }
+  if (ctx.global_map == nullptr) { *err = "localizer mml-track: needs a global map"; return nullptr; }
+  long config = 3;
+  if (!parse_int(ctx.options, "config", 1, 4, &config, "mml-track", err)) return nullptr;
+  auto cfg = mml_config(static_cast<int>(config), ctx.seed);
+  if (!apply_local_map_options(ctx.options, "mml-track", &cfg, err)) return nullptr;
+  fw::track::TrackOptions to;
+  const auto a = ctx.options.find("alert");
+  if (a != ctx.options.end()) {
+    char* end = nullptr;
+    const double v = std::strtod(a->second.c_str(), &end);
+    if (end == a->second.c_str() || *end != '\0' || !(v > 0.0 && v <= 100.0)) {
+      *err = "localizer mml-track: option alert='" + a->second + "' (expected metres in (0, 100])";
+      return nullptr;
+    }
+    to.alert_limit_m = static_cast<float>(v);
+    if (to.lost_limit_m < to.alert_limit_m) to.lost_limit_m = to.alert_limit_m;
+  }
+  static const std::vector<std::uint8_t> kEmpty;
+  return wrap_hooks(OwnedLocalizer::make_track(*ctx.global_map, ctx.map_image ? *ctx.map_image : kEmpty, cfg, to,
+                                               ctx.threads, err),
                     ctx);
 }
 

@@ -9,10 +9,12 @@
 #include <string>
 #include <vector>
 
+#include "firmware/app/system.h"
 #include "firmware/base/arena.h"
 #include "firmware/base/worker_pool.h"
 #include "firmware/map/global_map.h"
 #include "firmware/mcl/mcl_localizer.h"
+#include "firmware/mcl/mcl_presets.h"
 #include "firmware/mml/handoff_localizer.h"
 #include "firmware/mml/mml_localizer.h"
 #include "firmware/runtime/localizer.h"
@@ -32,33 +34,41 @@ namespace sim::mmleval {
 //   C3: precomputed table, fixed local map (last 8 fragments of 2 m), Bollinger, 30k iterations
 //   C4: as C3 with 60k iterations
 fw::mml::MmlLocalizerConfig mml_config(int config, std::uint64_t seed);
-// The thesis's baseline: beam model on 18 beams; `particles` 15k–120k.
-fw::mcl::MclOptions mcl_baseline_options(std::uint32_t particles, std::uint64_t seed);
-// Tracking filter used after the hand-off (few particles, likelihood field, many beams).
-fw::mcl::MclOptions mcl_tracking_options(std::uint64_t seed);
+// MCL presets: firmware/mcl/mcl_presets.h (shared with the firmware).
+using fw::mcl::mcl_baseline_options;
+using fw::mcl::mcl_tracking_options;
 
-// A localizer together with everything it needs (arena, pool). reset()/step() forward.
+// A localizer together with everything it needs (arena, pool), built by the firmware's one
+// start-up builder (firmware/app/system.h) exactly as mmlfw builds it. reset()/step() forward.
 class OwnedLocalizer : public fw::Localizer {
  public:
-  const char* name() const override { return inner_ ? inner_->name() : "none"; }
-  void reset() override { inner_->reset(); }
+  const char* name() const override { return system_.name(); }
+  void reset() override { system_.localizer().reset(); }
   fw::Status step(const hal::LaserScan& scan, const hal::Odometry& odom, hal::PoseEstimate* out) override {
-    return inner_->step(scan, odom, out);
+    return system_.localizer().step(scan, odom, out);
   }
-  // Hypotheses (best clusters of the last MML step) for pictures; empty for MCL.
+  // Hypotheses (best clusters of the last MML step) for pictures; empty while tracking and for MCL.
   void hypotheses(std::vector<HypothesisPoint>* out) const;
-  fw::mml::MmlLocalizer* mml() { return mml_.get(); }
-  fw::mcl::MclLocalizer* mcl() { return mcl_.get(); }
-  fw::mml::HandoffLocalizer* handoff() { return handoff_.get(); }
+  fw::LocalizationSystem& system() { return system_; }
+  fw::mml::MmlLocalizer* mml() { return system_.mml(); }
+  fw::mcl::MclLocalizer* mcl() { return system_.mcl(); }
+  fw::mml::HandoffLocalizer* handoff() { return system_.handoff(); }
+  fw::track::TrackedLocalizer* tracked() { return system_.tracked(); }
   std::size_t arena_bytes() const { return arena_.used(); }
   // Static memory of the firmware objects + arena (what a robot would reserve), bytes.
-  std::size_t static_bytes() const;
+  std::size_t static_bytes() const { return arena_.used(); }
 
-  // Builders. `image` = the compiled map image bytes (for a precomputed relation table section);
-  // may be empty. `threads` ≥ 1.
+  // The general builder: `spec` as mmlfw's config gives it (overrides allowed). `image` = the
+  // compiled map image bytes (for a precomputed relation table section); may be empty. `threads` ≥ 1.
+  static std::unique_ptr<OwnedLocalizer> make(const fw::SystemSpec& spec, const fw::GlobalMap& map,
+                                              const std::vector<std::uint8_t>& image, int threads, std::string* err);
+  // Shorthands used by the evaluation (configs given explicitly).
   static std::unique_ptr<OwnedLocalizer> make_mml(const fw::GlobalMap& map, const std::vector<std::uint8_t>& image,
                                                   const fw::mml::MmlLocalizerConfig& cfg, int threads,
                                                   std::string* err);
+  static std::unique_ptr<OwnedLocalizer> make_track(const fw::GlobalMap& map, const std::vector<std::uint8_t>& image,
+                                                    const fw::mml::MmlLocalizerConfig& cfg,
+                                                    const fw::track::TrackOptions& track, int threads, std::string* err);
   static std::unique_ptr<OwnedLocalizer> make_mcl(const fw::GlobalMap& map, const fw::mcl::MclOptions& opt,
                                                   int threads, std::string* err);
   static std::unique_ptr<OwnedLocalizer> make_handoff(const fw::GlobalMap& map, const std::vector<std::uint8_t>& image,
@@ -68,20 +78,19 @@ class OwnedLocalizer : public fw::Localizer {
                                                       std::string* err);
 
  private:
-  fw::StartupArena arena_;
+  // Declaration order = destruction order reversed: the system (objects in the arena) goes first.
   std::unique_ptr<fw::WorkerPool> pool_;
-  std::unique_ptr<fw::mml::MmlLocalizer> mml_;
-  std::unique_ptr<fw::mcl::MclLocalizer> mcl_;
-  std::unique_ptr<fw::mml::HandoffLocalizer> handoff_;
-  fw::Localizer* inner_ = nullptr;
+  fw::StartupArena arena_;
+  fw::LocalizationSystem system_;
   bool start_pool(int threads, std::string* err);
 };
 
-// Simulator registry entries (sim/cli/localizer_factory): "mml", "mcl", "handoff".
+// Simulator registry entries (sim/cli/localizer_factory): "mml-track", "mml", "mcl", "handoff".
 // Options (--opt k=v): mml: config=1..4, iterations=N, correct=0|1 (local map correction,
 // Eq. 5.23–5.27), reduce=0|1 (local map reduction, Eq. 5.28–5.30); mcl: particles=N,
 // model=beam|field, kld=0|1, inject=0|1; handoff: config=1..4, correct=0|1, reduce=0|1.
 std::unique_ptr<fw::Localizer> make_mml_localizer(const LocalizerContext& ctx, std::string* err);
+std::unique_ptr<fw::Localizer> make_track_localizer(const LocalizerContext& ctx, std::string* err);
 std::unique_ptr<fw::Localizer> make_mcl_localizer(const LocalizerContext& ctx, std::string* err);
 std::unique_ptr<fw::Localizer> make_handoff_localizer(const LocalizerContext& ctx, std::string* err);
 

@@ -50,6 +50,13 @@ fw::Status encode_pose(const hal::PoseEstimate& pose, std::uint8_t tag, bool fd,
 fw::Status encode_health(const HealthRecord& health, std::uint8_t tag, bool fd, hal::CanFrame* out,
                          std::size_t capacity, std::size_t* count);
 
+// Protection level ↔ u16 wire code (POSE part 5; `lsb_per_unit` = kProtectionXyPerMetre or
+// kProtectionThetaPerRad). Encoding rounds up, maps NaN / ≤ 0 to 0 (no bound) and saturates at
+// kProtectionSaturated (also +inf); it never wraps. Decoding maps 0 → 0 and the saturated code →
+// +infinity (no finite bound is known to hold).
+std::uint16_t protection_code(float bound, double lsb_per_unit);
+float protection_value(std::uint16_t code, double lsb_per_unit);
+
 struct DecoderStats {
   std::uint32_t frames = 0;
   std::uint32_t unknown_ids = 0;       // frames with an ID outside the message set (ignored)

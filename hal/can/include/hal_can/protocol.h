@@ -25,13 +25,27 @@ constexpr std::uint32_t kOdomId = 0x100;       // 4 parts 0x100..0x103; FD 0x500
 constexpr std::uint32_t kScanStartId = 0x110;  // 4 parts 0x110..0x113; FD 0x510
 constexpr std::uint32_t kScanDataId = 0x118;   // classic; FD 0x518
 constexpr std::uint32_t kScanEndId = 0x119;    // 8 bytes on both buses
-constexpr std::uint32_t kPoseId = 0x120;       // 5 parts 0x120..0x124; FD 0x520
+constexpr std::uint32_t kPoseId = 0x120;       // 6 parts 0x120..0x125; FD 0x520
 constexpr std::uint32_t kHealthId = 0x130;     // 5 parts 0x130..0x134; FD 0x530
 
 constexpr std::size_t kPartBytes = 7;
-constexpr std::size_t kOdomParts = 4, kScanStartParts = 4, kPoseParts = 5, kHealthParts = 5;
-constexpr std::size_t kMaxParts = 5;
-constexpr std::size_t kMaxRecordBytes = kMaxParts * kPartBytes;  // 35
+constexpr std::size_t kOdomParts = 4, kScanStartParts = 4, kPoseParts = 6, kHealthParts = 5;
+constexpr std::size_t kMaxParts = 6;
+constexpr std::size_t kMaxRecordBytes = kMaxParts * kPartBytes;  // 42
+
+// POSE layout byte (payload offset 34, reserved and 0 before protection levels existed). Layouts
+// only append: layout 0 = the original 5-part record (parts 0x120..0x124), layout 1 adds part 5
+// (0x125) with the protection level and unsupported_steps. Receivers accept both; a layout-0
+// record decodes with protection 0 (= no bound) and unsupported_steps 0.
+constexpr std::size_t kPoseLayoutOffset = 34;
+constexpr std::uint8_t kPoseLayout = 1;
+constexpr std::size_t kPoseLegacyParts = 5;  // layout 0
+
+// Protection level on the wire (POSE part 5): u16, rounded *up* (a bound must not shrink);
+// 0 = no bound, kProtectionSaturated = "at least the largest code" (decodes as +infinity).
+constexpr double kProtectionXyPerMetre = 1000.0;     // 1 mm LSB, up to 65.534 m
+constexpr double kProtectionThetaPerRad = 10000.0;   // 1e-4 rad LSB, up to 6.5534 rad
+constexpr std::uint16_t kProtectionSaturated = 0xFFFF;
 
 constexpr std::size_t kClassicRangesPerSegment = 3;
 constexpr std::size_t kFdRangesPerSegment = 31;

@@ -1,0 +1,86 @@
+// LocalizationSystem: the one start-up builder of "the firmware's localizer". mmlfw, mml-sim,
+// mml-eval, the benchmarks, the HIL scenarios and the budget replay all build the localizer here,
+// from the same spec, so a figure measured on one is a figure of all.
+// Localizers (SystemSpec.localizer):
+//   mml-track  [default] MML global localization, confirmed and then tracked on the global map at
+//              every scan with an integrity monitor and a protection level (firmware/track)
+//   mml        MML global localization alone (dissertation Ch. 5)
+//   handoff    MML handing off to MCL tracking (baseline)
+//   mcl        MCL global localization (the thesis's baseline)
+//   odom       odometry pass-through (dead reckoning)
+// The localizer objects are placed in the start-up arena (only the ones the spec needs), so the
+// footprint is what the chosen system uses; nothing is allocated after build().
+#pragma once
+
+#include <cstddef>
+#include <cstdint>
+
+#include "firmware/app/localizer_names.h"
+#include "firmware/base/arena.h"
+#include "firmware/base/worker_pool.h"
+#include "firmware/map/global_map.h"
+#include "firmware/mcl/mcl_localizer.h"
+#include "firmware/mml/handoff_localizer.h"
+#include "firmware/mml/mml_localizer.h"
+#include "firmware/runtime/localizer.h"
+#include "firmware/runtime/odometry_localizer.h"
+#include "firmware/track/tracked_localizer.h"
+
+namespace fw {
+
+struct SystemSpec {
+  const char* localizer = kDefaultLocalizer;
+  int mml_preset = 3;              // C1..C4 (firmware/mml/mml_presets.h)
+  std::uint64_t seed = 1;
+  std::uint32_t mcl_particles = 30000;  // `mcl` baseline
+  // Optional overrides (host tools and tests); null = the shipped configuration. The MML config is
+  // still fitted to the map (contact field) by the builder.
+  const mml::MmlLocalizerConfig* mml = nullptr;
+  const track::TrackOptions* track = nullptr;
+  const mcl::MclOptions* mcl = nullptr;
+  const mml::HandoffOptions* handoff = nullptr;
+  const OdometryLocalizerOptions* odom = nullptr;
+};
+
+class LocalizationSystem {
+ public:
+  LocalizationSystem() = default;
+  LocalizationSystem(const LocalizationSystem&) = delete;
+  LocalizationSystem& operator=(const LocalizationSystem&) = delete;
+  ~LocalizationSystem();
+
+  // `table_section` (may be null): the map image's precomputed relation table, read in place.
+  // `pool` (may be null): worker threads for RBSM / pRANSAM / MCL. Errors name the part that failed.
+  Status build(const SystemSpec& spec, const GlobalMap& map, const std::uint8_t* table_section,
+               std::size_t table_len, StartupArena& arena, WorkerPool* pool);
+
+  bool built() const { return localizer_ != nullptr; }
+  Localizer& localizer() { return *localizer_; }
+  const char* name() const { return localizer_ != nullptr ? localizer_->name() : "none"; }
+  // The parts (null when the chosen system has none).
+  mml::MmlLocalizer* mml() { return mml_; }
+  const mml::MmlLocalizer* mml() const { return mml_; }
+  track::TrackedLocalizer* tracked() { return tracked_; }
+  const track::TrackedLocalizer* tracked() const { return tracked_; }
+  mcl::MclLocalizer* mcl() { return mcl_; }
+  mml::HandoffLocalizer* handoff() { return handoff_; }
+  const mml::HandoffLocalizer* handoff() const { return handoff_; }
+  OdometryLocalizer* odom() { return odom_; }
+  // True when MML reads the map image's relation table in place (keep the image mapped).
+  bool table_in_use() const;
+  // Bytes of the localizer objects (they live in the arena; counted in arena.used()).
+  std::size_t object_bytes() const { return object_bytes_; }
+
+ private:
+  template <typename T>
+  Result<T*> emplace(StartupArena& arena, const char* what);
+  Localizer* localizer_ = nullptr;
+  OdometryLocalizer* odom_ = nullptr;
+  mml::MmlLocalizer* mml_ = nullptr;
+  track::TrackedLocalizer* tracked_ = nullptr;
+  mcl::MclLocalizer* mcl_ = nullptr;
+  mml::HandoffLocalizer* handoff_ = nullptr;
+  std::size_t object_bytes_ = 0;
+};
+
+}  // namespace fw
