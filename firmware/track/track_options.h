@@ -28,11 +28,13 @@ struct ScanAlignOptions {
 
 struct TrackOptions {
   ScanAlignOptions align;
-  // Odometry noise (as AMCL's α1..α4): σ_trans = a_tt·|Δs| + a_tr·|Δθ|, σ_rot = a_rr·|Δθ| + a_rt·|Δs|.
-  float odom_trans_per_m = 0.10f;
-  float odom_trans_per_rad = 0.05f;
-  float odom_rot_per_rad = 0.10f;
-  float odom_rot_per_m = 0.05f;
+  // Odometry noise (AMCL's α1..α4 and their defaults, 0.2): σ_trans = a_tt·|Δs| + a_tr·|Δθ|,
+  // σ_rot = a_rr·|Δθ| + a_rt·|Δs|. Too tight a model makes good scans fail the innovation test
+  // (availability), never a wrong pose pass it: the fit test does not depend on it.
+  float odom_trans_per_m = 0.2f;
+  float odom_trans_per_rad = 0.2f;
+  float odom_rot_per_rad = 0.2f;
+  float odom_rot_per_m = 0.2f;
   // Odometry increments beyond these between two scans are not physical (a jump, a reset of the
   // wheel counters): the pose cannot be carried across them.
   float max_odom_step_m = 2.0f;
