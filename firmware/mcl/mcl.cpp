@@ -55,6 +55,8 @@ Status MclOptions::validate() const {
   FW_RETURN_IF_ERROR(check_range("localized_mean_m", localized_mean_m, 0.0, 1e6));
   FW_RETURN_IF_ERROR(check_range("localized_min_mass", localized_min_mass, 0.0, 1.0));
   FW_RETURN_IF_ERROR(check_range("estimate_radius_m", estimate_radius_m, 1e-3, 1e6));
+  FW_RETURN_IF_ERROR(check_range("update_min_d", update_min_d, 0.0, 100.0));
+  FW_RETURN_IF_ERROR(check_range("update_min_a", update_min_a, 0.0, kPi));
   return Status::ok();
 }
 
@@ -64,10 +66,27 @@ Status Mcl::init(const MclOptions& options, const MapView& map, WorkerPool* pool
   options_ = options;
   map_ = map;
   pool_ = pool;
-  main_rng_.reseed(options.seed, 1000003);
   initialized_ = true;
-  n_ = 0;
+  reset();
   return Status::ok();
+}
+
+// The state init() leaves: no particles, main stream reseeded, per-step streams from step 0,
+// no constraint window, no injection averages, counters zero. The main stream used to be seeded
+// only in init(), so every run after the first drew other initial particles and resampling
+// pointers: a trial's result depended on the trials run before it.
+void Mcl::reset() {
+  main_rng_.reseed(options_.seed, 1000003);
+  n_ = 0;
+  num_beams_ = 0;
+  delta_ = Se2f();
+  apply_motion_ = false;
+  step_count_ = 0;
+  w_slow_ = w_fast_ = 0.0f;
+  have_best_prev_ = false;
+  best_prev_ = Se2f();
+  best_dist_.clear();
+  updates_ = resamples_ = 0;
 }
 
 Status Mcl::sample_free(RandomStream* rng, Particle* p) {
@@ -298,6 +317,7 @@ void Mcl::resample(MclStepResult* out) {
   }
   for (std::size_t i = 0; i < m; ++i) particles_[i] = scratch_[i];
   n_ = m;
+  ++resamples_;
   out->resampled = true;
   out->injected = injected;
 }
@@ -364,6 +384,7 @@ Status Mcl::step(const hal::LaserScan& scan, const Se2f& odom_delta, bool have_d
   }
 
   ++step_count_;
+  ++updates_;
   delta_ = odom_delta;
   if (have_delta) run_chunks(&Mcl::motion_job);
   run_chunks(&Mcl::weight_job);

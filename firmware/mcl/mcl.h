@@ -48,17 +48,24 @@ class Mcl {
 
   // `pool` may be null (single-threaded). The map must outlive the filter.
   Status init(const MclOptions& options, const MapView& map, WorkerPool* pool);
+  // Back to the state after init() (no particles; streams as freshly seeded; counters zero).
+  void reset();
   // Uniform over the free cells (global localization).
   Status init_uniform();
   // Gaussian around a pose (hand-off from MML / tracking).
   Status init_gaussian(const Se2f& pose, const Eigen::Matrix3f& cov);
-  // One filter step: `odom_delta` is the odometry motion since the previous step (robot frame),
-  // `have_delta` false on the first step after an init (no motion update).
+  // One filter step (motion + sensor update, resampling when due): `odom_delta` is the odometry
+  // motion since the previous step (robot frame), `have_delta` false on the first step after an
+  // init (no motion update). Always updates; the update gate (options().update_min_d / _a) is
+  // applied by MclLocalizer, which accumulates the odometry of gated scans into the next delta.
   Status step(const hal::LaserScan& scan, const Se2f& odom_delta, bool have_delta, MclStepResult* out);
 
   std::size_t size() const { return n_; }
   const Particle* particles() const { return particles_; }
   const MclOptions& options() const { return options_; }
+  // Sensor updates (step() calls) and resamplings since init() / reset().
+  std::uint64_t updates() const { return updates_; }
+  std::uint64_t resamples() const { return resamples_; }
   static std::size_t storage_bytes() { return sizeof(Mcl); }
 
  private:
@@ -99,6 +106,7 @@ class Mcl {
   bool have_best_prev_ = false;
   Se2f best_prev_;
   RingBuffer<float, kMaxConstraintWindow> best_dist_;
+  std::uint64_t updates_ = 0, resamples_ = 0;
 };
 
 }  // namespace mcl

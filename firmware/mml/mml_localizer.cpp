@@ -102,27 +102,51 @@ Status MmlLocalizer::init(const MmlLocalizerConfig& config, const GlobalMap& map
   return Status::ok();
 }
 
+// Back to exactly the state after init(): a trial's result must not depend on the trials before
+// it. The front end resets RBSM (streams reseeded, end-point window un-centred) and the local map;
+// the matcher drops its online tables; everything this object keeps between steps is cleared here,
+// counters included (they describe the run since the last reset).
 void MmlLocalizer::reset() {
   front_end_.reset();
+  matcher_.reset();
   interp_.reset();
   observations_.clear();
   last_ = InterpretResult();
-  have_odom_ = false;
-  have_h_ = false;
   num_scene_ = 0;
+  matched_points_ = 0;
+  num_scan_pts_ = 0;
+  have_odom_ = false;
+  prev_odom_ = Se2f();
+  have_h_ = false;
+  last_h_ = Se2f();
   steps_ = 0;
+  front_end_failures_ = 0;
   no_match_steps_ = 0;
   have_wheel_ = false;
+  prev_wheel_ = Se2f();
   tracked_valid_ = false;
+  tracked_pose_ = Se2f();
   tracked_bad_steps_ = tracked_unlocalized_steps_ = 0;
   last_refine_ = RefineResult();
   last_unique_ = UniquenessResult();
+  unique_rejections_ = 0;
   last_out_ = hal::PoseEstimate();
+  perf_match_.reset();
   have_newest_ = false;
+  newest_id_ = 0;
   corrections_applied_ = 0;
   last_correction_ = CorrectionResult();
-  rule_.reset();
+  rule_ = ReductionRule(config_.mml);
   red_head_ = red_count_ = 0;
+  for (ReducedObservation& r : red_) r.fragment_id = r.n = 0;
+  // step() swaps the two pending buffers every step: put them back in init()'s order.
+  if (pending_cur_.pts != nullptr && pending_cur_.pts < pending_prev_.pts) {
+    Point2f* const t = pending_prev_.pts;
+    pending_prev_.pts = pending_cur_.pts;
+    pending_cur_.pts = t;
+  }
+  pending_prev_.fragment_id = pending_prev_.n = 0;
+  pending_cur_.fragment_id = pending_cur_.n = 0;
   have_prev_obs_ = have_cur_obs_ = false;
   observations_accepted_ = 0;
   localized_prev_ = localized_before_prev_ = false;

@@ -408,6 +408,34 @@ void Matcher<D>::reset_online_table(int table) {
 }
 
 template <int D>
+void Matcher<D>::reset() {
+  if (!initialized_) return;
+  // R_A is only written online; R_B only when it is not the (read-only or start-up) model table.
+  reset_online_table(0);
+  if (!precomputed_) reset_online_table(1);
+  for (int w = 0; w < options_.num_workers; ++w) {
+    WorkerState& st = workers_[w];
+    st.rng.reseed(0, 0);
+    st.num_inserts = 0;
+    st.num_collected = 0;
+    st.dropped = 0;
+    st.best = Hypothesis<D>{};
+    st.best_valid = false;
+    st.reached = false;
+    st.batch = 0;
+    st.first_iteration = 0;
+    st.stats = MatchStats{};
+  }
+  scene_ = nullptr;
+  scene_n_ = 0;
+  params_ = MatchParams{};
+  filter_ = TripleFilter{};
+  num_workers_ = 0;
+  tau_ = 0;
+  round_bound_ = 0.0f;
+}
+
+template <int D>
 Status Matcher<D>::match(const Point<D>* scene, std::size_t n, const MatchParams& params, MatchResult<D>* out) {
   if (out == nullptr) return Status::error(Errc::kInvalidArgument, "pransam match: no result object");
   *out = MatchResult<D>{};

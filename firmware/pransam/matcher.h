@@ -133,6 +133,13 @@ class Matcher {
   const RelationTable& model_table() const { return table_b_; }
   const RelationTable& scene_table() const { return table_a_; }
 
+  // Back to the state right after init() + set_model() (+ a precomputed table, which is kept):
+  // online relation tables R_A / R_B emptied with their statistics, per-worker state and buffers
+  // cleared. match() itself derives everything else from its MatchParams (worker streams from
+  // params.seed, round counters, Ω_best bound), so after reset() the same calls give bit-identical
+  // results whatever was matched before.
+  void reset();
+
   // Matches A (non-owning, finite points) to B. Errors: not initialised, no model, |A| < 3,
   // NaN/inf point, capacity, all triples of A rejected (collinear or too large).
   Status match(const Point<D>* scene, std::size_t n, const MatchParams& params, MatchResult<D>* out);

@@ -246,6 +246,48 @@ TEST_F(Matcher2DTest, RecoversKnownScanPoseWithPrecomputedTableAndSectionRoundTr
   ASSERT_TRUE(matcher_->set_model(world_->map.data(), world_->map.size(), "floor plan").is_ok());
 }
 
+// reset(): the online tables are emptied (with their statistics) and a match after other matches
+// and reset() repeats the first one bit-identically; a precomputed R_B filled at start-up survives.
+TEST_F(Matcher2DTest, ResetEmptiesOnlineTablesKeepsPrecomputedOne) {
+  RandomStream rng(51, 0);
+  const std::vector<P2> x = sim::pransam_scenes::cast_scan(world_->segs, Se2f(6.0f, 5.0f, 0.4f), 10.0f, 0.01f, rng);
+  const std::vector<P2> y = sim::pransam_scenes::cast_scan(world_->segs, Se2f(18.0f, 11.0f, -1.2f), 10.0f, 0.01f, rng);
+  MatchParams p;
+  p.seed = 3;
+  p.max_iterations = 30000;
+  p.omega_thres = 0.6f;
+  p.collect_all = true;
+  auto run = [&](const std::vector<P2>& scene, std::vector<Hypothesis<2>>* hyps) {
+    MatchResult<2> r;
+    ASSERT_TRUE(matcher_->match(scene.data(), scene.size(), p, &r).is_ok());
+    hyps->assign(r.hypotheses, r.hypotheses + r.num_hypotheses);
+  };
+  std::vector<Hypothesis<2>> first, other, again;
+  run(x, &first);
+  ASSERT_FALSE(first.empty());
+  run(y, &other);
+  EXPECT_GT(matcher_->scene_table().stats().inserts, 0u);
+  matcher_->reset();
+  EXPECT_EQ(matcher_->scene_table().count_filled(), 0u);
+  EXPECT_EQ(matcher_->model_table().count_filled(), 0u);
+  EXPECT_EQ(matcher_->scene_table().stats().inserts, 0u);
+  run(x, &again);
+  ASSERT_EQ(first.size(), again.size());
+  for (std::size_t i = 0; i < first.size(); ++i) {
+    EXPECT_EQ(first[i].quality, again[i].quality) << i;
+    EXPECT_EQ(first[i].iteration, again[i].iteration) << i;
+    EXPECT_TRUE(first[i].translation == again[i].translation) << i;
+  }
+  // Start-up fill used in place (MML without a map-image table): reset() must keep it.
+  ASSERT_TRUE(matcher_->fill_model_table(13, 100000, 10.0f, 0.1f).is_ok());
+  ASSERT_TRUE(matcher_->use_precomputed_table(matcher_->model_table().data(), 10.0f).is_ok());
+  const std::size_t filled = matcher_->model_table().count_filled();
+  matcher_->reset();
+  EXPECT_TRUE(matcher_->has_precomputed_table());
+  EXPECT_EQ(matcher_->model_table().count_filled(), filled);
+  ASSERT_TRUE(matcher_->set_model(world_->map.data(), world_->map.size(), "floor plan").is_ok());
+}
+
 TEST_F(Matcher2DTest, RefinementAndFreeSpaceGateKeepTheRightAnswer) {
   RandomStream rng(47, 0);
   const Se2f pose(20.0f, 13.0f, -0.8f);

@@ -127,6 +127,13 @@ void EndpointGrid::clear() {
   occupied_count_ = 0;
   dirty_x0_ = dirty_y0_ = 0;
   dirty_x1_ = dirty_y1_ = -1;
+  // The window goes back to where init() left it (not centred; the next follow/insert centres it
+  // on the robot). Keeping the old window made a run after reset() start in a window shifted by
+  // wherever the previous run left it (up to recenter_fraction of the side): other points fell
+  // outside it and RBSM's lookup coordinates were relative to another origin, so the same inputs
+  // gave a different local map (trial results depended on the trials before them).
+  origin_cx_ = origin_cy_ = 0;
+  centered_ = false;
 }
 
 void EndpointGrid::center_on(float x, float y) {

@@ -45,7 +45,8 @@ class EndpointGrid {
   bool initialized() const { return occupancy_ != nullptr; }
   const EndpointGridOptions& options() const { return options_; }
 
-  // Removes every point (only the region ever written is cleared).
+  // Removes every point (only the region ever written is cleared) and returns the window to its
+  // state after init(): not centred, so the next follow()/insert() centres it afresh.
   void clear();
   // Centres the window on (x, y) (world, m); call once before the first insert.
   void center_on(float x, float y);

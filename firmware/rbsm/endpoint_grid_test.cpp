@@ -68,6 +68,28 @@ TEST_F(GridFixture, ScrollingDropsCellsThatLeaveTheWindow) {
   EXPECT_GT(grid.likelihood(3.026f, 0.126f), 200);
 }
 
+// clear() returns the window to its state after init(): a grid that scrolled and was cleared
+// behaves exactly like a fresh one (RBSM's reset() relies on it; a window left where the previous
+// run scrolled it made runs after a reset differ from the first).
+TEST_F(GridFixture, ClearForgetsTheScrolledWindow) {
+  fw::EndpointGridOptions o;
+  o.size_log2 = 6;  // 64 cells = 3.2 m, re-centred 0.8 m off-centre
+  make(o);
+  ASSERT_TRUE(grid.insert(0.0f, 0.0f));  // centres the window on the first point
+  const std::int32_t fresh_x = grid.origin_cx(), fresh_y = grid.origin_cy();
+  EXPECT_TRUE(grid.follow(1.0f, 0.5f));  // 20 cells off-centre > 16: window moves by (20, 10)
+  ASSERT_TRUE(grid.insert(1.1f, 0.5f));
+  grid.clear();
+  EXPECT_EQ(grid.occupied_count(), 0u);
+  // Within the re-centring margin of the scrolled window: only a fresh window lands back on 0.
+  ASSERT_TRUE(grid.insert(0.0f, 0.0f));
+  EXPECT_EQ(grid.origin_cx(), fresh_x);
+  EXPECT_EQ(grid.origin_cy(), fresh_y);
+  EXPECT_FALSE(grid.occupied(1.1f, 0.5f));
+  EXPECT_EQ(grid.likelihood(1.126f, 0.526f), 0);
+  EXPECT_GT(grid.likelihood(0.026f, 0.026f), 200);
+}
+
 TEST(EndpointGridOptionsTest, RejectsBadValues) {
   fw::EndpointGridOptions o;
   o.resolution = 0;

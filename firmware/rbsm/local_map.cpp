@@ -38,6 +38,8 @@ void LocalMap::reset() {
   head_ = count_ = 0;
   next_id_ = dropped_ = 0;
   has_last_pose_ = false;
+  last_pose_ = Se2f();
+  for (Fragment& f : fragments_) f = Fragment{};
 }
 
 bool LocalMap::drop_oldest() {

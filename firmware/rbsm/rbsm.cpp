@@ -71,10 +71,18 @@ Status Rbsm::init(const RbsmOptions& options, StartupArena& arena, WorkerPool* p
   return Status::ok();
 }
 
+// Back to the state after init(): empty map with its window un-centred (EndpointGrid::clear),
+// streams reseeded, no tracking. Nothing of a previous run may leak into the next one.
 void Rbsm::reset() {
   grid_.clear();
   tracking_ = false;
-  for (std::uint32_t p = 0; p < RbsmOptions::kPartitions; ++p) streams_[p].reseed(options_.seed, 1 + p);
+  last_estimate_ = Se2f();
+  num_points_ = 0;
+  cur_sig_xy_ = cur_sig_psi_ = 0.0f;
+  for (std::uint32_t p = 0; p < RbsmOptions::kPartitions; ++p) {
+    streams_[p].reseed(options_.seed, 1 + p);
+    part_best_w_[p] = part_best_j_[p] = 0;
+  }
   resample_stream_.reseed(options_.seed, 0);
   if (x_ != nullptr) {
     for (std::uint32_t j = 0; j < options_.num_particles; ++j) x_[j] = y_[j] = psi_[j] = 0.0f;

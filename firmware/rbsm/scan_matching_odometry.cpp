@@ -28,6 +28,7 @@ void ScanMatchingOdometry::reset(const Se2f& start) {
   started_ = false;
   start_ = start;
   pose_ = start;
+  last_odom_ = odom_at_match_ = Se2f();
   matches_ = failures_ = 0;
 }
 
