@@ -37,6 +37,8 @@ void PoseTracker::reset() {
   bias_xy_m_ = map_.geometry.resolution;
   bias_theta_rad_ = 0.0f;
   unsupported_ = faulty_ = outside_ = 0;
+  consistent_since_fault_ = 0;
+  had_fault_ = false;
   last_ = TrackStep();
 }
 
@@ -73,6 +75,12 @@ void PoseTracker::predict_to(const Se2f& odom) {
   cov_ = 0.5f * (cov_ + cov_.transpose()).eval();
 }
 
+namespace {
+bool outside_bound(const Eigen::Vector3f& e, const ProtectionLevel& pl) {
+  return std::hypot(e(0), e(1)) > pl.xy_m || std::fabs(e(2)) > pl.theta_rad;
+}
+}  // namespace
+
 TrackStep PoseTracker::step(const Point2f* points, std::size_t n, const Se2f& odom, bool predict) {
   TrackStep out;
   if (!active_) {
@@ -88,11 +96,13 @@ TrackStep PoseTracker::step(const Point2f* points, std::size_t n, const Se2f& od
     predict_to(odom);
   }
   const Se2f pred = pose_;
+  const ProtectionLevel pred_pl = protection_level(cov_, k_, bias_xy_m_, bias_theta_rad_);
   out.alignment = align_scan(map_, points, n, pred, o.align);
   const ScanAlignment& a = out.alignment;
 
   // Verdict of this scan on the pose (fault detection).
   ScanVerdict v = ScanVerdict::kSupported;
+  bool innovation_fault = false;
   Eigen::Matrix3f p_post = cov_;
   Eigen::Vector3f e = Eigen::Vector3f::Zero();
   if (odom_jump) {
@@ -115,7 +125,11 @@ TrackStep PoseTracker::step(const Point2f* points, std::size_t n, const Se2f& od
     out.innovation_chi2 = static_cast<float>(ed.dot(sinv * ed));
     if (!std::isfinite(out.innovation_chi2) || !post.allFinite()) {
       v = ScanVerdict::kContradicting;
-    } else if (out.innovation_chi2 > o.innovation_chi2) {
+    } else if (out.innovation_chi2 > o.innovation_chi2 && outside_bound(e, pred_pl)) {
+      innovation_fault = true;
+      // A significant innovation is a fault only when the scan fix lies outside what the prediction
+      // promises (its protection level): within it, the published bound already covers the
+      // disagreement, and the scan is fused (measurement models of real scans are never exact).
       v = ScanVerdict::kContradicting;
     } else {
       p_post = post.cast<float>();
@@ -138,14 +152,35 @@ TrackStep PoseTracker::step(const Point2f* points, std::size_t n, const Se2f& od
         out.fused = true;
       }
     }
-    bias_xy_m_ = std::fmax(map_.geometry.resolution, a.rms_m);
+    // The map's own error does not average out over scans: one cell of quantisation plus the
+    // scan's residual RMS (how far the map's walls are from where this scan sees them).
+    bias_xy_m_ = map_.geometry.resolution + a.rms_m;
     bias_theta_rad_ = bias_xy_m_ / std::fmax(a.lever_m, 1.0f);
     unsupported_ = 0;
     faulty_ = 0;
     outside_ = 0;
+    ++consistent_since_fault_;
   } else {
     ++unsupported_;
-    if (v == ScanVerdict::kContradicting) ++faulty_; else faulty_ = 0;
+    if (v == ScanVerdict::kContradicting && innovation_fault) {
+      // The scan fits the map well but not where the odometry says (wheel slip, a push, laser /
+      // odometry latency): the prediction is what failed. The scan sees the fault only along the
+      // axes it constrains; along a corridor the same odometry may be as wrong unseen. So the
+      // covariance widens by the size of the disagreement in every direction, and the status is
+      // not `localized` again until scans constrain every axis back under the alert limit.
+      const float exy2 = e(0) * e(0) + e(1) * e(1);
+      cov_(0, 0) += exy2;
+      cov_(1, 1) += exy2;
+      cov_(2, 2) += e(2) * e(2);
+      cov_ = 0.5f * (cov_ + cov_.transpose()).eval();
+    }
+    if (v == ScanVerdict::kContradicting) {
+      ++faulty_;
+      had_fault_ = true;
+      consistent_since_fault_ = 0;
+    } else {
+      faulty_ = 0;
+    }
     if (v == ScanVerdict::kOutsideMap) ++outside_; else outside_ = 0;
   }
 
@@ -158,7 +193,8 @@ TrackStep PoseTracker::step(const Point2f* points, std::size_t n, const Se2f& od
   const bool within = out.pl.xy_m <= o.alert_limit_m && out.pl.theta_rad <= o.alert_limit_rad;
   if (v == ScanVerdict::kOutsideMap) {
     out.status = hal::LocalizationStatus::kOutsideMap;
-  } else if (v != ScanVerdict::kContradicting && faulty_ == 0 && within) {
+  } else if (v != ScanVerdict::kContradicting && faulty_ == 0 && within &&
+             (!had_fault_ || consistent_since_fault_ >= o.recovery_steps)) {
     out.status = hal::LocalizationStatus::kLocalized;
   } else {
     out.status = hal::LocalizationStatus::kAmbiguous;

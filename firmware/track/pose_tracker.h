@@ -9,7 +9,8 @@
 //   update    only on a consistent scan, and only after the robot moved a little (no re-counting of
 //             the same map error while standing still): P = (P⁻⁻¹ + H)⁻¹, x = x⁻ + P H (x_s − x⁻);
 //   publish   the protection level (protection_level.h) and a status: `localized` only when this
-//             scan does not contradict the pose, no contradiction is pending and PL ≤ alert limits.
+//             scan does not contradict the pose, the last contradiction is `recovery_steps`
+//             consistent scans old and PL ≤ alert limits.
 // A scan that says nothing leaves the pose on the prediction and the PL grows with the odometry
 // noise until the status drops; contradicting or outside-map scans drop it at once; persistent
 // contradiction, persistent outside-map or a PL beyond the lost limit end the track (`lost`), and
@@ -79,6 +80,8 @@ class PoseTracker {
   bool fused_once_ = false;
   float bias_xy_m_ = 0.0f, bias_theta_rad_ = 0.0f;  // of the last supported scan
   std::uint32_t unsupported_ = 0, faulty_ = 0, outside_ = 0;
+  std::uint32_t consistent_since_fault_ = 0;  // consistent scans since the last contradicting one
+  bool had_fault_ = false;
   TrackStep last_;
 };
 

@@ -194,6 +194,41 @@ TEST(PoseTrackerTest, OdometryJumpContradicts) {
   EXPECT_NE(s.status, hal::LocalizationStatus::kLocalized);
 }
 
+// A scan that fits the map well away from where the odometry put the robot (wheel slip, a push):
+// the covariance widens in every direction and `localized` comes back only after recovery_steps
+// consistent scans, at the right pose.
+TEST(PoseTrackerTest, OdometryFaultRecoversOnlyAfterConsistentScans) {
+  PoseTracker t;
+  TrackOptions o;
+  o.odom_trans_per_m = 0.05f;  // a good odometry model: a 0.25 m slip is well outside its bound
+  ASSERT_TRUE(t.init(o, room_map().map).is_ok());
+  RandomStream rng(19, 0);
+  const Se2f truth(6.0f, 2.5f, 0.0f);
+  t.start(truth, small_cov(), Se2f());
+  auto pts = testing::scan_at(room(), truth, &rng);
+  t.step(pts.data(), pts.size(), Se2f(), false);
+  // The wheels report 0.25 m forward, the robot did not move.
+  Se2f odom(0.25f, 0.0f, 0.0f);
+  pts = testing::scan_at(room(), truth, &rng);
+  const TrackStep fault = t.step(pts.data(), pts.size(), odom);
+  EXPECT_EQ(fault.verdict, ScanVerdict::kContradicting);
+  EXPECT_NE(fault.status, hal::LocalizationStatus::kLocalized);
+  EXPECT_GT(fault.cov(1, 1), 0.25f * 0.25f * 0.5f) << "widened across the motion too";
+  for (std::uint32_t i = 0; i < o.recovery_steps + 2; ++i) {
+    odom = odom.compose(Se2f(0.0f, 0.0f, 0.06f));  // turn in place so every scan is fused
+    const Se2f tr(truth.x, truth.y, 0.06f * static_cast<float>(i + 1));
+    pts = testing::scan_at(room(), tr, &rng);
+    const TrackStep s = t.step(pts.data(), pts.size(), odom);
+    EXPECT_EQ(s.verdict, ScanVerdict::kSupported) << i;
+    if (i + 1 < o.recovery_steps) {
+      EXPECT_NE(s.status, hal::LocalizationStatus::kLocalized) << "too early at " << i;
+    } else {
+      EXPECT_EQ(s.status, hal::LocalizationStatus::kLocalized) << i;
+      EXPECT_LT(err_xy(s.pose, tr), s.pl.xy_m) << i;
+    }
+  }
+}
+
 TEST(PoseTrackerTest, BadOptionsNameTheField) {
   TrackOptions o;
   o.alert_limit_m = -1.0f;

@@ -5,9 +5,9 @@
 //   error of a 2-D Gaussian whose both axes had the larger variance (Rayleigh tail: P(r > Kσ) =
 //   exp(−K²/2) = α), K_θ the two-sided normal quantile at α;
 // - a bias part the covariance cannot see because it does not average out over scans: the map's
-//   own error. b_xy = max(map cell, RMS residual of the scan's inliers) (the residuals measure how
-//   well the map explains the scan here and now), b_θ = b_xy / lever (the angle that shift makes at
-//   the RMS distance of the inliers).
+//   own error. b_xy = map cell + RMS residual of the scan's inliers (quantisation, plus how far
+//   the map's walls are from where the scan sees them here and now), b_θ = b_xy / lever (the
+//   angle that shift makes at the RMS distance of the inliers, lever ≥ 1 m).
 // α is the integrity risk per `localized` step (1e-3 by default).
 #pragma once
 

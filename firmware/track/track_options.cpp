@@ -50,6 +50,9 @@ Status TrackOptions::validate() const {
     return Status::error(Errc::kInvalidArgument, "TrackOptions: max_faulty_steps %u / max_outside_steps %u out of range [1, 10000]",
                          max_faulty_steps, max_outside_steps);
   }
+  if (recovery_steps > 10000) {
+    return Status::error(Errc::kInvalidArgument, "TrackOptions.recovery_steps = %u out of range [0, 10000]", recovery_steps);
+  }
   FW_RETURN_IF_ERROR(check_range("integrity_risk", integrity_risk, 1e-9f, 0.5f));
   FW_RETURN_IF_ERROR(check_range("alert_limit_m", alert_limit_m, 0.001f, 100.0f));
   FW_RETURN_IF_ERROR(check_range("alert_limit_rad", alert_limit_rad, 0.0001f, 3.2f));
