@@ -43,5 +43,8 @@ int main(int argc, char** argv) {
     std::fprintf(stderr, "mml-sim: wrote %s/steps.csv, summary.json%s\n", cfg.out_dir.c_str(),
                  cfg.pictures ? ", run.svg, run.png" : "");
   }
+  // Last, on stdout (for scripts): fix, availability, integrity, protection level, kidnap, final error.
+  std::fflush(stderr);
+  std::printf("%s\n", sim::summary_line(result.summary).c_str());
   return 0;
 }

@@ -132,22 +132,29 @@ TEST(SimRunner, NoiselessOdometryPassThroughReproducesGroundTruth) {
   std::string err;
   ASSERT_TRUE(run_simulation(cfg, &r, &err)) << err;
   ASSERT_GT(r.steps.size(), 100u);
+  // The pass-through is always `searching`, so the simulator scores none of its poses (err_m is
+  // NaN): the pairing is checked on the raw estimate here.
+  auto dist = [](const StepRecord& s) { return std::hypot(s.estimate.x - s.truth.x, s.estimate.y - s.truth.y); };
   double max_err = 0, sum = 0;
   for (const StepRecord& s : r.steps) {
     ASSERT_TRUE(s.has_truth);
     EXPECT_EQ(s.estimate.status, hal::LocalizationStatus::kSearching);
-    max_err = std::max(max_err, s.err_m);
-    sum += s.err_m;
+    EXPECT_FALSE(s.has_pose);
+    EXPECT_TRUE(std::isnan(s.err_m));
+    max_err = std::max(max_err, dist(s));
+    sum += dist(s);
   }
   EXPECT_LT(max_err, 0.05);
   EXPECT_LT(sum / r.steps.size(), 0.01);
   EXPECT_EQ(r.summary.scans_dropped, 0u);
   EXPECT_EQ(r.summary.ring_drops, 0u);
   EXPECT_EQ(r.summary.first_localized_step, -1);
+  EXPECT_EQ(r.summary.final_pose_step, -1);
+  EXPECT_TRUE(std::isnan(r.summary.final_err_m));
   // With the default noise the same run drifts far more.
   cfg.synthetic.odometry = OdometryNoiseOptions();
   ASSERT_TRUE(run_simulation(cfg, &r, &err)) << err;
-  EXPECT_GT(r.summary.final_err_m, 0.2);
+  EXPECT_GT(dist(r.steps.back()), 0.2);
 }
 
 TEST(SimRunner, BadInputsAreClearErrors) {
@@ -264,6 +271,265 @@ TEST(SimRunner, CustomWorldAndPacing) {
   EXPECT_GE(wall, 0.25 - 0.01);  // scans at 0, 0.05, ..., 0.25 s, paced at real time
   cfg.pace_speed = 100;           // paced 100× faster
   ASSERT_TRUE(run_simulation(cfg, &r, &err)) << err;
+}
+
+// A localizer whose published pose is a scripted mix of placeholders and real poses: the pose of
+// a dead-reckoning pass-through anchored at the true start (noiseless odometry: ≈ the truth), or
+// the (0, 0, 0) placeholder with no covariance, under a scripted status and protection level.
+class ScriptedLocalizer final : public fw::Localizer {
+ public:
+  explicit ScriptedLocalizer(const fw::OdometryLocalizerOptions& o) : inner_(o) {}
+  const char* name() const override { return "test-scripted"; }
+  void reset() override { inner_.reset(); }
+  fw::Status step(const hal::LaserScan& scan, const hal::Odometry& odom, hal::PoseEstimate* out) override {
+    const fw::Status st = inner_.step(scan, odom, out);
+    const int k = n_++;
+    // 0-4 searching, 5-9 ambiguous, 10-14 outside-map: all without a pose; 15-29 localized with a
+    // pose and a protection level; 30-34 fault; 35-39 outside-map without a pose.
+    const bool pose = k >= 15 && k < 30;
+    out->status = k < 5    ? hal::LocalizationStatus::kSearching
+                  : k < 10 ? hal::LocalizationStatus::kAmbiguous
+                  : k < 15 ? hal::LocalizationStatus::kOutsideMap
+                  : k < 30 ? hal::LocalizationStatus::kLocalized
+                  : k < 35 ? hal::LocalizationStatus::kFault
+                           : hal::LocalizationStatus::kOutsideMap;
+    if (!pose) {
+      out->x = out->y = out->theta = 0.0f;
+      for (float& c : out->cov) c = 0.0f;
+      out->protection_xy_m = out->protection_theta_rad = 0.0f;
+      out->unsupported_steps = 0;
+      out->mode = hal::LocalizationMode::kGlobal;
+    } else {
+      out->mode = hal::LocalizationMode::kTracking;
+      out->protection_xy_m = 0.2f;
+      out->protection_theta_rad = 0.05f;
+      out->unsupported_steps = static_cast<std::uint16_t>(k % 3);
+    }
+    return st;
+  }
+
+ private:
+  fw::OdometryLocalizer inner_;
+  int n_ = 0;
+};
+
+std::vector<std::string> split_csv_line(const std::string& line) {
+  std::vector<std::string> f;
+  std::string cur;
+  for (char c : line) {
+    if (c == ',') {
+      f.push_back(cur);
+      cur.clear();
+    } else {
+      cur += c;
+    }
+  }
+  f.push_back(cur);
+  return f;
+}
+
+// The summary never reports an error computed from a placeholder pose, and steps.csv carries the
+// protection level columns.
+TEST(SimSummary, PlaceholderPosesAreNeverScored) {
+  register_localizer("test-scripted", "test: scripted placeholders", [](const LocalizerContext& ctx, std::string*) {
+    fw::OdometryLocalizerOptions o;
+    o.initial_pose = ctx.true_start.cast<float>();
+    return std::unique_ptr<fw::Localizer>(std::make_unique<ScriptedLocalizer>(o));
+  });
+  const std::string d = temp_dir("placeholder");
+  SimConfig cfg = small_run(d, 3);
+  cfg.steps = 40;
+  cfg.localizer = "test-scripted";
+  cfg.synthetic.odometry.sigma_trans = 0;
+  cfg.synthetic.odometry.sigma_rot_deg = 0;
+  SimResult r;
+  std::string err;
+  ASSERT_TRUE(run_simulation(cfg, &r, &err)) << err;
+  ASSERT_EQ(r.steps.size(), 40u);
+  // The start is far enough from the origin that a placeholder scored against the truth would show.
+  ASSERT_GT(std::hypot(r.steps.front().truth.x, r.steps.front().truth.y), 1.0);
+  for (const StepRecord& s : r.steps) {
+    const bool pose = s.step >= 15 && s.step < 30;
+    EXPECT_EQ(s.has_pose, pose) << "step " << s.step;
+    EXPECT_EQ(estimate_has_pose(s.estimate), pose) << "step " << s.step;
+    if (pose) {
+      EXPECT_LT(s.err_m, 0.05) << "step " << s.step;
+    } else {
+      EXPECT_TRUE(std::isnan(s.err_m) && std::isnan(s.err_deg)) << "step " << s.step << ": error " << s.err_m;
+    }
+  }
+  const SimSummary& sum = r.summary;
+  EXPECT_EQ(sum.first_localized_step, 15);
+  EXPECT_LT(sum.first_localized_err_m, 0.05);
+  EXPECT_EQ(sum.final_pose_step, 29);  // not the outside-map placeholder at the end
+  EXPECT_EQ(sum.final_pose_status, "localized");
+  EXPECT_LT(sum.final_err_m, 0.05);
+  EXPECT_LT(sum.max_err_localized_m, 0.05);
+  EXPECT_EQ(sum.integrity_failures, 0u);
+  EXPECT_EQ(sum.localized_steps, 15u);
+  EXPECT_EQ(sum.pl_steps, 15u);
+  EXPECT_EQ(sum.pl_exceeded, 0u);
+  EXPECT_NEAR(sum.pl_xy_m_p50, 0.2, 1e-6);
+  EXPECT_EQ(sum.availability_steps, 24u);  // steps 16..39
+  EXPECT_EQ(sum.availability_localized, 14u);
+  EXPECT_EQ(sum.tracking_steps, 15u);
+  EXPECT_NE(summary_line(sum).find("(step 29, localized)"), std::string::npos) << summary_line(sum);
+
+  // steps.csv: the new columns, empty errors where there is no pose, the PL where there is one.
+  std::istringstream csv(read_all(d + "/steps.csv"));
+  std::string line;
+  ASSERT_TRUE(std::getline(csv, line));
+  const std::vector<std::string> head = split_csv_line(line);
+  auto col = [&](const std::string& name) {
+    const auto it = std::find(head.begin(), head.end(), name);
+    EXPECT_NE(it, head.end()) << "steps.csv has no column " << name << ": " << line;
+    return static_cast<size_t>(it - head.begin());
+  };
+  const size_t c_status = col("status"), c_err = col("err_m"), c_deg = col("err_deg"), c_pl = col("pl_xy_m"),
+               c_plt = col("pl_theta_deg"), c_uns = col("unsupported_steps"), c_tx = col("truth_x");
+  int rows = 0;
+  while (std::getline(csv, line)) {
+    const std::vector<std::string> f = split_csv_line(line);
+    ASSERT_EQ(f.size(), head.size()) << line;
+    const bool pose = rows >= 15 && rows < 30;
+    EXPECT_FALSE(f[c_tx].empty()) << line;  // the truth is there either way
+    if (pose) {
+      EXPECT_EQ(f[c_status], "localized");
+      EXPECT_LT(std::stod(f[c_err]), 0.05) << line;
+      EXPECT_NEAR(std::stod(f[c_pl]), 0.2, 1e-4) << line;
+      EXPECT_NEAR(std::stod(f[c_plt]), 0.05 * 180 / M_PI, 1e-2) << line;
+      EXPECT_EQ(std::stoi(f[c_uns]), rows % 3) << line;
+    } else {
+      EXPECT_TRUE(f[c_err].empty() && f[c_deg].empty()) << line;
+      EXPECT_TRUE(f[c_pl].empty() && f[c_plt].empty()) << line;
+    }
+    ++rows;
+  }
+  EXPECT_EQ(rows, 40);
+  const std::string json = read_all(d + "/summary.json");
+  EXPECT_NE(json.find("\"final_pose_step\": 29"), std::string::npos) << json;
+  EXPECT_NE(json.find("\"availability\": "), std::string::npos);
+  EXPECT_NE(json.find("\"integrity_failures\": 0"), std::string::npos);
+  EXPECT_NE(json.find("\"pl_xy_m_max\": 0.2"), std::string::npos) << json;
+  EXPECT_NE(read_all(d + "/run.svg").find("protection level (1 in 10 localized)"), std::string::npos);
+  std::filesystem::remove_all(d);
+}
+
+StepRecord rec(std::uint32_t step, hal::LocalizationStatus st, double err_m, double err_deg = 0.1) {
+  StepRecord r;
+  r.step = step;
+  r.t = 0.4 * step;
+  r.travelled_m = 0.3 * step;
+  r.has_truth = true;
+  r.estimate.status = st;
+  r.estimate.x = 1.0f;  // any pose but the placeholder
+  r.has_pose = st != hal::LocalizationStatus::kSearching;
+  if (r.has_pose) {
+    r.err_m = err_m;
+    r.err_deg = err_deg;
+  }
+  return r;
+}
+
+// The figures of the summary from hand-made steps: first fix, availability (the unknown area left
+// out), integrity failures (position or heading), protection level exceedances, kidnap detection
+// and re-fix, final error.
+TEST(SimSummary, FiguresFromSteps) {
+  using S = hal::LocalizationStatus;
+  std::vector<StepRecord> v;
+  for (std::uint32_t i = 0; i < 5; ++i) v.push_back(rec(i, S::kSearching, 0));  // 0-4: no pose
+  for (std::uint32_t i = 5; i < 15; ++i) {                                         // 5-14: tracked
+    v.push_back(rec(i, S::kLocalized, 0.01 * (i - 4)));
+    v.back().estimate.mode = hal::LocalizationMode::kTracking;
+    v.back().estimate.protection_xy_m = 0.05f;  // exceeded from step 10 on (err 0.06 m)
+    v.back().estimate.protection_theta_rad = 0.1f;
+  }
+  v.push_back(rec(15, S::kLocalized, 0.2, 7.0));  // heading off by 7°: integrity failure
+  v.back().estimate.mode = hal::LocalizationMode::kTracking;
+  v.push_back(rec(16, S::kAmbiguous, 0.3));
+  v.back().in_unknown = true;  // left out of the availability
+  v.push_back(rec(17, S::kLocalized, 40.0));  // 17: kidnapped, still `localized` (failure)
+  v.back().kidnapped = true;
+  v.back().estimate.mode = hal::LocalizationMode::kTracking;
+  v.push_back(rec(18, S::kLocalized, 40.0));
+  v.back().estimate.mode = hal::LocalizationMode::kTracking;
+  v.push_back(rec(19, S::kAmbiguous, 40.0));   // detected: 2 steps after the kidnap
+  v.push_back(rec(20, S::kSearching, 0));
+  v.push_back(rec(21, S::kLocalized, 0.02));   // re-fix
+  v.back().estimate.mode = hal::LocalizationMode::kTracking;
+  v.push_back(rec(22, S::kOutsideMap, 0));
+  v.back().has_pose = false;  // a placeholder: the final error is step 21's
+  v.back().err_m = v.back().err_deg = NAN;
+  SimSummary s;
+  s.source = "test";
+  summarize_steps(v, &s);
+  EXPECT_EQ(s.steps, 23u);
+  EXPECT_EQ(s.first_localized_step, 5);
+  EXPECT_DOUBLE_EQ(s.first_localized_err_m, 0.01);
+  EXPECT_EQ(s.localized_steps, 14u);
+  EXPECT_EQ(s.unknown_area_steps, 1u);
+  EXPECT_EQ(s.availability_steps, 16u);  // steps 6..22 without 16
+  EXPECT_EQ(s.availability_localized, 13u);  // 6-15, 17, 18, 21
+  EXPECT_NEAR(s.availability, 13.0 / 16.0, 1e-12);
+  EXPECT_EQ(s.integrity_failures, 3u);  // 15 (heading), 17 and 18 (kidnapped)
+  EXPECT_EQ(s.integrity_failures_kidnap, 2u);
+  EXPECT_EQ(s.first_integrity_failure_step, 15);
+  EXPECT_EQ(s.wrong_localized_steps, 2u);  // the dissertation's 20° does not count step 15
+  EXPECT_EQ(s.pl_steps, 10u);
+  EXPECT_EQ(s.pl_exceeded, 5u);
+  EXPECT_NEAR(s.pl_exceedance_rate, 0.5, 1e-12);
+  EXPECT_NEAR(s.pl_xy_m_max, 0.05, 1e-6);
+  EXPECT_EQ(s.kidnap_step, 17);
+  EXPECT_EQ(s.kidnap_detected_step, 19);
+  EXPECT_EQ(s.kidnap_detection_delay_steps, 2);
+  EXPECT_EQ(s.relocalized_step, 21);
+  EXPECT_NEAR(s.refix_travelled_m, 0.3 * 4, 1e-9);
+  EXPECT_NEAR(s.refix_err_m, 0.02, 1e-12);
+  EXPECT_EQ(s.final_pose_step, 21);
+  EXPECT_EQ(s.final_pose_status, "localized");
+  EXPECT_DOUBLE_EQ(s.final_err_m, 0.02);
+  EXPECT_EQ(s.tracking_steps, 14u);
+  EXPECT_EQ(s.source, "test");  // what the caller measured is kept
+  const std::string line = summary_line(s);
+  for (const char* part : {"first fix at step 5", "availability 81.2 %", "integrity failures 3",
+                           "kidnap at step 17: detected after 2 steps", "(step 21, localized)"}) {
+    EXPECT_NE(line.find(part), std::string::npos) << part << " not in: " << line;
+  }
+  // No steps with a pose: nothing to report, and nothing made up.
+  SimSummary none;
+  summarize_steps({rec(0, S::kSearching, 0), rec(1, S::kSearching, 0)}, &none);
+  EXPECT_EQ(none.first_localized_step, -1);
+  EXPECT_EQ(none.final_pose_step, -1);
+  EXPECT_TRUE(std::isnan(none.final_err_m));
+  EXPECT_TRUE(std::isnan(none.availability));
+  EXPECT_NE(summary_line(none).find("no fix"), std::string::npos);
+}
+
+// Protection circles (radius in metres) and failure crosses reach both renderers and the legend.
+TEST(Picture, CirclesAndCrosses) {
+  Picture pic;
+  pic.title = "circles";
+  pic.x_min = 0;
+  pic.y_min = 0;
+  pic.x_max = 10;
+  pic.y_max = 5;
+  pic.pixels_per_metre = 50;
+  pic.circle_sets.push_back({{{2, 2, 0.5}, {5, 2, 1.0}, {7, 2, NAN}}, {0, 170, 190}, 1.2, "protection level"});
+  pic.point_sets.push_back({{{5, 2}}, {255, 0, 40}, 7.0, "integrity failure (1)", PointShape::kCross});
+  const std::string d = temp_dir("circles");
+  std::filesystem::create_directories(d);
+  std::string err;
+  ASSERT_TRUE(write_svg(pic, d + "/c.svg", &err)) << err;
+  ASSERT_TRUE(write_png(pic, d + "/c.png", &err)) << err;
+  const std::string svg = read_all(d + "/c.svg");
+  EXPECT_NE(svg.find("r=\"25\""), std::string::npos);  // 0.5 m at 50 px/m
+  EXPECT_NE(svg.find("r=\"50\""), std::string::npos);
+  EXPECT_EQ(svg.find("nan"), std::string::npos);       // the non-finite circle is skipped
+  EXPECT_NE(svg.find("<path d=\"M"), std::string::npos);
+  EXPECT_NE(svg.find("integrity failure (1)"), std::string::npos);
+  EXPECT_NE(svg.find("protection level"), std::string::npos);
+  EXPECT_EQ(read_all(d + "/c.png").substr(1, 3), "PNG");
+  if (std::getenv("MML_SIM_TEST_KEEP") == nullptr) std::filesystem::remove_all(d);
 }
 
 TEST(Picture, Base64AndPngEncoding) {

@@ -6,6 +6,7 @@
 
 #include <algorithm>
 #include <chrono>
+#include <cstdarg>
 #include <cmath>
 #include <cstdio>
 #include <filesystem>
@@ -52,6 +53,7 @@ struct FrameInfo {
   fw::Se2d truth;
   double travelled_m = 0;
   bool kidnapped = false;
+  bool in_unknown = false;
 };
 
 // A CARMEN log prepared as frames: odometry records in file order before each scan, plus the
@@ -145,6 +147,51 @@ double percentile(std::vector<double> v, double p) {
   return v[std::min(idx, v.size() - 1)];
 }
 
+std::string fmt(const char* f, ...) __attribute__((format(printf, 1, 2)));
+std::string fmt(const char* f, ...) {
+  char b[512];
+  va_list ap;
+  va_start(ap, f);
+  std::vsnprintf(b, sizeof(b), f, ap);
+  va_end(ap);
+  return b;
+}
+
+std::string final_error_text(const SimSummary& s) {
+  if (s.final_pose_step < 0) return "final error: none (no step with a pose)";
+  if (!std::isfinite(s.final_err_m)) {
+    return fmt("final pose: step %ld (%s), no ground truth", s.final_pose_step, s.final_pose_status.c_str());
+  }
+  return fmt("final error %.2f m / %.1f deg (step %ld, %s)", s.final_err_m, s.final_err_deg, s.final_pose_step,
+             s.final_pose_status.c_str());
+}
+
+std::string availability_text(const SimSummary& s) {
+  if (!std::isfinite(s.availability)) return "availability n/a";
+  std::string t = fmt("availability %.1f %% (%zu/%zu steps after the fix", 100.0 * s.availability,
+                      s.availability_localized, s.availability_steps);
+  if (s.unknown_area_steps > 0) t += fmt(", %zu in unknown area left out", s.unknown_area_steps);
+  return t + ")";
+}
+
+std::string pl_text(const SimSummary& s) {
+  if (s.pl_steps == 0) return "protection level: none published";
+  std::string t = fmt("protection level median %.2f m / %.1f deg, max %.2f m / %.1f deg", s.pl_xy_m_p50,
+                      s.pl_theta_deg_p50, s.pl_xy_m_max, s.pl_theta_deg_max);
+  if (s.pl_scored > 0) {
+    t += fmt(", exceeded %zu/%zu (%.2f %%)", s.pl_exceeded, s.pl_scored, 100.0 * s.pl_exceedance_rate);
+  }
+  return t;
+}
+
+std::string kidnap_text(const SimSummary& s) {
+  std::string t = fmt("kidnap at step %ld", s.kidnap_step);
+  if (s.kidnap_detected_step < 0) return t + ": never detected (localized to the end)";
+  t += fmt(": detected after %ld steps", s.kidnap_detection_delay_steps);
+  if (s.relocalized_step < 0) return t + ", no re-fix before the end";
+  return t + fmt(", re-fixed after %.1f m / %.1f s", s.refix_travelled_m, s.refix_s);
+}
+
 Rgb status_colour(hal::LocalizationStatus s) {
   switch (s) {
     case hal::LocalizationStatus::kSearching: return {150, 150, 150};
@@ -161,16 +208,23 @@ bool write_pictures(const SimConfig& cfg, const SimResult& r, const World* world
   Picture pic;
   const SimSummary& s = r.summary;
   pic.title = "mml-sim: " + s.source + ", localizer " + s.localizer + ", seed " + std::to_string(cfg.seed);
-  char buf[256];
+  // Notes short enough for the PNG font (12 px a character over ~1600 px).
+  char buf[320];
   if (s.first_localized_step >= 0) {
-    std::snprintf(buf, sizeof(buf), "localized at step %ld after %.1f m (error %.2f m); wrong-localized steps %zu",
-                  s.first_localized_step, s.first_localized_travelled_m, s.first_localized_err_m, s.wrong_localized_steps);
+    std::snprintf(buf, sizeof(buf), "first fix at step %ld after %.1f s / %.1f m (error %.2f m); %s",
+                  s.first_localized_step, s.first_localized_t, s.first_localized_travelled_m, s.first_localized_err_m,
+                  availability_text(s).c_str());
   } else {
     std::snprintf(buf, sizeof(buf), "never localized in %zu steps (%.1f m driven)", s.steps, s.path_length_m);
   }
   pic.notes.push_back(buf);
-  std::snprintf(buf, sizeof(buf), "step time mean %.2f ms, p99 %.2f ms; final error %.2f m", s.step_ms_mean,
-                s.step_ms_p99, s.final_err_m);
+  std::snprintf(buf, sizeof(buf), "integrity failures %zu (localized, error > %.1f m or > %.0f deg)",
+                s.integrity_failures, kIntegrityLimitM, kIntegrityLimitDeg);
+  pic.notes.push_back(buf);
+  pic.notes.push_back(pl_text(s));
+  if (s.kidnap_step >= 0) pic.notes.push_back(kidnap_text(s));
+  std::snprintf(buf, sizeof(buf), "step time p50 %.2f ms, p99 %.2f ms; %s", s.step_ms_p50, s.step_ms_p99,
+                final_error_text(s).c_str());
   pic.notes.push_back(buf);
   pic.map = grid;
   if (world != nullptr) {
@@ -190,8 +244,28 @@ bool write_pictures(const SimConfig& cfg, const SimResult& r, const World* world
     by_status[i].radius_px = 2.0;
     by_status[i].label = std::string("estimate: ") + names[i];
   }
+  // Protection level as a circle around the estimate at every n-th `localized` step (about 100
+  // circles at most), and every integrity failure as a cross.
+  std::size_t with_pl = 0;
+  for (const StepRecord& st : r.steps) {
+    with_pl += st.estimate.status == hal::LocalizationStatus::kLocalized && st.estimate.protection_xy_m > 0;
+  }
+  const std::size_t pl_every = std::max<std::size_t>(10, (with_pl + 99) / 100);
+  CircleSet pl_circles{{}, {0, 170, 190}, 1.2,
+                       "protection level (1 in " + std::to_string(pl_every) + " localized)"};
+  PointSet failures{{}, {255, 0, 40}, 7.0,
+                    "integrity failure (" + std::to_string(s.integrity_failures) + ")",
+                    PointShape::kCross};
+  std::size_t pl_seen = 0;
   std::vector<Polyline> truth_before;
   for (const StepRecord& st : r.steps) {
+    const bool loc = st.estimate.status == hal::LocalizationStatus::kLocalized;
+    if (loc && st.estimate.protection_xy_m > 0 && pl_seen++ % pl_every == 0) {
+      pl_circles.circles.push_back({st.estimate.x, st.estimate.y, st.estimate.protection_xy_m});
+    }
+    if (loc && std::isfinite(st.err_m) && (st.err_m > kIntegrityLimitM || st.err_deg > kIntegrityLimitDeg)) {
+      failures.points.push_back({st.estimate.x, st.estimate.y});
+    }
     if (st.kidnapped && !truth.points.empty()) {  // no line across the carry
       truth_before.push_back(truth);
       truth_before.back().label.clear();
@@ -204,9 +278,15 @@ bool write_pictures(const SimConfig& cfg, const SimResult& r, const World* world
       est_runs.push_back(est);
       est.points.clear();
     }
-    const int k = static_cast<int>(st.estimate.status);
-    if (k >= 0 && k < 5) by_status[k].points.push_back({st.estimate.x, st.estimate.y});
+    // A dot for every pose the localizer gave (a dead-reckoning pose while `searching` too), never
+    // for the (0, 0, 0) placeholder of a step without one.
+    const hal::PoseEstimate& e = st.estimate;
+    const int k = static_cast<int>(e.status);
+    if (k >= 0 && k < 5 && !is_placeholder_pose(e) && e.status != hal::LocalizationStatus::kFault) {
+      by_status[k].points.push_back({e.x, e.y});
+    }
   }
+  if (!pl_circles.circles.empty()) pic.circle_sets.push_back(pl_circles);
   for (const auto& l : truth_before) pic.lines.push_back(l);
   pic.lines.push_back(truth);
   if (!est.points.empty()) est_runs.push_back(est);
@@ -217,6 +297,8 @@ bool write_pictures(const SimConfig& cfg, const SimResult& r, const World* world
   for (auto& ps : by_status) {
     if (!ps.points.empty()) pic.point_sets.push_back(ps);
   }
+  // Shown (with its count) whenever there is a fix, so a clean run says "0" in the legend.
+  if (s.first_localized_step >= 0) pic.point_sets.push_back(failures);
   if (!r.last_hypotheses.empty()) {
     PointSet h{{}, {230, 30, 30}, 3.0, "hypotheses (step " + std::to_string(r.last_hypotheses_step) + ")"};
     for (const auto& p : r.last_hypotheses) h.points.push_back({p.x, p.y});
@@ -258,19 +340,33 @@ bool write_steps_csv(const std::string& path, const std::vector<StepRecord>& ste
   }
   std::fprintf(f,
                "step,t_s,scan_id,status,mode,x,y,theta,truth_x,truth_y,truth_theta,err_m,err_deg,travelled_m,"
-               "hypotheses,clusters,rating,odom_x,odom_y,odom_theta,cov_xx,cov_yy,cov_tt,step_ms,kidnapped\n");
+               "hypotheses,clusters,rating,odom_x,odom_y,odom_theta,cov_xx,cov_yy,cov_tt,step_ms,kidnapped,"
+               "pl_xy_m,pl_theta_deg,unsupported_steps,in_unknown\n");
   for (const StepRecord& s : steps) {
     const hal::PoseEstimate& e = s.estimate;
     std::fprintf(f, "%u,%.3f,%u,%s,%s,%.4f,%.4f,%.5f,", s.step, s.t, e.scan_id, hal::status_name(e.status),
                  e.mode == hal::LocalizationMode::kTracking ? "tracking" : "global", e.x, e.y, e.theta);
     if (s.has_truth) {
-      std::fprintf(f, "%.4f,%.4f,%.5f,%.4f,%.3f,", s.truth.x, s.truth.y, s.truth.theta, s.err_m, s.err_deg);
+      std::fprintf(f, "%.4f,%.4f,%.5f,", s.truth.x, s.truth.y, s.truth.theta);
     } else {
-      std::fprintf(f, ",,,,,");
+      std::fprintf(f, ",,,");
     }
-    std::fprintf(f, "%.3f,%u,%u,%.4f,%.4f,%.4f,%.5f,%.6g,%.6g,%.6g,%.4f,%d\n", s.travelled_m, e.hypothesis_count,
+    // The error only where there is a pose to score (never from a placeholder).
+    if (std::isfinite(s.err_m) && std::isfinite(s.err_deg)) {
+      std::fprintf(f, "%.4f,%.3f,", s.err_m, s.err_deg);
+    } else {
+      std::fprintf(f, ",,");
+    }
+    std::fprintf(f, "%.3f,%u,%u,%.4f,%.4f,%.4f,%.5f,%.6g,%.6g,%.6g,%.4f,%d,", s.travelled_m, e.hypothesis_count,
                  e.cluster_count, e.rating, s.odom.x, s.odom.y, s.odom.theta, e.cov[0], e.cov[4], e.cov[8], s.step_ms,
                  s.kidnapped ? 1 : 0);
+    // Protection level: empty when none was published (0).
+    if (e.protection_xy_m > 0 || e.protection_theta_rad > 0) {
+      std::fprintf(f, "%.4f,%.3f,", e.protection_xy_m, e.protection_theta_rad * kRadToDeg);
+    } else {
+      std::fprintf(f, ",,");
+    }
+    std::fprintf(f, "%u,%d\n", e.unsupported_steps, s.in_unknown ? 1 : 0);
   }
   const bool ok = std::fclose(f) == 0;
   if (!ok) *err = "error writing '" + path + "'";
@@ -296,11 +392,36 @@ bool write_summary_json(const std::string& path, const SimSummary& s, std::strin
   std::fprintf(f, "  \"first_localized_travelled_m\": %s,\n  \"first_localized_err_m\": %s,\n",
                s.first_localized_step >= 0 ? num(s.first_localized_travelled_m).c_str() : "null",
                s.first_localized_step >= 0 ? num(s.first_localized_err_m).c_str() : "null");
-  std::fprintf(f, "  \"kidnap_step\": %ld,\n  \"relocalized_step\": %ld,\n", s.kidnap_step, s.relocalized_step);
+  std::fprintf(f, "  \"first_localized_pl_xy_m\": %s,\n", num(s.first_localized_pl_xy_m).c_str());
+  std::fprintf(f, "  \"availability\": %s,\n  \"availability_steps\": %zu,\n  \"availability_localized_steps\": %zu,\n",
+               num(s.availability).c_str(), s.availability_steps, s.availability_localized);
+  std::fprintf(f, "  \"unknown_area_steps_excluded\": %zu,\n", s.unknown_area_steps);
+  std::fprintf(f, "  \"integrity_failures\": %zu,\n  \"integrity_failures_before_kidnap_detection\": %zu,\n",
+               s.integrity_failures, s.integrity_failures_kidnap);
+  std::fprintf(f, "  \"first_integrity_failure_step\": %ld,\n  \"integrity_limit_m\": %s,\n  \"integrity_limit_deg\": %s,\n",
+               s.first_integrity_failure_step, num(kIntegrityLimitM).c_str(), num(kIntegrityLimitDeg).c_str());
+  std::fprintf(f, "  \"pl_steps\": %zu,\n  \"pl_scored_steps\": %zu,\n  \"pl_exceeded_steps\": %zu,\n  \"pl_exceedance_rate\": %s,\n",
+               s.pl_steps, s.pl_scored, s.pl_exceeded, num(s.pl_exceedance_rate).c_str());
+  std::fprintf(f, "  \"pl_xy_m_p50\": %s,\n  \"pl_xy_m_max\": %s,\n  \"pl_theta_deg_p50\": %s,\n  \"pl_theta_deg_max\": %s,\n",
+               num(s.pl_xy_m_p50).c_str(), num(s.pl_xy_m_max).c_str(), num(s.pl_theta_deg_p50).c_str(),
+               num(s.pl_theta_deg_max).c_str());
+  std::fprintf(f, "  \"tracking_steps\": %zu,\n  \"tracking_err_m_p50\": %s,\n  \"tracking_err_m_p95\": %s,\n",
+               s.tracking_steps, num(s.tracking_err_m_p50).c_str(), num(s.tracking_err_m_p95).c_str());
+  std::fprintf(f, "  \"tracking_err_deg_p50\": %s,\n  \"tracking_err_deg_p95\": %s,\n", num(s.tracking_err_deg_p50).c_str(),
+               num(s.tracking_err_deg_p95).c_str());
+  std::fprintf(f, "  \"kidnap_step\": %ld,\n  \"kidnap_jump_m\": %s,\n  \"kidnap_detected_step\": %ld,\n", s.kidnap_step,
+               num(s.kidnap_jump_m).c_str(), s.kidnap_detected_step);
+  std::fprintf(f, "  \"kidnap_detection_delay_steps\": %ld,\n  \"relocalized_step\": %ld,\n",
+               s.kidnap_detection_delay_steps, s.relocalized_step);
+  std::fprintf(f, "  \"refix_travelled_m\": %s,\n  \"refix_s\": %s,\n  \"refix_err_m\": %s,\n", num(s.refix_travelled_m).c_str(),
+               num(s.refix_s).c_str(), num(s.refix_err_m).c_str());
   std::fprintf(f, "  \"localized_steps\": %zu,\n  \"wrong_localized_steps\": %zu,\n", s.localized_steps,
                s.wrong_localized_steps);
-  std::fprintf(f, "  \"mean_err_localized_m\": %s,\n  \"max_err_localized_m\": %s,\n  \"final_err_m\": %s,\n",
-               num(s.mean_err_localized_m).c_str(), num(s.max_err_localized_m).c_str(), num(s.final_err_m).c_str());
+  std::fprintf(f, "  \"mean_err_localized_m\": %s,\n  \"max_err_localized_m\": %s,\n", num(s.mean_err_localized_m).c_str(),
+               num(s.max_err_localized_m).c_str());
+  std::fprintf(f, "  \"final_err_m\": %s,\n  \"final_err_deg\": %s,\n  \"final_pose_step\": %ld,\n  \"final_pose_status\": %s,\n",
+               num(s.final_err_m).c_str(), num(s.final_err_deg).c_str(), s.final_pose_step,
+               s.final_pose_step >= 0 ? ("\"" + s.final_pose_status + "\"").c_str() : "null");
   const char* names[5] = {"searching", "ambiguous", "localized", "outside_map", "fault"};
   for (int i = 0; i < 5; ++i) std::fprintf(f, "  \"steps_%s\": %zu,\n", names[i], s.status_counts[i]);
   std::fprintf(f, "  \"step_ms_mean\": %s,\n  \"step_ms_p50\": %s,\n  \"step_ms_p99\": %s,\n  \"step_ms_max\": %s,\n",
@@ -317,6 +438,226 @@ bool write_summary_json(const std::string& path, const SimSummary& s, std::strin
   const bool ok = std::fclose(f) == 0;
   if (!ok) *err = "error writing '" + path + "'";
   return ok;
+}
+
+bool is_placeholder_pose(const hal::PoseEstimate& e) {
+  if (!std::isfinite(e.x) || !std::isfinite(e.y) || !std::isfinite(e.theta)) return true;
+  if (e.x != 0.0f || e.y != 0.0f || e.theta != 0.0f) return false;
+  for (float c : e.cov) {
+    if (c != 0.0f) return false;
+  }
+  return true;
+}
+
+bool estimate_has_pose(const hal::PoseEstimate& e) {
+  if (e.status == hal::LocalizationStatus::kSearching || e.status == hal::LocalizationStatus::kFault) return false;
+  return !is_placeholder_pose(e);
+}
+
+void summarize_steps(const std::vector<StepRecord>& steps, SimSummary* s) {
+  const SimSummary keep = *s;
+  // Start from the defaults for every derived field, keep what the caller measured.
+  *s = SimSummary();
+  s->source = keep.source;
+  s->localizer = keep.localizer;
+  s->scans_dropped = keep.scans_dropped;
+  s->wall_s = keep.wall_s;
+  s->scans_per_s = keep.scans_per_s;
+  s->load_s = keep.load_s;
+  s->odom_rejected = keep.odom_rejected;
+  s->scans_held = keep.scans_held;
+  s->ring_drops = keep.ring_drops;
+  s->step_errors = keep.step_errors;
+  s->scans_restamped = keep.scans_restamped;
+  s->deadline_misses = keep.deadline_misses;
+  s->steps = steps.size();
+  if (steps.empty()) return;
+
+  std::vector<double> ms, err_loc, trk_m, trk_deg, glob_m, glob_deg, pl_xy, pl_th;
+  bool any_tracking = false;
+  double kidnap_travelled = 0, kidnap_t = 0;
+  for (std::size_t i = 0; i < steps.size(); ++i) {
+    const StepRecord& r = steps[i];
+    const hal::PoseEstimate& e = r.estimate;
+    const long step = static_cast<long>(i);
+    const bool loc = e.status == hal::LocalizationStatus::kLocalized;
+    const bool scored = std::isfinite(r.err_m) && std::isfinite(r.err_deg);
+    ms.push_back(r.step_ms);
+    const int k = static_cast<int>(e.status);
+    if (k >= 0 && k < 5) ++s->status_counts[k];
+
+    // Kidnapping: detection = the first step from the kidnap scan on that is not `localized`; the
+    // re-fix = the first `localized` step after that.
+    if (r.kidnapped && s->kidnap_step < 0) {
+      s->kidnap_step = step;
+      kidnap_travelled = r.travelled_m;
+      kidnap_t = r.t;
+      if (i > 0 && steps[i - 1].has_truth && r.has_truth) {
+        s->kidnap_jump_m = std::hypot(r.truth.x - steps[i - 1].truth.x, r.truth.y - steps[i - 1].truth.y);
+      }
+    }
+    const bool undetected_kidnap = s->kidnap_step >= 0 && s->kidnap_detected_step < 0;
+    if (undetected_kidnap && !loc) {
+      s->kidnap_detected_step = step;
+      s->kidnap_detection_delay_steps = step - s->kidnap_step;
+    } else if (s->kidnap_detected_step >= 0 && s->relocalized_step < 0 && loc) {
+      s->relocalized_step = step;
+      s->refix_travelled_m = r.travelled_m - kidnap_travelled;
+      s->refix_s = r.t - kidnap_t;
+      s->refix_err_m = r.err_m;
+    }
+
+    // Availability over the steps after the first fix (the unknown area left out).
+    if (s->first_localized_step >= 0) {
+      if (r.in_unknown) {
+        ++s->unknown_area_steps;
+      } else {
+        ++s->availability_steps;
+        if (loc) ++s->availability_localized;
+      }
+    }
+
+    if (loc) {
+      ++s->localized_steps;
+      if (s->first_localized_step < 0) {
+        s->first_localized_step = step;
+        s->first_localized_t = r.t;
+        s->first_localized_travelled_m = r.travelled_m;
+        s->first_localized_err_m = r.err_m;
+        if (e.protection_xy_m > 0) s->first_localized_pl_xy_m = e.protection_xy_m;
+      }
+      if (scored) {
+        err_loc.push_back(r.err_m);
+        if (r.err_m >= kWrongM || r.err_deg >= kWrongDeg) ++s->wrong_localized_steps;
+        if (r.err_m > kIntegrityLimitM || r.err_deg > kIntegrityLimitDeg) {
+          ++s->integrity_failures;
+          if (undetected_kidnap) ++s->integrity_failures_kidnap;
+          if (s->first_integrity_failure_step < 0) s->first_integrity_failure_step = step;
+        }
+        if (e.mode == hal::LocalizationMode::kTracking) {
+          any_tracking = true;
+          trk_m.push_back(r.err_m);
+          trk_deg.push_back(r.err_deg);
+        } else {
+          glob_m.push_back(r.err_m);
+          glob_deg.push_back(r.err_deg);
+        }
+      }
+      if (e.protection_xy_m > 0 || e.protection_theta_rad > 0) {
+        ++s->pl_steps;
+        pl_xy.push_back(e.protection_xy_m);
+        pl_th.push_back(e.protection_theta_rad * kRadToDeg);
+        if (scored) {
+          ++s->pl_scored;
+          if (r.err_m > e.protection_xy_m || r.err_deg > e.protection_theta_rad * kRadToDeg) ++s->pl_exceeded;
+        }
+      }
+    }
+    if (r.has_pose) {
+      s->final_pose_step = step;
+      s->final_pose_status = hal::status_name(e.status);
+      s->final_err_m = r.err_m;
+      s->final_err_deg = r.err_deg;
+    }
+  }
+  if (s->availability_steps > 0) {
+    s->availability = static_cast<double>(s->availability_localized) / static_cast<double>(s->availability_steps);
+  }
+  if (!err_loc.empty()) {
+    double sum = 0;
+    for (double v : err_loc) sum += v;
+    s->mean_err_localized_m = sum / static_cast<double>(err_loc.size());
+    s->max_err_localized_m = *std::max_element(err_loc.begin(), err_loc.end());
+  }
+  // A localizer without a tracking mode (mml): its `localized` steps are the tracking error.
+  if (!any_tracking) {
+    trk_m.swap(glob_m);
+    trk_deg.swap(glob_deg);
+  }
+  s->tracking_steps = trk_m.size();
+  if (!trk_m.empty()) {
+    s->tracking_err_m_p50 = percentile(trk_m, 0.5);
+    s->tracking_err_m_p95 = percentile(trk_m, 0.95);
+    s->tracking_err_deg_p50 = percentile(trk_deg, 0.5);
+    s->tracking_err_deg_p95 = percentile(trk_deg, 0.95);
+  }
+  if (s->pl_scored > 0) s->pl_exceedance_rate = static_cast<double>(s->pl_exceeded) / static_cast<double>(s->pl_scored);
+  if (!pl_xy.empty()) {
+    s->pl_xy_m_p50 = percentile(pl_xy, 0.5);
+    s->pl_xy_m_max = *std::max_element(pl_xy.begin(), pl_xy.end());
+    s->pl_theta_deg_p50 = percentile(pl_th, 0.5);
+    s->pl_theta_deg_max = *std::max_element(pl_th.begin(), pl_th.end());
+  }
+  s->path_length_m = steps.back().travelled_m;
+  double tot = 0;
+  for (double v : ms) tot += v;
+  s->step_ms_mean = tot / static_cast<double>(ms.size());
+  s->step_ms_p50 = percentile(ms, 0.5);
+  s->step_ms_p99 = percentile(ms, 0.99);
+  s->step_ms_max = *std::max_element(ms.begin(), ms.end());
+}
+
+std::string summary_line(const SimSummary& s) {
+  std::string t = "mml-sim summary: " + s.source + ", " + s.localizer + ", " + std::to_string(s.steps) + " steps: ";
+  if (s.first_localized_step >= 0) {
+    t += fmt("first fix at step %ld (%.1f s, %.1f m)", s.first_localized_step, s.first_localized_t,
+             s.first_localized_travelled_m);
+  } else {
+    t += "no fix";
+  }
+  t += "; " + availability_text(s);
+  t += fmt("; integrity failures %zu (> %.1f m or > %.0f deg)", s.integrity_failures, kIntegrityLimitM,
+           kIntegrityLimitDeg);
+  t += "; " + pl_text(s);
+  if (std::isfinite(s.tracking_err_m_p50)) {
+    t += fmt("; tracking error median %.3f m, p95 %.3f m", s.tracking_err_m_p50, s.tracking_err_m_p95);
+  }
+  if (s.kidnap_step >= 0) t += "; " + kidnap_text(s);
+  t += fmt("; step p50 %.2f ms, p99 %.2f ms", s.step_ms_p50, s.step_ms_p99);
+  t += "; " + final_error_text(s);
+  return t;
+}
+
+std::string summary_story(const SimSummary& s) {
+  std::string t;
+  if (s.first_localized_step < 0) {
+    t += fmt("  no fix in %zu steps (%.1f m driven)\n", s.steps, s.path_length_m);
+  } else {
+    t += fmt("  first fix at step %ld after %.1f s and %.1f m", s.first_localized_step, s.first_localized_t,
+             s.first_localized_travelled_m);
+    if (std::isfinite(s.first_localized_err_m)) t += fmt(", error %.2f m", s.first_localized_err_m);
+    if (std::isfinite(s.first_localized_pl_xy_m)) t += fmt(", protection level %.2f m", s.first_localized_pl_xy_m);
+    t += "\n  then: " + availability_text(s);
+    if (std::isfinite(s.tracking_err_m_p50)) {
+      t += fmt("; error while localized median %.3f m, p95 %.3f m (%.2f / %.2f deg)", s.tracking_err_m_p50,
+               s.tracking_err_m_p95, s.tracking_err_deg_p50, s.tracking_err_deg_p95);
+    }
+    t += "\n";
+  }
+  if (s.kidnap_step >= 0) {
+    t += fmt("  kidnapped at step %ld", s.kidnap_step);
+    if (std::isfinite(s.kidnap_jump_m)) t += fmt(" (carried %.1f m; the odometry saw nothing)", s.kidnap_jump_m);
+    if (s.kidnap_detected_step < 0) {
+      t += ": never detected, localized to the end";
+    } else {
+      t += fmt(": not localized from step %ld (detected after %ld steps)", s.kidnap_detected_step,
+               s.kidnap_detection_delay_steps);
+      if (s.relocalized_step < 0) {
+        t += "; no re-fix before the end of the run";
+      } else {
+        t += fmt("; localized again at step %ld after %.1f m / %.1f s", s.relocalized_step, s.refix_travelled_m,
+                 s.refix_s);
+        if (std::isfinite(s.refix_err_m)) t += fmt(", error %.2f m", s.refix_err_m);
+      }
+    }
+    t += "\n";
+  }
+  t += fmt("  integrity: %zu of %zu localized steps off by > %.1f m or > %.0f deg", s.integrity_failures,
+           s.localized_steps, kIntegrityLimitM, kIntegrityLimitDeg);
+  if (s.integrity_failures_kidnap > 0) t += fmt(" (%zu before the kidnap was detected)", s.integrity_failures_kidnap);
+  t += "; " + pl_text(s) + "\n";
+  t += "  " + final_error_text(s) + "\n";
+  return t;
 }
 
 // --dataset NAME: the raw log, its reference poses and the global map built from the corrected log
@@ -529,8 +870,10 @@ bool run_simulation(const SimConfig& cfg_in, SimResult* out, std::string* err) {
         r.truth = fi.truth;
         r.travelled_m = fi.travelled_m;
         r.kidnapped = fi.kidnapped;
+        r.in_unknown = fi.in_unknown;
       }
-      if (r.has_truth) {
+      r.has_pose = estimate_has_pose(e);
+      if (r.has_truth && r.has_pose) {
         r.err_m = std::hypot(e.x - r.truth.x, e.y - r.truth.y);
         r.err_deg = std::fabs(fw::wrap_angle(static_cast<double>(e.theta) - r.truth.theta)) * kRadToDeg;
       }
@@ -547,7 +890,12 @@ bool run_simulation(const SimConfig& cfg_in, SimResult* out, std::string* err) {
         std::fprintf(stderr, "%sstep %u (t=%.1f s, %.1f m): %s -> %s at (%.2f, %.2f, %.1f deg)", tty ? "\r\033[K" : "",
                      r.step, r.t, r.travelled_m, hal::status_name(last_status), hal::status_name(e.status), e.x, e.y,
                      e.theta * kRadToDeg);
-        if (r.has_truth) std::fprintf(stderr, "; truth (%.2f, %.2f), error %.2f m", r.truth.x, r.truth.y, r.err_m);
+        if (!r.has_pose) std::fprintf(stderr, " (no pose)");
+        if (r.has_truth) std::fprintf(stderr, "; truth (%.2f, %.2f)", r.truth.x, r.truth.y);
+        if (r.has_truth && r.has_pose) std::fprintf(stderr, ", error %.2f m", r.err_m);
+        if (e.protection_xy_m > 0) {
+          std::fprintf(stderr, ", PL %.2f m / %.1f deg", e.protection_xy_m, e.protection_theta_rad * kRadToDeg);
+        }
         std::fprintf(stderr, "\n");
       }
       last_status = e.status;
@@ -571,6 +919,9 @@ bool run_simulation(const SimConfig& cfg_in, SimResult* out, std::string* err) {
   Frame frame;
   SyntheticFrame sframe;
   double t_first = 0;
+  // Whether a step's truth lies in the unknown area is known for a world whose unknown area was
+  // erased from the map (availability leaves those steps out: there is nothing to localize on).
+  const bool unknown_known = !cfg.world.empty() && cfg.raster.erase_unknown_areas && !world.unknown_areas.empty();
   for (std::size_t k = 0; k < total; ++k) {
     if (!cfg.world.empty()) {
       if (!synthetic.next(&sframe)) break;
@@ -592,7 +943,11 @@ bool run_simulation(const SimConfig& cfg_in, SimResult* out, std::string* err) {
       std::this_thread::sleep_until(due);
     }
     if (info.size() <= frame.scan.scan_id) info.resize(frame.scan.scan_id + 1);
-    info[frame.scan.scan_id] = {frame.t, frame.has_truth, frame.truth, frame.travelled_m, frame.kidnapped};
+    bool in_unknown = false;
+    if (unknown_known && frame.has_truth) {
+      for (const Box& b : world.unknown_areas) in_unknown |= b.contains(Vec2(frame.truth.x, frame.truth.y));
+    }
+    info[frame.scan.scan_id] = {frame.t, frame.has_truth, frame.truth, frame.travelled_m, frame.kidnapped, in_unknown};
     for (const hal::Odometry& o : frame.odometry) {
       if (!odom->push(o)) ++ring_drops;
     }
@@ -609,7 +964,7 @@ bool run_simulation(const SimConfig& cfg_in, SimResult* out, std::string* err) {
         std::fprintf(stderr, "%s[%s %s] step %zu/%zu  t=%.1f s  %.1f m  status=%s", tty ? "\r\033[K" : "",
                      sum.source.c_str(), cfg.localizer.c_str(), k + 1, total, frame.t, frame.travelled_m,
                      lr ? hal::status_name(lr->estimate.status) : "-");
-        if (lr && lr->has_truth) std::fprintf(stderr, "  err=%.2f m", lr->err_m);
+        if (lr && std::isfinite(lr->err_m)) std::fprintf(stderr, "  err=%.2f m", lr->err_m);
         if (lr) std::fprintf(stderr, "  hyps=%u  %.2f ms/step", lr->estimate.hypothesis_count, lr->step_ms);
         if (!tty) std::fprintf(stderr, "\n");
       }
@@ -637,47 +992,9 @@ bool run_simulation(const SimConfig& cfg_in, SimResult* out, std::string* err) {
   sum.odom_rejected = loop->counters().odom_rejected;
   sum.scans_held = loop->counters().scans_held;
   sum.deadline_misses = loop->health().deadline_misses;
-  std::vector<double> ms;
-  double err_sum = 0;
-  for (const StepRecord& r : out->steps) {
-    ms.push_back(r.step_ms);
-    if (r.kidnapped && sum.kidnap_step < 0) sum.kidnap_step = r.step;
-    if (sum.kidnap_step >= 0 && sum.relocalized_step < 0 && r.estimate.status == hal::LocalizationStatus::kLocalized) {
-      sum.relocalized_step = r.step;
-    }
-    const int k = static_cast<int>(r.estimate.status);
-    if (k >= 0 && k < 5) ++sum.status_counts[k];
-    if (r.estimate.status == hal::LocalizationStatus::kLocalized) {
-      ++sum.localized_steps;
-      if (sum.first_localized_step < 0) {
-        sum.first_localized_step = r.step;
-        sum.first_localized_t = r.t;
-        sum.first_localized_travelled_m = r.travelled_m;
-        sum.first_localized_err_m = r.err_m;
-      }
-      if (r.has_truth) {
-        err_sum += r.err_m;
-        sum.max_err_localized_m = std::max(sum.max_err_localized_m, r.err_m);
-        if (r.err_m >= kWrongM || r.err_deg >= kWrongDeg) ++sum.wrong_localized_steps;
-      }
-    }
-  }
-  if (sum.localized_steps > 0) sum.mean_err_localized_m = err_sum / static_cast<double>(sum.localized_steps);
-  if (!out->steps.empty()) {
-    sum.final_err_m = out->steps.back().err_m;
-    sum.path_length_m = out->steps.back().travelled_m;
-    double tot = 0;
-    for (double v : ms) tot += v;
-    sum.step_ms_mean = tot / static_cast<double>(ms.size());
-    sum.step_ms_p50 = percentile(ms, 0.5);
-    sum.step_ms_p99 = percentile(ms, 0.99);
-    sum.step_ms_max = *std::max_element(ms.begin(), ms.end());
-  }
+  summarize_steps(out->steps, &sum);
   if (cfg.progress) {
-    if (sum.first_localized_step >= 0) {
-      std::fprintf(stderr, "LOCALIZED at step %ld (t=%.1f s, after %.1f m) with error %.2f m\n", sum.first_localized_step,
-                   sum.first_localized_t, sum.first_localized_travelled_m, sum.first_localized_err_m);
-    } else {
+    if (sum.first_localized_step < 0) {
       std::fprintf(stderr, "not localized in %zu steps (%.1f m); localizer '%s'\n", sum.steps, sum.path_length_m,
                    cfg.localizer.c_str());
     }
@@ -695,6 +1012,7 @@ bool run_simulation(const SimConfig& cfg_in, SimResult* out, std::string* err) {
       std::fprintf(stderr, "firmware: (%llu warnings/errors in total, last %zu shown)\n",
                    static_cast<unsigned long long>(logs->total()), shown);
     }
+    std::fputs(summary_story(sum).c_str(), stderr);
   }
 
   // ---- outputs ----

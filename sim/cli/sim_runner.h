@@ -1,9 +1,12 @@
 // The simulator driver behind mml-sim: feeds a synthetic world or a CARMEN log through the hal/sim
 // backend into the firmware's LocalizationLoop in lockstep (stepped clock set to each scan's time)
 // or paced at the data's real time, and records per step: estimate, status, ground truth, error,
-// timing. Writes steps.csv, summary.json, run.svg, run.png (and the map as map.yaml/.pgm).
+// protection level, timing. Writes steps.csv, summary.json, run.svg, run.png (and the map as
+// map.yaml/.pgm). Errors are computed only for steps that have a pose (estimate_has_pose): a
+// `searching` step or a placeholder pose (0, 0, 0) is never scored against the truth.
 #pragma once
 
+#include <cmath>
 #include <cstdint>
 #include <map>
 #include <string>
@@ -41,13 +44,26 @@ struct SimConfig {
   RasterOptions raster;
 };
 
+// The placeholder a localizer leaves in a PoseEstimate before it has any pose: x = y = θ = 0 with a
+// zero covariance (not finite counts as no pose either).
+bool is_placeholder_pose(const hal::PoseEstimate& e);
+// Whether a published estimate carries a pose to score: not `searching` or `fault`, and not the
+// placeholder.
+bool estimate_has_pose(const hal::PoseEstimate& e);
+
+// Bounds of an integrity failure: a `localized` step farther off than the product's alert limits
+// (firmware/track/track_options.h: 0.5 m, 5°).
+constexpr double kIntegrityLimitM = 0.5, kIntegrityLimitDeg = 5.0;
+
 struct StepRecord {
   std::uint32_t step = 0;
   double t = 0;  // s since the first scan
   hal::PoseEstimate estimate;
+  bool has_pose = false;   // estimate_has_pose(estimate)
   bool has_truth = false;
+  bool in_unknown = false;  // the truth lies in the world's unknown area (erased from the map)
   fw::Se2d truth;
-  double err_m = 0, err_deg = 0;
+  double err_m = NAN, err_deg = NAN;  // NaN without truth or without a pose
   double travelled_m = 0;
   bool kidnapped = false;  // the robot was carried away just before this scan
   fw::Se2d odom;
@@ -59,11 +75,39 @@ struct SimSummary {
   std::size_t steps = 0, scans_dropped = 0;
   long first_localized_step = -1;
   long kidnap_step = -1;
-  // After a kidnapping: first step localized again (−1 = never).
+  // After a kidnapping: first step localized again after the detection (−1 = never).
   long relocalized_step = -1;
-  double first_localized_t = 0, first_localized_travelled_m = 0, first_localized_err_m = 0;
+  double first_localized_t = 0, first_localized_travelled_m = 0, first_localized_err_m = NAN;
+  double first_localized_pl_xy_m = NAN;  // its protection level (NaN: none published)
   std::size_t localized_steps = 0, wrong_localized_steps = 0;  // wrong: error ≥ 0.5 m or ≥ 20° while localized
-  double mean_err_localized_m = 0, max_err_localized_m = 0, final_err_m = 0;
+  double mean_err_localized_m = NAN, max_err_localized_m = NAN;
+  // Final error: of the last step that has a pose (final_pose_step, −1 = none; its status).
+  long final_pose_step = -1;
+  std::string final_pose_status;
+  double final_err_m = NAN, final_err_deg = NAN;
+  // Availability: share of the steps after the first fix that are `localized`. Steps whose truth
+  // lies in the world's unknown area (not in the map: nothing to localize on) are left out when
+  // known (built-in worlds with the unknown area erased); unknown_area_steps counts them.
+  std::size_t availability_steps = 0, availability_localized = 0, unknown_area_steps = 0;
+  double availability = NAN;
+  // Integrity failures: `localized` steps with error > kIntegrityLimitM or > kIntegrityLimitDeg;
+  // of them, those between a kidnapping and its detection.
+  std::size_t integrity_failures = 0, integrity_failures_kidnap = 0;
+  long first_integrity_failure_step = -1;
+  // Protection level over `localized` steps that carry one (> 0): exceedances (error beyond the PL
+  // in position or heading; scored where the truth is known), median and maximum.
+  std::size_t pl_steps = 0, pl_scored = 0, pl_exceeded = 0;
+  double pl_exceedance_rate = NAN;
+  double pl_xy_m_p50 = NAN, pl_xy_m_max = NAN, pl_theta_deg_p50 = NAN, pl_theta_deg_max = NAN;
+  // Error of the `localized` steps in tracking mode (all `localized` steps for a localizer without one).
+  std::size_t tracking_steps = 0;
+  double tracking_err_m_p50 = NAN, tracking_err_m_p95 = NAN, tracking_err_deg_p50 = NAN, tracking_err_deg_p95 = NAN;
+  // Kidnapping (--kidnap-at): the first step at or after it that is not `localized` (detection,
+  // delay in steps; 0 = the kidnap scan itself), then the first `localized` step after that
+  // (relocalized_step) with the metres / seconds since the kidnapping and its error.
+  long kidnap_detected_step = -1, kidnap_detection_delay_steps = -1;
+  double kidnap_jump_m = NAN;
+  double refix_travelled_m = NAN, refix_s = NAN, refix_err_m = NAN;
   std::size_t status_counts[5] = {};
   double step_ms_mean = 0, step_ms_p50 = 0, step_ms_p99 = 0, step_ms_max = 0;
   // wall_s / scans_per_s: the run through hal/sim and the localizer (log parsing and map building
@@ -88,5 +132,13 @@ bool run_simulation(const SimConfig& cfg, SimResult* out, std::string* err);
 // Output writers (also used by tests).
 bool write_steps_csv(const std::string& path, const std::vector<StepRecord>& steps, std::string* err);
 bool write_summary_json(const std::string& path, const SimSummary& s, std::string* err);
+// Summary figures of a run from its steps (also used by tests): first fix, availability, integrity,
+// protection level, tracking error, kidnap detection and re-fix, final error, step times. Fills the
+// fields of *s that derive from the steps; counters of the loop are left alone.
+void summarize_steps(const std::vector<StepRecord>& steps, SimSummary* s);
+// The one-line summary mml-sim prints last ("mml-sim summary: ...").
+std::string summary_line(const SimSummary& s);
+// A few lines that tell the run: fix, tracking, kidnapping, integrity.
+std::string summary_story(const SimSummary& s);
 
 }  // namespace sim

@@ -39,6 +39,7 @@ int legend_entries(const Picture& pic) {
   int n = 0;
   for (const auto& l : pic.lines) n += !l.label.empty();
   for (const auto& p : pic.point_sets) n += !p.label.empty();
+  for (const auto& c : pic.circle_sets) n += !c.label.empty();
   for (const auto& b : pic.boxes) n += !b.label.empty();
   return n;
 }
@@ -162,6 +163,18 @@ struct Canvas {
       disc(xa + s * (xb - xa), ya + s * (yb - ya), width / 2, c);
     }
   }
+  // Circle outline (polygon fine enough for its size).
+  void ring(double cx, double cy, double r, double width, Rgb c) {
+    const int n = std::clamp(static_cast<int>(std::ceil(2 * M_PI * r / 3.0)), 12, 360);
+    for (int k = 0; k < n; ++k) {
+      const double a0 = 2 * M_PI * k / n, a1 = 2 * M_PI * (k + 1) / n;
+      line(cx + r * std::cos(a0), cy + r * std::sin(a0), cx + r * std::cos(a1), cy + r * std::sin(a1), width, c);
+    }
+  }
+  void cross(double cx, double cy, double r, double width, Rgb c) {
+    line(cx - r, cy - r, cx + r, cy + r, width, c);
+    line(cx - r, cy + r, cx + r, cy - r, width, c);
+  }
   void rect_outline(double xa, double ya, double xb, double yb, Rgb c) {
     line(xa, ya, xb, ya, 2, c); line(xb, ya, xb, yb, 2, c); line(xb, yb, xa, yb, 2, c); line(xa, yb, xa, ya, 2, c);
   }
@@ -188,13 +201,16 @@ struct Canvas {
 struct LegendItem {
   std::string label;
   Rgb color;
-  int kind;  // 0 line, 1 points, 2 box
+  int kind;  // 0 line, 1 points, 2 box, 3 circle outline, 4 cross
 };
 
 std::vector<LegendItem> legend_items(const Picture& pic) {
   std::vector<LegendItem> items;
   for (const auto& l : pic.lines) if (!l.label.empty()) items.push_back({l.label, l.color, 0});
-  for (const auto& p : pic.point_sets) if (!p.label.empty()) items.push_back({p.label, p.color, 1});
+  for (const auto& c : pic.circle_sets) if (!c.label.empty()) items.push_back({c.label, c.color, 3});
+  for (const auto& p : pic.point_sets) {
+    if (!p.label.empty()) items.push_back({p.label, p.color, p.shape == PointShape::kCross ? 4 : 1});
+  }
   for (const auto& b : pic.boxes) if (!b.label.empty()) items.push_back({b.label, b.color, 2});
   return items;
 }
@@ -290,7 +306,27 @@ bool write_svg(const Picture& pic, const std::string& path, std::string* err) {
     }
     s << "\"/>\n";
   }
+  for (const auto& cs : pic.circle_sets) {
+    s << "<g fill=\"none\" stroke=\"" << hex(cs.color) << "\" stroke-width=\"" << cs.width_px
+      << "\" stroke-opacity=\"0.8\">\n";
+    for (const auto& c : cs.circles) {
+      if (!std::isfinite(c.x) || !std::isfinite(c.y) || !std::isfinite(c.radius_m) || c.radius_m <= 0) continue;
+      s << "<circle cx=\"" << L.px(c.x) << "\" cy=\"" << L.py(c.y) << "\" r=\"" << c.radius_m * L.ppm << "\"/>\n";
+    }
+    s << "</g>\n";
+  }
   for (const auto& ps : pic.point_sets) {
+    if (ps.shape == PointShape::kCross) {
+      s << "<g stroke=\"" << hex(ps.color) << "\" stroke-width=\"2.5\" fill=\"none\">\n";
+      for (const auto& p : ps.points) {
+        if (!std::isfinite(p.x) || !std::isfinite(p.y)) continue;
+        const double cx = L.px(p.x), cy = L.py(p.y), r = ps.radius_px;
+        s << "<path d=\"M" << cx - r << ' ' << cy - r << 'L' << cx + r << ' ' << cy + r << 'M' << cx - r << ' '
+          << cy + r << 'L' << cx + r << ' ' << cy - r << "\"/>\n";
+      }
+      s << "</g>\n";
+      continue;
+    }
     s << "<g fill=\"" << hex(ps.color) << "\" fill-opacity=\"0.8\">\n";
     for (const auto& p : ps.points) {
       if (!std::isfinite(p.x) || !std::isfinite(p.y)) continue;
@@ -322,6 +358,12 @@ bool write_svg(const Picture& pic, const std::string& path, std::string* err) {
         << hex(items[i].color) << "\" stroke-width=\"3\"/>\n";
     } else if (items[i].kind == 1) {
       s << "<circle cx=\"" << x + 12 << "\" cy=\"" << y + 6 << "\" r=\"4\" fill=\"" << hex(items[i].color) << "\"/>\n";
+    } else if (items[i].kind == 3) {
+      s << "<circle cx=\"" << x + 12 << "\" cy=\"" << y + 6 << "\" r=\"6\" fill=\"none\" stroke=\"" << hex(items[i].color)
+        << "\" stroke-width=\"1.5\"/>\n";
+    } else if (items[i].kind == 4) {
+      s << "<path d=\"M" << x + 7 << ' ' << y + 1 << 'L' << x + 17 << ' ' << y + 11 << 'M' << x + 7 << ' ' << y + 11
+        << 'L' << x + 17 << ' ' << y + 1 << "\" stroke=\"" << hex(items[i].color) << "\" stroke-width=\"2.5\"/>\n";
     } else {
       s << "<rect x=\"" << x << "\" y=\"" << y << "\" width=\"24\" height=\"12\" fill=\"" << hex(items[i].color)
         << "\" fill-opacity=\"0.25\" stroke=\"" << hex(items[i].color) << "\"/>\n";
@@ -389,9 +431,17 @@ bool write_png(const Picture& pic, const std::string& path, std::string* err) {
       c.line(L.px(a.x), L.py(a.y), L.px(b.x), L.py(b.y), l.width_px, l.color);
     }
   }
+  for (const auto& cs : pic.circle_sets) {
+    for (const auto& ci : cs.circles) {
+      if (!std::isfinite(ci.x) || !std::isfinite(ci.y) || !std::isfinite(ci.radius_m) || ci.radius_m <= 0) continue;
+      c.ring(L.px(ci.x), L.py(ci.y), ci.radius_m * L.ppm, cs.width_px, cs.color);
+    }
+  }
   for (const auto& ps : pic.point_sets) {
     for (const auto& p : ps.points) {
-      if (std::isfinite(p.x) && std::isfinite(p.y)) c.disc(L.px(p.x), L.py(p.y), ps.radius_px, ps.color);
+      if (!std::isfinite(p.x) || !std::isfinite(p.y)) continue;
+      if (ps.shape == PointShape::kCross) c.cross(L.px(p.x), L.py(p.y), ps.radius_px, 2.5, ps.color);
+      else c.disc(L.px(p.x), L.py(p.y), ps.radius_px, ps.color);
     }
   }
   for (const auto& m : pic.markers) {
@@ -425,6 +475,8 @@ bool write_png(const Picture& pic, const std::string& path, std::string* err) {
     const int y = L.header + L.map_h + kMargin + static_cast<int>(i / 3) * kLineHeight;
     if (items[i].kind == 0) c.line(x, y + 7, x + 24, y + 7, 3, items[i].color);
     else if (items[i].kind == 1) c.disc(x + 12, y + 7, 4, items[i].color);
+    else if (items[i].kind == 3) c.ring(x + 12, y + 7, 6, 1.5, items[i].color);
+    else if (items[i].kind == 4) c.cross(x + 12, y + 7, 5, 2.5, items[i].color);
     else c.fill_rect(x, y + 1, x + 24, y + 13, items[i].color, 0.4);
     c.text(x + 30, y, items[i].label, {0, 0, 0});
   }

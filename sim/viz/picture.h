@@ -27,10 +27,24 @@ struct Polyline {
   std::string label;  // legend entry (empty: none)
 };
 
+enum class PointShape { kDisc, kCross };
+
 struct PointSet {
   std::vector<PicturePoint> points;
   Rgb color;
   double radius_px = 2.0;
+  std::string label;
+  PointShape shape = PointShape::kDisc;  // kCross: an × of half-size radius_px (e.g. failures)
+};
+
+// Circles with a radius in metres (e.g. the protection level around an estimate): outlines only.
+struct WorldCircle {
+  double x = 0, y = 0, radius_m = 0;
+};
+struct CircleSet {
+  std::vector<WorldCircle> circles;
+  Rgb color;
+  double width_px = 1.0;
   std::string label;
 };
 
@@ -56,6 +70,7 @@ struct Picture {
   double pixels_per_metre = 0;  // 0 = fit the long side into ~1600 px
   std::vector<BoxOverlay> boxes;
   std::vector<Polyline> lines;
+  std::vector<CircleSet> circle_sets;  // drawn under the point sets
   std::vector<PointSet> point_sets;
   std::vector<Marker> markers;
 };

@@ -62,7 +62,7 @@ int main(int argc, char** argv) {
   const std::string v = read_all(build + "/hil/vcan/results.json");
   j.add_bool("hil_vcan_passed", vrc == 0);
   for (const char* k : {"hil_vcan_scans_sent", "hil_vcan_scans_decoded", "hil_vcan_scans_processed", "hil_vcan_localized",
-                        "hil_vcan_localized_scans", "hil_vcan_pose_err_m", "hil_vcan_pose_err_all_m", "hil_fd_ok",
+                        "hil_vcan_localized_scans", "hil_vcan_availability", "hil_vcan_pose_err_m", "hil_vcan_pose_err_all_m", "hil_fd_ok",
                         "hil_classic_scans_decoded", "corrupt_segments_counted", "fault_scans_faulty", "fault_crc_errors",
                         "fault_bus_off", "fault_wrong_localized"}) {
     copy_num(j, v, k);
@@ -76,7 +76,7 @@ int main(int argc, char** argv) {
   copy_num(j, s, "serial_scans_sent");
   copy_num(j, s, "serial_scans_received");
 
-  std::printf("bench_hal: 75 Hz host replay (aces, MML, 2 pinned workers) ...\n");
+  std::printf("bench_hal: 75 Hz host replay (aces, mmlfw's default localizer, 2 pinned workers) ...\n");
   std::fflush(stdout);
   mmlfw_hil::ReplayOptions o;
   mmlfw_hil::ReplayResult r;
@@ -90,6 +90,7 @@ int main(int argc, char** argv) {
     j.add("replay_75hz_processed_rate_hz", r.achieved_rate_hz);
     j.add("static_memory_mib", r.static_memory_mib);
     j.add_int("replay_75hz_localized", static_cast<long long>(r.localized));
+    j.add("replay_75hz_availability", r.availability);
     j.add_int("replay_75hz_wrong_localized", static_cast<long long>(r.wrong_localized));
     std::map<std::string, double> budget;
     if (mmlfw_hil::read_budget(src + "/firmware/app/budget.txt", &budget, &err)) {

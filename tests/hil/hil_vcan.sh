@@ -5,7 +5,8 @@
 #   hil_vcan.sh BUILD_DIR   (results: BUILD_DIR/hil/vcan/results.json)
 # Exit 77 = skipped (no UML, no data); CTest maps it to "Skipped".
 # Environment: HIL_SCANS (FD scenario scans, default 250), HIL_SPEED (replay speed-up, default 2),
-#              HIL_LOCALIZER (mml when the map can be built, else odom), HIL_REQUIRE_LOCALIZED (0/1),
+#              HIL_LOCALIZER (mmlfw's default mml-track when the map can be built, else odom; mml,
+#              handoff, mcl selectable), HIL_REQUIRE_LOCALIZED (0/1),
 #              HIL_ALLOW_WRONG_LOCALIZED=1 (clean scenarios only warn about wrong `localized` poses;
 #              the fault scenario always asserts none).
 set -u
@@ -34,28 +35,32 @@ rm -rf "$W"; mkdir -p "$W"
 export MMLFW_DATA_DIR=$DATA
 CANDEV=$B/sim/devices/mml-candev
 
-# The map for MML: built from the corrected log by mml-mapbuild, in the shared map cache
-# (MMLFW_MAP_DIR, else <source>/build/maps, as sim::map_cache_dir()).
+# The map for the localizer: built from the corrected log by mml-mapbuild, in the shared map cache
+# (MMLFW_MAP_DIR, else <source>/build/maps, as sim::map_cache_dir()). The firmware runs its default
+# localizer, mml-track (MML global localization, then tracking with a protection level).
 LOC=${HIL_LOCALIZER:-}
 MAPDIR=${MMLFW_MAP_DIR:-$here/../../build/maps}
 MAP=$MAPDIR/$DS.mmap
 if [ -z "$LOC" ]; then
   LOC=odom
-  if [ -f "$MAP" ]; then LOC=mml
+  if [ -f "$MAP" ]; then LOC=mml-track
   elif [ -x "$B/sim/map/mml-mapbuild" ]; then
     mkdir -p "$MAPDIR"
     if timeout 300 "$B/sim/map/mml-mapbuild" --dataset $DS --out "$MAPDIR" > "$W/mapbuild.log" 2>&1 && [ -f "$MAP" ]; then
-      LOC=mml
+      LOC=mml-track
     else
       say "NOTE: mml-mapbuild failed (see $W/mapbuild.log); running with the odometry localizer"
     fi
   fi
 fi
 say "localizer $LOC (map $MAP)"
+# Localizers that run MML (global localization) use pRANSAM's relation table.
+USES_MML=0
+case "$LOC" in mml|mml-track|handoff) USES_MML=1 ;; esac
 # The FD scenario runs on an image with the precomputed relation table (mml-mapc --relation-table,
 # Sec. 5.5.2); the others on the plain image, where mmlfw fills the table at start-up.
 TABLE_MAP=$MAP
-if [ "$LOC" = mml ]; then
+if [ "$USES_MML" = 1 ]; then
   if "$B/sim/map/mml-mapc" --relation-table "${MAP%.mmap}.yaml" "$W/$DS-table.mmap" > "$W/mapc.log" 2>&1; then
     TABLE_MAP=$W/$DS-table.mmap
   else
@@ -110,7 +115,8 @@ for s in fd classic fault; do
   check "$s: canplayer replayed the log" test "$(cat "$W/$s/canplayer.rc" 2>/dev/null)" = 0
   summary $s > /dev/null || { say "FAIL - $s: no mmlfw summary"; fail=1; continue; }
   "$CANDEV" score --dataset $DS --first $first --count $count --capture "$W/$s/capture.log" --bound 1.0 \
-    --json "$W/$s/score.json" > /dev/null 2> "$W/$s/score.err" || { say "FAIL - $s: scoring failed"; cat "$W/$s/score.err"; fail=1; continue; }
+    --json "$W/$s/score.json" --dump "$W/$s/poses.txt" > /dev/null 2> "$W/$s/score.err" \
+    || { say "FAIL - $s: scoring failed"; cat "$W/$s/score.err"; fail=1; continue; }
   sent=$(jget "$W/$s.sent.json" scans_sent); intact=$(jget "$W/$s.sent.json" scans_intact)
   ok=$(jget "$W/$s/summary.json" can_scans_ok); dropped=$(jget "$W/$s/summary.json" can_scans_dropped)
   processed=$(jget "$W/$s/summary.json" scans_processed); poses=$(jget "$W/$s/score.json" poses)
@@ -145,24 +151,33 @@ check "fault: health frame reports bus-off" test "$(jget $f/score.json health_bu
 check "fault: health frame reports CRC errors" test "$(jget $f/score.json health_crc_errors)" = "$(jget $W/fault.sent.json scans_corrupted)"
 check "classic: runs on a classic-only bus (no FD frames in the capture)" bash -c "! grep -q '##' '$W/classic/capture.log'"
 check "fd: pose frames are CAN FD" grep -q '520##' "$W/fd/capture.log"
-if [ "$LOC" = mml ]; then
+if [ "$USES_MML" = 1 ]; then
   check "fd: mmlfw used the image's precomputed relation table" grep -q "precomputed relation table" "$W/fd/mmlfw.log"
   check "classic: mmlfw filled the relation table at start-up" grep -q "filling it at start-up" "$W/classic/mmlfw.log"
 fi
 
+# Availability of `localized` in the captured poses (mml-candev score --dump: one line per scored
+# pose, "index status x y ref_x ref_y err", in arrival order): the share of the poses after the
+# first `localized` one that are `localized`, as mml-sim and the replay count it.
+availability() {
+  awk 'fix { n++; if ($2 == "localized") l++ } $2 == "localized" { fix = 1 }
+       END { if (n > 0) printf "%.4f", l / n; else print "null" }' "$1" 2>/dev/null || echo null
+}
+AVAIL=$(availability "$W/fd/poses.txt")
 LOCALIZED=$(jget "$W/fd/score.json" localized)
-if [ "$LOC" = mml ]; then
-  say "fd: MML localized on $LOCALIZED of $(jget "$W/fd/score.json" poses) scans, first after $(jget "$W/fd/score.json" first_localized_scan) scans, mean error while localized $(jget "$W/fd/score.json" mean_err_localized_m) m"
+if [ "$LOC" != odom ]; then
+  say "fd: $LOC localized on $LOCALIZED of $(jget "$W/fd/score.json" poses) captured poses, first after $(jget "$W/fd/score.json" first_localized_scan) scans, availability after the first fix $AVAIL, mean error while localized $(jget "$W/fd/score.json" mean_err_localized_m) m"
   if [ "${HIL_REQUIRE_LOCALIZED:-1}" = 1 ]; then
-    check "fd: the robot localizes (MML)" test "$LOCALIZED" -ge 1
+    check "fd: the robot localizes ($LOC)" test "$LOCALIZED" -ge 1
   fi
 else
   say "NOTE: odometry localizer: localization is not asserted (status is always 'searching')"
 fi
 
-python3 - "$W" "$LOC" <<'PY'
+python3 - "$W" "$LOC" "$AVAIL" "$(availability "$W/classic/poses.txt")" <<'PY'
 import json, sys
 w, loc = sys.argv[1], sys.argv[2]
+avail = lambda a: None if a in ("", "null") else float(a)
 j = lambda p: json.load(open(p))
 fd, fds, fs = j(f"{w}/fd/score.json"), j(f"{w}/fd/summary.json"), j(f"{w}/fd.sent.json")
 cl = j(f"{w}/classic/summary.json")
@@ -176,6 +191,9 @@ out = {
   "hil_vcan_localized_scans": fd["localized"],
   "hil_vcan_pose_err_m": fd["mean_err_localized_m"] if fd["localized"] else None,
   "hil_vcan_pose_err_all_m": fd["mean_err_m"],
+  "hil_vcan_first_localized_scan": fd["first_localized_scan"] if fd["localized"] else None,
+  "hil_vcan_availability": avail(sys.argv[3]),
+  "hil_classic_availability": avail(sys.argv[4]),
   "hil_fd_ok": fds["can_scans_ok"] == fs["scans_sent"] and fd["violations"] == 0,
   "hil_classic_scans_decoded": cl["can_scans_ok"],
   "corrupt_segments_counted": fas["can_crc_errors"] + fas["can_duplicate_segments"] + fas["can_lost_segments"],

@@ -7,8 +7,10 @@
 #include <cmath>
 #include <fstream>
 #include <memory>
+#include <optional>
 #include <sstream>
 
+#include "firmware/app/system.h"
 #include "firmware/base/arena.h"
 #include "firmware/base/memory_report.h"
 #include "firmware/base/worker_pool.h"
@@ -16,9 +18,7 @@
 #include "firmware/map/map_image.h"
 #include "firmware/map/map_image_file.h"
 #include "firmware/mml/mml_localizer.h"
-#include "firmware/mml/mml_presets.h"
 #include "firmware/runtime/localization_loop.h"
-#include "firmware/runtime/odometry_localizer.h"
 #include "hal/hal.h"
 #include "hal_linux/linux_clock.h"
 #include "hal_sim/sim_sensor_io.h"
@@ -37,8 +37,10 @@ std::uint64_t mono_ns() {
   return static_cast<std::uint64_t>(t.tv_sec) * 1000000000ull + static_cast<std::uint64_t>(t.tv_nsec);
 }
 
-// Static storage as in mmlfw (the MML object is large).
-fw::mml::MmlLocalizer g_mml;
+// Static storage as in mmlfw (firmware/app/mmlfw_main.cpp: `fw::LocalizationSystem g_system`; the
+// localizer objects themselves are placed in the start-up arena by the builder). Re-created per
+// run so that its objects are destroyed before the arena they live in is set up again.
+std::optional<fw::LocalizationSystem> g_system;
 
 }  // namespace
 
@@ -72,6 +74,7 @@ bool run_replay(const ReplayOptions& o, ReplayResult* r, std::string* error) {
   if (!sim::ensure_global_map(o.dataset, 0, dir, &ros, error)) return false;
   const std::string image_path = sim::global_map_image_path(o.dataset, dir);
 
+  g_system.reset();  // before its arena is set up again
   fw::MemoryReport::instance().clear();
   static fw::StartupArena arena;
   fw::Status st = arena.init_mapped(256u << 20, false, "arena");
@@ -95,19 +98,21 @@ bool run_replay(const ReplayOptions& o, ReplayResult* r, std::string* error) {
   if (!st) { *error = st.message(); return false; }
   r->pin_warnings = pool.warning_count();
 
-  static fw::OdometryLocalizer odom_loc;
-  fw::Localizer* loc = &odom_loc;
-  if (o.localizer == "mml") {
-    // The configuration mmlfw runs (firmware/app/mmlfw_main.cpp): preset C3 fitted to the map; the
-    // relation table is the image's section or filled at start-up.
-    fw::mml::MmlLocalizerConfig mc =
-        fw::mml::fit_contact_field_to_map(fw::mml::mml_preset(fw::mml::kDefaultMmlPreset, o.seed), map);
-    st = g_mml.init(mc, map, table, table_len, arena, &pool);
-    if (!st) { *error = std::string("mml: ") + st.message(); pool.stop(); return false; }
-    loc = &g_mml;
-  }
+  // The localizer exactly as mmlfw builds it (firmware/app/mmlfw_main.cpp): the one start-up
+  // builder with the config's localizer name, MML preset and seed; the relation table is the
+  // image's section or filled at start-up.
+  g_system.emplace();
+  fw::LocalizationSystem& sys = *g_system;
+  fw::SystemSpec spec;
+  spec.localizer = o.localizer.c_str();
+  spec.mml_preset = o.mml_preset;
+  spec.seed = o.seed;
+  st = sys.build(spec, map, table, table_len, arena, &pool);
+  if (!st) { *error = std::string("localizer: ") + st.message(); pool.stop(); return false; }
+  fw::Localizer* loc = &sys.localizer();
+  r->localizer = sys.name();
   // A table section in use is read in place: keep the image mapped (as mmlfw does).
-  if (!(loc == &g_mml && table != nullptr && g_mml.using_precomputed_table())) image.close();
+  if (!(table != nullptr && sys.table_in_use())) image.close();
 
   static hal_linux::LinuxClock clock;
   static hal_sim::SteppedClock stepped;  // lockstep: HAL time = time of the newest scan fed
@@ -136,8 +141,9 @@ bool run_replay(const ReplayOptions& o, ReplayResult* r, std::string* error) {
     if (std::string(reg.module) == "arena") continue;
     r->module_mib[reg.module] += static_cast<double>(reg.bytes) * mib;
   }
-  const double statics = static_cast<double>(sizeof(g_mml) + sizeof(loop) + sizeof(pool) + sizeof(laser) +
-                                             sizeof(odom) + sizeof(sink)) * mib;
+  // (The localizer objects are in the arena, as in mmlfw: counted in arena_used.)
+  const double statics = static_cast<double>(sizeof(fw::LocalizationSystem) + sizeof(loop) + sizeof(pool) +
+                                             sizeof(laser) + sizeof(odom) + sizeof(sink)) * mib;
   r->module_mib["statics"] = statics;
   r->module_mib["arena_used"] = static_cast<double>(arena.used()) * mib;
   r->static_memory_mib = static_cast<double>(arena.used()) * mib + statics;
@@ -214,16 +220,24 @@ bool run_replay(const ReplayOptions& o, ReplayResult* r, std::string* error) {
     hal::PoseEstimate e;
     while (sink.pop(&e)) {
       ++r->scans_processed;
-      if (o.trace && loc == &g_mml && e.scan_id < reference.size()) {
-        const fw::mml::InterpretResult& ir = g_mml.last();
+      const fw::mml::MmlLocalizer* mml = sys.mml();
+      if (o.trace && mml != nullptr && e.scan_id < reference.size()) {
+        const fw::mml::InterpretResult& ir = mml->last();
         const fw::Se2d& ref = reference[e.scan_id];
-        std::printf("trace %u %-10s err %6.3f pose %8.3f %8.3f %6.3f ref %8.3f %8.3f hyps %4u cl %3u r %.3f d2 %8.2f smed %6.2f c %d%d%d soft %d inl %.2f uq %d %.3f/%.3f\n",
-                    e.scan_id, hal::status_name(e.status), std::hypot(e.x - ref.x, e.y - ref.y), e.x, e.y, e.theta, ref.x,
-                    ref.y, ir.hypotheses_valid, ir.cluster_count, ir.best_rating, ir.d2, ir.sigma_med, ir.c_rating,
-                    ir.c_mahalanobis, ir.c_median, ir.soft, g_mml.last_refine().inlier_ratio, g_mml.last_uniqueness().unique, g_mml.last_uniqueness().cost,
-                    g_mml.last_uniqueness().rival_cost);
+        std::printf("trace %u %-10s %s err %6.3f pose %8.3f %8.3f %6.3f ref %8.3f %8.3f pl %.3f hyps %4u cl %3u r %.3f d2 %8.2f smed %6.2f c %d%d%d soft %d inl %.2f uq %d %.3f/%.3f\n",
+                    e.scan_id, hal::status_name(e.status), e.mode == hal::LocalizationMode::kTracking ? "trk" : "glb",
+                    std::hypot(e.x - ref.x, e.y - ref.y), e.x, e.y, e.theta, ref.x, ref.y, e.protection_xy_m,
+                    ir.hypotheses_valid, ir.cluster_count, ir.best_rating, ir.d2, ir.sigma_med, ir.c_rating,
+                    ir.c_mahalanobis, ir.c_median, ir.soft, mml->last_refine().inlier_ratio, mml->last_uniqueness().unique,
+                    mml->last_uniqueness().cost, mml->last_uniqueness().rival_cost);
+      }
+      // Availability: share of the poses after the first fix that are `localized` (as mml-sim).
+      if (r->first_localized_scan >= 0) {
+        ++r->after_first_fix;
+        if (e.status == hal::LocalizationStatus::kLocalized) ++r->localized_after_first_fix;
       }
       if (e.status == hal::LocalizationStatus::kLocalized) {
+        if (r->first_localized_scan < 0) r->first_localized_scan = static_cast<long>(e.scan_id);
         ++r->localized;
         const size_t idx = e.scan_id;  // to_laser_scan: scan_id = log index
         if (idx < reference.size()) {
@@ -245,6 +259,9 @@ bool run_replay(const ReplayOptions& o, ReplayResult* r, std::string* error) {
   }
   const double wall = static_cast<double>(mono_ns() - t0) * 1e-9;
   if (r->localized) r->mean_err_localized_m /= static_cast<double>(r->localized);
+  if (r->after_first_fix) {
+    r->availability = static_cast<double>(r->localized_after_first_fix) / static_cast<double>(r->after_first_fix);
+  }
   pool.stop();
   const fw::PerfStats step = loop.perf_step().stats();
   r->step_p50_ms = step.p50_ms;

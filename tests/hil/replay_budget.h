@@ -1,6 +1,8 @@
 // Real-time replay on the host for the budget check: a CARMEN log is fed to the same firmware
-// stack as mmlfw (LocalizationLoop + MmlLocalizer with pinned WorkerPool threads, map image in a
-// StartupArena) through the hal/sim rings, scans due at the sensor rate (75 Hz) of the wall clock.
+// stack as mmlfw (LocalizationLoop + the localizer built by fw::LocalizationSystem from the same
+// SystemSpec fields as mmlfw's config — localizer, MML preset, seed — with pinned WorkerPool
+// threads, map image and localizer objects in a StartupArena) through the hal/sim rings, scans due
+// at the sensor rate (75 Hz) of the wall clock.
 // A step slower than the period delays later scans (they queue in the ring, overflow is counted);
 // a step longer than the deadline is a deadline miss.
 #pragma once
@@ -16,7 +18,10 @@ namespace mmlfw_hil {
 struct ReplayOptions {
   std::string dataset = "aces";
   std::string map_dir;          // map cache; empty = sim::map_cache_dir()
-  std::string localizer = "mml";
+  // As mmlfw's config keys (firmware/app/app_config.h) and their defaults: localizer (mml-track,
+  // mml, handoff, mcl, odom), mml_preset (C1..C4), seed (below).
+  std::string localizer = "mml-track";
+  int mml_preset = 3;
   size_t first_scan = 0, num_scans = 600;
   double rate_hz = 75.0;         // <= 0: lockstep (each scan processed before the next; deterministic)
   double localized_bound_m = 1.0;  // a `localized` pose farther from the reference is wrong
@@ -35,7 +40,11 @@ struct ReplayOptions {
 };
 
 struct ReplayResult {
+  std::string localizer;          // name of the localizer built (LocalizationSystem::name())
   size_t scans_fed = 0, scans_processed = 0, scans_dropped = 0, scans_lost = 0, localized = 0;
+  long first_localized_scan = -1;  // log index of the first `localized` pose
+  size_t after_first_fix = 0, localized_after_first_fix = 0;  // poses after the first `localized` one
+  double availability = 0;         // localized_after_first_fix / after_first_fix
   size_t deadline_misses = 0;
   size_t wrong_localized = 0;     // localized poses farther than localized_bound_m from the reference
   double mean_err_localized_m = 0;
