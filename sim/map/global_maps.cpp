@@ -55,12 +55,14 @@ std::string read_text(const std::string& path) {
 }  // namespace
 
 const std::vector<std::string>& global_map_datasets() {
-  static const std::vector<std::string> k = {"intel", "fr079", "aces", "mit-killian", "fr-clinic"};
+  static const std::vector<std::string> k = {"intel", "fr079", "aces", "mit-killian", "fr-clinic", "fr101",
+                                             "fr-campus"};
   return k;
 }
 
 double default_map_resolution(const std::string& dataset) {
-  return (dataset == "mit-killian" || dataset == "fr-clinic") ? 0.10 : 0.05;
+  // fr-campus: outdoor campus, large extent (see global_maps.h).
+  return (dataset == "mit-killian" || dataset == "fr-clinic" || dataset == "fr-campus") ? 0.10 : 0.05;
 }
 
 OccupancyBuildOptions global_map_options(const std::string& dataset, double resolution) {
@@ -68,7 +70,7 @@ OccupancyBuildOptions global_map_options(const std::string& dataset, double reso
   o.resolution = resolution;
   // Indoor office logs: the far returns are few and noisy (and 81.8 m means "no return");
   // MIT Killian Court is a large open courtyard with long corridors.
-  o.max_usable_range = dataset == "mit-killian" ? 40.0 : 25.0;
+  o.max_usable_range = (dataset == "mit-killian" || dataset == "fr-campus") ? 40.0 : 25.0;
   return o;
 }
 
@@ -85,7 +87,7 @@ std::string global_map_source(const std::string& dataset) {
 bool build_global_map(const std::string& dataset, double resolution, RosMap* out, std::string* error,
                       OccupancyBuildStats* stats, std::string* report_out) {
   if (!known(dataset)) {
-    return fail(error, "unknown dataset '" + dataset + "' (known: intel, fr079, aces, mit-killian, fr-clinic)");
+    return fail(error, "unknown dataset '" + dataset + "' (known: intel, fr079, aces, mit-killian, fr-clinic, fr101, fr-campus)");
   }
   const Dataset* d = find_dataset(dataset);
   if (d == nullptr) return fail(error, "dataset '" + dataset + "' missing from sim/io/datasets.h");
@@ -291,7 +293,7 @@ bool ensure_global_map(const std::string& dataset, double resolution, const std:
   if (resolution <= 0.0) resolution = default_map_resolution(dataset);
   if (rebuilt != nullptr) *rebuilt = false;
   if (!known(dataset)) {
-    return fail(error, "unknown dataset '" + dataset + "' (known: intel, fr079, aces, mit-killian, fr-clinic)");
+    return fail(error, "unknown dataset '" + dataset + "' (known: intel, fr079, aces, mit-killian, fr-clinic, fr101, fr-campus)");
   }
   const std::string yaml = global_map_yaml_path(dataset, dir);
   const std::string sig_path = dir + "/" + dataset + ".build.txt";

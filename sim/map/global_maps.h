@@ -2,8 +2,9 @@
 // logs (sim/map/occupancy_builder.h) and cached as ROS maps + compiled map images:
 //   <cache>/<dataset>.yaml, .pgm, .png (picture), .mmap (firmware image), .build.txt (parameters)
 // <cache> = $MMLFW_MAP_DIR, else <source dir>/build/maps. Default resolutions: 0.05 m for the
-// office buildings (intel, fr079, aces), 0.10 m for mit-killian (250 x 245 m) and fr-clinic (440 x 241 m;
-// at 5 cm its image would be 212 MB).
+// office buildings (intel, fr079, aces, fr101), 0.10 m for mit-killian (250 x 245 m), fr-clinic (440 x 241 m;
+// at 5 cm its image would be 212 MB) and the outdoor fr-campus (max usable range 40 m as mit-killian).
+// fr101 and fr-campus have only corrected logs: their maps come from those (as the others').
 #pragma once
 
 #include <string>
@@ -15,7 +16,7 @@
 
 namespace sim {
 
-// Datasets with a global map: intel, fr079, aces, mit-killian, fr-clinic.
+// Datasets with a global map: intel, fr079, aces, mit-killian, fr-clinic, fr101, fr-campus.
 const std::vector<std::string>& global_map_datasets();
 double default_map_resolution(const std::string& dataset);
 // Builder options used for a dataset (resolution filled in by the caller).

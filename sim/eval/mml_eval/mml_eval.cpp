@@ -3,6 +3,9 @@
 #include "sim/viz/font5x7.h"
 
 #include <algorithm>
+#include <cctype>
+#include <filesystem>
+#include <unordered_map>
 #include <chrono>
 #include <cmath>
 #include <cstdio>
@@ -39,14 +42,110 @@ bool load_image(LoadedDataset* ds, std::string* err) {
 
 }  // namespace
 
+namespace {
+
+// Cumulative odometry path length at every scan.
+void fill_travelled(LoadedDataset* ds) {
+  ds->travelled.clear();
+  double acc = 0;
+  for (std::size_t i = 0; i < ds->odometry.size(); ++i) {
+    if (i > 0) acc += std::hypot(ds->odometry[i].x - ds->odometry[i - 1].x, ds->odometry[i].y - ds->odometry[i - 1].y);
+    ds->travelled.push_back(acc);
+  }
+}
+
+// Relations whose timestamps are scan ipc timestamps of the log: check the reference (and say so).
+void check_reference_file(LoadedDataset* ds, const std::string& relations_path) {
+  std::vector<Relation> rel;
+  std::string e;
+  if (!read_relations(relations_path, &rel, &e)) {
+    ds->ref_check_note = "reference not checked: " + e;
+    return;
+  }
+  check_reference_against_relations(ds, rel);
+}
+
+}  // namespace
+
+std::vector<fw::Se2d> synthesize_odometry(const std::vector<fw::Se2d>& reference, std::uint64_t seed) {
+  std::vector<fw::Se2d> out;
+  if (reference.empty()) return out;
+  fw::RandomStream rng(seed, 4242);
+  out.push_back(reference[0]);
+  for (std::size_t i = 1; i < reference.size(); ++i) {
+    const fw::Se2d d = reference[i - 1].between(reference[i]);
+    const double ds = std::hypot(d.x, d.y), dth = std::fabs(fw::wrap_angle(d.theta));
+    const double st = 0.05 * ds + 0.01 * dth, sr = 0.05 * dth + 0.01 * ds;
+    const double nx = st * rng.gaussian(), ny = st * rng.gaussian(), nt = sr * rng.gaussian();
+    out.push_back(out.back().compose(fw::Se2d(d.x + nx, d.y + ny, fw::wrap_angle(d.theta + nt))));
+  }
+  return out;
+}
+
+std::size_t check_reference_against_relations(LoadedDataset* ds, const std::vector<Relation>& relations,
+                                              double max_dt_s, double tol_m, double tol_rad) {
+  const std::size_t n = ds->log.scans.size();
+  ds->ref_unreliable.assign(n, 0);
+  // Scan index by ipc timestamp (µs; intel's timestamps are not monotonic).
+  std::unordered_map<long long, std::size_t> by_t;
+  for (std::size_t i = 0; i < n; ++i) by_t.emplace(std::llround(ds->log.scans[i].ipc_timestamp * 1e6), i);
+  auto find = [&](double t) -> std::size_t {
+    const long long k = std::llround(t * 1e6);
+    for (long long d : {0LL, -1LL, 1LL}) {
+      auto it = by_t.find(k + d);
+      if (it != by_t.end()) return it->second;
+    }
+    return TrialResult::kNone;
+  };
+  std::size_t checked = 0, bad = 0;
+  for (const Relation& r : relations) {
+    if (std::fabs(r.t2 - r.t1) > max_dt_s) continue;
+    const std::size_t a = find(r.t1), b = find(r.t2);
+    if (a == TrialResult::kNone || b == TrialResult::kNone || a >= ds->reference.size() || b >= ds->reference.size())
+      continue;
+    ++checked;
+    const fw::Se2d e = r.delta.between(ds->reference[a].between(ds->reference[b]));
+    if (std::hypot(e.x, e.y) > tol_m || std::fabs(fw::wrap_angle(e.theta)) > tol_rad) {
+      ++bad;
+      for (std::size_t i = std::min(a, b); i <= std::max(a, b); ++i) ds->ref_unreliable[i] = 1;
+    }
+  }
+  ds->ref_excluded_scans = 0;
+  for (auto u : ds->ref_unreliable) ds->ref_excluded_scans += u;
+  char buf[256];
+  std::snprintf(buf, sizeof(buf),
+                "reference checked against %zu relations (|dt| <= %.0f s): %zu disagree by > %.2f m / %.1f deg, %zu of %zu "
+                "scans excluded from error metrics",
+                checked, max_dt_s, bad, tol_m, tol_rad * 180.0 / 3.14159265358979, ds->ref_excluded_scans, n);
+  ds->ref_check_note = buf;
+  return checked;
+}
+
 bool load_dataset(const std::string& name, LoadedDataset* ds, std::string* err) {
   const Dataset* d = find_dataset(name);
-  if (d == nullptr || d->raw_log.empty()) return fail(err, "mml-eval: unknown dataset or no raw log: '" + name + "'");
+  if (d == nullptr || (d->raw_log.empty() && d->corrected_log.empty()))
+    return fail(err, "mml-eval: unknown dataset or no log: '" + name + "'");
   ds->name = name;
   ds->key = name;
   std::replace(ds->key.begin(), ds->key.end(), '-', '_');
   ds->success_bound_m = name == "mit-killian" ? 1.0 : 0.5;
   std::string e;
+  if (d->raw_log.empty()) {
+    // fr101, fr-campus: only the corrected log. Reference = its (laser) poses — the map's frame;
+    // odometry synthesised from the pose increments (documented noise model, seed 1).
+    if (!read_carmen_log(data_path(d->corrected_log), CarmenReadOptions{}, &ds->log, &e)) return fail(err, e);
+    ds->reference.clear();
+    for (const auto& s : ds->log.scans) ds->reference.push_back(s.pose);
+    ds->reference_note = "corrected log poses (no raw log); odometry synthesised (synthesize_odometry, seed 1)";
+    ds->odometry = synthesize_odometry(ds->reference, 1);
+    ds->synthetic_odometry = true;
+    ds->ref_check_note = "reference not checked: no benchmark relations for this dataset";
+    fill_travelled(ds);
+    if (!ensure_global_map(name, -1.0, map_cache_dir(), &ds->ros, &e)) return fail(err, e);
+    if (!ros_map_to_grid(ds->ros, &ds->grid, &e)) return fail(err, e);
+    if (!read_file_bytes(global_map_image_path(name), &ds->image, &e)) return fail(err, e);
+    return load_image(ds, err);
+  }
   if (!read_carmen_log(data_path(d->raw_log), CarmenReadOptions{}, &ds->log, &e)) return fail(err, e);
   const bool robotlaser = !ds->log.scans.empty() && ds->log.scans[0].type == "ROBOTLASER1";
   if (!d->corrected_poses.empty()) {
@@ -55,6 +154,7 @@ bool load_dataset(const std::string& name, LoadedDataset* ds, std::string* err) 
     ds->reference = reference_at_every_scan(ds->log, cp);
     ds->reference_note = "corrected poses chained with odometry (sim/io/reference_trajectory.h)";
   }
+  bool from_relations = false;
   if (ds->reference.empty() && !d->relations.empty()) {
     // fr-clinic: no corrected log. Its global map is built from the pose graph of the benchmark
     // relations (sim/map/global_maps.h), so the reference is that graph's robot poses chained with
@@ -76,6 +176,7 @@ bool load_dataset(const std::string& name, LoadedDataset* ds, std::string* err) 
         ds->reference[i] = ds->reference[i].compose(s.odom.between(s.pose));
       }
       ds->reference_note = "pose graph of the benchmark relations chained with odometry (as the map)";
+      from_relations = true;
     } else {
       std::fprintf(stderr, "mml-eval: %s: relation graph: %s; falling back to the raw laser poses\n", name.c_str(),
                    e.c_str());
@@ -87,19 +188,93 @@ bool load_dataset(const std::string& name, LoadedDataset* ds, std::string* err) 
     ds->reference_note = "raw laser poses (no corrected log, no relation graph)";
   }
   ds->odometry.clear();
-  ds->travelled.clear();
-  double acc = 0;
   for (std::size_t i = 0; i < ds->log.scans.size(); ++i) {
     const auto& s = ds->log.scans[i];
     // ROBOTLASER1: the laser pose is the map frame's pose (map built from it); FLASER: odometry.
-    const fw::Se2d o = robotlaser ? s.pose : s.odom;
-    if (i > 0) acc += std::hypot(o.x - ds->odometry.back().x, o.y - ds->odometry.back().y);
-    ds->odometry.push_back(o);
-    ds->travelled.push_back(acc);
+    ds->odometry.push_back(robotlaser ? s.pose : s.odom);
+  }
+  fill_travelled(ds);
+  if (!d->relations.empty() && d->relations_match_log && !from_relations) {
+    check_reference_file(ds, data_path(d->relations));
+  } else if (from_relations) {
+    ds->ref_check_note = "reference not checked: it is built from the relations themselves (circular)";
+  } else {
+    ds->ref_check_note = "reference not checked: the relations' timestamps are not the log's";
   }
   if (!ensure_global_map(name, -1.0, map_cache_dir(), &ds->ros, &e)) return fail(err, e);
   if (!ros_map_to_grid(ds->ros, &ds->grid, &e)) return fail(err, e);
   if (!read_file_bytes(global_map_image_path(name), &ds->image, &e)) return fail(err, e);
+  return load_image(ds, err);
+}
+
+bool load_dataset_files(const DatasetFiles& f, LoadedDataset* ds, std::string* err) {
+  namespace fs = std::filesystem;
+  if (f.log.empty()) return fail(err, "mml-eval: --log is required");
+  if (f.map_yaml.empty()) return fail(err, "mml-eval: --map is required");
+  if (f.reference.empty()) return fail(err, "mml-eval: --reference is required");
+  for (const std::string* p : {&f.log, &f.map_yaml, &f.reference, &f.relations}) {
+    if (!p->empty() && !fs::exists(*p)) return fail(err, "mml-eval: " + *p + ": file not found");
+  }
+  ds->name = f.name.empty() ? "custom" : f.name;
+  ds->key = ds->name;
+  for (char& c : ds->key)
+    if (!std::isalnum(static_cast<unsigned char>(c))) c = '_';
+  ds->success_bound_m = 0.5;
+  std::string e;
+  if (!read_carmen_log(f.log, CarmenReadOptions{}, &ds->log, &e)) return fail(err, "mml-eval: log " + e);
+  if (ds->log.scans.empty()) return fail(err, "mml-eval: " + f.log + ": no laser scans (FLASER/ROBOTLASER1) in the log");
+  // Reference: corrected-poses rows, or a CARMEN log with a pose per scan.
+  std::vector<CorrectedPose> cp;
+  std::string e_rows;
+  if (read_corrected_poses(f.reference, &cp, &e_rows)) {
+    if (cp.empty()) return fail(err, "mml-eval: " + f.reference + ": no reference poses");
+    if (cp.front().flaser_index >= ds->log.scans.size()) {
+      return fail(err, "mml-eval: " + f.reference + ": first flaser_index " + std::to_string(cp.front().flaser_index) +
+                           " is beyond the log's " + std::to_string(ds->log.scans.size()) + " scans (" + f.log + ")");
+    }
+    ds->reference = reference_at_every_scan(ds->log, cp);
+    ds->reference_note = "corrected poses " + f.reference + " chained with odometry";
+  } else {
+    CarmenLog ref;
+    std::string e_log;
+    if (!read_carmen_log(f.reference, CarmenReadOptions{}, &ref, &e_log) || ref.scans.empty()) {
+      return fail(err, "mml-eval: " + f.reference +
+                           ": neither 'flaser_index ipc_timestamp logger_timestamp x y theta' rows (" + e_rows +
+                           ") nor a CARMEN log with laser scans" + (e_log.empty() ? "" : " (" + e_log + ")"));
+    }
+    if (ref.scans.size() != ds->log.scans.size()) {
+      return fail(err, "mml-eval: " + f.reference + ": CARMEN reference has " + std::to_string(ref.scans.size()) +
+                           " scans but " + f.log + " has " + std::to_string(ds->log.scans.size()) +
+                           " (a CARMEN reference needs one pose per scan; otherwise give flaser_index rows)");
+    }
+    for (const auto& s : ref.scans) ds->reference.push_back(s.pose);
+    ds->reference_note = "laser poses of the CARMEN log " + f.reference;
+  }
+  if (ds->reference.size() != ds->log.scans.size())
+    return fail(err, "mml-eval: " + f.reference + ": no usable reference poses for " + f.log);
+  const bool robotlaser = ds->log.scans[0].type == "ROBOTLASER1";
+  if (f.synthetic_odometry) {
+    ds->odometry = synthesize_odometry(ds->reference, f.odometry_seed);
+    ds->synthetic_odometry = true;
+  } else {
+    for (const auto& s : ds->log.scans) ds->odometry.push_back(robotlaser ? s.pose : s.odom);
+  }
+  fill_travelled(ds);
+  if (ds->travelled.back() <= 0.0) {
+    return fail(err, "mml-eval: " + f.log + ": the odometry never moves (no ODOM data?); use --synthetic-odometry");
+  }
+  if (!f.relations.empty()) {
+    std::vector<Relation> rel;
+    if (!read_relations(f.relations, &rel, &e)) return fail(err, "mml-eval: relations " + e);
+    if (check_reference_against_relations(ds, rel) == 0) {
+      return fail(err, "mml-eval: " + f.relations + ": no relation's timestamps are scan ipc timestamps of " + f.log);
+    }
+  } else {
+    ds->ref_check_note = "reference not checked: no --relations given";
+  }
+  if (!read_ros_map(f.map_yaml, &ds->ros, &e)) return fail(err, "mml-eval: map " + e);
+  if (!ros_map_to_grid(ds->ros, &ds->grid, &e)) return fail(err, "mml-eval: " + f.map_yaml + ": " + e);
+  if (!compile_map_image(ds->ros, &ds->image, &e)) return fail(err, "mml-eval: " + f.map_yaml + ": " + e);
   return load_image(ds, err);
 }
 
@@ -140,19 +315,46 @@ TrialResult run_trial(fw::Localizer& loc, const LoadedDataset& ds, std::size_t s
   tr.start = start;
   loc.reset();
   static hal::LaserScan scan;
-  fw::Se2d last_used;
+  fw::Se2d last_used;  // last odometry fed (after the kidnap shift)
   bool have_last = false;
   std::size_t localized_run = 0;
   double err_sum = 0;
   std::size_t err_n = 0;
-  for (std::size_t i = start; i < ds.log.scans.size() && tr.steps.size() < opt.max_steps; ++i) {
-    const fw::Se2d& od = ds.odometry[i];
+  // Odometry fed = shift ⊕ log odometry; the shift changes only at a kidnap (continuity).
+  fw::Se2d shift(0, 0, 0);
+  std::size_t segment = 0, seg_steps = 0;
+  double travelled_base = -ds.travelled[start];  // travelled = travelled_base + ds.travelled[i]
+  const std::size_t cap = opt.max_steps == 0 ? static_cast<std::size_t>(-1) : opt.max_steps;
+  for (std::size_t i = start; i < ds.log.scans.size() && tr.steps.size() < cap; ++i) {
+    const bool kidnap_now =
+        segment == 0 && ((opt.kidnap_at_step > 0 && tr.steps.size() == opt.kidnap_at_step) ||
+                         (opt.kidnap_after_fix_steps > 0 && tr.localized &&
+                          tr.steps.size() == tr.steps_to_localize + opt.kidnap_after_fix_steps));
+    const std::size_t target =
+        kidnap_now ? (opt.kidnap_target ? opt.kidnap_target(tr.steps.empty() ? start : tr.steps.back().scan)
+                                        : opt.kidnap_to_scan)
+                   : 0;
+    if (kidnap_now && target < ds.log.scans.size()) {
+      // Kidnap: carry the robot to another part of the log. The new segment's odometry is shifted so
+      // that its first scan sits exactly at the last fed odometry pose: zero odometry delta at the jump.
+      const std::size_t j = target;
+      tr.kidnap_scan_from = tr.steps.empty() ? start : tr.steps.back().scan;
+      tr.kidnap_travelled = tr.steps.empty() ? 0.0 : tr.steps.back().travelled;
+      shift = (have_last ? last_used : ds.odometry[j]).compose(ds.odometry[j].inverse());
+      travelled_base = tr.kidnap_travelled - ds.travelled[j];
+      segment = 1;
+      seg_steps = 0;
+      i = j;
+      tr.kidnap_step = tr.steps.size();
+    }
+    if (segment == 1 && opt.kidnap_steps_after > 0 && seg_steps >= opt.kidnap_steps_after) break;
+    const fw::Se2d od = shift.compose(ds.odometry[i]);
     if (have_last) {
       const double dm = std::hypot(od.x - last_used.x, od.y - last_used.y);
       const double dt = std::fabs(fw::wrap_angle(od.theta - last_used.theta));
       if (dm < opt.min_move_m && dt < opt.min_turn_rad) continue;
     }
-    const double travelled = ds.travelled[i] - ds.travelled[start];
+    const double travelled = travelled_base + ds.travelled[i];
     if (travelled > opt.max_metres) break;
     last_used = od;
     have_last = true;
@@ -172,8 +374,11 @@ TrialResult run_trial(fw::Localizer& loc, const LoadedDataset& ds, std::size_t s
       tr.error = std::string("scan ") + std::to_string(i) + ": " + s.message();
       break;
     }
+    ++seg_steps;
     StepLog st;
     st.scan = i;
+    st.segment = segment;
+    st.odom = od;
     if (matched_points) st.matched_points = matched_points();
     st.travelled = travelled;
     st.status = est.status;
@@ -181,28 +386,38 @@ TrialResult run_trial(fw::Localizer& loc, const LoadedDataset& ds, std::size_t s
     st.step_ms = std::chrono::duration<double, std::milli>(t1 - t0).count();
     st.estimate = fw::Se2d(est.x, est.y, est.theta);
     st.truth = ds.reference[i];
-    st.err_m = std::hypot(est.x - st.truth.x, est.y - st.truth.y);
-    st.err_rad = std::fabs(fw::wrap_angle(static_cast<double>(est.theta) - st.truth.theta));
+    st.ref_ok = !ds.reference_unreliable(i);
+    st.pl_xy = est.protection_xy_m;
+    st.pl_theta = est.protection_theta_rad;
+    st.unsupported_steps = est.unsupported_steps;
+    // Searching / fault: the published pose is a placeholder (no pose); never compare it.
+    st.has_pose = est.status != hal::LocalizationStatus::kSearching && est.status != hal::LocalizationStatus::kFault;
+    if (st.has_pose) {
+      st.err_m = std::hypot(est.x - st.truth.x, est.y - st.truth.y);
+      st.err_rad = std::fabs(fw::wrap_angle(static_cast<double>(est.theta) - st.truth.theta));
+    } else {
+      st.err_m = st.err_rad = std::numeric_limits<double>::quiet_NaN();
+    }
     if (region) {
       st.in_region = st.truth.x >= region[0] && st.truth.x <= region[2] && st.truth.y >= region[1] && st.truth.y <= region[3];
     }
     tr.steps.push_back(st);
     if (std::getenv("MML_EVAL_TRACE")) {
-      std::printf("    step %3zu scan %5zu %-11s %s est (%.2f %.2f %.2f) ref (%.2f %.2f %.2f) err %.2f m %.1f deg  hyp %u cl %u r %.2f %.1f ms\n",
+      std::printf("    step %3zu scan %5zu %-11s %s est (%.2f %.2f %.2f) ref (%.2f %.2f %.2f) err %.2f m %.1f deg  hyp %u cl %u r %.2f PL %.2f m %.1f deg %.1f ms\n",
                   tr.steps.size(), i, hal::status_name(est.status),
                   est.mode == hal::LocalizationMode::kTracking ? "T" : "G", est.x, est.y, est.theta, st.truth.x,
                   st.truth.y, st.truth.theta, st.err_m, st.err_rad * 57.2958, est.hypothesis_count, est.cluster_count,
-                  est.rating, st.step_ms);
+                  est.rating, est.protection_xy_m, est.protection_theta_rad * 57.2958, st.step_ms);
     }
     if (est.status == hal::LocalizationStatus::kLocalized) {
-      const bool ok = st.err_m < ds.success_bound_m && st.err_rad < ds.success_bound_rad;
+      const bool ok = !st.ref_ok || (st.err_m < ds.success_bound_m && st.err_rad < ds.success_bound_rad);
       if (!tr.localized) {
         tr.localized = true;
         tr.steps_to_localize = tr.steps.size();
         tr.metres_to_localize = travelled;
         tr.success = ok;
       }
-      if (!ok) tr.failure = true;
+      if (!ok && segment == 0) tr.failure = true;
       err_sum += st.err_m;
       ++err_n;
       ++localized_run;
@@ -216,6 +431,86 @@ TrialResult run_trial(fw::Localizer& loc, const LoadedDataset& ds, std::size_t s
   return tr;
 }
 
+TrialMetrics trial_metrics(const TrialResult& t, const MetricBounds& b) {
+  const double nan = std::numeric_limits<double>::quiet_NaN();
+  TrialMetrics m;
+  m.steps = t.steps.size();
+  m.m_to_fix = nan;
+  m.kidnap_delay_steps = nan;
+  m.refix_m = nan;
+  const std::size_t kid = t.kidnap_step;
+  auto is_loc = [](const StepLog& s) { return s.status == hal::LocalizationStatus::kLocalized; };
+  // Error-checkable: a localized pose with a reliable reference and a real error.
+  auto checkable = [&](const StepLog& s) { return is_loc(s) && s.ref_ok && s.has_pose && std::isfinite(s.err_m); };
+  auto wrong = [&](const StepLog& s) { return s.err_m > b.bound_m || s.err_rad > b.bound_rad; };
+  const std::size_t pre = std::min(kid, t.steps.size());  // steps before the kidnap
+  // First fix: the first `localized` (before any kidnap) within the window; its correctness is judged
+  // at the first localized step from there on with a reliable reference, still within the window.
+  for (std::size_t k = 0; k < pre && k < b.fix_within_steps; ++k) {
+    if (!is_loc(t.steps[k])) continue;
+    m.first_fix = true;
+    m.first_fix_index = k;
+    m.m_to_fix = t.steps[k].travelled;
+    for (std::size_t j = k; j < pre && j < b.fix_within_steps; ++j) {
+      if (checkable(t.steps[j])) {
+        m.first_fix_success = !wrong(t.steps[j]);
+        break;
+      }
+    }
+    break;
+  }
+  // Availability counts from the first `localized` even when it came after the first-fix window.
+  std::size_t first_loc = m.first_fix ? m.first_fix_index : TrialResult::kNone;
+  for (std::size_t k = 0; k < pre && first_loc == TrialResult::kNone; ++k)
+    if (is_loc(t.steps[k])) first_loc = k;
+  if (first_loc != TrialResult::kNone) {
+    for (std::size_t k = first_loc + 1; k < pre; ++k) {
+      if (t.steps[k].in_region) continue;
+      ++m.avail_steps;
+      m.avail_localized += is_loc(t.steps[k]);
+    }
+  }
+  for (std::size_t k = 0; k < t.steps.size(); ++k) {
+    const StepLog& s = t.steps[k];
+    if (!is_loc(s)) continue;
+    if (!checkable(s)) {
+      ++m.excluded_ref_steps;
+      continue;
+    }
+    ++m.localized_steps;
+    const bool w = wrong(s);
+    m.integrity_failures += w;
+    if (k >= kid) m.kidnap_integrity_failures += w;
+    if (s.pl_xy > 0.0f || s.pl_theta > 0.0f) {
+      ++m.pl_steps;
+      const bool ex_xy = s.pl_xy > 0.0f && s.err_m > s.pl_xy;
+      const bool ex_th = s.pl_theta > 0.0f && s.err_rad > s.pl_theta;
+      m.pl_exceed += ex_xy || ex_th;
+      m.pl_exceed_xy += ex_xy;
+      m.pl_exceed_theta += ex_th;
+    }
+    if (s.mode == hal::LocalizationMode::kTracking) m.track_err.push_back(s.err_m);
+  }
+  if (kid != TrialResult::kNone && kid < t.steps.size()) {
+    m.kidnapped = true;
+    for (std::size_t k = kid; k < t.steps.size(); ++k) {
+      if (!is_loc(t.steps[k])) {
+        m.kidnap_detected = true;
+        m.kidnap_delay_steps = static_cast<double>(k - kid);
+        break;
+      }
+    }
+    for (std::size_t k = kid; k < t.steps.size() && k - kid < b.refix_within_steps; ++k) {
+      if (checkable(t.steps[k]) && !wrong(t.steps[k])) {
+        m.kidnap_refix = true;
+        m.refix_m = t.steps[k].travelled - t.kidnap_travelled;
+        break;
+      }
+    }
+  }
+  return m;
+}
+
 double percentile(std::vector<double> v, double p) {
   if (v.empty()) return std::numeric_limits<double>::quiet_NaN();
   std::sort(v.begin(), v.end());
@@ -225,7 +520,7 @@ double percentile(std::vector<double> v, double p) {
 }
 
 SystemSummary summarize(const std::string& dataset, const std::string& system, const std::vector<TrialResult>& trials,
-                        double memory_mib) {
+                        double memory_mib, const MetricBounds& bounds) {
   SystemSummary s;
   s.dataset = dataset;
   s.system = system;
@@ -249,11 +544,11 @@ SystemSummary summarize(const std::string& dataset, const std::string& system, c
         matched_sum += static_cast<double>(st.matched_points);
         ++matched_n;
       }
-      if (st.status == hal::LocalizationStatus::kLocalized) {
+      if (st.status == hal::LocalizationStatus::kLocalized && st.ref_ok && std::isfinite(st.err_m)) {
         err_sum += st.err_m;
         ++err_n;
       }
-      if (st.mode == hal::LocalizationMode::kTracking) {
+      if (st.mode == hal::LocalizationMode::kTracking && st.ref_ok && std::isfinite(st.err_m)) {
         track_err.push_back(st.err_m);
         track_ms.push_back(st.step_ms);
       }
@@ -279,7 +574,67 @@ SystemSummary summarize(const std::string& dataset, const std::string& system, c
   s.tracking_err_median_m = percentile(track_err, 50);
   s.tracking_step_ms_p50 = percentile(track_ms, 50);
   s.tracking_step_ms_p99 = percentile(track_ms, 99);
+  // Product metrics.
+  const double nan = std::numeric_limits<double>::quiet_NaN();
+  std::vector<double> m_fix, terr, delays, refix_m;
+  std::size_t avail_loc = 0;
+  for (const auto& t : trials) {
+    const TrialMetrics m = trial_metrics(t, bounds);
+    s.first_fixes += m.first_fix;
+    s.first_fix_successes += m.first_fix_success;
+    if (m.first_fix) m_fix.push_back(m.m_to_fix);
+    s.avail_steps += m.avail_steps;
+    avail_loc += m.avail_localized;
+    s.localized_checked += m.localized_steps;
+    s.integrity_failures += m.integrity_failures;
+    s.excluded_ref_steps += m.excluded_ref_steps;
+    s.pl_steps += m.pl_steps;
+    s.pl_exceed += m.pl_exceed;
+    s.pl_exceed_xy += m.pl_exceed_xy;
+    s.pl_exceed_theta += m.pl_exceed_theta;
+    terr.insert(terr.end(), m.track_err.begin(), m.track_err.end());
+    if (m.kidnapped) {
+      ++s.kidnaps;
+      s.kidnaps_detected += m.kidnap_detected;
+      s.kidnap_refixes += m.kidnap_refix;
+      s.kidnap_integrity_failures += m.kidnap_integrity_failures;
+      if (m.kidnap_detected) delays.push_back(m.kidnap_delay_steps);
+      if (m.kidnap_refix) refix_m.push_back(m.refix_m);
+    }
+  }
+  s.first_fix_success = trials.empty() ? nan : static_cast<double>(s.first_fix_successes) / trials.size();
+  s.m_to_fix_median = percentile(m_fix, 50);
+  s.availability = s.avail_steps ? static_cast<double>(avail_loc) / s.avail_steps : nan;
+  s.integrity_failure_rate = s.localized_checked ? static_cast<double>(s.integrity_failures) / s.localized_checked : nan;
+  s.pl_exceed_rate = s.pl_steps ? static_cast<double>(s.pl_exceed) / s.pl_steps : nan;
+  s.track_err_median_m = percentile(terr, 50);
+  s.track_err_p95_m = percentile(terr, 95);
+  s.kidnap_delay_median = percentile(delays, 50);
+  s.kidnap_refix_m_median = percentile(refix_m, 50);
+  s.kidnap_refix_success = s.kidnaps ? static_cast<double>(s.kidnap_refixes) / s.kidnaps : nan;
   return s;
+}
+
+std::string product_markdown_table(const std::vector<SystemSummary>& rows) {
+  std::ostringstream o;
+  o << "| dataset | system | trials | first-fix success | m to fix (median) | availability | localized steps checked | "
+       "integrity failures | PL exceed rate | track err median (m) | track err p95 (m) | kidnaps | kidnap delay "
+       "(median steps) | kidnap re-fix success | re-fix m (median) | kidnap integrity failures | excluded (ref) | step "
+       "p50 (ms) | step p99 (ms) |\n";
+  o << "|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|\n";
+  char buf[768];
+  for (const auto& r : rows) {
+    std::snprintf(buf, sizeof(buf),
+                  "| %s | %s | %zu | %.2f (%zu/%zu) | %.1f | %.4f | %zu | %zu | %.4f (%zu/%zu) | %.3f | %.3f | %zu | %.0f | "
+                  "%.2f | %.1f | %zu | %zu | %.2f | %.1f |\n",
+                  r.dataset.c_str(), r.system.c_str(), r.trials, r.first_fix_success, r.first_fix_successes, r.trials,
+                  r.m_to_fix_median, r.availability, r.localized_checked, r.integrity_failures, r.pl_exceed_rate,
+                  r.pl_exceed, r.pl_steps, r.track_err_median_m, r.track_err_p95_m, r.kidnaps, r.kidnap_delay_median,
+                  r.kidnap_refix_success, r.kidnap_refix_m_median, r.kidnap_integrity_failures, r.excluded_ref_steps,
+                  r.step_ms_p50, r.step_ms_p99);
+    o << buf;
+  }
+  return o.str();
 }
 
 std::string markdown_table(const std::vector<SystemSummary>& rows) {
@@ -348,9 +703,11 @@ bool write_error_plot(const std::string& path, const std::string& title, const s
     << "' stroke='#d62728' stroke-dasharray='4 3'/>\n";
   for (const auto& t : trials) {
     o << "<polyline fill='none' stroke='#bbb' stroke-width='1' points='";
-    for (const auto& s : t.steps) o << X(s.travelled) << "," << Y(s.err_m) << " ";
+    for (const auto& s : t.steps)
+      if (std::isfinite(s.err_m)) o << X(s.travelled) << "," << Y(s.err_m) << " ";
     o << "'/>\n";
     for (const auto& s : t.steps) {
+      if (!std::isfinite(s.err_m)) continue;  // no pose (searching)
       o << "<circle cx='" << X(s.travelled) << "' cy='" << Y(s.err_m) << "' r='2' fill='" << status_color(s.status, s.mode)
         << "'/>\n";
     }
@@ -419,6 +776,7 @@ bool write_error_plot_png(const std::string& path, const std::string& title, con
   for (int x = L; x < W - R; x += 4) put(x, Y(bound_m), {214, 39, 40});
   for (const auto& t : trials) {
     for (const auto& s : t.steps) {
+      if (!std::isfinite(s.err_m)) continue;  // no pose (searching)
       Rgb c{170, 170, 170};
       if (s.mode == hal::LocalizationMode::kTracking) c = {31, 119, 180};
       else if (s.status == hal::LocalizationStatus::kLocalized) c = {44, 160, 44};

@@ -16,6 +16,7 @@
 #include "firmware/runtime/localizer.h"
 #include "hal/msg/pose_estimate.h"
 #include "sim/io/carmen_log.h"
+#include "sim/io/relations.h"
 #include "sim/io/ros_map.h"
 
 namespace sim::mmleval {
@@ -35,10 +36,50 @@ struct LoadedDataset {
   double success_bound_m = 0.5;     // 1 m for mit-killian
   double success_bound_rad = 20.0 * 3.14159265358979 / 180.0;
   std::string reference_note;
+  // Reference quality (check_reference_against_relations): 1 = the reference at this scan disagrees
+  // with a benchmark relation touching it; such scans are excluded from every error-based metric.
+  // Empty = all reliable.
+  std::vector<std::uint8_t> ref_unreliable;
+  std::size_t ref_excluded_scans = 0;
+  std::string ref_check_note;       // "checked against N relations: M scans excluded", or why not
+  bool synthetic_odometry = false;  // odometry synthesised from the reference (synthesize_odometry)
+  bool reference_unreliable(std::size_t scan) const { return scan < ref_unreliable.size() && ref_unreliable[scan]; }
 };
 
 // Loads log, reference and the cached global map (built on first use under build/maps).
+// fr101 / fr-campus (only corrected logs exist): log = corrected log, reference = its poses,
+// odometry synthesised (synthesize_odometry, seed 1). Datasets with relations matching the log are
+// checked with check_reference_against_relations (defaults).
 bool load_dataset(const std::string& name, LoadedDataset* out, std::string* err);
+
+// Any building by path (mml-eval --log/--map/--reference): `log` = CARMEN log (.gz ok), `map_yaml`
+// = ROS map (compiled to a map image here), `reference` = "flaser_index ipc logger x y theta" rows
+// (like intel.corrected-poses.txt) or a CARMEN log with one scan per scan of `log` (its laser
+// poses), `relations` optional (benchmark relations with the log's ipc timestamps),
+// `synthetic_odometry`: feed odometry synthesised from the reference instead of the log's.
+// Errors name the file and the problem.
+struct DatasetFiles {
+  std::string name = "custom";
+  std::string log, map_yaml, reference, relations;
+  bool synthetic_odometry = false;
+  std::uint64_t odometry_seed = 1;
+};
+bool load_dataset_files(const DatasetFiles& files, LoadedDataset* out, std::string* err);
+
+// Wheel odometry synthesised from reference increments (for logs without raw odometry): per scan
+// pair Δ = ref[i-1] ⊖ ref[i], Δs = |Δ_xy|, Δθ = wrap(Δ_θ); odometry increment = Δ + n with
+// n_x, n_y ~ N(0, σ_t²), n_θ ~ N(0, σ_r²), σ_t = 0.05·Δs + 0.01·|Δθ| (m), σ_r = 0.05·|Δθ| + 0.01·Δs
+// (rad) — AMCL's noise form with α = 0.05 / 0.01 — from fw::RandomStream(seed, 4242). Starts at ref[0].
+std::vector<fw::Se2d> synthesize_odometry(const std::vector<fw::Se2d>& reference, std::uint64_t seed);
+
+// Reference-quality rule (README "Reference quality"): every benchmark relation with
+// |t2 − t1| ≤ max_dt_s whose two scans are in the log is evaluated on the reference; if it
+// disagrees by more than tol_m (translation) or tol_rad (rotation), every scan from t1's to t2's
+// (inclusive, log order) is marked unreliable. Fills ds->ref_unreliable / ref_excluded_scans /
+// ref_check_note. Returns the number of relations checked.
+std::size_t check_reference_against_relations(LoadedDataset* ds, const std::vector<Relation>& relations,
+                                              double max_dt_s = 3.0, double tol_m = 0.10,
+                                              double tol_rad = 3.14159265358979 / 180.0);
 // Replaces the map by a copy with the axis-aligned box erased (cells → unknown); the image and
 // GlobalMap are rebuilt.
 bool erase_region(LoadedDataset* ds, double x0, double y0, double x1, double y1, std::string* err);
@@ -50,6 +91,19 @@ struct TrialOptions {
   double min_turn_rad = 0.15;       // … or turned this much (same rule for every system)
   bool stop_after_localized = false;  // stop once localized for `settle_steps` steps
   std::size_t settle_steps = 20;
+  // max_steps == 0: no step cap (to the end of the log, or max_metres).
+  // Kidnap: after `kidnap_at_step` steps (0 = none) the scan index jumps to `kidnap_to_scan` and the
+  // run continues there for at most `kidnap_steps_after` steps (0 = to the end / max_steps). The
+  // odometry fed to the localizer stays continuous: the new segment's odometry is shifted so that
+  // its first scan has exactly the last fed odometry pose (the wheels do not see the carrying).
+  std::size_t kidnap_at_step = 0;
+  std::size_t kidnap_to_scan = 0;
+  std::size_t kidnap_steps_after = 0;
+  // Kidnap this many steps after the first `localized` instead (0 = off); kidnap_at_step then is
+  // the latest step at which the kidnap happens anyway.
+  std::size_t kidnap_after_fix_steps = 0;
+  // Picks the target scan given the scan before the jump (overrides kidnap_to_scan when set).
+  std::function<std::size_t(std::size_t from_scan)> kidnap_target;
 };
 
 struct StepLog {
@@ -57,9 +111,17 @@ struct StepLog {
   double travelled = 0;  // since the trial start
   hal::LocalizationStatus status = hal::LocalizationStatus::kSearching;
   hal::LocalizationMode mode = hal::LocalizationMode::kGlobal;
+  // Error against the reference; NaN when the localizer gave no pose (searching / fault: the
+  // published pose is a placeholder and must never be compared).
   double err_m = 0, err_rad = 0;
+  bool has_pose = true;
+  bool ref_ok = true;       // reference reliable at this scan (check_reference_against_relations)
+  float pl_xy = 0, pl_theta = 0;  // published protection level (0 = none)
+  std::uint16_t unsupported_steps = 0;
+  std::size_t segment = 0;  // 1 after a kidnap
   double step_ms = 0;
   fw::Se2d estimate, truth;
+  fw::Se2d odom;            // odometry fed to the localizer
   bool in_region = false;  // inside the erased region (unknown-area runs)
   std::size_t matched_points = 0;  // MML: local map points handed to pRANSAM (0: not matched / not MML)
 };
@@ -74,7 +136,42 @@ struct TrialResult {
   bool failure = false;  // any localized estimate beyond the bound
   double mean_err_localized = 0;
   std::string error;     // a localizer error that ended the trial
+  static constexpr std::size_t kNone = static_cast<std::size_t>(-1);
+  std::size_t kidnap_step = kNone;  // index in `steps` of the first step after the kidnap jump
+  std::size_t kidnap_scan_from = 0;  // last scan before the jump
+  double kidnap_travelled = 0;       // `travelled` at the jump
+  bool whole_log = false;            // a whole-log run (label only)
 };
+
+// The product metrics of one trial (README "Metrics"). Bounds: position `bound_m` (dataset bound:
+// 0.5 m, 1 m at mit-killian), heading `bound_rad` (5°).
+struct MetricBounds {
+  double bound_m = 0.5;
+  double bound_rad = 5.0 * 3.14159265358979 / 180.0;
+  std::size_t fix_within_steps = 200;    // first-fix success window
+  std::size_t refix_within_steps = 200;  // kidnap re-fix window
+};
+struct TrialMetrics {
+  std::size_t steps = 0;
+  bool first_fix = false;          // some `localized` within fix_within_steps
+  bool first_fix_success = false;  // … and correct (first such step with a reliable reference)
+  std::size_t first_fix_index = TrialResult::kNone;  // index in steps
+  double m_to_fix = 0;             // NaN when no first fix
+  std::size_t avail_steps = 0, avail_localized = 0;  // after the first fix, before a kidnap, outside the erased region
+  std::size_t localized_steps = 0;      // `localized` with a reliable reference (error-checked)
+  std::size_t integrity_failures = 0;   // of those: error beyond the bounds
+  std::size_t pl_steps = 0, pl_exceed = 0;
+  std::size_t pl_exceed_xy = 0, pl_exceed_theta = 0;  // which bound was exceeded (both may count)
+  std::size_t excluded_ref_steps = 0;   // `localized` steps skipped: reference unreliable
+  std::vector<double> track_err;        // localized, tracking mode, reliable reference
+  bool kidnapped = false;
+  bool kidnap_detected = false;         // status left `localized` after the kidnap
+  double kidnap_delay_steps = 0;        // steps from the kidnap until not `localized` (NaN: never)
+  bool kidnap_refix = false;            // correct `localized` within refix_within_steps after the kidnap
+  double refix_m = 0;                   // metres from the kidnap to it (NaN: none)
+  std::size_t kidnap_integrity_failures = 0;  // wrong `localized` steps from the kidnap on
+};
+TrialMetrics trial_metrics(const TrialResult& t, const MetricBounds& b);
 
 // Drives `loc` (reset first) from scan `start` on. `region` (optional) marks steps inside it.
 // `matched_points` (optional) reports the local map points matched in the last step (MML).
@@ -98,16 +195,31 @@ struct SystemSummary {
   double tracking_err_median_m = 0;  // steps in tracking mode (hand-off)
   double tracking_step_ms_p50 = 0, tracking_step_ms_p99 = 0;
   double matched_points_mean = 0;    // MML: mean local map points matched per matching step (NaN: none)
+  // Product metrics (trial_metrics pooled over the trials; NaN where nothing to measure).
+  std::size_t first_fixes = 0, first_fix_successes = 0;
+  double first_fix_success = 0;      // share of trials
+  double m_to_fix_median = 0;
+  double availability = 0;           // pooled avail_localized / avail_steps
+  std::size_t avail_steps = 0;
+  std::size_t localized_checked = 0, integrity_failures = 0, excluded_ref_steps = 0;
+  double integrity_failure_rate = 0;  // per error-checked localized step
+  std::size_t pl_steps = 0, pl_exceed = 0, pl_exceed_xy = 0, pl_exceed_theta = 0;
+  double pl_exceed_rate = 0;
+  double track_err_median_m = 0, track_err_p95_m = 0;
+  std::size_t kidnaps = 0, kidnaps_detected = 0, kidnap_refixes = 0, kidnap_integrity_failures = 0;
+  double kidnap_delay_median = 0, kidnap_refix_m_median = 0, kidnap_refix_success = 0;
 };
 
 SystemSummary summarize(const std::string& dataset, const std::string& system, const std::vector<TrialResult>& trials,
-                        double memory_mib);
+                        double memory_mib, const MetricBounds& bounds = MetricBounds());
 
 // Percentile of a copy (p in [0, 100]); NaN for empty input.
 double percentile(std::vector<double> v, double p);
 
 // Reports.
 std::string markdown_table(const std::vector<SystemSummary>& rows);
+// The product metrics (first fix, availability, integrity, PL, tracking error, kidnap).
+std::string product_markdown_table(const std::vector<SystemSummary>& rows);
 // Error / status over metres travelled, one polyline per trial (Figs. 5.7–5.22 style).
 bool write_error_plot(const std::string& path, const std::string& title, const std::vector<TrialResult>& trials,
                       double bound_m, std::string* err);

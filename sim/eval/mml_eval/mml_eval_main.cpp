@@ -7,11 +7,24 @@
 //   --correct / --reduce: local map correction (Eq. 5.23–5.27) / reduction (Eq. 5.28–5.30) on in
 //   every MML run (labels mml-C3+corr, +red); --compare-local-map-options: the main configuration
 //   also with correction and with reduction, side by side (JSON keys <dataset>_mml_c3_corr_*, _red_*).
+//
+// Localizer product metrics (mml-track; sim/eval/mml_eval/localize_eval.h, README "Localizer product
+// metrics"):
+//   mml-eval --localize [--datasets intel,fr101] [--whole-runs 3] [--steps 0] [--fix-trials 10]
+//            [--fix-steps 200] [--mcl-trials 3] [--mcl-datasets intel,fr079] [--kidnap-runs 2]
+//            [--kidnap-datasets intel,fr079,aces] [--no-unknown] [--seed 1] [--threads 2] [--out DIR]
+//   --steps 0 = whole-log runs continue to the end of the log (else at most that many steps).
+// Any building by path (implies --localize; only this building unless --datasets is given):
+//   mml-eval --log LOG.clf[.gz] --map MAP.yaml --reference POSES.txt|CORRECTED.log[.gz]
+//            [--relations R] [--name NAME] [--synthetic-odometry]
+//   POSES.txt rows: "flaser_index ipc_timestamp logger_timestamp x y theta" (like
+//   intel.corrected-poses.txt); a CARMEN reference log must have one scan per scan of LOG.
 #include <cstdio>
 #include <cstdlib>
 #include <sstream>
 #include <string>
 
+#include "sim/eval/mml_eval/localize_eval.h"
 #include "sim/eval/mml_eval/mml_eval_run.h"
 
 namespace {
@@ -33,6 +46,10 @@ int main(int argc, char** argv) {
   plan.out_dir = "build/eval/mml";
   plan.trial_mit = plan.trial;
   plan.trial_mit.max_steps = 300;
+  sim::mmleval::LocalizePlan lp;
+  lp.out_dir = "build/eval/localize";
+  bool localize = false, datasets_given = false;
+  sim::mmleval::DatasetFiles files;
   for (int i = 1; i < argc; ++i) {
     const std::string a = argv[i];
     auto next = [&](long lo, long hi) -> long {
@@ -42,29 +59,66 @@ int main(int argc, char** argv) {
       if (*end != '\0' || v < lo || v > hi) std::exit(usage(("bad value for " + a + ": '" + argv[i] + "'").c_str()));
       return v;
     };
-    if (a == "--datasets" && i + 1 < argc) plan.datasets = split(argv[++i]);
+    auto str = [&]() -> std::string {
+      if (i + 1 >= argc) std::exit(usage(("missing value for " + a).c_str()));
+      return argv[++i];
+    };
+    if (a == "--localize") localize = true;
+    else if (a == "--log") { files.log = str(); localize = true; }
+    else if (a == "--map") { files.map_yaml = str(); localize = true; }
+    else if (a == "--reference") { files.reference = str(); localize = true; }
+    else if (a == "--relations") files.relations = str();
+    else if (a == "--name") files.name = str();
+    else if (a == "--synthetic-odometry") files.synthetic_odometry = true;
+    else if (a == "--whole-runs") lp.whole_runs = next(0, 1000);
+    else if (a == "--fix-trials") lp.fix_trials = next(0, 1000);
+    else if (a == "--fix-steps") lp.fix_steps = next(1, 100000);
+    else if (a == "--mcl-datasets") lp.mcl_datasets = split(str());
+    else if (a == "--kidnap-runs") lp.kidnap_runs = next(0, 1000);
+    else if (a == "--kidnap-datasets") lp.kidnap_datasets = split(str());
+    else if (a == "--datasets" && i + 1 < argc) { plan.datasets = split(argv[++i]); datasets_given = true; }
     else if (a == "--trials") plan.trials = next(1, 1000);
-    else if (a == "--mcl-trials") plan.mcl_trials = next(1, 1000);
-    else if (a == "--steps") plan.trial.max_steps = next(1, 100000);
+    else if (a == "--mcl-trials") lp.mcl_trials = plan.mcl_trials = next(0, 1000);
+    else if (a == "--steps") lp.whole_max_steps = plan.trial.max_steps = next(0, 100000);
     else if (a == "--mit-steps") plan.trial_mit.max_steps = next(1, 100000);
-    else if (a == "--seed") plan.seed = next(0, 1L << 40);
-    else if (a == "--threads") plan.threads = static_cast<int>(next(1, 16));
+    else if (a == "--seed") lp.seed = plan.seed = next(0, 1L << 40);
+    else if (a == "--threads") lp.threads = plan.threads = static_cast<int>(next(1, 16));
     else if (a == "--config") plan.mml_config = static_cast<int>(next(1, 4));
     else if (a == "--all-configs") plan.extra_mml_configs = {1, 2, 3, 4};
     else if (a == "--mcl-particles") plan.mcl_particles = next(100, 131072);
     else if (a == "--mcl-particles-mit") plan.mcl_particles_mit = next(100, 131072);
     else if (a == "--no-handoff") plan.run_handoff = false;
     else if (a == "--no-mcl") plan.run_mcl = false;
-    else if (a == "--no-unknown") plan.run_unknown = false;
+    else if (a == "--no-unknown") lp.run_unknown = plan.run_unknown = false;
     else if (a == "--correct") plan.mml_correct = true;
     else if (a == "--reduce") plan.mml_reduce = true;
     else if (a == "--no-unique") plan.mml_unique = false;
     else if (a == "--compare-local-map-options") plan.compare_local_map_options = true;
-    else if (a == "--out" && i + 1 < argc) plan.out_dir = argv[++i];
+    else if (a == "--out" && i + 1 < argc) lp.out_dir = plan.out_dir = argv[++i];
     else return usage(("unknown argument '" + a + "'").c_str());
   }
   sim::BenchJson json;
   std::string err;
+  if (localize) {
+    const bool custom = !files.log.empty() || !files.map_yaml.empty() || !files.reference.empty();
+    if (custom) {
+      if (files.log.empty() || files.map_yaml.empty() || files.reference.empty())
+        return usage("--log, --map and --reference go together");
+      lp.custom.push_back(files);
+      lp.datasets = datasets_given ? plan.datasets : std::vector<std::string>{};
+      lp.kidnap_datasets.push_back(files.name);
+      if (!datasets_given) lp.run_unknown = false;
+    } else if (datasets_given) {
+      lp.datasets = plan.datasets;
+    }
+    if (!sim::mmleval::run_localize_evaluation(lp, &json, &err)) {
+      std::fprintf(stderr, "%s%s\n", err.rfind("mml-eval:", 0) == 0 ? "" : "mml-eval: ", err.c_str());
+      return 1;
+    }
+    json.write(lp.out_dir + "/localize.json");
+    std::printf("wrote %s/{localize.json,localize.md,*.svg,*.png}\n", lp.out_dir.c_str());
+    return 0;
+  }
   if (!sim::mmleval::run_evaluation(plan, &json, &err)) {
     std::fprintf(stderr, "mml-eval: %s\n", err.c_str());
     return 1;

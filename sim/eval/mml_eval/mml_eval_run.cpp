@@ -169,7 +169,7 @@ bool run_evaluation(const EvalPlan& plan, BenchJson* json, std::string* err) {
       SystemRun r = run_system(*loc, ds, "handoff", starts, ho, plan.verbose);
       for (const auto& t : r.trials)
         for (const auto& s : t.steps)
-          if (s.mode == hal::LocalizationMode::kTracking) {
+          if (s.mode == hal::LocalizationMode::kTracking && std::isfinite(s.err_m) && s.ref_ok) {
             track_err.push_back(s.err_m);
             track_ms.push_back(s.step_ms);
           }

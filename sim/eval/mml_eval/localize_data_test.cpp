@@ -1,0 +1,102 @@
+// Datasets of the product evaluation on the real logs (../shared/data, MMLFW_DATA_DIR): fr101 (only a
+// corrected log: synthesised odometry, map from the corrected log), the reference-quality rule on
+// intel, the path-based loader on intel's own files, and a short mml-track kidnap run on fr101.
+#include <gtest/gtest.h>
+#include <sys/stat.h>
+
+#include <cmath>
+#include <string>
+
+#include "sim/eval/mml_eval/mml_eval.h"
+#include "sim/eval/mml_eval/mml_systems.h"
+#include "sim/io/datasets.h"
+
+namespace sim::mmleval {
+namespace {
+
+bool data_available() {
+  struct stat st;
+  return stat(data_path("README.md").c_str(), &st) == 0;
+}
+
+#define REQUIRE_DATA()                                                                              \
+  if (!data_available()) GTEST_SKIP() << "dataset folder not found: " << data_dir()                \
+                                      << " (set MMLFW_DATA_DIR to ../shared/data)"
+
+TEST(LocalizeData, Fr101SynthesisedOdometry) {
+  REQUIRE_DATA();
+  LoadedDataset ds;
+  std::string err;
+  ASSERT_TRUE(load_dataset("fr101", &ds, &err)) << err;
+  EXPECT_TRUE(ds.synthetic_odometry);
+  ASSERT_EQ(ds.log.scans.size(), 292u);
+  ASSERT_EQ(ds.odometry.size(), ds.reference.size());
+  // Increments close to the reference's (noise ~5 % of the motion), drift grows over the log.
+  double worst = 0;
+  for (std::size_t i = 1; i < ds.odometry.size(); ++i) {
+    const fw::Se2d a = ds.odometry[i - 1].between(ds.odometry[i]), b = ds.reference[i - 1].between(ds.reference[i]);
+    const double len = std::hypot(b.x, b.y);
+    worst = std::max(worst, std::hypot(a.x - b.x, a.y - b.y) / (len + 0.05));
+  }
+  EXPECT_LT(worst, 0.5);
+  EXPECT_GT(ds.map.num_points, 1000u);
+}
+
+TEST(LocalizeData, IntelReferenceExclusionIsReported) {
+  REQUIRE_DATA();
+  LoadedDataset ds;
+  std::string err;
+  ASSERT_TRUE(load_dataset("intel", &ds, &err)) << err;
+  EXPECT_GT(ds.ref_excluded_scans, 0u);
+  EXPECT_LT(ds.ref_excluded_scans, ds.log.scans.size() / 2);
+  EXPECT_NE(ds.ref_check_note.find("scans excluded"), std::string::npos) << ds.ref_check_note;
+}
+
+TEST(LocalizeData, PathLoaderOnIntelFiles) {
+  REQUIRE_DATA();
+  LoadedDataset ref;
+  std::string err;
+  ASSERT_TRUE(load_dataset("intel", &ref, &err)) << err;  // builds / reads the cached map
+  DatasetFiles f;
+  f.name = "intel-by-path";
+  f.log = data_path("intel/intel.clf.gz");
+  f.map_yaml = ref.ros.yaml_path;
+  f.reference = data_path("intel/intel.corrected-poses.txt");
+  f.relations = data_path("intel/intel.relations");
+  LoadedDataset ds;
+  ASSERT_TRUE(load_dataset_files(f, &ds, &err)) << err;
+  ASSERT_EQ(ds.reference.size(), ref.reference.size());
+  EXPECT_EQ(ds.ref_excluded_scans, ref.ref_excluded_scans);
+  EXPECT_DOUBLE_EQ(ds.reference[5000].x, ref.reference[5000].x);
+  // Relations of another log: none match → a clear error.
+  f.relations = data_path("aces/aces.relations");
+  EXPECT_FALSE(load_dataset_files(f, &ds, &err));
+  EXPECT_NE(err.find("aces.relations: no relation's timestamps"), std::string::npos) << err;
+}
+
+TEST(LocalizeData, Fr101KidnapRunKeepsOdometryContinuous) {
+  REQUIRE_DATA();
+  LoadedDataset ds;
+  std::string err;
+  ASSERT_TRUE(load_dataset("fr101", &ds, &err)) << err;
+  auto loc = OwnedLocalizer::make_track(ds.map, ds.image, mml_config(3, 1), fw::track::TrackOptions(), 1, &err);
+  ASSERT_TRUE(loc) << err;
+  TrialOptions opt;
+  opt.max_steps = 0;
+  opt.kidnap_at_step = 60;
+  opt.kidnap_to_scan = 200;
+  opt.kidnap_steps_after = 60;
+  const TrialResult t = run_trial(*loc, ds, 0, opt);
+  ASSERT_EQ(t.kidnap_step, 60u);
+  const fw::Se2d jump = t.steps[59].odom.between(t.steps[60].odom);
+  const fw::Se2d logd = ds.odometry[200].between(ds.odometry[t.steps[60].scan]);
+  EXPECT_NEAR(jump.x, logd.x, 1e-6);
+  EXPECT_NEAR(jump.y, logd.y, 1e-6);
+  const TrialMetrics m = trial_metrics(t, MetricBounds());
+  EXPECT_TRUE(m.kidnapped);
+  for (const auto& s : t.steps)
+    if (s.status == hal::LocalizationStatus::kSearching) EXPECT_TRUE(std::isnan(s.err_m));
+}
+
+}  // namespace
+}  // namespace sim::mmleval

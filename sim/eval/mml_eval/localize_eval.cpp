@@ -1,0 +1,371 @@
+#include "sim/eval/mml_eval/localize_eval.h"
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <cstdio>
+#include <filesystem>
+#include <fstream>
+#include <limits>
+#include <sstream>
+
+#include "firmware/base/rng.h"
+#include "sim/eval/mml_eval/mml_systems.h"
+
+namespace sim::mmleval {
+
+namespace {
+
+double since(std::chrono::steady_clock::time_point t0) {
+  return std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+}
+
+std::size_t count_for(const std::vector<std::pair<std::string, std::size_t>>& ov, const std::string& name,
+                      std::size_t def) {
+  for (const auto& p : ov)
+    if (p.first == name) return p.second;
+  return def;
+}
+
+MetricBounds bounds_for(const LoadedDataset& ds) {
+  MetricBounds b;
+  b.bound_m = ds.success_bound_m;  // dataset bound: 0.5 m (1 m at mit-killian)
+  return b;
+}
+
+// Integrity failures and the status history before them, for the lead (stdout + report).
+void describe_failures(const LoadedDataset& ds, const std::string& label, std::size_t trial, const TrialResult& t,
+                       const MetricBounds& b, std::ostringstream* notes, bool verbose) {
+  std::size_t shown = 0, total = 0;
+  for (std::size_t k = 0; k < t.steps.size(); ++k) {
+    const StepLog& s = t.steps[k];
+    if (s.status != hal::LocalizationStatus::kLocalized || !s.ref_ok || !std::isfinite(s.err_m)) continue;
+    if (s.err_m <= b.bound_m && s.err_rad <= b.bound_rad) continue;
+    ++total;
+    // One line per failure episode (first step of a run of failures), at most 5 per trial.
+    const bool new_episode = k == 0 || !(t.steps[k - 1].status == hal::LocalizationStatus::kLocalized &&
+                                         std::isfinite(t.steps[k - 1].err_m) &&
+                                         (t.steps[k - 1].err_m > b.bound_m || t.steps[k - 1].err_rad > b.bound_rad));
+    if (!new_episode || shown >= 5) continue;
+    ++shown;
+    std::string hist;
+    for (std::size_t j = k >= 8 ? k - 8 : 0; j <= k; ++j) {
+      const StepLog& h = t.steps[j];
+      char c = '?';
+      switch (h.status) {
+        case hal::LocalizationStatus::kSearching: c = 's'; break;
+        case hal::LocalizationStatus::kAmbiguous: c = 'a'; break;
+        case hal::LocalizationStatus::kLocalized: c = h.mode == hal::LocalizationMode::kTracking ? 'T' : 'L'; break;
+        case hal::LocalizationStatus::kOutsideMap: c = 'o'; break;
+        default: c = 'f';
+      }
+      hist += c;
+    }
+    char buf[512];
+    std::snprintf(buf, sizeof(buf),
+                  "integrity failure: %s %s trial %zu (start scan %zu) step %zu scan %zu%s: err %.2f m %.1f deg, PL %.2f m "
+                  "%.1f deg, mode %s, unsupported %u, history (s=searching a=ambiguous L=localized-global "
+                  "T=localized-tracking o=outside) %s",
+                  ds.name.c_str(), label.c_str(), trial, t.start, k + 1, s.scan,
+                  s.segment ? " (after kidnap)" : "", s.err_m, s.err_rad * 57.2958, s.pl_xy, s.pl_theta * 57.2958,
+                  s.mode == hal::LocalizationMode::kTracking ? "tracking" : "global", s.unsupported_steps, hist.c_str());
+    *notes << "- " << buf << "\n";
+    if (verbose) std::printf("    %s\n", buf);
+  }
+  if (total > 0) {
+    char buf[160];
+    std::snprintf(buf, sizeof(buf), "  (%s %s trial %zu: %zu integrity-failure steps in total)", ds.name.c_str(),
+                  label.c_str(), trial, total);
+    *notes << buf << "\n";
+    if (verbose) std::printf("  %s\n", buf);
+  }
+}
+
+void progress(const LoadedDataset& ds, const std::string& label, std::size_t k, std::size_t n, const TrialResult& t,
+              const MetricBounds& b, double secs) {
+  const TrialMetrics m = trial_metrics(t, b);
+  std::printf("  %-11s %-12s %2zu/%zu start %5zu: %5zu steps %6.0f m, first fix %s %.1f m, avail %.3f, integrity "
+              "failures %zu/%zu, PL exceed %zu/%zu (xy %zu, theta %zu)%s (%.0f s)\n",
+              ds.name.c_str(), label.c_str(), k + 1, n, t.start, t.steps.size(),
+              t.steps.empty() ? 0.0 : t.steps.back().travelled,
+              m.first_fix ? (m.first_fix_success ? "ok" : "WRONG") : "none", m.first_fix ? m.m_to_fix : 0.0,
+              m.avail_steps ? static_cast<double>(m.avail_localized) / m.avail_steps : 0.0, m.integrity_failures,
+              m.localized_steps, m.pl_exceed, m.pl_steps, m.pl_exceed_xy, m.pl_exceed_theta, t.error.empty() ? "" : (" error: " + t.error).c_str(), secs);
+  if (m.kidnapped) {
+    std::printf("  %-11s %-12s      kidnap at step %zu (scan %zu -> %zu): detected %s after %.0f steps, re-fix %s "
+                "after %.1f m, wrong localized after kidnap %zu\n",
+                ds.name.c_str(), label.c_str(), t.kidnap_step, t.kidnap_scan_from,
+                t.kidnap_step < t.steps.size() ? t.steps[t.kidnap_step].scan : 0, m.kidnap_detected ? "yes" : "NO",
+                m.kidnap_delay_steps, m.kidnap_refix ? "yes" : "NO", m.refix_m, m.kidnap_integrity_failures);
+  }
+  std::fflush(stdout);
+}
+
+struct Run {
+  std::vector<TrialResult> trials;
+};
+
+void write_plots(const LocalizePlan& plan, const LoadedDataset& ds, const std::string& label,
+                 const std::vector<TrialResult>& trials, const double* region) {
+  if (!plan.plots || trials.empty()) return;
+  const std::string base = plan.out_dir + "/" + ds.key + "_" + label;
+  std::string e;
+  if (!write_error_plot(base + "_error.svg", ds.name + " - " + label + ": error over metres", trials,
+                        ds.success_bound_m, &e) ||
+      !write_map_plot(base + "_map.svg", base + "_map.png", ds, ds.name + " - " + label, trials, region, &e)) {
+    std::fprintf(stderr, "localize: plots of %s %s: %s\n", ds.name.c_str(), label.c_str(), e.c_str());
+  }
+}
+
+}  // namespace
+
+bool run_localize_evaluation(const LocalizePlan& plan, BenchJson* json, std::string* err) {
+  const auto t_all = std::chrono::steady_clock::now();
+  std::filesystem::create_directories(plan.out_dir);
+  std::vector<SystemSummary> rows;
+  std::ostringstream notes, refnotes;
+  std::vector<double> track_ms_all;
+  std::vector<TrialResult> kidnap_all;
+  MetricBounds kidnap_bounds;
+  json->add_int("seed", static_cast<long long>(plan.seed));
+  json->add_int("whole_runs_per_dataset", static_cast<long long>(plan.whole_runs));
+  json->add_int("fix_trials_per_dataset", static_cast<long long>(plan.fix_trials));
+  json->add_int("fix_steps", static_cast<long long>(plan.fix_steps));
+
+  struct Job {
+    std::string name;
+    const DatasetFiles* files = nullptr;
+  };
+  std::vector<Job> jobs;
+  for (const auto& n : plan.datasets) jobs.push_back({n, nullptr});
+  for (const auto& f : plan.custom) jobs.push_back({f.name, &f});
+
+  const fw::mml::MmlLocalizerConfig mml_cfg = mml_config(plan.mml_config, plan.seed);
+  for (const Job& job : jobs) {
+    const auto t0 = std::chrono::steady_clock::now();
+    LoadedDataset ds;
+    if (job.files ? !load_dataset_files(*job.files, &ds, err) : !load_dataset(job.name, &ds, err)) return false;
+    if (plan.verbose) {
+      std::printf("dataset %s: %zu scans, %.0f m of path, map %ux%u @ %.2f m, reference: %s%s (loaded in %.1f s)\n  %s\n",
+                  ds.name.c_str(), ds.log.scans.size(), ds.travelled.back(), ds.map.geometry.width,
+                  ds.map.geometry.height, ds.map.geometry.resolution, ds.reference_note.c_str(),
+                  ds.synthetic_odometry ? " [synthetic odometry]" : "", since(t0), ds.ref_check_note.c_str());
+      std::fflush(stdout);
+    }
+    refnotes << "- " << ds.name << ": " << ds.ref_check_note << "\n";
+    json->add_int(ds.key + "_ref_excluded_scans", static_cast<long long>(ds.ref_excluded_scans));
+    const MetricBounds b = bounds_for(ds);
+    std::string e;
+    auto loc = OwnedLocalizer::make_track(ds.map, ds.image, mml_cfg, fw::track::TrackOptions(), plan.threads, &e);
+    if (!loc) return (*err = ds.name + ": mml-track: " + e, false);
+
+    std::vector<TrialResult> all;  // every mml-track trial on this dataset (whole + fix)
+    // Whole-log runs.
+    const std::size_t nwhole = count_for(plan.whole_runs_override, ds.name, plan.whole_runs);
+    {
+      const double total = ds.travelled.back();
+      std::size_t last = 0;
+      for (std::size_t i = 0; i < ds.travelled.size(); ++i)
+        if (ds.travelled[i] <= plan.whole_start_fraction * total) last = i;
+      fw::RandomStream rng(plan.seed, 501);
+      TrialOptions opt = plan.step_rule;
+      opt.max_steps = plan.whole_max_steps;
+      std::vector<TrialResult> whole;
+      for (std::size_t k = 0; k < nwhole; ++k) {
+        const std::size_t start = last > 0 ? rng.uniform_index(static_cast<std::uint32_t>(last)) : 0;
+        const auto tk = std::chrono::steady_clock::now();
+        TrialResult t = run_trial(*loc, ds, start, opt);
+        t.whole_log = true;
+        if (plan.verbose) progress(ds, "whole-log", k, nwhole, t, b, since(tk));
+        describe_failures(ds, "whole-log", k, t, b, &notes, plan.verbose);
+        whole.push_back(t);
+        all.push_back(std::move(t));
+      }
+      write_plots(plan, ds, "mml-track_whole", whole, nullptr);
+    }
+    // First-fix trials.
+    const std::size_t nfix = count_for(plan.fix_trials_override, ds.name, plan.fix_trials);
+    TrialOptions fopt = plan.step_rule;
+    fopt.max_steps = plan.fix_steps;
+    const std::vector<std::size_t> starts = draw_starts(ds, nfix, plan.seed, fopt);
+    {
+      std::vector<TrialResult> fix;
+      for (std::size_t k = 0; k < starts.size(); ++k) {
+        const auto tk = std::chrono::steady_clock::now();
+        TrialResult t = run_trial(*loc, ds, starts[k], fopt);
+        if (plan.verbose) progress(ds, "fix-trial", k, starts.size(), t, b, since(tk));
+        describe_failures(ds, "fix-trial", k, t, b, &notes, plan.verbose);
+        fix.push_back(t);
+        all.push_back(std::move(t));
+      }
+      write_plots(plan, ds, "mml-track_fix", fix, nullptr);
+    }
+    SystemSummary s = summarize(ds.name, "mml-track", all, loc->static_bytes() / (1024.0 * 1024.0), b);
+    rows.push_back(s);
+    for (const auto& t : all)
+      for (const auto& st : t.steps)
+        if (st.mode == hal::LocalizationMode::kTracking) track_ms_all.push_back(st.step_ms);
+    const std::string& D = ds.key;
+    json->add(D + "_first_fix_success", s.first_fix_success);
+    json->add(D + "_m_to_fix_median", s.m_to_fix_median);
+    json->add(D + "_availability", s.availability);
+    json->add_int(D + "_integrity_failures", static_cast<long long>(s.integrity_failures));
+    json->add_int(D + "_localized_steps_checked", static_cast<long long>(s.localized_checked));
+    json->add(D + "_pl_exceed_rate", s.pl_exceed_rate);
+    json->add(D + "_pl_exceed_xy_rate", s.pl_steps ? static_cast<double>(s.pl_exceed_xy) / s.pl_steps : NAN);
+    json->add(D + "_pl_exceed_theta_rate", s.pl_steps ? static_cast<double>(s.pl_exceed_theta) / s.pl_steps : NAN);
+    json->add(D + "_availability_steps", static_cast<double>(s.avail_steps));
+    json->add(D + "_track_err_m_median", s.track_err_median_m);
+    json->add(D + "_track_err_m_p95", s.track_err_p95_m);
+    json->add(D + "_step_ms_p50", s.step_ms_p50);
+    json->add(D + "_step_ms_p99", s.step_ms_p99);
+    json->add_int(D + "_trials", static_cast<long long>(s.trials));
+
+    // MCL baseline: metres to the first fix on the first fix-trial starts.
+    if (std::find(plan.mcl_datasets.begin(), plan.mcl_datasets.end(), ds.name) != plan.mcl_datasets.end() &&
+        plan.mcl_trials > 0) {
+      auto mcl = OwnedLocalizer::make_mcl(ds.map, mcl_baseline_options(plan.mcl_particles, plan.seed), plan.threads, &e);
+      if (!mcl) return (*err = ds.name + ": mcl: " + e, false);
+      std::vector<TrialResult> mt;
+      const std::string label = "mcl-" + std::to_string(plan.mcl_particles / 1000) + "k";
+      for (std::size_t k = 0; k < std::min(plan.mcl_trials, starts.size()); ++k) {
+        const auto tk = std::chrono::steady_clock::now();
+        mt.push_back(run_trial(*mcl, ds, starts[k], fopt));
+        if (plan.verbose) progress(ds, label, k, std::min(plan.mcl_trials, starts.size()), mt.back(), b, since(tk));
+      }
+      SystemSummary ms = summarize(ds.name, label, mt, mcl->static_bytes() / (1024.0 * 1024.0), b);
+      rows.push_back(ms);
+      json->add(D + "_mcl_m_to_fix_median", ms.m_to_fix_median);
+      json->add(D + "_mcl_first_fix_success", ms.first_fix_success);
+    }
+    // Kidnaps.
+    if (std::find(plan.kidnap_datasets.begin(), plan.kidnap_datasets.end(), ds.name) != plan.kidnap_datasets.end() &&
+        plan.kidnap_runs > 0) {
+      TrialOptions kopt = plan.step_rule;
+      kopt.kidnap_after_fix_steps = plan.kidnap_after_fix;
+      kopt.kidnap_at_step = plan.kidnap_latest_step;
+      kopt.kidnap_steps_after = plan.kidnap_steps_after;
+      kopt.max_steps = 0;
+      TrialOptions sopt = kopt;
+      sopt.max_steps = plan.kidnap_latest_step + plan.kidnap_steps_after;
+      const std::vector<std::size_t> kstarts = draw_starts(ds, plan.kidnap_runs, plan.seed + 7, sopt);
+      fw::RandomStream krng(plan.seed, 733);
+      // Targets: a random scan at least kidnap_min_dist_m from the robot's true position, with room
+      // for kidnap_steps_after steps of log after it.
+      const double need = static_cast<double>(plan.kidnap_steps_after) * plan.step_rule.min_move_m * 0.5;
+      std::size_t last = 0;
+      for (std::size_t i = 0; i < ds.travelled.size(); ++i)
+        if (ds.travelled[i] <= ds.travelled.back() - need) last = i;
+      kopt.kidnap_target = [&](std::size_t from) -> std::size_t {
+        for (int attempt = 0; attempt < 200; ++attempt) {
+          const std::size_t j = krng.uniform_index(static_cast<std::uint32_t>(std::max<std::size_t>(last, 1)));
+          const fw::Se2d& a = ds.reference[from];
+          const fw::Se2d& c = ds.reference[j];
+          if (std::hypot(a.x - c.x, a.y - c.y) >= plan.kidnap_min_dist_m) return j;
+        }
+        return krng.uniform_index(static_cast<std::uint32_t>(std::max<std::size_t>(last, 1)));
+      };
+      std::vector<TrialResult> kt;
+      for (std::size_t k = 0; k < kstarts.size(); ++k) {
+        const auto tk = std::chrono::steady_clock::now();
+        kt.push_back(run_trial(*loc, ds, kstarts[k], kopt));
+        if (plan.verbose) progress(ds, "kidnap", k, kstarts.size(), kt.back(), kidnap_bounds, since(tk));
+        describe_failures(ds, "kidnap", k, kt.back(), b, &notes, plan.verbose);
+      }
+      SystemSummary ks = summarize(ds.name, "mml-track kidnap", kt, 0, b);
+      rows.push_back(ks);
+      json->add(D + "_kidnap_refix_success", ks.kidnap_refix_success);
+      json->add_int(D + "_kidnap_integrity_failures", static_cast<long long>(ks.kidnap_integrity_failures));
+      write_plots(plan, ds, "mml-track_kidnap", kt, nullptr);
+      kidnap_all.insert(kidnap_all.end(), kt.begin(), kt.end());
+    }
+    if (plan.verbose) {
+      std::printf("dataset %s done in %.1f s (total %.1f s)\n", ds.name.c_str(), since(t0), since(t_all));
+      std::fflush(stdout);
+    }
+  }
+  if (!kidnap_all.empty()) {
+    SystemSummary ks = summarize("all", "mml-track kidnap", kidnap_all, 0, kidnap_bounds);
+    json->add("kidnap_refix_success", ks.kidnap_refix_success);
+    json->add_int("kidnap_integrity_failures", static_cast<long long>(ks.kidnap_integrity_failures));
+    json->add_int("kidnap_runs", static_cast<long long>(ks.kidnaps));
+    json->add("kidnap_detected_rate", ks.kidnaps ? static_cast<double>(ks.kidnaps_detected) / ks.kidnaps : NAN);
+    json->add("kidnap_delay_steps_median", ks.kidnap_delay_median);
+    json->add("kidnap_refix_m_median", ks.kidnap_refix_m_median);
+  }
+
+  // Unknown area: as mml_eval_run.cpp (same region and starts), with mml-track.
+  if (plan.run_unknown) {
+    const auto t0 = std::chrono::steady_clock::now();
+    LoadedDataset ds;
+    if (!load_dataset(plan.unknown_dataset, &ds, err)) return false;
+    fw::RandomStream rng(plan.seed, 991);
+    const std::size_t n = ds.log.scans.size();
+    const std::size_t c = n / 4 + rng.uniform_index(static_cast<std::uint32_t>(n / 2));
+    const fw::Se2d rc = ds.reference[c];
+    const double half = 4.0;
+    const double region[4] = {rc.x - half, rc.y - half, rc.x + half, rc.y + half};
+    if (!erase_region(&ds, region[0], region[1], region[2], region[3], err)) return false;
+    std::vector<std::size_t> starts;
+    for (std::size_t k = 0; k < plan.unknown_trials; ++k) {
+      const double back = 8.0 + 10.0 * static_cast<double>(k);
+      std::size_t s = c;
+      while (s > 0 && ds.travelled[c] - ds.travelled[s] < back) --s;
+      starts.push_back(s);
+    }
+    std::string e;
+    auto loc = OwnedLocalizer::make_track(ds.map, ds.image, mml_cfg, fw::track::TrackOptions(), plan.threads, &e);
+    if (!loc) return (*err = "unknown area: mml-track: " + e, false);
+    TrialOptions uo = plan.step_rule;
+    uo.max_steps = plan.unknown_steps;
+    const MetricBounds b = bounds_for(ds);
+    std::vector<TrialResult> ut;
+    for (std::size_t k = 0; k < starts.size(); ++k) {
+      const auto tk = std::chrono::steady_clock::now();
+      ut.push_back(run_trial(*loc, ds, starts[k], uo, region));
+      if (plan.verbose) progress(ds, "unknown-area", k, starts.size(), ut.back(), b, since(tk));
+      describe_failures(ds, "unknown-area", k, ut.back(), b, &notes, plan.verbose);
+    }
+    SystemSummary us = summarize(ds.name + "-erased", "mml-track", ut, 0, b);
+    rows.push_back(us);
+    std::size_t in_region = 0, in_region_loc = 0, in_region_wrong = 0;
+    for (const auto& t : ut)
+      for (const auto& st : t.steps) {
+        if (!st.in_region) continue;
+        ++in_region;
+        if (st.status == hal::LocalizationStatus::kLocalized) {
+          ++in_region_loc;
+          in_region_wrong += std::isfinite(st.err_m) && (st.err_m > b.bound_m || st.err_rad > b.bound_rad);
+        }
+      }
+    json->add_int("unknown_area_integrity_failures", static_cast<long long>(us.integrity_failures));
+    json->add_int("unknown_area_in_region_steps", static_cast<long long>(in_region));
+    json->add("unknown_area_in_region_localized_fraction",
+              in_region ? static_cast<double>(in_region_loc) / in_region : NAN);
+    json->add("unknown_area_availability_outside_region", us.availability);
+    write_plots(plan, ds, "mml-track_unknown", ut, region);
+    if (plan.verbose)
+      std::printf("unknown area (%s, 8 x 8 m erased): %zu in-region steps, %zu localized there (%zu wrong); integrity "
+                  "failures %zu; done in %.1f s\n",
+                  ds.name.c_str(), in_region, in_region_loc, in_region_wrong, us.integrity_failures, since(t0));
+  }
+  json->add("track_step_ms_p50", percentile(track_ms_all, 50));
+  json->add("track_step_ms_p99", percentile(track_ms_all, 99));
+  json->add("localize_eval_seconds", since(t_all));
+
+  const std::string table = product_markdown_table(rows);
+  std::ofstream md(plan.out_dir + "/localize.md");
+  md << "# Localizer (mml-track) product evaluation\n\nSeed " << plan.seed << "; per dataset " << plan.whole_runs
+     << " whole-log runs (kidnapped start drawn over the first " << plan.whole_start_fraction * 100
+     << " % of the path, to the end of the log) + " << plan.fix_trials << " kidnapped-start trials of " << plan.fix_steps
+     << " steps (overrides: see the bench source); a step is a scan after >= " << plan.step_rule.min_move_m << " m or >= "
+     << plan.step_rule.min_turn_rad
+     << " rad of odometry motion. Bounds: dataset position bound (0.5 m; 1 m at mit-killian) and 5 deg. "
+        "Definitions: sim/eval/mml_eval/README.md.\n\n"
+     << table << "\n## Reference quality\n\n" << refnotes.str() << "\n## Integrity failures\n\n"
+     << (notes.str().empty() ? std::string("none\n") : notes.str());
+  if (plan.verbose) std::printf("\n%s\nreference:\n%s\ntotal %.1f s\n", table.c_str(), refnotes.str().c_str(), since(t_all));
+  return true;
+}
+
+}  // namespace sim::mmleval
