@@ -1,6 +1,7 @@
 // MclLocalizer: the AMCL-style update gate (update_min_d / update_min_a) and reset() giving a
 // fresh start (same inputs after reset() ⇒ bit-identical outputs to a freshly initialised object).
 #include "firmware/mcl/mcl_localizer.h"
+#include "firmware/mcl/mcl_presets.h"
 
 #include <gtest/gtest.h>
 
@@ -16,18 +17,8 @@ namespace {
 
 using testing::GridWorld;
 
-// The hand-off tracking configuration (sim/eval mml_systems.cpp: 1000 particles × 30 beams, LF).
-MclOptions tracking_options() {
-  MclOptions o;
-  o.num_particles = 1000;
-  o.model = SensorModel::kLikelihoodField;
-  o.num_beams = 30;
-  o.lf_sigma_m = 0.08f;
-  o.alpha1 = o.alpha3 = 0.05f;
-  o.alpha2 = o.alpha4 = 0.02f;
-  o.resample_neff_ratio = 0.5f;
-  return o;
-}
+// The hand-off tracking configuration the product ships (mcl_presets.h).
+MclOptions tracking_options() { return mcl_tracking_options(1); }
 
 hal::Odometry odometry(const Se2f& p) {
   hal::Odometry o;

@@ -13,14 +13,8 @@ namespace {
 using testing::GridWorld;
 using testing::OwnedGlobalMap;
 
-const GridWorld& room() {
-  static GridWorld g = mcl::testing::unique_room();
-  return g;
-}
-const OwnedGlobalMap& room_map() {
-  static OwnedGlobalMap m(room());
-  return m;
-}
+using testing::room;
+using testing::room_map;
 
 Eigen::Matrix3f small_cov() {
   Eigen::Matrix3f c = Eigen::Matrix3f::Zero();

@@ -15,6 +15,16 @@ namespace testing {
 using mcl::testing::GridWorld;
 using mml::testing::OwnedGlobalMap;
 
+// The 12 × 8 m room with a unique layout and its global map.
+inline const GridWorld& room() {
+  static GridWorld g = mcl::testing::unique_room();
+  return g;
+}
+inline const OwnedGlobalMap& room_map() {
+  static OwnedGlobalMap m(room());
+  return m;
+}
+
 // Scan end-points (sensor frame) of a simulated scan at `pose` in `world`, with range noise.
 inline std::vector<Point2f> scan_at(const GridWorld& world, const Se2f& pose, RandomStream* rng, float noise = 0.01f,
                                     float maxr = 8.0f) {

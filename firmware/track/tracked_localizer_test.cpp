@@ -34,14 +34,8 @@ struct Rig {
   }
 };
 
-const GridWorld& room() {
-  static GridWorld g = mcl::testing::unique_room();
-  return g;
-}
-const OwnedGlobalMap& room_map() {
-  static OwnedGlobalMap m(room());
-  return m;
-}
+using testing::room;
+using testing::room_map;
 
 std::vector<Se2f> tour() {
   return mml::testing::waypoint_path({{1.5f, 1.5f}, {1.5f, 6.5f}, {4.5f, 6.5f}, {4.5f, 2.0f}, {10.5f, 3.5f},
