@@ -21,20 +21,17 @@ void TrackedLocalizer::reset() {
   fixes_ = fix_rejections_ = tracks_lost_ = 0;
 }
 
-// End-points within the tracker's range, evenly subsampled to at most align.max_points (beam order kept).
+// End-points within the tracker's range, evenly subsampled to at most align.max_points (beam order
+// kept). In place: the k-th kept point comes from index k·count/cap ≥ k, never one already overwritten.
 std::size_t TrackedLocalizer::scan_points(const hal::LaserScan& scan) {
   ScanPointsOptions so;
   so.max_range = tracker_.options().align.max_range_m;
   ScanPointsResult sr;
-  if (!scan_to_points(scan, so, all_pts_, hal::LaserScan::kMaxBeams, &sr).is_ok()) return 0;
+  if (!scan_to_points(scan, so, pts_, hal::LaserScan::kMaxBeams, &sr).is_ok()) return 0;
   const std::size_t cap = tracker_.options().align.max_points;
-  if (sr.count <= cap) {
-    for (std::size_t i = 0; i < sr.count; ++i) pts_[i] = all_pts_[i];
-    return sr.count;
-  }
-  std::size_t m = 0;
-  for (std::size_t k = 0; k < cap; ++k) pts_[m++] = all_pts_[k * sr.count / cap];
-  return m;
+  if (sr.count <= cap) return sr.count;
+  for (std::size_t k = 0; k < cap; ++k) pts_[k] = pts_[k * sr.count / cap];
+  return cap;
 }
 
 void TrackedLocalizer::publish_track(const TrackStep& ts, hal::PoseEstimate* out) const {

@@ -39,7 +39,6 @@ class TrackedLocalizer final : public Localizer {
   void publish_track(const TrackStep& ts, hal::PoseEstimate* out) const;
   mml::MmlLocalizer* mml_ = nullptr;
   PoseTracker tracker_;
-  Point2f all_pts_[hal::LaserScan::kMaxBeams];
   Point2f pts_[hal::LaserScan::kMaxBeams];
   std::uint32_t fixes_ = 0, fix_rejections_ = 0, tracks_lost_ = 0;
 };

@@ -298,21 +298,10 @@ bool run_localize_evaluation(const LocalizePlan& plan, BenchJson* json, std::str
   if (plan.run_unknown) {
     const auto t0 = std::chrono::steady_clock::now();
     LoadedDataset ds;
-    if (!load_dataset(plan.unknown_dataset, &ds, err)) return false;
-    fw::RandomStream rng(plan.seed, 991);
-    const std::size_t n = ds.log.scans.size();
-    const std::size_t c = n / 4 + rng.uniform_index(static_cast<std::uint32_t>(n / 2));
-    const fw::Se2d rc = ds.reference[c];
-    const double half = 4.0;
-    const double region[4] = {rc.x - half, rc.y - half, rc.x + half, rc.y + half};
-    if (!erase_region(&ds, region[0], region[1], region[2], region[3], err)) return false;
+    double region[4];
     std::vector<std::size_t> starts;
-    for (std::size_t k = 0; k < plan.unknown_trials; ++k) {
-      const double back = 8.0 + 10.0 * static_cast<double>(k);
-      std::size_t s = c;
-      while (s > 0 && ds.travelled[c] - ds.travelled[s] < back) --s;
-      starts.push_back(s);
-    }
+    if (!prepare_unknown_area(plan.unknown_dataset, plan.seed, plan.unknown_trials, &ds, region, &starts, err))
+      return false;
     std::string e;
     auto loc = OwnedLocalizer::make_track(ds.map, ds.image, mml_cfg, fw::track::TrackOptions(), plan.threads, &e);
     if (!loc) return (*err = "unknown area: mml-track: " + e, false);

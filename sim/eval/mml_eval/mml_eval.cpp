@@ -294,6 +294,29 @@ bool erase_region(LoadedDataset* ds, double x0, double y0, double x1, double y1,
   return load_image(ds, err);
 }
 
+bool prepare_unknown_area(const std::string& name, std::uint64_t seed, std::size_t trials, LoadedDataset* ds,
+                          double region[4], std::vector<std::size_t>* starts, std::string* err) {
+  if (!load_dataset(name, ds, err)) return false;
+  fw::RandomStream rng(seed, 991);
+  const std::size_t n = ds->log.scans.size();
+  const std::size_t c = n / 4 + rng.uniform_index(static_cast<std::uint32_t>(n / 2));
+  const fw::Se2d rc = ds->reference[c];
+  const double half = 4.0;
+  region[0] = rc.x - half;
+  region[1] = rc.y - half;
+  region[2] = rc.x + half;
+  region[3] = rc.y + half;
+  if (!erase_region(ds, region[0], region[1], region[2], region[3], err)) return false;
+  starts->clear();
+  for (std::size_t k = 0; k < trials; ++k) {
+    const double back = 8.0 + 10.0 * static_cast<double>(k);
+    std::size_t s = c;
+    while (s > 0 && ds->travelled[c] - ds->travelled[s] < back) --s;
+    starts->push_back(s);
+  }
+  return true;
+}
+
 std::vector<std::size_t> draw_starts(const LoadedDataset& ds, std::size_t count, std::uint64_t seed,
                                      const TrialOptions& opt) {
   // Leave room for the trial: a start needs roughly max_steps·min_move metres of log after it.

@@ -84,6 +84,12 @@ std::size_t check_reference_against_relations(LoadedDataset* ds, const std::vect
 // GlobalMap are rebuilt.
 bool erase_region(LoadedDataset* ds, double x0, double y0, double x1, double y1, std::string* err);
 
+// The unknown-area experiment, one definition for mml-eval and bench_localize: loads `name`, erases
+// an 8 × 8 m box around a scan drawn from `seed` in the middle half of the log (region = x0 y0 x1
+// y1) and returns `trials` starts 8, 18, 28 … m of travel before it.
+bool prepare_unknown_area(const std::string& name, std::uint64_t seed, std::size_t trials, LoadedDataset* ds,
+                          double region[4], std::vector<std::size_t>* starts, std::string* err);
+
 struct TrialOptions {
   std::size_t max_steps = 150;      // localizer steps per trial
   double max_metres = 1e9;          // stop when the robot travelled this far
