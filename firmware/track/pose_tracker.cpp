@@ -4,6 +4,9 @@
 #include <Eigen/LU>
 #include <cmath>
 
+#include "firmware/map/distance_sample.h"
+#include "firmware/mml/pose_uniqueness.h"
+
 namespace fw {
 namespace track {
 
@@ -13,6 +16,7 @@ const char* verdict_name(ScanVerdict v) {
     case ScanVerdict::kUninformative: return "uninformative";
     case ScanVerdict::kContradicting: return "contradicting";
     case ScanVerdict::kOutsideMap: return "outside-map";
+    case ScanVerdict::kAmbiguous: return "ambiguous";
   }
   return "unknown";
 }
@@ -76,6 +80,35 @@ void PoseTracker::predict_to(const Se2f& odom) {
 }
 
 namespace {
+// Paired test of the truncated per-point costs (pose_uniqueness.h) of the same end-points at the
+// pose and at the rival: the rival is better only when the mean difference exceeds z standard
+// errors, with the end-points counted as `independent` observations (the correlation cells of the
+// alignment) — a few cluttered beams or a map drawn a little off in a corridor do not move a track.
+bool rival_significantly_better(const GlobalMap& map, const Point2f* pts, std::size_t n, const Se2f& pose,
+                                const Se2f& rival, float clip_m, std::uint32_t independent, float z) {
+  if (n < 2 || independent < 2) return false;
+  const float c0 = std::cos(pose.theta), s0 = std::sin(pose.theta);
+  const float c1 = std::cos(rival.theta), s1 = std::sin(rival.theta);
+  const double clip2 = static_cast<double>(clip_m) * clip_m;
+  auto cost = [&](float x, float y) {
+    float d = 0.0f, gx = 0.0f, gy = 0.0f;
+    if (!sample_distance<float>(map, x, y, &d, &gx, &gy) || d > clip_m) return 1.0;
+    return static_cast<double>(d) * d / clip2;
+  };
+  double sum = 0.0, sq = 0.0;
+  for (std::size_t i = 0; i < n; ++i) {
+    const float px = pts[i].x(), py = pts[i].y();
+    const double diff = cost(pose.x + c0 * px - s0 * py, pose.y + s0 * px + c0 * py) -
+                        cost(rival.x + c1 * px - s1 * py, rival.y + s1 * px + c1 * py);
+    sum += diff;
+    sq += diff * diff;
+  }
+  const double mean = sum / static_cast<double>(n);
+  const double var = std::fmax(sq / static_cast<double>(n) - mean * mean, 0.0);
+  const double se = std::sqrt(var / static_cast<double>(independent));
+  return mean > static_cast<double>(z) * se;
+}
+
 bool outside_bound(const Eigen::Vector3f& e, const ProtectionLevel& pl) {
   return std::hypot(e(0), e(1)) > pl.xy_m || std::fabs(e(2)) > pl.theta_rad;
 }
@@ -135,9 +168,31 @@ TrackStep PoseTracker::step(const Point2f* points, std::size_t n, const Se2f& od
       p_post = post.cast<float>();
     }
   }
+  // Alias check at the scan fix: does the scan fit as well (or better) somewhere else nearby?
+  if (v == ScanVerdict::kSupported && o.alias_check) {
+    mml::UniquenessOptions uo;
+    uo.clip_m = o.alias_clip_m;
+    uo.max_shift_m = o.alias_max_shift_m;
+    uo.shift_step_m = o.alias_step_m;
+    uo.min_separation_m = o.alias_min_separation_m;
+    uo.margin = o.alias_margin;
+    const std::size_t stride = (n + kAliasMaxPoints - 1) / kAliasMaxPoints;
+    std::size_t m = 0;
+    for (std::size_t i = 0; i < n && m < kAliasMaxPoints; i += stride) alias_points_[m++] = points[i];
+    const mml::UniquenessResult u = mml::check_pose_uniqueness(map_, alias_points_, m, a.pose, uo);
+    out.alias_cost = u.cost;
+    out.alias_rival_cost = u.rival_cost;
+    if (u.rival_cost < u.cost - o.alias_margin &&
+        rival_significantly_better(map_, alias_points_, m, a.pose, u.rival, o.alias_clip_m, a.independent,
+                                   o.alias_z)) {
+      v = ScanVerdict::kContradicting;  // the scan says the robot is elsewhere
+    } else if (!u.unique) {
+      v = ScanVerdict::kAmbiguous;      // fused (odometry keeps the mode), never `localized`
+    }
+  }
   out.verdict = v;
 
-  if (v == ScanVerdict::kSupported) {
+  if (v == ScanVerdict::kSupported || v == ScanVerdict::kAmbiguous) {
     const Se2f since = odom_at_fuse_.between(odom);
     const bool moved = !fused_once_ || !predict || std::hypot(since.x, since.y) >= o.update_min_d_m ||
                        std::fabs(since.theta) >= o.update_min_a_rad;
@@ -159,7 +214,12 @@ TrackStep PoseTracker::step(const Point2f* points, std::size_t n, const Se2f& od
     unsupported_ = 0;
     faulty_ = 0;
     outside_ = 0;
-    ++consistent_since_fault_;
+    if (v == ScanVerdict::kAmbiguous) {
+      had_fault_ = true;  // `localized` again only after recovery_steps unique scans
+      consistent_since_fault_ = 0;
+    } else {
+      ++consistent_since_fault_;
+    }
   } else {
     ++unsupported_;
     if (v == ScanVerdict::kContradicting && innovation_fault) {
@@ -193,7 +253,7 @@ TrackStep PoseTracker::step(const Point2f* points, std::size_t n, const Se2f& od
   const bool within = out.pl.xy_m <= o.alert_limit_m && out.pl.theta_rad <= o.alert_limit_rad;
   if (v == ScanVerdict::kOutsideMap) {
     out.status = hal::LocalizationStatus::kOutsideMap;
-  } else if (v != ScanVerdict::kContradicting && faulty_ == 0 && within &&
+  } else if (v != ScanVerdict::kContradicting && v != ScanVerdict::kAmbiguous && faulty_ == 0 && within &&
              (!had_fault_ || consistent_since_fault_ >= o.recovery_steps)) {
     out.status = hal::LocalizationStatus::kLocalized;
   } else {

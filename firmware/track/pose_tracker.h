@@ -4,7 +4,9 @@
 //   predict   x⁻ = x ⊕ Δodom, P⁻ = F P Fᵀ + G Q(Δ) Gᵀ (odometry noise grows with the motion);
 //   align     the scan on the distance field from x⁻ (scan_alignment.h) → x_s, information H;
 //   check     fault detection on the residuals: too few end-points explained by the map, or a scan
-//             fix that disagrees with the prediction (χ² of the innovation), contradicts the pose;
+//             fix that disagrees with the prediction (χ² of the innovation), or a rival pose along
+//             a weak axis that explains the scan better (alias check), contradicts the pose; a
+//             rival that explains it as well makes it ambiguous (not `localized`, still tracked);
 //             most end-points in unknown space means outside the map; too few points says nothing;
 //   update    only on a consistent scan, and only after the robot moved a little (no re-counting of
 //             the same map error while standing still): P = (P⁻⁻¹ + H)⁻¹, x = x⁻ + P H (x_s − x⁻);
@@ -36,6 +38,7 @@ enum class ScanVerdict : std::uint8_t {
   kUninformative = 1,  // too few end-points on the map to say anything
   kContradicting = 2,  // poor fit or inconsistent with the odometry prediction
   kOutsideMap = 3,     // most end-points in unknown space
+  kAmbiguous = 4,      // fits, but as well at a rival pose along a weak axis (alias check)
 };
 const char* verdict_name(ScanVerdict v);
 
@@ -49,6 +52,7 @@ struct TrackStep {
   bool lost = false;            // the track is given up: go back to global localization
   std::uint32_t unsupported_steps = 0, faulty_steps = 0, outside_steps = 0;
   float innovation_chi2 = 0.0f;
+  float alias_cost = 0.0f, alias_rival_cost = 1.0f;  // alias check (1 = not run)
   ScanAlignment alignment;
 };
 
@@ -68,6 +72,10 @@ class PoseTracker {
 
  private:
   void predict_to(const Se2f& odom);
+  // The alias check refines ~30 rivals: it uses at most this many end-points (evenly subsampled),
+  // which halves its cost at the 360 points of the alignment and keeps one point = 1/180 of the cost.
+  static constexpr std::size_t kAliasMaxPoints = 180;
+  Point2f alias_points_[kAliasMaxPoints];
   TrackOptions options_;
   GlobalMap map_;
   ProtectionFactors k_;

@@ -50,9 +50,19 @@ Status TrackOptions::validate() const {
     return Status::error(Errc::kInvalidArgument, "TrackOptions: max_faulty_steps %u / max_outside_steps %u out of range [1, 10000]",
                          max_faulty_steps, max_outside_steps);
   }
+  if (cross_check_steps > 1000000) {
+    return Status::error(Errc::kInvalidArgument, "TrackOptions.cross_check_steps = %u out of range [0, 1000000]",
+                         cross_check_steps);
+  }
   if (recovery_steps > 10000) {
     return Status::error(Errc::kInvalidArgument, "TrackOptions.recovery_steps = %u out of range [0, 10000]", recovery_steps);
   }
+  FW_RETURN_IF_ERROR(check_range("alias_max_shift_m", alias_max_shift_m, 0.0f, 50.0f));
+  FW_RETURN_IF_ERROR(check_range("alias_step_m", alias_step_m, 0.05f, 10.0f));
+  FW_RETURN_IF_ERROR(check_range("alias_min_separation_m", alias_min_separation_m, 0.01f, 10.0f));
+  FW_RETURN_IF_ERROR(check_range("alias_clip_m", alias_clip_m, 0.01f, 2.0f));
+  FW_RETURN_IF_ERROR(check_range("alias_margin", alias_margin, 0.0f, 1.0f));
+  FW_RETURN_IF_ERROR(check_range("alias_z", alias_z, 0.0f, 100.0f));
   FW_RETURN_IF_ERROR(check_range("integrity_risk", integrity_risk, 1e-9f, 0.5f));
   FW_RETURN_IF_ERROR(check_range("alert_limit_m", alert_limit_m, 0.001f, 100.0f));
   FW_RETURN_IF_ERROR(check_range("alert_limit_rad", alert_limit_rad, 0.0001f, 3.2f));

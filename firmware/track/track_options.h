@@ -58,6 +58,28 @@ struct TrackOptions {
   // After a contradicting scan, this many consecutive consistent scans before `localized` again
   // (hysteresis: a fault seen is evidence that the odometry or the fit may be wrong unseen too).
   std::uint32_t recovery_steps = 5;
+  // Alias check (ambiguity along weak axes, firmware/mml/pose_uniqueness.h): every supported scan
+  // is also refined from rivals seeded every `alias_step_m` up to `alias_max_shift_m` along the two
+  // principal axes of its information. A rival > alias_min_separation_m away that fits better by
+  // more than `alias_margin` (truncated cost, units of clip²) contradicts the pose — the scan says
+  // the robot is elsewhere (a track that slid into a look-alike); one within the margin makes the
+  // pose ambiguous: the data cannot tell the two apart, so the PL (one Gaussian mode) cannot cover
+  // the error and the status is not `localized` until the scans are unique again for
+  // `recovery_steps` scans. The PL is a single-mode bound; this check is what makes it one.
+  bool alias_check = true;
+  float alias_max_shift_m = 3.0f;
+  float alias_step_m = 0.4f;
+  float alias_min_separation_m = 0.4f;
+  float alias_clip_m = 0.15f;
+  float alias_margin = 0.01f;
+  // A better rival contradicts only when a paired test of the per-point costs says so at this z
+  // (3.09: one-sided 1e-3), the end-points counted once per correlation cell.
+  float alias_z = 3.09f;
+  // Global cross-check (tracked_localizer.h): when the track stops being `localized` while still
+  // tracked (an alias, a fault being recovered, scans that say nothing), MML searches in the
+  // background from a fresh local map for at most this many scans; if it isolates a pose outside the
+  // track's protection level, the track was in a look-alike and MML's fix replaces it. 0 = off.
+  std::uint32_t cross_check_steps = 300;
   // Protection level (protection_level.h): integrity risk per `localized` step and alert limits.
   float integrity_risk = 1e-3f;
   float alert_limit_m = 0.5f;             // PL beyond → not `localized` (the product's 0.5 m bound)

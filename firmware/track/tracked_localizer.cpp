@@ -18,7 +18,8 @@ Status TrackedLocalizer::init(const TrackOptions& options, const GlobalMap& map,
 void TrackedLocalizer::reset() {
   tracker_.reset();
   if (mml_ != nullptr) mml_->reset();
-  fixes_ = fix_rejections_ = tracks_lost_ = 0;
+  fixes_ = fix_rejections_ = tracks_lost_ = cross_check_switches_ = 0;
+  cross_check_left_ = 0;
 }
 
 // End-points within the tracker's range, evenly subsampled to at most align.max_points (beam order
@@ -64,9 +65,11 @@ Status TrackedLocalizer::step(const hal::LaserScan& scan, const hal::Odometry& o
     out->timestamp_ns = scan.timestamp_ns;
     out->scan_id = scan.scan_id;
     publish_track(ts, out);
-    if (ts.lost) {
+    if (!ts.lost) return cross_check(scan, odom, wheel, n, ts, out);
+    {
       // The track is given up: global localization from a fresh local map, starting with this scan.
       ++tracks_lost_;
+      cross_check_left_ = 0;
       mml_->reset();
       hal::PoseEstimate g;
       FW_RETURN_IF_ERROR(mml_->step(scan, odom, &g));
@@ -82,19 +85,57 @@ Status TrackedLocalizer::step(const hal::LaserScan& scan, const hal::Odometry& o
   out->protection_xy_m = out->protection_theta_rad = 0.0f;
   if (out->status != hal::LocalizationStatus::kLocalized) return Status::ok();
   // MML says the pose is isolated: the tracker must confirm it on this scan before it is published.
+  const hal::PoseEstimate g = *out;
+  start_from_fix(g, wheel, n, out);
+  return Status::ok();
+}
+
+bool TrackedLocalizer::start_from_fix(const hal::PoseEstimate& g, const Se2f& wheel, std::size_t n,
+                                      hal::PoseEstimate* out) {
   Eigen::Matrix3f cov;
   for (int r = 0; r < 3; ++r)
-    for (int c = 0; c < 3; ++c) cov(r, c) = out->cov[r * 3 + c];
-  tracker_.start(Se2f(out->x, out->y, out->theta), cov, wheel);
+    for (int c = 0; c < 3; ++c) cov(r, c) = g.cov[r * 3 + c];
+  tracker_.start(Se2f(g.x, g.y, g.theta), cov, wheel);
   const TrackStep ts = tracker_.step(pts_, n, wheel, /*predict=*/false);
   if (ts.status == hal::LocalizationStatus::kLocalized && !ts.lost) {
     ++fixes_;
     publish_track(ts, out);
-    return Status::ok();
+    return true;
   }
   ++fix_rejections_;
   tracker_.reset();
   out->status = hal::LocalizationStatus::kAmbiguous;
+  out->mode = hal::LocalizationMode::kGlobal;
+  out->protection_xy_m = out->protection_theta_rad = 0.0f;
+  return false;
+}
+
+Status TrackedLocalizer::cross_check(const hal::LaserScan& scan, const hal::Odometry& odom, const Se2f& wheel,
+                                     std::size_t n, const TrackStep& ts, hal::PoseEstimate* out) {
+  const std::uint32_t budget = tracker_.options().cross_check_steps;
+  if (budget == 0) return Status::ok();
+  if (ts.status != hal::LocalizationStatus::kLocalized) {
+    if (cross_check_left_ == 0) mml_->reset();  // a fresh local map from this scan on
+    cross_check_left_ = budget;                 // runs on for `budget` scans after the last doubt
+  }
+  if (cross_check_left_ == 0) return Status::ok();
+  --cross_check_left_;
+  hal::PoseEstimate g;
+  FW_RETURN_IF_ERROR(mml_->step(scan, odom, &g));
+  if (g.status != hal::LocalizationStatus::kLocalized) return Status::ok();
+  cross_check_left_ = 0;
+  const float d = std::hypot(g.x - ts.pose.x, g.y - ts.pose.y);
+  const float dth = std::fabs(wrap_angle(g.theta - ts.pose.theta));
+  if (d <= ts.pl.xy_m && dth <= ts.pl.theta_rad) return Status::ok();  // MML isolates the tracked pose
+  // MML isolates a pose the track does not contain: the track sat in a look-alike.
+  ++cross_check_switches_;
+  ++tracks_lost_;
+  *out = hal::PoseEstimate();
+  out->timestamp_ns = scan.timestamp_ns;
+  out->scan_id = scan.scan_id;
+  out->status = hal::LocalizationStatus::kAmbiguous;
+  out->mode = hal::LocalizationMode::kGlobal;
+  start_from_fix(g, wheel, n, out);
   return Status::ok();
 }
 

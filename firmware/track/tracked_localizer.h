@@ -4,6 +4,12 @@
 // `localized`. Tracking mode aligns every scan on the global map from the odometry prediction
 // (pose_tracker.h) and publishes the pose with its protection level; when the integrity monitor
 // gives the track up (kidnap, divergence, unmapped space) MML restarts with a fresh local map.
+// Global cross-check (extension): whenever the tracked pose stops being `localized` (an alias along a
+// weak axis, a fault being recovered), MML starts searching in the background from a fresh local map
+// and keeps going for TrackOptions::cross_check_steps scans; if it isolates a pose outside the
+// track's protection level, the track sat in a look-alike (a kidnap into a twin corridor with the
+// wheels still is invisible to every local test) and MML's fix, confirmed by the tracker as any fix,
+// replaces it. If MML isolates the tracked pose, the search stops.
 // PoseEstimate.mode says which one is active; protection_xy_m / protection_theta_rad are set on
 // every `localized` pose. Never allocates in step(); both parts live in static storage.
 #pragma once
@@ -33,14 +39,21 @@ class TrackedLocalizer final : public Localizer {
   std::uint32_t fixes() const { return fixes_; }
   std::uint32_t fix_rejections() const { return fix_rejections_; }
   std::uint32_t tracks_lost() const { return tracks_lost_; }
+  std::uint32_t cross_check_switches() const { return cross_check_switches_; }  // tracks replaced by MML
+  bool cross_checking() const { return cross_check_left_ > 0; }
 
  private:
   std::size_t scan_points(const hal::LaserScan& scan);
   void publish_track(const TrackStep& ts, hal::PoseEstimate* out) const;
+  // MML's fix in `g` → tracker started and confirmed on this scan; false (tracker reset) if not.
+  bool start_from_fix(const hal::PoseEstimate& g, const Se2f& wheel, std::size_t n, hal::PoseEstimate* out);
+  Status cross_check(const hal::LaserScan& scan, const hal::Odometry& odom, const Se2f& wheel, std::size_t n,
+                     const TrackStep& ts, hal::PoseEstimate* out);
   mml::MmlLocalizer* mml_ = nullptr;
   PoseTracker tracker_;
   Point2f pts_[hal::LaserScan::kMaxBeams];
-  std::uint32_t fixes_ = 0, fix_rejections_ = 0, tracks_lost_ = 0;
+  std::uint32_t fixes_ = 0, fix_rejections_ = 0, tracks_lost_ = 0, cross_check_switches_ = 0;
+  std::uint32_t cross_check_left_ = 0;  // scans the background search still runs (0 = idle)
 };
 
 }  // namespace track

@@ -130,7 +130,7 @@ std::vector<ReferencePose> reference_with_bounds(const CarmenLog& raw, const std
   // Before the first corrected pose: backward chain only.
   for (size_t i = 0; i < u.front().pos; ++i) {
     out[i].pose = chain(u.front().c->pose, odo(u.front().pos), odo(i));
-    out[i].bound = inf;
+    out[i].bound = out[i].bound_theta = inf;
   }
   for (size_t k = 0; k < u.size(); ++k) {
     const size_t a = u[k].pos;
@@ -139,7 +139,7 @@ std::vector<ReferencePose> reference_with_bounds(const CarmenLog& raw, const std
     if (k + 1 == u.size()) {
       for (size_t i = a + 1; i < n; ++i) {
         out[i].pose = chain(u[k].c->pose, odo(a), odo(i));
-        out[i].bound = inf;
+        out[i].bound = out[i].bound_theta = inf;
       }
       break;
     }
@@ -153,6 +153,7 @@ std::vector<ReferencePose> reference_with_bounds(const CarmenLog& raw, const std
       const fw::Se2d bb = chain(u[k + 1].c->pose, odo(b), odo(i));
       out[i].pose = blend(f, bb, w);
       out[i].bound = ((1.0 - w) * std::sqrt(w) + w * std::sqrt(1.0 - w)) * r;
+      out[i].bound_theta = ((1.0 - w) * std::sqrt(w) + w * std::sqrt(1.0 - w)) * std::fabs(closure.theta);
     }
   }
   return out;

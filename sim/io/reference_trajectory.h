@@ -19,7 +19,8 @@
 // bias even cancels to first order in the blend); for random-walk drift (ε(n) ∝ √n) it is
 // e_C + ((1-w)√w + w√(1-w))ε(D) ≤ e_C + 0.71ε(D). The closure residual r_k = |F_{i_{k+1}} ⊖ C_{k+1}|
 // (per gap: reference_gap_stats) is the observable estimate of ε(D) (it also contains the corrected
-// poses' own relative error). ReferencePose::bound = ((1-w)√w + w√(1-w))·r_k, which covers linear,
+// poses' own relative error). ReferencePose::bound = ((1-w)√w + w√(1-w))·r_k (bound_theta: the same
+// weight times the rotational closure residual), which covers linear,
 // convex and √n growth; e_C is not included (unknown; GMapping maps of these logs are consistent to a
 // few cm — see the relations figures in sim/io/data_test.cpp). One-sided extrapolation before the
 // first / after the last corrected pose has no bound (inf).
@@ -53,6 +54,7 @@ std::vector<fw::Se2d> reference_at_every_scan(const CarmenLog& raw, const std::v
 struct ReferencePose {
   fw::Se2d pose;
   double bound = 0;  // estimated translational error bound (m), see header comment; inf when extrapolated
+  double bound_theta = 0;  // the same for the heading (rad), from the rotational closure residual
   bool exact = false;  // a corrected pose was given for this scan
 };
 std::vector<ReferencePose> reference_with_bounds(const CarmenLog& raw, const std::vector<CorrectedPose>& corrected);

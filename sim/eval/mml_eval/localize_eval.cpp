@@ -43,9 +43,10 @@ void describe_failures(const LoadedDataset& ds, const std::string& label, std::s
     if (s.err_m <= b.bound_m && s.err_rad <= b.bound_rad) continue;
     ++total;
     // One line per failure episode (first step of a run of failures), at most 5 per trial.
-    const bool new_episode = k == 0 || !(t.steps[k - 1].status == hal::LocalizationStatus::kLocalized &&
-                                         std::isfinite(t.steps[k - 1].err_m) &&
-                                         (t.steps[k - 1].err_m > b.bound_m || t.steps[k - 1].err_rad > b.bound_rad));
+    const StepLog* p = k > 0 ? &t.steps[k - 1] : nullptr;
+    const bool new_episode = p == nullptr || !(p->status == hal::LocalizationStatus::kLocalized && p->ref_ok &&
+                                               std::isfinite(p->err_m) &&
+                                               (p->err_m > b.bound_m || p->err_rad > b.bound_rad));
     if (!new_episode || shown >= 5) continue;
     ++shown;
     std::string hist;
@@ -72,6 +73,25 @@ void describe_failures(const LoadedDataset& ds, const std::string& label, std::s
     *notes << "- " << buf << "\n";
     if (verbose) std::printf("    %s\n", buf);
   }
+  // Steps excluded by the reference checks (never silently): the first 3 per trial.
+  std::size_t listed = 0, excluded = 0;
+  for (std::size_t k = 0; k < t.steps.size(); ++k) {
+    const StepLog& s = t.steps[k];
+    if (!s.ref_map_contradicted && !s.ref_within_bound) continue;
+    ++excluded;
+    if (listed >= 3) continue;
+    ++listed;
+    char buf[400];
+    std::snprintf(buf, sizeof(buf),
+                  "excluded: %s %s trial %zu step %zu scan %zu: err vs log reference %.2f m %.1f deg, vs map pose %.2f m "
+                  "%.1f deg, reference bound %.2f m %.1f deg, PL %.2f m %.1f deg (%s)",
+                  ds.name.c_str(), label.c_str(), trial, k + 1, s.scan, s.err_m, s.err_rad * 57.2958, s.map_err_m,
+                  s.map_err_rad * 57.2958, s.ref_bound_m, s.ref_bound_rad * 57.2958, s.pl_xy, s.pl_theta * 57.2958,
+                  s.ref_map_contradicted ? "the map's pose clears it" : "within the reference's own bound");
+    *notes << "- " << buf << "\n";
+  }
+  if (excluded > listed) *notes << "  (" << ds.name << " " << label << " trial " << trial << ": " << excluded
+                                << " steps excluded by the reference checks in total)\n";
   if (total > 0) {
     char buf[160];
     std::snprintf(buf, sizeof(buf), "  (%s %s trial %zu: %zu integrity-failure steps in total)", ds.name.c_str(),
@@ -110,6 +130,23 @@ void write_plots(const LocalizePlan& plan, const LoadedDataset& ds, const std::s
   if (!plan.plots || trials.empty()) return;
   const std::string base = plan.out_dir + "/" + ds.key + "_" + label;
   std::string e;
+  // Every step of every trial, for a person (or a script) to look at a failure in detail.
+  {
+    std::ofstream csv(base + "_steps.csv");
+    csv << "trial,step,scan,segment,status,mode,est_x,est_y,est_theta,ref_x,ref_y,ref_theta,ref_ok,err_m,err_deg,"
+           "pl_xy_m,pl_theta_deg,unsupported\n";
+    for (std::size_t k = 0; k < trials.size(); ++k)
+      for (std::size_t i = 0; i < trials[k].steps.size(); ++i) {
+        const StepLog& s = trials[k].steps[i];
+        char buf[384];
+        std::snprintf(buf, sizeof(buf), "%zu,%zu,%zu,%zu,%s,%s,%.4f,%.4f,%.5f,%.4f,%.4f,%.5f,%d,%.4f,%.3f,%.3f,%.3f,%u\n", k, i,
+                      s.scan, s.segment, hal::status_name(s.status),
+                      s.mode == hal::LocalizationMode::kTracking ? "tracking" : "global", s.estimate.x, s.estimate.y,
+                      s.estimate.theta, s.truth.x, s.truth.y, s.truth.theta, s.ref_ok ? 1 : 0, s.err_m,
+                      s.err_rad * 57.29578, s.pl_xy, s.pl_theta * 57.29578, s.unsupported_steps);
+        csv << buf;
+      }
+  }
   if (!write_error_plot(base + "_error.svg", ds.name + " - " + label + ": error over metres", trials,
                         ds.success_bound_m, &e) ||
       !write_map_plot(base + "_map.svg", base + "_map.png", ds, ds.name + " - " + label, trials, region, &e)) {
@@ -212,6 +249,12 @@ bool run_localize_evaluation(const LocalizePlan& plan, BenchJson* json, std::str
     json->add_int(D + "_integrity_failures", static_cast<long long>(s.integrity_failures));
     json->add_int(D + "_localized_steps_checked", static_cast<long long>(s.localized_checked));
     json->add(D + "_pl_exceed_rate", s.pl_exceed_rate);
+    // The same against the log reference alone, and what the reference checks excluded.
+    json->add_int(D + "_integrity_failures_vs_log_reference", static_cast<long long>(s.integrity_failures_raw));
+    json->add(D + "_pl_exceed_rate_vs_log_reference",
+              s.pl_steps_raw ? static_cast<double>(s.pl_exceed_raw) / s.pl_steps_raw : NAN);
+    json->add_int(D + "_excluded_map_steps", static_cast<long long>(s.excluded_map_steps));
+    json->add_int(D + "_excluded_ref_bound_steps", static_cast<long long>(s.excluded_bound_steps));
     json->add(D + "_pl_exceed_xy_rate", s.pl_steps ? static_cast<double>(s.pl_exceed_xy) / s.pl_steps : NAN);
     json->add(D + "_pl_exceed_theta_rate", s.pl_steps ? static_cast<double>(s.pl_exceed_theta) / s.pl_steps : NAN);
     json->add(D + "_availability_steps", static_cast<double>(s.avail_steps));

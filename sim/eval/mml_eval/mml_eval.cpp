@@ -121,6 +121,22 @@ std::size_t check_reference_against_relations(LoadedDataset* ds, const std::vect
   return checked;
 }
 
+namespace {
+// Reference at every scan and its own error bounds (sim/io/reference_trajectory.h). Extrapolated
+// scans (before the first / after the last corrected pose) have no bound: 0 is used there, which
+// counts every error against the localizer.
+void set_reference(LoadedDataset* ds, const std::vector<CorrectedPose>& cp) {
+  ds->reference.clear();
+  ds->ref_bound_m.clear();
+  ds->ref_bound_rad.clear();
+  for (const ReferencePose& r : reference_with_bounds(ds->log, cp)) {
+    ds->reference.push_back(r.pose);
+    ds->ref_bound_m.push_back(std::isfinite(r.bound) ? r.bound : 0.0);
+    ds->ref_bound_rad.push_back(std::isfinite(r.bound_theta) ? r.bound_theta : 0.0);
+  }
+}
+}  // namespace
+
 bool load_dataset(const std::string& name, LoadedDataset* ds, std::string* err) {
   const Dataset* d = find_dataset(name);
   if (d == nullptr || (d->raw_log.empty() && d->corrected_log.empty()))
@@ -151,7 +167,7 @@ bool load_dataset(const std::string& name, LoadedDataset* ds, std::string* err) 
   if (!d->corrected_poses.empty()) {
     std::vector<CorrectedPose> cp;
     if (!read_corrected_poses(data_path(d->corrected_poses), &cp, &e)) return fail(err, e);
-    ds->reference = reference_at_every_scan(ds->log, cp);
+    set_reference(ds, cp);
     ds->reference_note = "corrected poses chained with odometry (sim/io/reference_trajectory.h)";
   }
   bool from_relations = false;
@@ -170,7 +186,7 @@ bool load_dataset(const std::string& name, LoadedDataset* ds, std::string* err) 
         cp[k].ipc_timestamp = ds->log.scans[idx[k]].ipc_timestamp;
         cp[k].pose = robot[k];
       }
-      ds->reference = reference_at_every_scan(ds->log, cp);
+      set_reference(ds, cp);
       for (std::size_t i = 0; i < ds->reference.size() && robotlaser; ++i) {
         const auto& s = ds->log.scans[i];
         ds->reference[i] = ds->reference[i].compose(s.odom.between(s.pose));
@@ -232,7 +248,7 @@ bool load_dataset_files(const DatasetFiles& f, LoadedDataset* ds, std::string* e
       return fail(err, "mml-eval: " + f.reference + ": first flaser_index " + std::to_string(cp.front().flaser_index) +
                            " is beyond the log's " + std::to_string(ds->log.scans.size()) + " scans (" + f.log + ")");
     }
-    ds->reference = reference_at_every_scan(ds->log, cp);
+    set_reference(ds, cp);
     ds->reference_note = "corrected poses " + f.reference + " chained with odometry";
   } else {
     CarmenLog ref;
@@ -332,6 +348,12 @@ std::vector<std::size_t> draw_starts(const LoadedDataset& ds, std::size_t count,
   return out;
 }
 
+const ReferenceMapFit& LoadedDataset::reference_map_fit(std::size_t scan) const {
+  auto it = ref_map_checks.find(scan);
+  if (it != ref_map_checks.end()) return it->second;
+  return ref_map_checks.emplace(scan, check_reference_against_map(map, log.scans[scan], reference[scan])).first->second;
+}
+
 TrialResult run_trial(fw::Localizer& loc, const LoadedDataset& ds, std::size_t start, const TrialOptions& opt,
                       const double* region, const std::function<std::size_t()>& matched_points) {
   TrialResult tr;
@@ -400,6 +422,7 @@ TrialResult run_trial(fw::Localizer& loc, const LoadedDataset& ds, std::size_t s
     ++seg_steps;
     StepLog st;
     st.scan = i;
+    st.map_err_m = st.map_err_rad = std::numeric_limits<double>::quiet_NaN();
     st.segment = segment;
     st.odom = od;
     if (matched_points) st.matched_points = matched_points();
@@ -420,6 +443,37 @@ TrialResult run_trial(fw::Localizer& loc, const LoadedDataset& ds, std::size_t s
       st.err_rad = std::fabs(fw::wrap_angle(static_cast<double>(est.theta) - st.truth.theta));
     } else {
       st.err_m = st.err_rad = std::numeric_limits<double>::quiet_NaN();
+    }
+    // A failure or PL exceedance must hold against the log reference AND the map's pose for this scan
+    // (reference_map_check.h); a step where the map clears the estimate is excluded and counted.
+    if (st.has_pose && st.ref_ok && est.status == hal::LocalizationStatus::kLocalized) {
+      const double bound_rad = 5.0 * 3.14159265358979 / 180.0;
+      // The log reference is itself off by up to its bound (closure residual, reference_trajectory.h):
+      // an error counts against the localizer only beyond the limit plus that bound.
+      const double rb_m = ds.reference_bound_m(i), rb_rad = ds.reference_bound_rad(i);
+      auto fails = [&](double em, double er, double bm, double br) {
+        return em > ds.success_bound_m + bm || er > bound_rad + br;
+      };
+      auto exceeds = [&](double em, double er, double bm, double br) {
+        return (st.pl_xy > 0 && em > st.pl_xy + bm) || (st.pl_theta > 0 && er > st.pl_theta + br);
+      };
+      if (fails(st.err_m, st.err_rad, 0, 0) || exceeds(st.err_m, st.err_rad, 0, 0)) {
+        const ReferenceMapFit& f = ds.reference_map_fit(i);
+        const double em = std::hypot(est.x - f.best.x, est.y - f.best.y);
+        const double er = std::fabs(fw::wrap_angle(static_cast<double>(est.theta) - f.best.theta));
+        st.map_err_m = em;
+        st.map_err_rad = er;
+        st.ref_bound_m = rb_m;
+        st.ref_bound_rad = rb_rad;
+        if (f.improves && ((fails(st.err_m, st.err_rad, rb_m, rb_rad) && !fails(em, er, 0, 0)) ||
+                           (exceeds(st.err_m, st.err_rad, rb_m, rb_rad) && !exceeds(em, er, 0, 0)))) {
+          st.ref_ok = false;
+          st.ref_map_contradicted = true;
+        } else if (!fails(st.err_m, st.err_rad, rb_m, rb_rad) && !exceeds(st.err_m, st.err_rad, rb_m, rb_rad)) {
+          st.ref_ok = false;  // within the reference's own error bound of the limits: cannot be judged
+          st.ref_within_bound = true;
+        }
+      }
     }
     if (region) {
       st.in_region = st.truth.x >= region[0] && st.truth.x <= region[2] && st.truth.y >= region[1] && st.truth.y <= region[3];
@@ -498,6 +552,15 @@ TrialMetrics trial_metrics(const TrialResult& t, const MetricBounds& b) {
     if (!is_loc(s)) continue;
     if (!checkable(s)) {
       ++m.excluded_ref_steps;
+      m.excluded_map_steps += s.ref_map_contradicted;
+      m.excluded_bound_steps += s.ref_within_bound;
+      if ((s.ref_map_contradicted || s.ref_within_bound) && std::isfinite(s.err_m)) {
+        m.integrity_failures_raw += wrong(s);
+        if (s.pl_xy > 0.0f || s.pl_theta > 0.0f) {
+          ++m.pl_steps_raw;
+          m.pl_exceed_raw += (s.pl_xy > 0.0f && s.err_m > s.pl_xy) || (s.pl_theta > 0.0f && s.err_rad > s.pl_theta);
+        }
+      }
       continue;
     }
     ++m.localized_steps;
@@ -514,6 +577,9 @@ TrialMetrics trial_metrics(const TrialResult& t, const MetricBounds& b) {
     }
     if (s.mode == hal::LocalizationMode::kTracking) m.track_err.push_back(s.err_m);
   }
+  m.integrity_failures_raw += m.integrity_failures;
+  m.pl_steps_raw += m.pl_steps;
+  m.pl_exceed_raw += m.pl_exceed;
   if (kid != TrialResult::kNone && kid < t.steps.size()) {
     m.kidnapped = true;
     for (std::size_t k = kid; k < t.steps.size(); ++k) {
@@ -611,6 +677,11 @@ SystemSummary summarize(const std::string& dataset, const std::string& system, c
     s.localized_checked += m.localized_steps;
     s.integrity_failures += m.integrity_failures;
     s.excluded_ref_steps += m.excluded_ref_steps;
+    s.excluded_map_steps += m.excluded_map_steps;
+    s.excluded_bound_steps += m.excluded_bound_steps;
+    s.integrity_failures_raw += m.integrity_failures_raw;
+    s.pl_steps_raw += m.pl_steps_raw;
+    s.pl_exceed_raw += m.pl_exceed_raw;
     s.pl_steps += m.pl_steps;
     s.pl_exceed += m.pl_exceed;
     s.pl_exceed_xy += m.pl_exceed_xy;
@@ -642,18 +713,18 @@ std::string product_markdown_table(const std::vector<SystemSummary>& rows) {
   std::ostringstream o;
   o << "| dataset | system | trials | first-fix success | m to fix (median) | availability | localized steps checked | "
        "integrity failures | PL exceed rate | track err median (m) | track err p95 (m) | kidnaps | kidnap delay "
-       "(median steps) | kidnap re-fix success | re-fix m (median) | kidnap integrity failures | excluded (ref) | step "
+       "(median steps) | kidnap re-fix success | re-fix m (median) | kidnap integrity failures | excluded (ref: all / map / bound) | step "
        "p50 (ms) | step p99 (ms) |\n";
   o << "|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|\n";
   char buf[768];
   for (const auto& r : rows) {
     std::snprintf(buf, sizeof(buf),
                   "| %s | %s | %zu | %.2f (%zu/%zu) | %.1f | %.4f | %zu | %zu | %.4f (%zu/%zu) | %.3f | %.3f | %zu | %.0f | "
-                  "%.2f | %.1f | %zu | %zu | %.2f | %.1f |\n",
+                  "%.2f | %.1f | %zu | %zu / %zu / %zu | %.2f | %.1f |\n",
                   r.dataset.c_str(), r.system.c_str(), r.trials, r.first_fix_success, r.first_fix_successes, r.trials,
                   r.m_to_fix_median, r.availability, r.localized_checked, r.integrity_failures, r.pl_exceed_rate,
                   r.pl_exceed, r.pl_steps, r.track_err_median_m, r.track_err_p95_m, r.kidnaps, r.kidnap_delay_median,
-                  r.kidnap_refix_success, r.kidnap_refix_m_median, r.kidnap_integrity_failures, r.excluded_ref_steps,
+                  r.kidnap_refix_success, r.kidnap_refix_m_median, r.kidnap_integrity_failures, r.excluded_ref_steps, r.excluded_map_steps, r.excluded_bound_steps,
                   r.step_ms_p50, r.step_ms_p99);
     o << buf;
   }

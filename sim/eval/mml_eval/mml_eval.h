@@ -6,6 +6,7 @@
 
 #include <cstdint>
 #include <functional>
+#include <map>
 #include <memory>
 #include <string>
 #include <vector>
@@ -16,6 +17,7 @@
 #include "firmware/runtime/localizer.h"
 #include "hal/msg/pose_estimate.h"
 #include "sim/io/carmen_log.h"
+#include "sim/eval/mml_eval/reference_map_check.h"
 #include "sim/io/relations.h"
 #include "sim/io/ros_map.h"
 
@@ -44,6 +46,16 @@ struct LoadedDataset {
   std::string ref_check_note;       // "checked against N relations: M scans excluded", or why not
   bool synthetic_odometry = false;  // odometry synthesised from the reference (synthesize_odometry)
   bool reference_unreliable(std::size_t scan) const { return scan < ref_unreliable.size() && ref_unreliable[scan]; }
+  // Reference checked against the map (reference_map_check.h), lazily at the scans where a
+  // `localized` error exceeds the bounds or the protection level; cached per scan (trials run one
+  // after the other).
+  mutable std::map<std::size_t, ReferenceMapFit> ref_map_checks;
+  // The reference's own error bound at every scan (closure residual weights, reference_trajectory.h);
+  // empty = exact reference (corrected logs).
+  std::vector<double> ref_bound_m, ref_bound_rad;
+  double reference_bound_m(std::size_t scan) const { return scan < ref_bound_m.size() ? ref_bound_m[scan] : 0.0; }
+  double reference_bound_rad(std::size_t scan) const { return scan < ref_bound_rad.size() ? ref_bound_rad[scan] : 0.0; }
+  const ReferenceMapFit& reference_map_fit(std::size_t scan) const;
 };
 
 // Loads log, reference and the cached global map (built on first use under build/maps).
@@ -122,6 +134,10 @@ struct StepLog {
   double err_m = 0, err_rad = 0;
   bool has_pose = true;
   bool ref_ok = true;       // reference reliable at this scan (check_reference_against_relations)
+  bool ref_map_contradicted = false;  // the map contradicts the reference here (ref_ok false too)
+  bool ref_within_bound = false;      // error beyond a limit by less than the reference's own bound (ref_ok false)
+  double map_err_m = 0, map_err_rad = 0;  // error against the map's pose (when the map check ran; else NaN)
+  double ref_bound_m = 0, ref_bound_rad = 0;  // the reference's own bound at this scan
   float pl_xy = 0, pl_theta = 0;  // published protection level (0 = none)
   std::uint16_t unsupported_steps = 0;
   std::size_t segment = 0;  // 1 after a kidnap
@@ -168,7 +184,12 @@ struct TrialMetrics {
   std::size_t integrity_failures = 0;   // of those: error beyond the bounds
   std::size_t pl_steps = 0, pl_exceed = 0;
   std::size_t pl_exceed_xy = 0, pl_exceed_theta = 0;  // which bound was exceeded (both may count)
-  std::size_t excluded_ref_steps = 0;   // `localized` steps skipped: reference unreliable
+  std::size_t excluded_ref_steps = 0;   // `localized` steps skipped: reference unreliable (relations or map)
+  std::size_t excluded_map_steps = 0;   // … of those: the map contradicts the reference (reference_map_check.h)
+  std::size_t excluded_bound_steps = 0; // … of those: beyond a limit by less than the reference's own bound
+  // Judged against the log reference alone (no map check, no reference bound): shown beside the
+  // judged figures so the exclusions can be weighed.
+  std::size_t integrity_failures_raw = 0, pl_steps_raw = 0, pl_exceed_raw = 0;
   std::vector<double> track_err;        // localized, tracking mode, reliable reference
   bool kidnapped = false;
   bool kidnap_detected = false;         // status left `localized` after the kidnap
@@ -207,7 +228,8 @@ struct SystemSummary {
   double m_to_fix_median = 0;
   double availability = 0;           // pooled avail_localized / avail_steps
   std::size_t avail_steps = 0;
-  std::size_t localized_checked = 0, integrity_failures = 0, excluded_ref_steps = 0;
+  std::size_t localized_checked = 0, integrity_failures = 0, excluded_ref_steps = 0, excluded_map_steps = 0,
+              excluded_bound_steps = 0, integrity_failures_raw = 0, pl_steps_raw = 0, pl_exceed_raw = 0;
   double integrity_failure_rate = 0;  // per error-checked localized step
   std::size_t pl_steps = 0, pl_exceed = 0, pl_exceed_xy = 0, pl_exceed_theta = 0;
   double pl_exceed_rate = 0;

@@ -1,0 +1,53 @@
+// Reference checked against the map at one scan (an evaluation rule, not a localizer guard).
+//
+// The references of the real logs are corrected poses chained with the raw odometry between them
+// (sim/io/reference_trajectory.h). Where the odometry sample attached to a scan is out of step with
+// the laser (fast in-place turns: aces scan 3718 has an odometry turn of 0.306 rad in 84 ms between
+// two scans and 0.056 rad in the next 316 ms), the chained reference is off by several degrees at
+// that single scan, and a localizer that is right there is counted as an integrity failure.
+//
+// The check asks the map for a second reference, independently of any localizer output: a
+// brute-force correlative search (no gradient solver — the tracker uses one, so the check must not
+// share its failure modes) over a window around the log reference counts scan end-points that land
+// within `inlier_m` of an occupied cell. Its best pose is used only when it explains clearly more
+// end-points than the log reference (+max(min_gain_points, min_gain_fraction · n); the reference
+// wins every tie, so a corridor's flat direction never moves it). The evaluation then counts an
+// integrity failure or a protection-level exceedance only when it holds against BOTH references;
+// a step where the map's pose clears the estimate is excluded from the error figures, counted and
+// listed in the report (never silently). A wrong pose in a look-alike place is far from both
+// references (the window is ±0.4 m / ±20° around the log reference), so it is still counted.
+#pragma once
+
+#include <cstddef>
+
+#include "firmware/base/se2.h"
+#include "firmware/map/global_map.h"
+#include "sim/io/carmen_log.h"
+
+namespace sim::mmleval {
+
+struct ReferenceMapCheckOptions {
+  double half_window_m = 0.40;      // translational search window (each axis)
+  double coarse_step_m = 0.05;      // one cell of the 5 cm maps
+  double fine_step_m = 0.0125;
+  double half_window_rad = 0.35;    // = 20°
+  double coarse_step_rad = 0.0087;  // 0.5°
+  double fine_step_rad = 0.0022;    // ≈ 0.125°: an end-point at 20 m moves 4 cm
+  double inlier_m = 0.10;           // two cells
+  double max_range_m = 30.0;
+  std::size_t max_points = 180;     // end-points used (evenly subsampled)
+  std::size_t min_gain_points = 3;
+  double min_gain_fraction = 0.03;
+};
+
+struct ReferenceMapFit {
+  bool improves = false;            // `best` explains clearly more end-points than the log reference
+  fw::Se2d best;                    // best pose of the window (the log reference when !improves)
+  std::size_t points = 0;           // end-points used
+  std::size_t inliers_reference = 0, inliers_best = 0;
+};
+
+ReferenceMapFit check_reference_against_map(const fw::GlobalMap& map, const CarmenScan& scan, const fw::Se2d& reference,
+                                            const ReferenceMapCheckOptions& opt = {});
+
+}  // namespace sim::mmleval
