@@ -5,6 +5,7 @@
 #include <errno.h>
 #include <fcntl.h>
 #include <string.h>
+#include <sys/stat.h>
 #include <unistd.h>
 
 #include <cmath>
@@ -42,17 +43,85 @@ bool spec_ok(const char* v, bool allow_serial, const char* extra) {
   return false;
 }
 
+// Serial rates the termios backend sets (hal/serial/termios_port.h); anything else is refused
+// here, with the line and key, instead of at open time.
+constexpr unsigned long kBauds[] = {9600, 19200, 38400, 57600, 115200, 230400, 500000};
+constexpr const char* kBaudList = "9600, 19200, 38400, 57600, 115200, 230400, 500000";
+
+// "@BAUD" of serial:DEVICE@BAUD: digits only, no overflow, a supported rate.
+bool parse_baud(const char* v, unsigned long* out) {
+  if (!*v) return false;
+  for (const char* c = v; *c; ++c)
+    if (*c < '0' || *c > '9') return false;
+  if (std::strlen(v) > 7) return false;  // > 9999999: no rate of ours, and no overflow below
+  const unsigned long b = std::strtoul(v, nullptr, 10);
+  for (unsigned long k : kBauds)
+    if (b == k) { *out = b; return true; }
+  return false;
+}
+
+// Keys the file may set, each at most once (a second `laser = ...` used to win silently).
+constexpr const char* kKeys[] = {"laser",     "odometry",  "output",  "can_fd",           "localizer",
+                                 "mml_preset", "map",       "workers", "cores",            "realtime",
+                                 "arena_mib", "step_deadline_ms", "health_period_ms", "laser_timeout_ms", "seed",
+                                 "log_level"};
+constexpr int kNumKeys = static_cast<int>(sizeof(kKeys) / sizeof(kKeys[0]));
+
+// The config path as shown in messages: at most kShownPath characters, the end kept (the file
+// name), so a long path never pushes the line, key and problem out of the message.
+constexpr std::size_t kShownPath = 96;
+void shown_path(const char* path, char* out, std::size_t cap) {
+  const std::size_t n = std::strlen(path);
+  if (n < cap) {
+    std::memcpy(out, path, n + 1);
+    return;
+  }
+  const std::size_t keep = cap - 4;
+  std::memcpy(out, "...", 3);
+  std::memcpy(out + 3, path + n - keep, keep + 1);
+}
+
 }  // namespace
 
 #define CFG_ERR(fmt, ...) \
   Status::error(Errc::kInvalidArgument, "config '%s' line %d: key '%s': " fmt, name, line, key, ##__VA_ARGS__)
 
-Status parse_app_config(const char* name, const char* text, std::size_t len, AppConfig* out) {
+namespace {
+
+// Length and form of the part after "kind:" (the board keeps it in fixed buffers): a value that
+// is too long is reported as such, not as a malformed spec; a serial rate must be one we set.
+Status check_backend_arg(const char* name, int line, const char* key, const char* v, std::size_t cap) {
+  const std::size_t n = std::strlen(v);
+  if (n >= cap) return CFG_ERR("value too long (%zu characters, at most %zu)", n, cap - 1);
+  if (!std::strncmp(v, "socketcan:", 10)) {
+    const std::size_t iface = n - 10;
+    if (iface > kMaxCanInterfaceName) {
+      return CFG_ERR("interface name too long (%zu characters, at most %zu)", iface, kMaxCanInterfaceName);
+    }
+    return Status::ok();
+  }
+  if (!std::strncmp(v, "serial:", 7)) {
+    const char* at = std::strchr(v + 7, '@');
+    if (at == v + 7) return CFG_ERR("'%s': no device before '@'", v);
+    if (at != nullptr) {
+      unsigned long baud = 0;
+      if (!parse_baud(at + 1, &baud)) return CFG_ERR("baud '%s' is not one of %s", at + 1, kBaudList);
+    }
+  }
+  return Status::ok();
+}
+
+}  // namespace
+
+Status parse_app_config(const char* path, const char* text, std::size_t len, AppConfig* out) {
   *out = AppConfig{};
+  char name[kShownPath + 1];
+  shown_path(path != nullptr ? path : "", name, sizeof(name));
   char buf[512];
   int line = 0;
   std::size_t pos = 0;
   bool seen_laser = false;
+  int key_line[kNumKeys] = {0};
   while (pos < len) {
     std::size_t e = pos;
     while (e < len && text[e] != '\n') ++e;
@@ -61,6 +130,12 @@ Status parse_app_config(const char* name, const char* text, std::size_t len, App
     if (n >= sizeof(buf)) {
       return Status::error(Errc::kInvalidArgument, "config '%s' line %d: longer than %zu characters", name, line,
                            sizeof(buf) - 1);
+    }
+    // A NUL byte would end the line early for every string function below (a line starting with
+    // one used to vanish): binary junk in a config is an error, not a comment.
+    if (const void* nul = std::memchr(text + pos, '\0', n)) {
+      return Status::error(Errc::kInvalidArgument, "config '%s' line %d: NUL byte at column %zu (binary data?)", name,
+                           line, static_cast<std::size_t>(static_cast<const char*>(nul) - (text + pos)) + 1);
     }
     std::memcpy(buf, text + pos, n);
     buf[n] = '\0';
@@ -84,17 +159,28 @@ Status parse_app_config(const char* name, const char* text, std::size_t len, App
     while (*v == ' ' || *v == '\t') ++v;
     if (!*key) return Status::error(Errc::kInvalidArgument, "config '%s' line %d: empty key", name, line);
     if (!*v) return CFG_ERR("empty value");
+    for (int k = 0; k < kNumKeys; ++k) {
+      if (std::strcmp(key, kKeys[k]) != 0) continue;
+      if (key_line[k] != 0) {
+        return Status::error(Errc::kInvalidArgument, "config '%s' line %d: key '%s' set again (first set on line %d)",
+                             name, line, key, key_line[k]);
+      }
+      key_line[k] = line;
+    }
     long x = 0;
     if (!std::strcmp(key, "laser")) {
-      if (!spec_ok(v, true, nullptr) || !copy(out->laser, sizeof(out->laser), v))
-        return CFG_ERR("'%s' is not socketcan:IFACE or serial:DEVICE[@BAUD]", v);
+      if (!spec_ok(v, true, nullptr)) return CFG_ERR("'%s' is not socketcan:IFACE or serial:DEVICE[@BAUD]", v);
+      FW_RETURN_IF_ERROR(check_backend_arg(name, line, key, v, sizeof(out->laser)));
+      copy(out->laser, sizeof(out->laser), v);
       seen_laser = true;
     } else if (!std::strcmp(key, "odometry")) {
-      if (!spec_ok(v, false, "none") || !copy(out->odometry, sizeof(out->odometry), v))
-        return CFG_ERR("'%s' is not socketcan:IFACE or none", v);
+      if (!spec_ok(v, false, "none")) return CFG_ERR("'%s' is not socketcan:IFACE or none", v);
+      FW_RETURN_IF_ERROR(check_backend_arg(name, line, key, v, sizeof(out->odometry)));
+      copy(out->odometry, sizeof(out->odometry), v);
     } else if (!std::strcmp(key, "output")) {
-      if (!spec_ok(v, false, "log") || !copy(out->output, sizeof(out->output), v))
-        return CFG_ERR("'%s' is not socketcan:IFACE or log", v);
+      if (!spec_ok(v, false, "log")) return CFG_ERR("'%s' is not socketcan:IFACE or log", v);
+      FW_RETURN_IF_ERROR(check_backend_arg(name, line, key, v, sizeof(out->output)));
+      copy(out->output, sizeof(out->output), v);
     } else if (!std::strcmp(key, "can_fd")) {
       bool b = false;
       if (!std::strcmp(v, "auto")) out->can_fd = -1;
@@ -138,6 +224,9 @@ Status parse_app_config(const char* name, const char* text, std::size_t len, App
     } else if (!std::strcmp(key, "health_period_ms")) {
       if (!parse_int(v, 10, 10000, &x)) return CFG_ERR("'%s' is not an integer in 10..10000", v);
       out->health_period_ms = static_cast<std::uint32_t>(x);
+    } else if (!std::strcmp(key, "laser_timeout_ms")) {
+      if (!parse_int(v, 10, 60000, &x)) return CFG_ERR("'%s' is not an integer in 10..60000", v);
+      out->laser_timeout_ms = static_cast<std::uint32_t>(x);
     } else if (!std::strcmp(key, "seed")) {
       if (!parse_int(v, 0, 0x7FFFFFFF, &x)) return CFG_ERR("'%s' is not a non-negative integer", v);
       out->seed = static_cast<std::uint64_t>(x);
@@ -166,10 +255,16 @@ Status parse_app_config(const char* name, const char* text, std::size_t len, App
 
 Status load_app_config(const char* path, AppConfig* out) {
   static char text[16384];
-  const int fd = ::open(path, O_RDONLY | O_CLOEXEC);
+  // O_NONBLOCK + a regular-file check: a FIFO or device given as the config must not block start-up.
+  const int fd = ::open(path, O_RDONLY | O_CLOEXEC | O_NONBLOCK);
   if (fd < 0) {
     const int e = errno;
     return Status::error(Errc::kIoError, "config '%s': %s", path, strerror(e));
+  }
+  struct stat st {};
+  if (::fstat(fd, &st) != 0 || !S_ISREG(st.st_mode)) {
+    ::close(fd);
+    return Status::error(Errc::kIoError, "config '%s': not a regular file", path);
   }
   std::size_t len = 0;
   for (;;) {
@@ -177,13 +272,17 @@ Status load_app_config(const char* path, AppConfig* out) {
     if (n < 0) {
       const int e = errno;
       ::close(fd);
-      return Status::error(Errc::kIoError, "config '%s': read: %s", path, strerror(e));
+      char name[kShownPath + 1];
+      shown_path(path, name, sizeof(name));
+      return Status::error(Errc::kIoError, "config '%s': read: %s", name, strerror(e));
     }
     if (n == 0) break;
     len += static_cast<std::size_t>(n);
     if (len == sizeof(text)) {
       ::close(fd);
-      return Status::error(Errc::kCapacityExceeded, "config '%s': larger than %zu bytes", path, sizeof(text) - 1);
+      char name[kShownPath + 1];
+      shown_path(path, name, sizeof(name));
+      return Status::error(Errc::kCapacityExceeded, "config '%s': larger than %zu bytes", name, sizeof(text) - 1);
     }
   }
   ::close(fd);

@@ -1,6 +1,8 @@
 // mmlfw configuration: a "key = value" text file ('#' comments), validated once at start-up.
-// Every error names the file, the line and the key. Keys (defaults in brackets):
+// Every error names the file, the line and the key; a key set twice, a NUL byte and an overlong
+// value are errors too (nothing is silently dropped or overridden). Keys (defaults in brackets):
 //   laser            socketcan:IFACE | serial:DEVICE[@BAUD]            (required)
+//                    BAUD: 9600 19200 38400 57600 115200 230400 500000 [38400]; IFACE ≤ 15 characters
 //   odometry         socketcan:IFACE | none              [laser's interface when socketcan, else none]
 //   output           socketcan:IFACE | log               [laser's interface when socketcan, else log]
 //   can_fd           auto | true | false                 [auto: FD when the interface MTU is 72]
@@ -13,6 +15,8 @@
 //   arena_mib        1..4096 start-up arena (map + localizer storage) [256]
 //   step_deadline_ms 0.1..1000 Localizer::step longer than this is a deadline miss [13.333 = 75 Hz]
 //   health_period_ms 10..10000 heartbeat period when no scans arrive [200]
+//   laser_timeout_ms 10..60000 no scan for this long: fault `laser-timeout` in HEALTH and a pose
+//                    with status `fault`, cleared by the next scan [500 = a few scan periods]
 //   seed             random seed of the localizer    [1]
 //   log_level        debug | info | warning | error  [info]
 #pragma once
@@ -23,6 +27,9 @@
 #include "firmware/base/status.h"
 
 namespace fw {
+
+// Longest SocketCAN interface name (IFNAMSIZ - 1).
+constexpr std::size_t kMaxCanInterfaceName = 15;
 
 struct AppConfig {
   static constexpr int kMaxCores = 16;
@@ -40,12 +47,13 @@ struct AppConfig {
   std::uint32_t arena_mib = 256;
   double step_deadline_ms = 1000.0 / 75.0;
   std::uint32_t health_period_ms = 200;
+  std::uint32_t laser_timeout_ms = 500;
   std::uint64_t seed = 1;
   int log_level = 1;         // hal::LogLevel
 };
 
-// Parses `text` (len bytes); `name` is used in messages.
-Status parse_app_config(const char* name, const char* text, std::size_t len, AppConfig* out);
+// Parses `text` (len bytes); `path` is used in messages (abbreviated to its last 96 characters).
+Status parse_app_config(const char* path, const char* text, std::size_t len, AppConfig* out);
 // Reads the file (at most 16 KiB) with read(2) into a static buffer and parses it.
 Status load_app_config(const char* path, AppConfig* out);
 

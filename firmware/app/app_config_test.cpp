@@ -1,6 +1,8 @@
 #include "firmware/app/app_config.h"
 
 #include <gtest/gtest.h>
+#include <sys/stat.h>
+#include <unistd.h>
 
 #include <cstring>
 #include <string>
@@ -59,6 +61,109 @@ TEST(AppConfig, ErrorsNameTheKey) {
     ASSERT_FALSE(s.is_ok()) << k.text;
     EXPECT_NE(std::strstr(s.message(), k.must_contain), nullptr) << s.message();
   }
+}
+
+// Issue 13 reproducers: input that used to be accepted silently (or reported wrongly).
+TEST(AppConfig, BaudOverflowIsAnErrorNamingLineAndKey) {
+  AppConfig c;
+  // 4295005696 = 2^32 + 38400: it used to wrap around and run at 38400 Bd.
+  Status s = parse("localizer = odom\nlaser = serial:/dev/ttyUSB0@4295005696\n", &c);
+  ASSERT_FALSE(s.is_ok());
+  EXPECT_NE(std::strstr(s.message(), "line 2: key 'laser'"), nullptr) << s.message();
+  EXPECT_NE(std::strstr(s.message(), "baud '4295005696'"), nullptr) << s.message();
+  for (const char* bad : {"@", "@-9600", "@9600x", "@12345", "@99999999999999999999999", "@0"}) {
+    s = parse(std::string("localizer = odom\nlaser = serial:/dev/ttyS0") + bad + "\n", &c);
+    EXPECT_FALSE(s.is_ok()) << bad;
+    EXPECT_NE(std::strstr(s.message(), "key 'laser'"), nullptr) << s.message();
+  }
+  for (const char* good : {"", "@9600", "@38400", "@500000"}) {
+    s = parse(std::string("localizer = odom\nlaser = serial:/dev/ttyS0") + good + "\n", &c);
+    EXPECT_TRUE(s.is_ok()) << good << ": " << s.message();
+  }
+}
+
+TEST(AppConfig, DuplicateKeysAreAnErrorNamingBothLines) {
+  AppConfig c;
+  Status s = parse("laser = socketcan:vcan0\nlocalizer = odom\nlaser = socketcan:vcan1\n", &c);
+  ASSERT_FALSE(s.is_ok());
+  EXPECT_NE(std::strstr(s.message(), "line 3: key 'laser' set again (first set on line 1)"), nullptr) << s.message();
+  s = parse("laser = socketcan:vcan0\nlocalizer = odom\nworkers = 2\n# comment\nworkers = 3\n", &c);
+  ASSERT_FALSE(s.is_ok());
+  EXPECT_NE(std::strstr(s.message(), "line 5: key 'workers' set again (first set on line 3)"), nullptr) << s.message();
+}
+
+TEST(AppConfig, LineWithNulIsAnErrorNotDropped) {
+  AppConfig c;
+  // A line starting with NUL used to vanish (here: the localizer would silently stay mml-track).
+  const std::string text = std::string("laser = socketcan:vcan0\nmap = /tmp/x.mmap\n") + '\0' + "localizer = odom\n";
+  Status s = parse(text, &c);
+  ASSERT_FALSE(s.is_ok());
+  EXPECT_NE(std::strstr(s.message(), "line 3: NUL byte at column 1"), nullptr) << s.message();
+  const std::string mid = std::string("laser = socketcan:vcan0\nlocalizer = odom") + '\0' + "x\n";
+  s = parse(mid, &c);
+  ASSERT_FALSE(s.is_ok());
+  EXPECT_NE(std::strstr(s.message(), "line 2: NUL byte at column 17"), nullptr) << s.message();
+}
+
+TEST(AppConfig, LongPathNeverCutsLineKeyOrProblem) {
+  AppConfig c;
+  const std::string dir = "/very/long/deployment/path/" + std::string(180, 'd') + "/";
+  const std::string path = dir + "robot.conf";
+  const std::string text = "laser = socketcan:vcan0\nlocalizer = odom\nstep_deadline_ms = not-a-number\n";
+  Status s = parse_app_config(path.c_str(), text.data(), text.size(), &c);
+  ASSERT_FALSE(s.is_ok());
+  const std::string m = s.message();
+  EXPECT_NE(m.find("robot.conf' line 3: key 'step_deadline_ms': 'not-a-number' is not a number in 0.1..1000"),
+            std::string::npos)
+      << m;
+  EXPECT_LT(m.size(), Status::kMessageCapacity - 1) << m;  // nothing cut
+  // A long map path (the map key allows 255 characters) with the problem after it still fits.
+  const std::string map_path = "/" + std::string(250, 'm');
+  Status t = Status::error(Errc::kCorruptData, "map image '%s': header says %llu bytes, the file has %llu (truncated, "
+                           "padded or still being written)", map_path.c_str(), 123456789ull, 4096ull);
+  EXPECT_NE(std::strstr(t.message(), "still being written)"), nullptr) << t.message();
+}
+
+TEST(AppConfig, LongLaserValueIsReportedAsTooLong) {
+  AppConfig c;
+  // 96..127 characters: accepted (the board keeps 127), not "not KIND:ARG".
+  const std::string dev100 = "serial:/dev/serial/by-id/" + std::string(75, 'u');
+  ASSERT_EQ(dev100.size(), 100u);
+  Status s = parse("localizer = odom\nlaser = " + dev100 + "\n", &c);
+  ASSERT_TRUE(s.is_ok()) << s.message();
+  EXPECT_STREQ(c.laser, dev100.c_str());
+  // 128 and more: "value too long", naming the line and key.
+  const std::string dev140 = "serial:/dev/serial/by-id/" + std::string(115, 'u');
+  s = parse("localizer = odom\nlaser = " + dev140 + "\n", &c);
+  ASSERT_FALSE(s.is_ok());
+  EXPECT_NE(std::strstr(s.message(), "line 2: key 'laser': value too long (140 characters, at most 127)"), nullptr)
+      << s.message();
+  s = parse("localizer = odom\nlaser = socketcan:a_very_long_can_interface\n", &c);
+  ASSERT_FALSE(s.is_ok());
+  EXPECT_NE(std::strstr(s.message(), "interface name too long (25 characters, at most 15)"), nullptr) << s.message();
+}
+
+TEST(AppConfig, LaserTimeoutKey) {
+  AppConfig c;
+  ASSERT_TRUE(parse("laser = socketcan:vcan0\nlocalizer = odom\n", &c).is_ok());
+  EXPECT_EQ(c.laser_timeout_ms, 500u);
+  ASSERT_TRUE(parse("laser = socketcan:vcan0\nlocalizer = odom\nlaser_timeout_ms = 250\n", &c).is_ok());
+  EXPECT_EQ(c.laser_timeout_ms, 250u);
+  Status s = parse("laser = socketcan:vcan0\nlocalizer = odom\nlaser_timeout_ms = 0\n", &c);
+  EXPECT_NE(std::strstr(s.message(), "line 3: key 'laser_timeout_ms'"), nullptr) << s.message();
+}
+
+TEST(AppConfig, FifoIsRefusedWithoutBlocking) {
+  char dir[] = "/tmp/mmlfw-config-fifo.XXXXXX";
+  ASSERT_NE(mkdtemp(dir), nullptr);
+  const std::string fifo = std::string(dir) + "/robot.conf";
+  ASSERT_EQ(mkfifo(fifo.c_str(), 0600), 0);
+  AppConfig c;
+  Status s = load_app_config(fifo.c_str(), &c);
+  unlink(fifo.c_str());
+  rmdir(dir);
+  ASSERT_FALSE(s.is_ok());
+  EXPECT_NE(std::strstr(s.message(), "not a regular file"), nullptr) << s.message();
 }
 
 TEST(AppConfig, MissingFileNamesThePath) {

@@ -3,7 +3,10 @@
 // threads (pinned, created once) → localizer → LocalizationLoop; then the arena is sealed and the
 // loop runs until SIGINT/SIGTERM (or --max-scans / --duration). Steady state allocates nothing.
 //   mmlfw --config FILE [--memory-report] [--max-scans N] [--duration S]
-// --memory-report: performs the full start-up, prints the static memory budget by module and exits.
+// --memory-report: performs the full start-up, prints the static memory budget by module and exits;
+// the exit status is non-zero (with the reason on stderr) when this machine cannot run the config:
+// the board (bus, device) cannot be opened, the footprint exceeds the memory the machine or its
+// limits allow, or realtime = true and the memory cannot be locked.
 // On exit a one-line summary "mmlfw summary: {...}" goes to stderr.
 #include <signal.h>
 #include <sys/mman.h>
@@ -13,6 +16,7 @@
 #include <cstring>
 
 #include "firmware/app/app_config.h"
+#include "firmware/app/memory_limits.h"
 #include "firmware/app/system.h"
 #include "firmware/base/arena.h"
 #include "firmware/base/memory_report.h"
@@ -117,14 +121,18 @@ int main(int argc, char** argv) {
   spec.can_fd = c.can_fd;
   spec.log_level = static_cast<hal::LogLevel>(c.log_level);
   st = g_board.create(spec);
-  // The memory report needs no I/O: on a machine without the configured bus it still runs.
+  // The memory report is a pre-flight check: it still prints the budget on a machine without the
+  // configured bus or device, but then exits non-zero with the reason (the hardware cannot run it).
+  const fw::Status board_status = st;
   const bool board_ok = st.is_ok();
   if (!board_ok && !memory_report) return fail("board", st);
-  if (!board_ok) std::fprintf(stderr, "mmlfw: warning: board: %s (memory report only)\n", st.message());
+  if (!board_ok) std::fprintf(stderr, "mmlfw: board: %s (memory report only)\n", st.message());
   hal::Hal& hal = g_board.hal();
   if (board_ok) hal.log->log(hal::LogLevel::kInfo, "mmlfw: board %s", g_board.describe());
 
+  bool lock_refused = false;
   if (c.realtime && mlockall(MCL_CURRENT | MCL_FUTURE) != 0) {
+    lock_refused = true;
     hal.log->log(hal::LogLevel::kWarning, "mmlfw: mlockall refused; continuing without locked memory");
   }
   st = g_arena.init_mapped(static_cast<std::size_t>(c.arena_mib) << 20, c.realtime, "arena");
@@ -166,13 +174,20 @@ int main(int argc, char** argv) {
   st = g_system.build(sys, map, table, table_len, g_arena, &g_pool);
   if (!st) return fail("localizer", st);
   fw::Localizer* localizer = &g_system.localizer();
-  // The map now lives in the arena; a relation table section in use is read in place from the
-  // mapped image (read-only, like flash), so the image stays mapped while the loop runs.
+  // The map now lives in the arena. The image is a start-up copy (map_image_file.h: the file on
+  // disk may be truncated or replaced while the firmware runs); a relation table section in use is
+  // read in place from that copy, so only its pages are kept.
   const bool table_in_use = table != nullptr && g_system.table_in_use();
-  if (!table_in_use) image.close();
+  if (table_in_use) {
+    st = image.retain(table, table_len);
+    if (!st) return fail("map", st);
+  } else {
+    image.close();
+  }
 
   fw::LocalizationLoopOptions lo;
   lo.step_deadline_ns = static_cast<std::uint64_t>(c.step_deadline_ms * 1e6);
+  lo.laser_timeout_ns = static_cast<std::uint64_t>(c.laser_timeout_ms) * 1000000ull;
   if (board_ok) {
     st = g_loop.init(hal, *localizer, lo);
     if (!st) return fail("loop", st);
@@ -182,25 +197,43 @@ int main(int argc, char** argv) {
   mr.add({"hal", "board (sockets, CAN node rings, SICK parser)", sizeof(g_board), 0, nullptr});
   mr.add({"runtime", "localization loop (odometry ring, pending scan, perf)", sizeof(g_loop), 0, nullptr});
   mr.add({"runtime", "worker pool", sizeof(g_pool), static_cast<std::size_t>(c.workers), nullptr});
-  if (table_in_use) mr.add({"map", "relation table (mapped image)", table_len, 0, nullptr});
+  if (table_in_use) mr.add({"map", "relation table (image copy)", table_len, 0, nullptr});
   g_arena.seal();
+  // The map/pransam/mml regions are carved from the arena (listed for the breakdown), so the
+  // footprint is the arena plus the static objects plus the relation table kept from the image.
+  // (The localizer objects are in the arena: system.h.)
+  const std::size_t statics = sizeof(g_board) + sizeof(g_loop) + sizeof(g_pool) + sizeof(g_system);
+  const std::size_t table_copy = table_in_use ? image.mapped_bytes() : 0;
+  const std::uint64_t footprint = static_cast<std::uint64_t>(g_arena.capacity()) + statics + table_copy;
+  const fw::Status memory_status =
+      fw::check_memory_fits(footprint, fw::read_memory_limits(), "arena_mib + static objects + table");
   if (memory_report) {
     std::printf("mmlfw memory report (config '%s', localizer %s, arena used %zu of %zu bytes)\n", config_path,
                 localizer->name(), g_arena.used(), g_arena.capacity());
     mr.print(stdout);
-    // The map/pransam/mml regions above are carved from the arena (listed for the breakdown), so
-    // the footprint is the arena plus the static objects.
-    // (The localizer objects are in the arena: system.h.)
-    const std::size_t statics = sizeof(g_board) + sizeof(g_loop) + sizeof(g_pool) + sizeof(g_system);
-    const std::size_t mapped = table_in_use ? table_len : 0;
-    std::printf("footprint: arena reserved %.3f MiB (used %.3f MiB) + static objects %.3f MiB + mapped table "
-                "%.3f MiB = %.3f MiB (%.3f MiB with the arena trimmed to its use)\n",
+    std::printf("footprint: arena reserved %.3f MiB (used %.3f MiB) + static objects %.3f MiB + relation table "
+                "(image copy) %.3f MiB = %.3f MiB (%.3f MiB with the arena trimmed to its use)\n",
                 g_arena.capacity() / 1048576.0, g_arena.used() / 1048576.0, statics / 1048576.0,
-                mapped / 1048576.0, (g_arena.capacity() + statics + mapped) / 1048576.0,
-                (g_arena.used() + statics + mapped) / 1048576.0);
+                table_copy / 1048576.0, footprint / 1048576.0, (g_arena.used() + statics + table_copy) / 1048576.0);
     g_pool.stop();
-    return 0;
+    // Pre-flight verdict: a configuration this machine cannot run is an error, with the reason.
+    int reasons = 0;
+    if (!board_ok) {
+      std::fprintf(stderr, "mmlfw: memory report: cannot run: board: %s\n", board_status.message());
+      ++reasons;
+    }
+    if (!memory_status) {
+      std::fprintf(stderr, "mmlfw: memory report: cannot run: memory: %s\n", memory_status.message());
+      ++reasons;
+    }
+    if (lock_refused) {
+      std::fprintf(stderr, "mmlfw: memory report: cannot run: realtime = true but mlockall was refused (ulimit -l / "
+                           "CAP_IPC_LOCK)\n");
+      ++reasons;
+    }
+    return reasons == 0 ? 0 : 1;
   }
+  if (!memory_status) hal.log->log(hal::LogLevel::kWarning, "mmlfw: memory: %s", memory_status.message());
 
   struct sigaction sa {};
   sa.sa_handler = on_signal;
@@ -245,6 +278,8 @@ int main(int argc, char** argv) {
                "\"can_crc_errors\": %u, \"can_lost_segments\": %u, \"can_duplicate_segments\": %u, "
                "\"can_odometry\": %u, \"can_rx_frames\": %llu, \"can_rx_dropped\": %llu, \"can_error_frames\": %llu, "
                "\"can_bus_off\": %llu, \"can_tx_failed\": %llu, \"serial_scans\": %u, \"serial_crc_errors\": %u, "
+               "\"invalid_scans\": %u, \"can_invalid_scans\": %u, \"serial_bad_measurements\": %u, "
+               "\"serial_reconnects\": %u, \"laser_timeouts\": %llu, \"fault_bits\": %u, "
                "\"last_status\": \"%s\"}\n",
                h.scans_processed, static_cast<unsigned long long>(step_errors), step.p50_ms, step.p99_ms, step.max_ms,
                total.p99_ms, h.deadline_misses, h.dropped_scans, h.timeouts,
@@ -258,8 +293,10 @@ int main(int argc, char** argv) {
                bus ? static_cast<unsigned long long>(bus->bus_off) : 0ull,
                bus ? static_cast<unsigned long long>(bus->tx_failed) : 0ull,
                g_board.sick() ? g_board.sick()->stats().scans : 0,
-               g_board.sick() ? g_board.sick()->parser_stats().crc_errors : 0,
-               hal::status_name(g_loop.last_estimate().status));
+               g_board.sick() ? g_board.sick()->parser_stats().crc_errors : 0, h.invalid_scans,
+               node ? node->decoder_stats().invalid_scans : 0, g_board.sick() ? g_board.sick()->stats().bad_measurements : 0,
+               g_board.serial_reconnects(), static_cast<unsigned long long>(g_loop.counters().laser_timeouts),
+               h.fault_bits, hal::status_name(g_loop.last_estimate().status));
   g_pool.stop();
   return 0;
 }

@@ -17,6 +17,10 @@ enum class Fault : std::uint32_t {
   kNumerical = 1u << 6,         // NaN where the math guarantees a number
 };
 
+// Bits 16..31 of the published fault word are hal::HealthFault (sensor/link faults such as
+// laser-timeout, hal/msg/health.h): they are bad luck, set and cleared by the runtime, never raised here.
+constexpr std::uint32_t kInternalFaultMask = 0x0000FFFFu;
+
 using FaultHandler = void (*)(Fault fault, std::uint32_t all_bits);
 
 // Sets the bit (atomic) and calls the handler if one is installed.

@@ -1,6 +1,7 @@
 #include "firmware/base/status.h"
 
 #include <cstdio>
+#include <cstring>
 
 namespace fw {
 
@@ -25,7 +26,8 @@ const char* errc_name(Errc code) {
 Status Status::verror(Errc code, const char* fmt, va_list args) {
   Status s;
   s.code_ = code;
-  std::vsnprintf(s.message_, kMessageCapacity, fmt, args);
+  const int n = std::vsnprintf(s.message_, kMessageCapacity, fmt, args);
+  if (n >= static_cast<int>(kMessageCapacity)) std::memcpy(s.message_ + kMessageCapacity - 4, "...", 3);
   return s;
 }
 

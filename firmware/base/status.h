@@ -28,12 +28,15 @@ const char* errc_name(Errc code);
 
 class Status {
  public:
-  static constexpr std::size_t kMessageCapacity = 160;
+  // Room for a path (config keys hold up to 255 characters) plus the line, key and problem: a
+  // long path must not cut off what went wrong (160 used to lose the line and key of a config).
+  static constexpr std::size_t kMessageCapacity = 512;
 
   constexpr Status() = default;
 
   static Status ok() { return Status(); }
-  // printf-style message; truncated (never overflowed) at kMessageCapacity - 1 characters.
+  // printf-style message; truncated (never overflowed) at kMessageCapacity - 1 characters, the
+  // last three then being "..." so a cut message is recognisable.
   static Status error(Errc code, const char* fmt, ...) __attribute__((format(printf, 2, 3)));
   static Status verror(Errc code, const char* fmt, va_list args);
 

@@ -27,6 +27,17 @@ TEST(StatusTest, LongMessageIsTruncatedNotOverflowed) {
   std::string longname(1000, 'x');
   Status s = Status::error(Errc::kIoError, "%s", longname.c_str());
   EXPECT_EQ(std::strlen(s.message()), Status::kMessageCapacity - 1);
+  // A cut message says so.
+  EXPECT_EQ(std::string(s.message()).substr(Status::kMessageCapacity - 4), "...");
+}
+
+TEST(StatusTest, RoomForALongPathAndTheProblem) {
+  // Issue 13: messages were cut at 159 characters, so a long path lost the line and key.
+  const std::string path(255, 'p');
+  Status s = Status::error(Errc::kInvalidArgument, "config '%s' line %d: key '%s': '%s' is not an integer in 1..16",
+                           path.c_str(), 12, "workers", "many");
+  EXPECT_NE(std::string(s.message()).find("line 12: key 'workers': 'many' is not an integer in 1..16"),
+            std::string::npos);
 }
 
 Result<int> parse_positive(int v) {

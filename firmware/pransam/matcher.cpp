@@ -175,9 +175,18 @@ Status Matcher<D>::fill_model_table(std::uint64_t seed, std::uint64_t triples, f
   const TripleFilter filter{extent, min_height_ratio, 0.0f};
   RandomStream rng(seed, kFillStream);
   std::uint64_t keyed = 0, draws = 0;
-  const std::uint64_t max_draws = triples * 200 + 100000;
+  // The work is bounded by what the map can give: at most kFillDrawsPerTriple draws per wanted
+  // triple, and the fill gives up as soon as it is statistically behind the pace that cap needs
+  // (a map with a handful of occupied cells keys no triple at all; it used to spin through all
+  // 400 million draws of a 2-million-triple table at start-up).
+  const std::uint64_t max_draws = triples * kFillDrawsPerTriple + kFillMinDraws;
+  bool hopeless = false;
   while (keyed < triples && draws < max_draws) {
     ++draws;
+    if ((draws & (kFillCheckEvery - 1)) == 0 && fill_behind_pace(keyed, draws, triples, max_draws)) {
+      hopeless = true;
+      break;
+    }
     Triple t;
     if (!index_b_.draw(rng, &t)) continue;
     std::uint32_t slot;
@@ -186,9 +195,17 @@ Status Matcher<D>::fill_model_table(std::uint64_t seed, std::uint64_t triples, f
     ++keyed;
   }
   if (keyed < triples) {
-    return Status::error(Errc::kNumerical, "pransam fill: only %llu of %llu triples keyable after %llu draws",
+    if (keyed == 0) {
+      return Status::error(Errc::kNumerical,
+                           "pransam fill: map has too few occupied points for a relation table: no keyable triple "
+                           "after %llu draws over %u points (extent %.1f m)",
+                           static_cast<unsigned long long>(draws), model_n_, static_cast<double>(extent));
+    }
+    return Status::error(Errc::kNumerical,
+                         "pransam fill: only %llu of %llu triples keyable after %llu draws over %u points%s",
                          static_cast<unsigned long long>(keyed), static_cast<unsigned long long>(triples),
-                         static_cast<unsigned long long>(draws));
+                         static_cast<unsigned long long>(draws), model_n_,
+                         hopeless ? " (keyable rate too low for the draw cap; gave up early)" : "");
   }
   return Status::ok();
 }

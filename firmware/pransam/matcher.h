@@ -24,6 +24,7 @@
 // contact field, indices, per-worker buffers) and registered with MemoryReport (module "pransam").
 #pragma once
 
+#include <cmath>
 #include <cstddef>
 #include <cstdint>
 
@@ -110,6 +111,26 @@ struct MatchResult {
   MatchStats stats;
 };
 
+// Work bound of Matcher::fill_model_table: at most kFillDrawsPerTriple draws per wanted triple
+// (+ kFillMinDraws), and every kFillCheckEvery draws the fill gives up when it is hopelessly behind
+// the pace that cap needs.
+constexpr std::uint64_t kFillDrawsPerTriple = 200;
+constexpr std::uint64_t kFillMinDraws = 100000;
+constexpr std::uint64_t kFillCheckEvery = 4096;  // power of two
+static_assert((kFillCheckEvery & (kFillCheckEvery - 1)) == 0, "kFillCheckEvery must be a power of two");
+
+// True when `keyed` keyable triples after `draws` draws cannot reach `triples` within `max_draws`
+// draws even at a generous upper bound of the observed keyable rate (keyed + 3·√keyed + 3, three
+// standard deviations of the Poisson count): draws are independent and identically distributed,
+// so a fill that far behind the needed pace would only spin until the cap and fail there.
+inline bool fill_behind_pace(std::uint64_t keyed, std::uint64_t draws, std::uint64_t triples,
+                             std::uint64_t max_draws) {
+  if (draws == 0 || max_draws == 0 || keyed >= triples) return false;
+  const double upper = static_cast<double>(keyed) + 3.0 * std::sqrt(static_cast<double>(keyed)) + 3.0;
+  const double pace = static_cast<double>(triples) * static_cast<double>(draws) / static_cast<double>(max_draws);
+  return upper < pace;
+}
+
 template <int D>
 class Matcher {
  public:
@@ -128,7 +149,9 @@ class Matcher {
   bool has_precomputed_table() const { return precomputed_; }
 
   // Offline fill of R_B (Theorem 2): draws from B until `triples` have been keyed, using the
-  // table extent `extent`. Leaves the table in R_B for serialisation (model_table()).
+  // table extent `extent`. Leaves the table in R_B for serialisation (model_table()). The work is
+  // bounded by what B can give (kFillDrawsPerTriple, fill_behind_pace): a degenerate map (a few
+  // occupied cells, all collinear, ...) fails within milliseconds with an error that says so.
   Status fill_model_table(std::uint64_t seed, std::uint64_t triples, float extent, float min_height_ratio);
   const RelationTable& model_table() const { return table_b_; }
   const RelationTable& scene_table() const { return table_a_; }

@@ -1,5 +1,6 @@
 #include <gtest/gtest.h>
 
+#include <chrono>
 #include <cmath>
 #include <cstring>
 #include <vector>
@@ -189,6 +190,39 @@ TEST_F(Matcher2DTest, RecoversKnownScanPosesOnline) {
     EXPECT_EQ(r.stats.stop, StopReason::kThreshold);
     EXPECT_GT(r.stats.collisions, 0u);
   }
+}
+
+// Issue 13: a degenerate map (3 occupied cells) made the start-up fill of a 2-million-triple
+// table spin 64 s ("0 of 2000000 triples keyable after 400100000 draws"). It must fail fast with
+// an error that names the problem.
+TEST_F(Matcher2DTest, DegenerateModelFailsFastInsteadOfSpinning) {
+  const P2 collinear[3] = {P2(1.025f, 1.025f), P2(1.075f, 1.025f), P2(1.125f, 1.025f)};  // 3 cells in a row
+  const P2 tiny[3] = {P2(1.025f, 1.025f), P2(1.075f, 1.025f), P2(1.025f, 1.075f)};      // an L of 3 cells
+  for (const P2* pts : {collinear, tiny}) {
+    ASSERT_TRUE(matcher_->set_model(pts, 3, "three cells").is_ok());
+    const auto t0 = std::chrono::steady_clock::now();
+    const Status s = matcher_->fill_model_table(7, 2000000, 10.0f, 0.1f);
+    const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+    EXPECT_FALSE(s.is_ok());
+    EXPECT_NE(std::strstr(s.message(), "too few occupied points"), nullptr) << s.message();
+    EXPECT_NE(std::strstr(s.message(), "no keyable triple"), nullptr) << s.message();
+    EXPECT_LT(seconds, 2.0) << s.message();
+  }
+  ASSERT_TRUE(matcher_->set_model(world_->map.data(), world_->map.size(), "floor plan").is_ok());
+}
+
+TEST(FillBoundTest, GivesUpOnlyWhenHopelesslyBehindThePace) {
+  const std::uint64_t triples = 2000000, cap = triples * kFillDrawsPerTriple + kFillMinDraws;
+  // Nothing keyable after the first check: hopeless.
+  EXPECT_TRUE(fill_behind_pace(0, kFillCheckEvery, triples, cap));
+  // Exactly on the pace the cap needs (0.5 %), or better: keep drawing.
+  EXPECT_FALSE(fill_behind_pace(21, kFillCheckEvery, triples, cap));
+  EXPECT_FALSE(fill_behind_pace(400, kFillCheckEvery, triples, cap));
+  // Half the needed rate, measured over a million draws: hopeless.
+  EXPECT_TRUE(fill_behind_pace(2500, 1000000, triples, cap));
+  // Small tables are never refused early for a slow start.
+  EXPECT_FALSE(fill_behind_pace(0, kFillCheckEvery, 10, 10 * kFillDrawsPerTriple + kFillMinDraws));
+  EXPECT_FALSE(fill_behind_pace(5, 0, triples, cap));
 }
 
 TEST_F(Matcher2DTest, RecoversKnownScanPoseWithPrecomputedTableAndSectionRoundTrip) {

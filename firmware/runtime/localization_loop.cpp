@@ -3,6 +3,7 @@
 #include <cmath>
 #include <cstdarg>
 
+#include "firmware/base/fault.h"
 #include "firmware/runtime/odometry_interpolation.h"
 
 namespace fw {
@@ -33,7 +34,41 @@ Status LocalizationLoop::init(hal::Hal& hal, Localizer& localizer, const Localiz
   counters_ = LoopCounters();
   health_ = hal::Health();
   estimate_ = hal::PoseEstimate();
+  last_scan_ns_ = hal.clock->now_ns();
+  laser_timed_out_ = false;
+  published_ = false;
   return Status::ok();
+}
+
+void LocalizationLoop::refresh_health(std::uint64_t now) {
+  health_.timestamp_ns = now;
+  health_.fault_bits = (fault_bits() & kInternalFaultMask) | (hal_->laser->fault_bits() & hal::kHealthFaultMask) |
+                       (laser_timed_out_ ? static_cast<std::uint32_t>(hal::HealthFault::kLaserTimeout) : 0u);
+  health_.invalid_scans = hal_->laser->invalid_scans();
+}
+
+void LocalizationLoop::check_laser_silence(std::uint64_t now) {
+  if (options_.laser_timeout_ns == 0 || laser_timed_out_ || now < last_scan_ns_ ||
+      now - last_scan_ns_ <= options_.laser_timeout_ns) {
+    return;
+  }
+  laser_timed_out_ = true;
+  ++counters_.laser_timeouts;
+  ++health_.timeouts;
+  refresh_health(now);
+  log(hal::LogLevel::kWarning, "laser: no usable scan for %llu ms: fault %s%s",
+      static_cast<unsigned long long>((now - last_scan_ns_) / 1000000),
+      hal::health_fault_name(hal::HealthFault::kLaserTimeout),
+      (health_.fault_bits & static_cast<std::uint32_t>(hal::HealthFault::kLaserDisconnected)) ? " (laser-disconnected)"
+                                                                                                : "");
+  if (published_) {
+    // The last published pose must not stay the robot's latest word: flag it.
+    estimate_.status = hal::LocalizationStatus::kFault;
+    estimate_.protection_xy_m = 0.0f;
+    estimate_.protection_theta_rad = 0.0f;
+    hal_->pose_sink->publish(estimate_);
+  }
+  hal_->pose_sink->publish_health(health_);
 }
 
 void LocalizationLoop::reset() {
@@ -152,10 +187,24 @@ Status LocalizationLoop::spin_once() {
     while (!has_pending_ && hal_->laser->poll(&pending_)) {
       ++counters_.scans_received;
       has_pending_ = validate_scan(pending_);
-      if (!has_pending_) ++health_.dropped_scans;
+      if (!has_pending_) {
+        ++health_.dropped_scans;
+      } else {
+        if (laser_timed_out_) {
+          log(hal::LogLevel::kInfo, "laser: scans back after %llu ms: %s cleared",
+              static_cast<unsigned long long>(now > last_scan_ns_ ? (now - last_scan_ns_) / 1000000 : 0),
+              hal::health_fault_name(hal::HealthFault::kLaserTimeout));
+        }
+        laser_timed_out_ = false;
+        last_scan_ns_ = now;
+      }
     }
   }
-  if (!has_pending_) return Status::ok();
+  refresh_health(now);  // a heartbeat between scans carries the current faults
+  if (!has_pending_) {
+    check_laser_silence(now);
+    return Status::ok();
+  }
 
   Pairing pairing;
   {
@@ -187,10 +236,10 @@ Status LocalizationLoop::spin_once() {
   {
     PerfScope scope(perf_publish_, *perf_clock_);
     ++health_.scans_processed;
-    health_.timestamp_ns = now;
-    health_.fault_bits = fault_bits();
+    refresh_health(now);
     hal_->pose_sink->publish(estimate_);
     hal_->pose_sink->publish_health(health_);
+    published_ = true;
   }
   stepped_ = true;
   perf_total_.add_ns(perf_clock_->now_ns() - t_start);

@@ -12,6 +12,13 @@
 //    older (a timeout), else dropped;
 //  - a scan older than the oldest kept odometry is paired with it when within `max_odom_gap_ns`,
 //    else dropped.
+//
+// Laser silence (`laser_timeout_ns`, 0 = off; mmlfw's config key laser_timeout_ms): when no usable
+// scan arrived for that long (since init or the last one), the fault `laser-timeout`
+// (hal::HealthFault) is set in health().fault_bits, counted in timeouts, logged, and a pose with
+// status `fault` is published (the last pose flagged, so a robot reading POSE frames only does
+// not keep trusting it) followed by a health frame; the next usable scan clears the fault. The
+// laser source's own faults (laser-disconnected) and invalid-scan count reach health() as well.
 #pragma once
 
 #include <cstdint>
@@ -28,6 +35,7 @@ struct LocalizationLoopOptions {
   std::uint64_t odom_wait_ns = 200'000'000;     // how long a scan may wait for bracketing odometry
   std::uint64_t max_odom_gap_ns = 500'000'000;  // largest gap bridged by holding an odometry sample
   std::uint64_t step_deadline_ns = 0;           // Localizer::step longer than this counts a miss (0 = off)
+  std::uint64_t laser_timeout_ns = 0;           // no usable scan for this long: laser-timeout (0 = off)
   // Clock for the perf counters. The simulator steps hal.clock (deterministic time domain) and
   // measures with a real monotonic clock here; nullptr = hal.clock.
   const hal::Clock* perf_clock = nullptr;
@@ -45,6 +53,7 @@ struct LoopCounters {
   std::uint64_t scans_interpolated = 0;
   std::uint64_t scans_held = 0;      // paired with a held (not bracketing) odometry sample
   std::uint64_t step_errors = 0;
+  std::uint64_t laser_timeouts = 0;  // laser-timeout episodes (each also one health timeout)
 };
 
 class LocalizationLoop {
@@ -69,7 +78,10 @@ class LocalizationLoop {
   const hal::PoseEstimate& last_estimate() const { return estimate_; }
   // Odometry paired with the last processed scan.
   const hal::Odometry& last_odometry() const { return paired_odom_; }
+  // Counters and fault bits as published; also refreshed by every spin_once() without a scan,
+  // so a heartbeat sent between scans carries the current faults.
   const hal::Health& health() const { return health_; }
+  bool laser_timed_out() const { return laser_timed_out_; }
   const LoopCounters& counters() const { return counters_; }
 
   const PerfCounter& perf_poll() const { return perf_poll_; }
@@ -85,6 +97,8 @@ class LocalizationLoop {
   void drain_odometry();
   bool validate_scan(const hal::LaserScan& scan);
   Pairing pair(std::uint64_t now, hal::Odometry* out);
+  void refresh_health(std::uint64_t now);
+  void check_laser_silence(std::uint64_t now);
   void log(hal::LogLevel level, const char* fmt, ...) __attribute__((format(printf, 3, 4)));
 
   hal::Hal* hal_ = nullptr;
@@ -101,6 +115,9 @@ class LocalizationLoop {
   hal::Health health_;
   LoopCounters counters_;
   std::uint64_t last_step_ns_ = 0;
+  std::uint64_t last_scan_ns_ = 0;  // clock time of the last usable scan (or of init)
+  bool laser_timed_out_ = false;
+  bool published_ = false;          // an estimate went out (a timeout then publishes `fault`)
 
   PerfCounter perf_poll_{"loop.poll"};
   PerfCounter perf_pair_{"loop.pair"};

@@ -216,3 +216,111 @@ TEST(LocalizationLoop, DeadlineMissesAreCountedWithThePerfClock) {
 }
 
 }  // namespace
+
+namespace {
+
+// Issue 13: 4 s of laser silence raised no timeout and no fault.
+TEST(LocalizationLoop, LaserSilenceRaisesANamedFaultAndAFaultPoseUntilScansReturn) {
+  Rig r;
+  fw::LocalizationLoopOptions opt;
+  opt.laser_timeout_ns = 500 * kMs;
+  ASSERT_TRUE(r.loop.init(r.hal, r.localizer, opt).is_ok());
+  const std::uint32_t kTimeoutBit = static_cast<std::uint32_t>(hal::HealthFault::kLaserTimeout);
+  r.push_odom(0, 0.0f, 0.0f, 0.0f);
+  r.push_odom(100 * kMs, 0.1f, 0.0f, 0.0f);
+  r.push_scan(50 * kMs, 1);
+  r.clock.set_ns(100 * kMs);
+  ASSERT_TRUE(r.loop.spin_once().is_ok());
+  ASSERT_TRUE(r.loop.stepped());
+  hal::PoseEstimate e;
+  ASSERT_TRUE(r.sink.pop(&e));
+  EXPECT_NE(e.status, hal::LocalizationStatus::kFault);
+  // Quiet for less than the timeout: nothing.
+  r.clock.set_ns(550 * kMs);
+  ASSERT_TRUE(r.loop.spin_once().is_ok());
+  EXPECT_EQ(r.loop.health().fault_bits & kTimeoutBit, 0u);
+  EXPECT_FALSE(r.sink.pop(&e));
+  // 4 s of silence (the reproducer): fault laser-timeout, counted once, a `fault` pose for the
+  // last scan and a health frame carrying the bit.
+  const std::uint64_t health_frames = r.sink.health_count();
+  for (std::uint64_t t = 650; t <= 4100; t += 50) {
+    r.clock.set_ns(t * kMs);
+    ASSERT_TRUE(r.loop.spin_once().is_ok());
+    EXPECT_FALSE(r.loop.stepped());
+  }
+  EXPECT_TRUE(r.loop.laser_timed_out());
+  EXPECT_EQ(r.loop.health().fault_bits & kTimeoutBit, kTimeoutBit);
+  EXPECT_EQ(r.loop.health().timeouts, 1u);
+  EXPECT_EQ(r.loop.counters().laser_timeouts, 1u);
+  ASSERT_TRUE(r.sink.pop(&e));
+  EXPECT_EQ(e.status, hal::LocalizationStatus::kFault);
+  EXPECT_EQ(e.scan_id, 1u);
+  EXPECT_FALSE(r.sink.pop(&e));  // once per silence, not per spin
+  EXPECT_EQ(r.sink.health_count(), health_frames + 1);
+  EXPECT_EQ(r.sink.last_health().fault_bits & kTimeoutBit, kTimeoutBit);
+  EXPECT_STREQ(hal::health_fault_name(hal::HealthFault::kLaserTimeout), "laser-timeout");
+  EXPECT_GE(r.log.count(hal::LogLevel::kWarning), 1u);
+  // Scans return: the fault clears with the next pose.
+  r.push_odom(4200 * kMs, 0.2f, 0.0f, 0.0f);
+  r.push_scan(4150 * kMs, 2);
+  r.clock.set_ns(4200 * kMs);
+  ASSERT_TRUE(r.loop.spin_once().is_ok());
+  ASSERT_TRUE(r.loop.stepped());
+  EXPECT_FALSE(r.loop.laser_timed_out());
+  EXPECT_EQ(r.loop.health().fault_bits & kTimeoutBit, 0u);
+  EXPECT_EQ(r.sink.last_health().fault_bits & kTimeoutBit, 0u);
+  ASSERT_TRUE(r.sink.pop(&e));
+  EXPECT_EQ(e.scan_id, 2u);
+  EXPECT_NE(e.status, hal::LocalizationStatus::kFault);
+}
+
+TEST(LocalizationLoop, LaserThatNeverStartsTimesOutWithoutAPose) {
+  Rig r;
+  fw::LocalizationLoopOptions opt;
+  opt.laser_timeout_ns = 500 * kMs;
+  r.clock.set_ns(1000 * kMs);
+  ASSERT_TRUE(r.loop.init(r.hal, r.localizer, opt).is_ok());
+  r.clock.set_ns(1400 * kMs);
+  ASSERT_TRUE(r.loop.spin_once().is_ok());
+  EXPECT_FALSE(r.loop.laser_timed_out());
+  r.clock.set_ns(1600 * kMs);
+  ASSERT_TRUE(r.loop.spin_once().is_ok());
+  EXPECT_TRUE(r.loop.laser_timed_out());
+  hal::PoseEstimate e;
+  EXPECT_FALSE(r.sink.pop(&e));  // nothing was published yet: nothing to flag
+  EXPECT_TRUE(r.sink.has_health());
+  EXPECT_NE(r.sink.last_health().fault_bits & static_cast<std::uint32_t>(hal::HealthFault::kLaserTimeout), 0u);
+  // Off by default (simulators step their clock with the scans).
+  Rig q;
+  ASSERT_TRUE(q.loop.init(q.hal, q.localizer).is_ok());
+  q.clock.set_ns(60'000 * kMs);
+  ASSERT_TRUE(q.loop.spin_once().is_ok());
+  EXPECT_FALSE(q.loop.laser_timed_out());
+  EXPECT_EQ(q.loop.health().fault_bits, 0u);
+}
+
+// A laser source with link faults and rejected scans (SickLaser, CanNode::Laser): both reach Health.
+class FaultyLaser final : public hal::LaserScanSource {
+ public:
+  bool poll(hal::LaserScan*) override { return false; }
+  std::uint32_t fault_bits() const override { return bits; }
+  std::uint32_t invalid_scans() const override { return invalid; }
+  std::uint32_t bits = 0, invalid = 0;
+};
+
+TEST(LocalizationLoop, SourceFaultsAndInvalidScansReachHealth) {
+  Rig r;
+  FaultyLaser laser;
+  r.hal.laser = &laser;
+  ASSERT_TRUE(r.loop.init(r.hal, r.localizer).is_ok());
+  laser.bits = static_cast<std::uint32_t>(hal::HealthFault::kLaserDisconnected) | 0x1u;  // internal bits are not the source's
+  laser.invalid = 3;
+  ASSERT_TRUE(r.loop.spin_once().is_ok());
+  EXPECT_EQ(r.loop.health().fault_bits, static_cast<std::uint32_t>(hal::HealthFault::kLaserDisconnected));
+  EXPECT_EQ(r.loop.health().invalid_scans, 3u);
+  laser.bits = 0;
+  ASSERT_TRUE(r.loop.spin_once().is_ok());
+  EXPECT_EQ(r.loop.health().fault_bits, 0u);
+}
+
+}  // namespace

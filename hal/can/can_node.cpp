@@ -96,10 +96,12 @@ void CanNode::Sink::publish_health(const hal::Health& h) {
   r.deadline_misses = sat16(h.deadline_misses);
   r.bus_off = sat16(std::uint64_t{h.bus_off_count} + (b ? b->bus_off : 0));
   r.scans_processed = h.scans_processed;
+  r.invalid_scans = sat16(h.invalid_scans);  // the laser source's count (CanNode::Laser: decoder's)
   r.rx_dropped = sat16(b ? b->rx_dropped : 0);
   r.error_frames = sat16(b ? b->error_frames : 0);
   r.fault_bits = h.fault_bits;
-  r.state = h.fault_bits ? 2 : ((r.crc_errors || r.lost_segments || r.dropped_scans || r.bus_off) ? 1 : 0);
+  r.state = h.fault_bits ? 2
+            : ((r.crc_errors || r.lost_segments || r.dropped_scans || r.bus_off || r.invalid_scans) ? 1 : 0);
   std::size_t n = 0;
   if (encode_health(r, node_->health_tag_++, node_->fd_, node_->tx_, kMaxParts, &n).is_ok()) {
     node_->send_frames(node_->tx_, n);

@@ -86,6 +86,34 @@ std::uint32_t choose_range_unit_um(float range_max) {
 
 }  // namespace
 
+const char* scan_defect_name(ScanDefect d) {
+  switch (d) {
+    case ScanDefect::kNone: return "none";
+    case ScanDefect::kRangeMax: return "range_max not in [0.1, 250] m";
+    case ScanDefect::kRangeMin: return "range_min negative or not below range_max";
+    case ScanDefect::kAngleIncrement: return "angle increment zero, not finite or beyond 2 pi";
+    case ScanDefect::kFieldOfView: return "field of view beyond 2 pi";
+    case ScanDefect::kAngleMin: return "angle_min beyond +-2 pi";
+    case ScanDefect::kRangeBeyondMax: return "reading beyond range_max";
+  }
+  return "unknown";
+}
+
+ScanDefect scan_geometry_defect(const hal::LaserScan& s) {
+  constexpr double kTwoPi = 6.283185307179586;
+  constexpr double kSlack = 1e-4;  // quantisation of the wire fields (0.1 µrad, 1 µrad)
+  if (!(s.range_max >= kMinPlausibleRangeM) || !(s.range_max <= kMaxPlausibleRangeM)) return ScanDefect::kRangeMax;
+  if (!(s.range_min >= 0.0f) || !(s.range_min < s.range_max)) return ScanDefect::kRangeMin;
+  const double inc = static_cast<double>(s.angle_increment);
+  if (!std::isfinite(inc) || inc == 0.0 || std::fabs(inc) > kTwoPi + kSlack) return ScanDefect::kAngleIncrement;
+  const double fov = std::fabs(inc) * (s.beam_count > 0 ? s.beam_count - 1 : 0);
+  if (fov > kTwoPi + kSlack) return ScanDefect::kFieldOfView;
+  if (!std::isfinite(s.angle_min) || std::fabs(static_cast<double>(s.angle_min)) > kTwoPi + kSlack) {
+    return ScanDefect::kAngleMin;
+  }
+  return ScanDefect::kNone;
+}
+
 std::uint8_t fd_length_for(std::size_t n) {
   static const std::uint8_t kLens[] = {12, 16, 20, 24, 32, 48, 64};
   if (n <= 8) return static_cast<std::uint8_t>(n);
@@ -137,6 +165,13 @@ Status encode_scan(const hal::LaserScan& scan, const EncodeOptions& opt, hal::Ca
       scan.range_max <= 0.0f) {
     return Status::error(Errc::kInvalidArgument, "encode scan %u: non-finite angle or range_max %g", scan.scan_id,
                          static_cast<double>(scan.range_max));
+  }
+  const ScanDefect defect = scan_geometry_defect(scan);
+  if (defect != ScanDefect::kNone) {
+    return Status::error(Errc::kInvalidArgument, "encode scan %u: %s (range %g..%g m, increment %g rad, %u beams)",
+                         scan.scan_id, scan_defect_name(defect), static_cast<double>(scan.range_min),
+                         static_cast<double>(scan.range_max), static_cast<double>(scan.angle_increment),
+                         scan.beam_count);
   }
   const std::size_t need = scan_frame_count(scan.beam_count, opt.fd);
   if (capacity < need) {
@@ -243,6 +278,7 @@ Status encode_health(const HealthRecord& h, std::uint8_t tag, bool fd, hal::CanF
   std::uint8_t p[kHealthPayload] = {};
   put_u32(p + 0, h.uptime_ms);
   p[4] = h.state;
+  put_u16(p + 5, h.invalid_scans);
   put_u16(p + 7, h.crc_errors);
   put_u16(p + 9, h.lost_segments);
   put_u16(p + 11, h.dropped_scans);
@@ -334,6 +370,7 @@ void Decoder::start_scan(const std::uint8_t* p, std::uint64_t t_ns) {
   scan_work_.angle_increment = static_cast<float>(static_cast<std::int32_t>(get_u32(p + 14)) * 1e-7);
   scan_work_.range_min = static_cast<float>(get_u16(p + 18) * 0.01);
   scan_work_.timestamp_ns = get_u48(p + 21) * 1000;
+  scan_defect_ = scan_geometry_defect(scan_work_);
   scan_active_ = true;
   scan_broken_ = false;
   scan_started_ns_ = t_ns;
@@ -381,9 +418,14 @@ void Decoder::scan_segment(const hal::CanFrame& f, bool fd) {
     return;
   }
   const float unit_m = static_cast<float>(range_unit_um_ * 1e-6);
+  // The encoder sends readings at/above range_max as "no return"; anything decoded beyond it
+  // (more than the quantisation of both fields) cannot come from a sane scan.
+  const float beyond = scan_work_.range_max + unit_m + 0.01f;
   for (std::uint32_t i = 0; i < nb; ++i) {
     const std::uint16_t code = get_u16(f.data + 2 + 2 * i);
-    scan_work_.ranges[beams_received_ + i] = code == kNoReturn ? scan_work_.range_max : code * unit_m;
+    const float r = code == kNoReturn ? scan_work_.range_max : code * unit_m;
+    if (r > beyond && scan_defect_ == ScanDefect::kNone) scan_defect_ = ScanDefect::kRangeBeyondMax;
+    scan_work_.ranges[beams_received_ + i] = r;
   }
   scan_crc_ = crc32_update(scan_crc_, f.data + 2, 2 * nb);
   beams_received_ += nb;
@@ -415,6 +457,14 @@ bool Decoder::scan_end(const hal::CanFrame& f) {
   }
   if (crc32_end(scan_crc_) != crc) {
     ++stats_.crc_errors;
+    drop_scan(0);
+    return false;
+  }
+  if (scan_defect_ != ScanDefect::kNone) {
+    // Intact on the wire, impossible in content: a named decode error, never a valid scan.
+    ++stats_.invalid_scans;
+    ++stats_.invalid_by_defect[static_cast<int>(scan_defect_)];
+    stats_.last_defect = scan_defect_;
     drop_scan(0);
     return false;
   }
@@ -518,6 +568,7 @@ Decoded Decoder::feed(const hal::CanFrame& f) {
     health_ = HealthRecord{};
     health_.uptime_ms = get_u32(p + 0);
     health_.state = p[4];
+    health_.invalid_scans = get_u16(p + 5);
     health_.crc_errors = get_u16(p + 7);
     health_.lost_segments = get_u16(p + 9);
     health_.dropped_scans = get_u16(p + 11);

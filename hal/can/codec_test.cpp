@@ -2,6 +2,7 @@
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <cstring>
 #include <deque>
@@ -20,7 +21,9 @@ hal::LaserScan make_scan(std::uint32_t id, std::uint32_t beams) {
   s.beam_count = beams;
   s.timestamp_ns = 1234567890123000ull + id * 13333000ull;
   s.angle_min = -1.5707963f;
-  s.angle_increment = 0.017453292f;
+  // 1° steps, or a 270° field of view for more than 361 beams (1081 = 0.25°): the codec refuses a
+  // field of view beyond 2π.
+  s.angle_increment = beams > 361 ? 4.71238898f / static_cast<float>(beams - 1) : 0.017453292f;
   s.range_min = 0.0f;
   s.range_max = 81.91f;
   for (std::uint32_t i = 0; i < beams; ++i) s.ranges[i] = 0.5f + 0.037f * static_cast<float>((i * 7 + id) % 300);
@@ -104,6 +107,120 @@ TEST(ScanCodec, RejectsBadInput) {
   fw::Status st = encode_scan(s, {}, f.data(), f.size(), &n);
   EXPECT_FALSE(st.is_ok());
   EXPECT_NE(std::strstr(st.message(), "scan 1"), nullptr) << st.message();
+}
+
+// A scan transfer built field by field (not by encode_scan, which refuses impossible geometry),
+// with a correct CRC: what a buggy or hostile sender can put on the bus.
+struct RawScan {
+  std::uint16_t scan_id = 3, unit_um = 50000, range_max_cm = 1, range_min_cm = 65500;
+  std::int32_t angle_min_urad = -1570796, increment_01urad = 0;
+  std::vector<std::uint16_t> codes = std::vector<std::uint16_t>(30, 60000);  // 60000 · 50 mm = 3000 m
+};
+std::vector<hal::CanFrame> raw_scan_frames(const RawScan& r) {
+  std::uint8_t start[kScanStartParts * kPartBytes] = {};
+  put_u16(start + 0, r.scan_id);
+  put_u16(start + 2, static_cast<std::uint16_t>(r.codes.size()));
+  put_u16(start + 4, r.unit_um);
+  put_u32(start + 7, static_cast<std::uint32_t>(r.angle_min_urad));
+  put_u16(start + 11, r.range_max_cm);
+  put_u32(start + 14, static_cast<std::uint32_t>(r.increment_01urad));
+  put_u16(start + 18, r.range_min_cm);
+  put_u48(start + 21, 1000000);
+  std::vector<hal::CanFrame> out;
+  for (std::size_t k = 0; k < kScanStartParts; ++k) {
+    hal::CanFrame f;
+    f.id = kScanStartId + static_cast<std::uint32_t>(k);
+    f.len = 8;
+    f.data[0] = static_cast<std::uint8_t>(r.scan_id);
+    std::memcpy(f.data + 1, start + k * kPartBytes, kPartBytes);
+    out.push_back(f);
+  }
+  std::uint32_t crc = crc32_update(crc32_begin(), start, sizeof(start));
+  std::uint16_t seg = 0;
+  for (std::size_t b = 0; b < r.codes.size(); b += kClassicRangesPerSegment, ++seg) {
+    hal::CanFrame f;
+    f.id = kScanDataId;
+    put_u16(f.data, static_cast<std::uint16_t>(seg | ((r.scan_id & 0xF) << 12)));
+    const std::size_t nb = std::min(kClassicRangesPerSegment, r.codes.size() - b);
+    for (std::size_t i = 0; i < nb; ++i) put_u16(f.data + 2 + 2 * i, r.codes[b + i]);
+    crc = crc32_update(crc, f.data + 2, 2 * nb);
+    f.len = static_cast<std::uint8_t>(2 + 2 * nb);
+    out.push_back(f);
+  }
+  hal::CanFrame e;
+  e.id = kScanEndId;
+  e.len = 8;
+  put_u16(e.data, r.scan_id);
+  put_u16(e.data + 2, seg);
+  put_u32(e.data + 4, crc32_end(crc));
+  out.push_back(e);
+  return out;
+}
+
+// Issue 13: a CRC-correct scan with range_max 0.01 m, range_min 655 m, angle increment 0 and
+// readings of 3000 m was delivered as valid.
+TEST(ScanCodec, CrcCorrectScanWithImpossibleGeometryIsANamedDecodeError) {
+  Decoder d;
+  const RawScan reproducer;
+  for (const auto& f : raw_scan_frames(reproducer)) EXPECT_NE(d.feed(f), Decoded::kScan);
+  EXPECT_EQ(d.stats().crc_errors, 0u);
+  EXPECT_EQ(d.stats().scans_ok, 0u);
+  EXPECT_EQ(d.stats().invalid_scans, 1u);
+  EXPECT_EQ(d.stats().scans_dropped, 1u);
+  EXPECT_EQ(d.stats().last_defect, ScanDefect::kRangeMax);
+  EXPECT_STREQ(scan_defect_name(d.stats().last_defect), "range_max not in [0.1, 250] m");
+
+  // Each defect on its own (everything else sane: 30 beams of 1 deg, 1 mm unit, 30 m max).
+  RawScan sane;
+  sane.unit_um = 1000;
+  sane.range_max_cm = 3000;
+  sane.range_min_cm = 2;
+  sane.increment_01urad = 174533;
+  sane.codes.assign(30, 4000);  // 4 m
+  struct Case {
+    ScanDefect defect;
+    void (*spoil)(RawScan*);
+  } cases[] = {
+      {ScanDefect::kRangeMax, [](RawScan* r) { r->range_max_cm = 0; }},
+      {ScanDefect::kRangeMax, [](RawScan* r) { r->range_max_cm = 60000; r->unit_um = 10000; }},  // 600 m
+      {ScanDefect::kRangeMin, [](RawScan* r) { r->range_min_cm = 3000; }},
+      {ScanDefect::kAngleIncrement, [](RawScan* r) { r->increment_01urad = 0; }},
+      {ScanDefect::kAngleIncrement, [](RawScan* r) { r->increment_01urad = 70000000; }},  // 7 rad
+      {ScanDefect::kFieldOfView, [](RawScan* r) { r->increment_01urad = 3000000; }},     // 29 × 0.3 rad
+      {ScanDefect::kAngleMin, [](RawScan* r) { r->angle_min_urad = 100000000; }},        // 100 rad
+      {ScanDefect::kRangeBeyondMax, [](RawScan* r) { r->codes[7] = 60000; }},            // 60 m > 30 m
+  };
+  std::uint32_t expected = 1;
+  for (const Case& c : cases) {
+    RawScan r = sane;
+    c.spoil(&r);
+    ++r.scan_id;
+    for (const auto& f : raw_scan_frames(r)) EXPECT_NE(d.feed(f), Decoded::kScan) << scan_defect_name(c.defect);
+    ++expected;
+    EXPECT_EQ(d.stats().invalid_scans, expected) << scan_defect_name(c.defect);
+    EXPECT_EQ(d.stats().last_defect, c.defect) << scan_defect_name(d.stats().last_defect);
+  }
+  EXPECT_EQ(d.stats().invalid_by_defect[static_cast<int>(ScanDefect::kRangeMax)], 3u);
+  // The sane scan itself (and a clockwise one) decode; "no return" codes are not readings.
+  RawScan ok = sane;
+  ok.codes[3] = kNoReturn;
+  for (const auto& f : raw_scan_frames(ok)) d.feed(f);
+  ok.increment_01urad = -174533;
+  ++ok.scan_id;
+  bool got = false;
+  for (const auto& f : raw_scan_frames(ok)) got = d.feed(f) == Decoded::kScan || got;
+  EXPECT_TRUE(got);
+  EXPECT_EQ(d.stats().scans_ok, 2u);
+  EXPECT_EQ(d.stats().crc_errors, 0u);
+
+  // The encoder refuses to produce such a scan.
+  hal::LaserScan bad = make_scan(9, 30);
+  bad.angle_increment = 0.0f;
+  std::vector<hal::CanFrame> frames(kMaxScanFrames);
+  std::size_t n = 0;
+  const fw::Status st = encode_scan(bad, {}, frames.data(), frames.size(), &n);
+  EXPECT_FALSE(st.is_ok());
+  EXPECT_NE(std::strstr(st.message(), "angle increment"), nullptr) << st.message();
 }
 
 TEST(ScanCodec, CorruptSegmentIsCrcError) {
@@ -501,6 +618,29 @@ TEST(CanNode, DeliversScansAndOdometryAndEncodesPoses) {
   EXPECT_EQ(d.feed(bus.tx[0]), Decoded::kPose);
   EXPECT_EQ(d.feed(bus.tx[1]), Decoded::kHealth);
   EXPECT_EQ(d.health().deadline_misses, 2);
+}
+
+TEST(CanNode, InvalidScansReachTheHealthFrame) {
+  static LoopbackBus bus;
+  static CanNode node;
+  node.init(&bus, nullptr, false);
+  for (const auto& f : raw_scan_frames(RawScan())) bus.rx.push_back(f);
+  static hal::LaserScan s;
+  EXPECT_FALSE(node.laser().poll(&s));
+  EXPECT_EQ(node.laser().invalid_scans(), 1u);
+  // The loop copies the source's count into Health (localization_loop.cpp); the node sends it.
+  hal::Health h;
+  h.invalid_scans = node.laser().invalid_scans();
+  h.fault_bits = static_cast<std::uint32_t>(hal::HealthFault::kLaserTimeout);
+  node.pose_sink().publish_health(h);
+  Decoder d;
+  Decoded k = Decoded::kNothing;
+  for (const auto& f : bus.tx) k = d.feed(f);
+  ASSERT_EQ(k, Decoded::kHealth);
+  EXPECT_EQ(d.health().invalid_scans, 1);
+  EXPECT_EQ(d.health().fault_bits, 1u << 16);
+  EXPECT_EQ(d.health().state, 2);
+  EXPECT_EQ(d.health().dropped_scans, 1);
 }
 
 TEST(CanNode, MapsSenderTimeToTheLocalClock) {

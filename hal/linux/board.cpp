@@ -22,9 +22,13 @@ Status parse_backend_spec(const char* what, const char* spec, char* kind, std::s
     return Status::ok();
   }
   const std::size_t kl = static_cast<std::size_t>(colon - spec);
-  if (kl == 0 || kl >= kind_len || std::strlen(colon + 1) >= arg_len || !colon[1]) {
+  if (kl == 0 || kl >= kind_len || !colon[1]) {
     return Status::error(Errc::kInvalidArgument, "%s: '%s' is not KIND:ARG (socketcan:IFACE, serial:DEVICE[@BAUD])",
                          what, spec);
+  }
+  if (std::strlen(colon + 1) >= arg_len) {
+    return Status::error(Errc::kInvalidArgument, "%s: '%s': argument too long (%zu characters, at most %zu)", what,
+                         spec, std::strlen(colon + 1), arg_len - 1);
   }
   std::memcpy(kind, spec, kl);
   kind[kl] = '\0';
@@ -49,9 +53,21 @@ void Board::LogPoseSink::publish(const hal::PoseEstimate& e) {
 }
 
 void Board::LogPoseSink::publish_health(const hal::Health& h) {
-  if (++health_count_ % 50 != 1) return;
-  board_->log_.log(hal::LogLevel::kInfo, "health scans=%u dropped=%u timeouts=%u deadline_misses=%u faults=0x%x",
-                   h.scans_processed, h.dropped_scans, h.timeouts, h.deadline_misses, h.fault_bits);
+  // Every 50th frame, and at once whenever the fault bits change.
+  const bool changed = h.fault_bits != last_fault_bits_;
+  last_fault_bits_ = h.fault_bits;
+  if (++health_count_ % 50 != 1 && !changed) return;
+  char names[64] = "";
+  const hal::HealthFault named[] = {hal::HealthFault::kLaserTimeout, hal::HealthFault::kLaserDisconnected};
+  for (hal::HealthFault f : named) {
+    if ((h.fault_bits & static_cast<std::uint32_t>(f)) == 0) continue;
+    const std::size_t n = std::strlen(names);
+    std::snprintf(names + n, sizeof(names) - n, " %s", hal::health_fault_name(f));
+  }
+  board_->log_.log(h.fault_bits ? hal::LogLevel::kWarning : hal::LogLevel::kInfo,
+                   "health scans=%u dropped=%u invalid=%u timeouts=%u deadline_misses=%u faults=0x%x%s",
+                   h.scans_processed, h.dropped_scans, h.invalid_scans, h.timeouts, h.deadline_misses, h.fault_bits,
+                   names);
 }
 
 Status Board::create(const BoardSpec& spec) {
@@ -59,7 +75,7 @@ Status Board::create(const BoardSpec& spec) {
   hal_ = hal::Hal{};
   hal_.clock = &clock_;
   hal_.log = &log_;
-  char lkind[16], larg[96];
+  char lkind[16], larg[kMaxBackendArg];
   FW_RETURN_IF_ERROR(parse_backend_spec("laser", spec.laser, lkind, sizeof(lkind), larg, sizeof(larg)));
   const bool laser_can = std::strcmp(lkind, "socketcan") == 0;
   const bool laser_serial = std::strcmp(lkind, "serial") == 0;
@@ -69,12 +85,12 @@ Status Board::create(const BoardSpec& spec) {
   }
   const char* odom_spec = spec.odometry ? spec.odometry : (laser_can ? spec.laser : "none");
   const char* out_spec = spec.output ? spec.output : (laser_can ? spec.laser : "log");
-  char okind[16], oarg[96], pkind[16], parg[96];
+  char okind[16], oarg[kMaxBackendArg], pkind[16], parg[kMaxBackendArg];
   FW_RETURN_IF_ERROR(parse_backend_spec("odometry", odom_spec, okind, sizeof(okind), oarg, sizeof(oarg)));
   FW_RETURN_IF_ERROR(parse_backend_spec("output", out_spec, pkind, sizeof(pkind), parg, sizeof(parg)));
 
   // All CAN roles must share one interface (one socket, one CanNode).
-  char can_iface_buf[96] = {0};
+  char can_iface_buf[kMaxBackendArg] = {0};
   auto want_can = [&can_iface_buf](const char* role, const char* kind, const char* arg) -> Status {
     if (std::strcmp(kind, "socketcan") != 0) return Status::ok();
     if (can_iface_buf[0] && std::strcmp(can_iface_buf, arg) != 0) {
@@ -112,17 +128,27 @@ Status Board::create(const BoardSpec& spec) {
     hal_.laser = &node_.laser();
   } else {
     // serial:DEVICE[@BAUD]
-    char dev[96];
+    char dev[kMaxBackendArg];
     std::strcpy(dev, larg);
     std::uint32_t baud = 38400;
     if (char* at = std::strchr(dev, '@')) {
       *at = '\0';
-      char* end = nullptr;
-      const unsigned long b = std::strtoul(at + 1, &end, 10);
-      if (end == at + 1 || *end) return Status::error(Errc::kInvalidArgument, "laser: baud '%s' is not a number", at + 1);
-      baud = static_cast<std::uint32_t>(b);
+      // Digits only and no wrap-around: "@4295005696" (2^32 + 38400) used to run at 38400 Bd.
+      const char* b = at + 1;
+      std::uint64_t v = 0;
+      bool ok = *b != '\0';
+      for (const char* c = b; ok && *c; ++c) {
+        ok = *c >= '0' && *c <= '9';
+        v = v * 10 + static_cast<std::uint64_t>(*c - '0');
+        if (v > 0xFFFFFFFFull) ok = false;
+      }
+      if (!ok) return Status::error(Errc::kInvalidArgument, "laser: baud '%s' is not a rate in Bd", b);
+      baud = static_cast<std::uint32_t>(v);
     }
     FW_RETURN_IF_ERROR(port_.open(dev, baud));
+    std::snprintf(serial_device_, sizeof(serial_device_), "%s", dev);
+    serial_baud_ = baud;
+    serial_down_ = false;
     sick_.init(&port_, &clock_, hal_serial::SickLaserOptions{});
     if (!sick_.start()) return Status::error(Errc::kIoError, "laser: serial '%s': request write failed", dev);
     sick_used_ = true;
@@ -135,16 +161,69 @@ Status Board::create(const BoardSpec& spec) {
   return Status::ok();
 }
 
+void Board::service_serial_link() {
+  if (!sick_used_) return;
+  const std::uint64_t now = clock_.now_ns();
+  if (!serial_down_) {
+    if (port_.is_open()) return;
+    // Lost since the last call (read error or hang-up): say so once and schedule the reopen.
+    serial_down_ = true;
+    serial_down_ns_ = now;
+    serial_backoff_ns_ = static_cast<std::uint64_t>(kSerialRetryMinMs) * 1000000ull;
+    serial_retry_ns_ = now + serial_backoff_ns_;
+    serial_failed_attempts_ = 0;
+    const int e = port_.last_error();
+    log_.log(hal::LogLevel::kWarning, "laser: serial '%s' lost (%s): fault %s, reopening every %d..%d ms",
+             serial_device_, e != 0 ? std::strerror(e) : "hang-up",
+             hal::health_fault_name(hal::HealthFault::kLaserDisconnected), kSerialRetryMinMs, kSerialRetryMaxMs);
+    return;
+  }
+  if (now < serial_retry_ns_) return;
+  const Status s = port_.open(serial_device_, serial_baud_);
+  if (s.is_ok() && sick_.restart()) {
+    serial_down_ = false;
+    ++serial_reconnects_;
+    log_.log(hal::LogLevel::kInfo, "laser: serial '%s' reopened after %.1f s (%u attempts); continuous output requested",
+             serial_device_, static_cast<double>(now - serial_down_ns_) * 1e-9, serial_failed_attempts_ + 1);
+    return;
+  }
+  if (s.is_ok()) port_.hang_up(0);  // opened but the request could not be written: try again later
+  if (++serial_failed_attempts_ == 1) {
+    log_.log(hal::LogLevel::kWarning, "laser: reopening serial '%s' failed: %s (retrying)", serial_device_,
+             s.is_ok() ? "request write failed" : s.message());
+  }
+  serial_backoff_ns_ *= 2;
+  const std::uint64_t max_ns = static_cast<std::uint64_t>(kSerialRetryMaxMs) * 1000000ull;
+  if (serial_backoff_ns_ > max_ns) serial_backoff_ns_ = max_ns;
+  serial_retry_ns_ = now + serial_backoff_ns_;
+}
+
 void Board::wait_for_input(int timeout_ms) {
+  service_serial_link();
   pollfd p[2];
-  int n = 0;
+  int n = 0, serial = -1;
   if (bus_.is_open()) p[n++] = {bus_.native_handle(), POLLIN, 0};
-  if (port_.is_open()) p[n++] = {port_.native_handle(), POLLIN, 0};
+  if (port_.is_open()) {
+    serial = n;
+    p[n++] = {port_.native_handle(), POLLIN, 0};
+  }
   if (n == 0) {
     ::poll(nullptr, 0, timeout_ms);
     return;
   }
-  ::poll(p, static_cast<nfds_t>(n), timeout_ms);
+  if (::poll(p, static_cast<nfds_t>(n), timeout_ms) <= 0 || serial < 0) return;
+  // A hung-up tty polls "ready" forever. With data still buffered (POLLIN) the reader drains it
+  // first (a pty whose peer closed then fails the read with EIO and the port closes itself); a
+  // hang-up still reported on the next wait means nothing more will come: drop the port here.
+  const short r = p[serial].revents;
+  if ((r & (POLLHUP | POLLERR | POLLNVAL)) == 0) {
+    serial_hup_polls_ = 0;
+    return;
+  }
+  if ((r & POLLIN) != 0 && ++serial_hup_polls_ < 2) return;
+  serial_hup_polls_ = 0;
+  port_.hang_up(0);
+  service_serial_link();
 }
 
 }  // namespace hal_linux

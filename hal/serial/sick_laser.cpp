@@ -19,6 +19,18 @@ bool SickLaser::start() {
   return port_->write(t, n) == static_cast<long>(n);
 }
 
+bool SickLaser::restart() {
+  parser_.reset();
+  has_scan_ = false;
+  ++stats_.restarts;
+  return start();
+}
+
+std::uint32_t SickLaser::fault_bits() const {
+  if (port_ != nullptr && !port_->connected()) return static_cast<std::uint32_t>(hal::HealthFault::kLaserDisconnected);
+  return 0;
+}
+
 void SickLaser::convert(const MeasuredValues& v, std::uint64_t t_ns) {
   hal::LaserScan& s = scan_;
   const std::uint32_t n = v.count;
@@ -39,8 +51,9 @@ void SickLaser::convert(const MeasuredValues& v, std::uint64_t t_ns) {
 
 bool SickLaser::poll(hal::LaserScan* out) {
   if (!port_) return false;
-  // Bounded work per call: at most a few reads, then parse what arrived.
-  for (int i = 0; i < 8; ++i) {
+  // Bounded work per call: at most a few reads, then parse what arrived. A port that is gone is
+  // not read (the board reopens it; no error is counted per poll meanwhile).
+  for (int i = 0; i < 8 && port_->connected(); ++i) {
     const long n = port_->read(rx_, sizeof(rx_));
     if (n < 0) {
       ++stats_.read_errors;

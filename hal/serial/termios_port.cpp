@@ -91,8 +91,22 @@ void TermiosPort::close() {
 long TermiosPort::read(std::uint8_t* buf, std::size_t len) {
   if (fd_ < 0) return -1;
   const ssize_t n = ::read(fd_, buf, len);
-  if (n < 0) return (errno == EAGAIN || errno == EWOULDBLOCK || errno == EINTR) ? 0 : -1;
+  if (n < 0) {
+    const int e = errno;
+    if (e == EAGAIN || e == EWOULDBLOCK || e == EINTR) return 0;
+    // The device is gone (pty peer closed: EIO; adapter unplugged: ENODEV/ENXIO): a dead
+    // descriptor polls readable forever, so drop it; the owner reopens the device.
+    if (e == EIO || e == ENODEV || e == ENXIO || e == EBADF) hang_up(e);
+    return -1;
+  }
   return static_cast<long>(n);
+}
+
+void TermiosPort::hang_up(int err) {
+  if (fd_ < 0) return;
+  ++hangups_;
+  last_error_ = err;
+  close();
 }
 
 long TermiosPort::write(const std::uint8_t* buf, std::size_t len) {

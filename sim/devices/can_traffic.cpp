@@ -144,12 +144,17 @@ PoseScore score_pose_frames(const std::vector<hal::CanFrame>& frames, const std:
     const hal_can::Decoded k = d.feed(f);
     if (k == hal_can::Decoded::kPose) {
       const hal::PoseEstimate& p = d.pose();
-      ++s.poses;
-      ++s.status_counts[static_cast<int>(p.status)];
       // scan_id is the log index modulo 2^16: recover the index among the sent scans.
       size_t base = o.first_scan & ~static_cast<size_t>(0xFFFF);
       size_t index = base + p.scan_id;
       if (index < o.first_scan) index += 0x10000;
+      if (static_cast<long long>(index) == prev_index && p.status == hal::LocalizationStatus::kFault) {
+        // The firmware's laser-timeout: the last pose repeated with status `fault` (no new scan).
+        ++s.fault_updates;
+        continue;
+      }
+      ++s.poses;
+      ++s.status_counts[static_cast<int>(p.status)];
       if (index < o.first_scan || index >= last) {
         s.violations.push_back("pose for scan id " + std::to_string(p.scan_id) + " that was never sent");
         continue;

@@ -63,10 +63,12 @@ struct PoseScore {
   hal_can::DecoderStats decoder;
   hal_can::HealthRecord last_health;
   size_t first_localized_scan = 0;                    // scans (from first_scan) until the first `localized`
+  size_t fault_updates = 0;  // the last pose repeated with status `fault` (laser-timeout); not in `poses`
 };
 
 // `reference[i]` = reference pose of log scan i (reference_at_every_scan); may be empty (no error
-// figures then). Checks the protocol: pose scan ids belong to sent scans and increase, health
+// figures then). Checks the protocol: pose scan ids belong to sent scans and increase (a repeat of
+// the last id with status `fault` is the firmware's laser-timeout, counted in fault_updates), health
 // uptime and counters never decrease.
 PoseScore score_pose_frames(const std::vector<hal::CanFrame>& frames, const std::vector<fw::Se2d>& reference,
                             const PoseScoreOptions& options);

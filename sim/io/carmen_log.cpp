@@ -452,7 +452,10 @@ hal::LaserScan to_laser_scan(const CarmenScan& scan, uint64_t timestamp_ns) {
   m.angle_increment = scan.angle_increment;
   m.range_min = 0.01f;
   m.range_max = scan.max_range;
-  std::memcpy(m.ranges, scan.ranges.data(), n * sizeof(float));
+  // A record with 0 readings ("FLASER 0 ...") has no data pointer: copying 0 bytes from null is
+  // still undefined (UBSan). The result is an empty scan (beam_count 0), which the localization
+  // loop drops as malformed and counts; localizers skip it.
+  if (n > 0) std::memcpy(m.ranges, scan.ranges.data(), n * sizeof(float));
   return m;
 }
 

@@ -111,8 +111,13 @@ bool run_replay(const ReplayOptions& o, ReplayResult* r, std::string* error) {
   if (!st) { *error = std::string("localizer: ") + st.message(); pool.stop(); return false; }
   fw::Localizer* loc = &sys.localizer();
   r->localizer = sys.name();
-  // A table section in use is read in place: keep the image mapped (as mmlfw does).
-  if (!(table != nullptr && sys.table_in_use())) image.close();
+  // A table section in use is read in place from the image copy: keep only its pages (as mmlfw does).
+  if (table != nullptr && sys.table_in_use()) {
+    st = image.retain(table, table_len);
+    if (!st) { *error = st.message(); pool.stop(); return false; }
+  } else {
+    image.close();
+  }
 
   static hal_linux::LinuxClock clock;
   static hal_sim::SteppedClock stepped;  // lockstep: HAL time = time of the newest scan fed

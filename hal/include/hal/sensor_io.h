@@ -3,6 +3,8 @@
 // false when nothing is pending.
 #pragma once
 
+#include <cstdint>
+
 #include "hal/msg/health.h"
 #include "hal/msg/laser_scan.h"
 #include "hal/msg/odometry.h"
@@ -15,6 +17,10 @@ class LaserScanSource {
   virtual ~LaserScanSource() = default;
   // Copies the next complete scan into *out; false if none is pending.
   virtual bool poll(LaserScan* out) = 0;
+  // Link faults of the source (HealthFault bits, e.g. laser-disconnected) and the number of scans
+  // it received intact but rejected as impossible; the loop puts both in the health frame.
+  virtual std::uint32_t fault_bits() const { return 0; }
+  virtual std::uint32_t invalid_scans() const { return 0; }
 };
 
 class OdometrySource {

@@ -13,6 +13,8 @@ class SerialPort {
   virtual long read(std::uint8_t* buf, std::size_t len) = 0;
   // Returns bytes written, or -1 on error.
   virtual long write(const std::uint8_t* buf, std::size_t len) = 0;
+  // False while the port is gone (peer closed, device unplugged) and not yet reopened.
+  virtual bool connected() const { return true; }
 };
 
 }  // namespace hal

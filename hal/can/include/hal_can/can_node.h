@@ -46,6 +46,7 @@ class CanNode {
    public:
     explicit Laser(CanNode* n) : node_(n) {}
     bool poll(hal::LaserScan* out) override;
+    std::uint32_t invalid_scans() const override { return node_->decoder_.stats().invalid_scans; }
    private:
     CanNode* node_;
   };

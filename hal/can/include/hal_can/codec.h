@@ -25,10 +25,32 @@ struct EncodeOptions {
   std::uint32_t range_unit_um = 0;  // metres per range LSB in µm; 0 = choose (1 mm, or 10 mm if range_max > 65 m)
 };
 
+// Scan geometry the decoder accepts. A scan whose CRC is right but whose content is impossible
+// (range_max 0.01 m, range_min 655 m, angle increment 0, readings of 3000 m, …) was delivered as
+// valid; now it is dropped with a named defect and counted (DecoderStats::invalid_scans, HEALTH
+// InvalidScans). The encoder refuses to produce such scans.
+constexpr float kMinPlausibleRangeM = 0.1f;    // range_max below this: no scanner
+constexpr float kMaxPlausibleRangeM = 250.0f;  // beyond any 2-D navigation/safety scanner
+
+enum class ScanDefect : std::uint8_t {
+  kNone = 0,
+  kRangeMax,            // range_max not in [kMinPlausibleRangeM, kMaxPlausibleRangeM] m
+  kRangeMin,            // range_min negative or not below range_max
+  kAngleIncrement,      // angle increment zero, not finite, or beyond 2π
+  kFieldOfView,         // |increment| · (beams − 1) beyond 2π
+  kAngleMin,            // angle_min not finite or beyond ±2π
+  kRangeBeyondMax,      // a reading (not "no return") beyond range_max
+};
+constexpr int kNumScanDefects = 7;
+const char* scan_defect_name(ScanDefect d);
+// The header checks (all but kRangeBeyondMax) of a scan as it would travel; kNone when valid.
+ScanDefect scan_geometry_defect(const hal::LaserScan& scan);
+
 // Health as it travels on the bus: the firmware's counters plus the bus statistics.
 struct HealthRecord {
   std::uint32_t uptime_ms = 0;
   std::uint8_t state = 0;  // 0 ok, 1 degraded (counters rising), 2 fault (fault_bits != 0)
+  std::uint16_t invalid_scans = 0;  // intact scans/telegrams with impossible content (payload bytes 5..6)
   std::uint16_t crc_errors = 0, lost_segments = 0, dropped_scans = 0;
   std::uint16_t timeouts = 0, deadline_misses = 0, bus_off = 0;
   std::uint32_t scans_processed = 0;
@@ -70,6 +92,9 @@ struct DecoderStats {
   std::uint32_t orphan_segments = 0;   // data segments with no transfer in progress
   std::uint32_t timeouts = 0;          // transfer not finished within the timeout
   std::uint32_t broken_records = 0;    // record parts missing / out of order / wrong tag
+  std::uint32_t invalid_scans = 0;     // CRC right but impossible geometry/readings (also in scans_dropped)
+  std::uint32_t invalid_by_defect[kNumScanDefects] = {};  // per ScanDefect
+  ScanDefect last_defect = ScanDefect::kNone;
   std::uint32_t odometry_ok = 0, poses_ok = 0, health_ok = 0;
 };
 
@@ -123,6 +148,7 @@ class Decoder {
   std::uint32_t beams_received_ = 0;
   std::uint32_t range_unit_um_ = 1000;
   std::uint32_t scan_crc_ = 0;
+  ScanDefect scan_defect_ = ScanDefect::kNone;  // decided at END, after the CRC
   hal::LaserScan scan_work_;
 
   hal::LaserScan scan_;

@@ -8,6 +8,7 @@
 // One SocketCanBus per distinct interface; everything is a member (no heap).
 #pragma once
 
+#include <cstddef>
 #include <cstdint>
 
 #include "firmware/base/status.h"
@@ -29,7 +30,11 @@ struct BoardSpec {
   hal::LogLevel log_level = hal::LogLevel::kInfo;
 };
 
-// Parses "kind:arg" (kind socketcan|serial) into the parts; errors name the spec.
+// Longest "arg" of a backend spec + 1 (the config's laser/odometry/output values are < 128).
+constexpr std::size_t kMaxBackendArg = 128;
+
+// Parses "kind:arg" (kind socketcan|serial) into the parts; errors name the spec and say whether
+// it is malformed or too long.
 fw::Status parse_backend_spec(const char* what, const char* spec, char* kind, std::size_t kind_len, char* arg,
                               std::size_t arg_len);
 
@@ -41,8 +46,15 @@ class Board {
 
   fw::Status create(const BoardSpec& spec);
   hal::Hal& hal() { return hal_; }
-  // Sleeps until input may be pending on any bus/port or timeout_ms passes (poll(2)).
+  // Sleeps until input may be pending on any bus/port or timeout_ms passes (poll(2)). A serial
+  // laser port that hung up (peer closed, device unplugged) is closed here and reopened with a
+  // back-off (kSerialRetryMinMs doubling to kSerialRetryMaxMs): the loop never spins on a dead
+  // descriptor, HEALTH shows laser-disconnected meanwhile, and the scans resume when it returns.
   void wait_for_input(int timeout_ms);
+  static constexpr int kSerialRetryMinMs = 100;
+  static constexpr int kSerialRetryMaxMs = 2000;
+  // Times the serial laser port was reopened after it was lost.
+  std::uint32_t serial_reconnects() const { return serial_reconnects_; }
   // Publishes a heartbeat even when no scans arrive (health frames keep flowing).
   void publish_heartbeat(const hal::Health& h) { if (hal_.pose_sink) hal_.pose_sink->publish_health(h); }
 
@@ -69,6 +81,7 @@ class Board {
    private:
     Board* board_;
     std::uint32_t health_count_ = 0;
+    std::uint32_t last_fault_bits_ = 0;
   };
 
   hal::Hal hal_;
@@ -78,9 +91,19 @@ class Board {
   hal_can::CanNode node_;
   bool node_used_ = false;
   bool can_fd_ = false;
+  void service_serial_link();
   hal_serial::TermiosPort port_;
   hal_serial::SickLaser sick_;
   bool sick_used_ = false;
+  char serial_device_[kMaxBackendArg] = {0};
+  std::uint32_t serial_baud_ = 0;
+  bool serial_down_ = false;            // lost and not yet reopened
+  std::uint64_t serial_down_ns_ = 0;    // when it was lost
+  std::uint64_t serial_retry_ns_ = 0;   // next reopen attempt
+  std::uint64_t serial_backoff_ns_ = 0;
+  std::uint32_t serial_reconnects_ = 0;
+  std::uint32_t serial_failed_attempts_ = 0;
+  int serial_hup_polls_ = 0;            // consecutive waits that saw a hang-up with data pending
   ZeroOdometry zero_odom_;
   LogPoseSink log_sink_pose_;
   char description_[200] = {0};

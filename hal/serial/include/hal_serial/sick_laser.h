@@ -22,11 +22,12 @@ struct SickLaserOptions {
 
 struct SickLaserStats {
   std::uint32_t scans = 0;
-  std::uint32_t bad_measurements = 0;  // CRC-valid 0xB0 telegrams with impossible content
+  std::uint32_t bad_measurements = 0;  // CRC-valid 0xB0 telegrams with impossible content (→ HEALTH invalid_scans)
   std::uint32_t other_telegrams = 0;   // responses we do not use (0xA0 acknowledges our request)
   std::uint32_t mode_acks = 0;
   std::uint32_t overwritten = 0;       // scans replaced before the loop took them
   std::uint32_t read_errors = 0;
+  std::uint32_t restarts = 0;          // restart() after the port was reopened
 };
 
 class SickLaser final : public hal::LaserScanSource {
@@ -34,7 +35,13 @@ class SickLaser final : public hal::LaserScanSource {
   void init(hal::SerialPort* port, const hal::Clock* clock, const SickLaserOptions& options);
   // Sends the request for continuous output (if configured). False if the write failed.
   bool start();
+  // After the port was reopened (the scanner or its cable came back): forgets the partial
+  // telegram of the old connection and requests continuous output again.
+  bool restart();
   bool poll(hal::LaserScan* out) override;
+  // laser-disconnected while the port is gone; CRC-valid telegrams with impossible content.
+  std::uint32_t fault_bits() const override;
+  std::uint32_t invalid_scans() const override { return stats_.bad_measurements; }
   const SickParserStats& parser_stats() const { return parser_.stats(); }
   const SickLaserStats& stats() const { return stats_; }
 

@@ -1,5 +1,8 @@
 // TermiosPort: hal::SerialPort on a Linux tty (termios): raw 8N1, non-blocking, standard rates
 // and 500 kBd (B500000) where the driver accepts it; the rate is read back and verified.
+// A port whose peer went away (pty master closed: EIO; USB adapter unplugged: ENODEV/ENXIO; a
+// hang-up seen by poll) is closed by read()/hang_up() and reports connected() == false, so the
+// caller stops polling a dead descriptor (it used to spin ~7000 reads a second) and reopens it.
 #pragma once
 
 #include <cstddef>
@@ -28,12 +31,21 @@ class TermiosPort final : public hal::SerialPort {
 
   long read(std::uint8_t* buf, std::size_t len) override;
   long write(const std::uint8_t* buf, std::size_t len) override;
+  bool connected() const override { return fd_ >= 0; }
   bool wait_readable(int timeout_ms) const;
+  // Closes the port after a hang-up (poll reported POLLHUP/POLLERR/POLLNVAL); `err` is the errno
+  // to report (0: "hang-up").
+  void hang_up(int err);
+  // Times the port was lost (read error or hang-up) and the errno of the last loss.
+  std::uint32_t hangups() const { return hangups_; }
+  int last_error() const { return last_error_; }
 
  private:
   int fd_ = -1;
   std::uint32_t baud_ = 0;
-  char device_[96] = {0};
+  std::uint32_t hangups_ = 0;
+  int last_error_ = 0;
+  char device_[128] = {0};
 };
 
 }  // namespace hal_serial

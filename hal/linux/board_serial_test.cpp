@@ -1,0 +1,134 @@
+// Board with a serial SICK laser on a pseudo-terminal whose peer closes and comes back (issue 13:
+// the firmware then polled/read ~7000 times a second, logged nothing and HEALTH showed no fault).
+// The pty is made here (posix_openpt) and reached through a symlink, as socat's `link=` and udev's
+// /dev/serial/by-id names are: the peer "returns" as a new pty behind the same name.
+#include "hal_linux/board.h"
+
+#include <gtest/gtest.h>
+#include <fcntl.h>
+#include <poll.h>
+#include <stdlib.h>
+#include <unistd.h>
+
+#include <cerrno>
+#include <chrono>
+#include <cstring>
+#include <string>
+
+#include "hal_serial/sick_telegram.h"
+
+namespace hal_linux {
+namespace {
+
+using Clock = std::chrono::steady_clock;
+
+// Master side of a pty, its slave reachable as `link`.
+struct Peer {
+  int master = -1;
+  bool open(const std::string& link) {
+    master = ::posix_openpt(O_RDWR | O_NOCTTY);
+    if (master < 0 || ::grantpt(master) != 0 || ::unlockpt(master) != 0) return false;
+    const char* slave = ::ptsname(master);
+    if (slave == nullptr) return false;
+    ::unlink(link.c_str());
+    return ::symlink(slave, link.c_str()) == 0;
+  }
+  void close() {
+    if (master >= 0) ::close(master);
+    master = -1;
+  }
+  // True when the scanner request (mode change to continuous output) arrived within timeout_ms.
+  bool got_request(int timeout_ms) {
+    hal_serial::SickParser parser;
+    hal_serial::SickTelegram t;
+    std::uint8_t buf[256];
+    const auto end = Clock::now() + std::chrono::milliseconds(timeout_ms);
+    while (Clock::now() < end) {
+      pollfd p{master, POLLIN, 0};
+      if (::poll(&p, 1, 5) > 0 && (p.revents & POLLIN)) {
+        const ssize_t n = ::read(master, buf, sizeof(buf));
+        if (n > 0) parser.feed(buf, static_cast<std::size_t>(n));
+        if (parser.next(&t)) return t.command == hal_serial::kCmdModeChange;
+      }
+    }
+    return false;
+  }
+  bool send_scan(std::uint16_t first) {
+    hal_serial::MeasuredValues v;
+    v.count = 181;
+    for (int i = 0; i < 181; ++i) v.values[i] = static_cast<std::uint16_t>(first + i);
+    std::uint8_t buf[hal_serial::kMaxTelegramBytes];
+    const std::size_t n = hal_serial::encode_measured_values(v, buf, sizeof(buf));
+    return ::write(master, buf, n) == static_cast<ssize_t>(n);
+  }
+  ~Peer() { close(); }
+};
+
+// Runs the firmware's idle cycle (wait_for_input(5) + laser poll) for `ms`; returns the cycles.
+int run_cycles(Board* board, int ms, int* scans) {
+  const auto end = Clock::now() + std::chrono::milliseconds(ms);
+  int cycles = 0;
+  hal::LaserScan scan;
+  while (Clock::now() < end) {
+    board->wait_for_input(5);
+    if (board->hal().laser->poll(&scan)) ++*scans;
+    ++cycles;
+  }
+  return cycles;
+}
+
+TEST(BoardSerial, PeerClosesThenReturns) {
+  char dir[] = "/tmp/mmlfw-board-serial.XXXXXX";
+  ASSERT_NE(::mkdtemp(dir), nullptr);
+  const std::string link = std::string(dir) + "/ttyLASER";
+  Peer peer;
+  ASSERT_TRUE(peer.open(link)) << std::strerror(errno);
+
+  static Board board;  // large (rings, parser): static storage as in mmlfw
+  BoardSpec spec;
+  const std::string laser = "serial:" + link + "@38400";
+  spec.laser = laser.c_str();
+  spec.odometry = "none";
+  spec.output = "log";
+  spec.log_level = hal::LogLevel::kWarning;
+  fw::Status s = board.create(spec);
+  ASSERT_TRUE(s.is_ok()) << s.message();
+  ASSERT_TRUE(peer.got_request(1000));
+  ASSERT_TRUE(peer.send_scan(100));
+  int scans = 0;
+  run_cycles(&board, 100, &scans);
+  EXPECT_EQ(scans, 1);
+  const hal::LaserScanSource& source = *board.hal().laser;
+  const std::uint32_t kDisconnected = static_cast<std::uint32_t>(hal::HealthFault::kLaserDisconnected);
+  EXPECT_EQ(source.fault_bits(), 0u);
+
+  // The peer closes (scanner unplugged / socat gone). 500 ms of the idle cycle: with a 5 ms wait
+  // that is ~100 cycles; the busy loop on the dead descriptor made thousands.
+  peer.close();
+  const int cycles = run_cycles(&board, 500, &scans);
+  EXPECT_LE(cycles, 150) << "busy loop on a hung-up serial port";
+  EXPECT_EQ(source.fault_bits() & kDisconnected, kDisconnected);
+  EXPECT_LE(board.sick()->stats().read_errors, 1u);  // not one error per cycle
+
+  // The peer returns behind the same name: the board reopens it within its back-off, requests
+  // continuous output again, and scans flow; the fault clears.
+  ASSERT_TRUE(peer.open(link));
+  bool requested = false;
+  const auto deadline = Clock::now() + std::chrono::milliseconds(2 * Board::kSerialRetryMaxMs + 1000);
+  while (!requested && Clock::now() < deadline) {
+    run_cycles(&board, 20, &scans);
+    requested = peer.got_request(10);
+  }
+  ASSERT_TRUE(requested) << "the board did not reopen the port";
+  EXPECT_EQ(board.serial_reconnects(), 1u);
+  EXPECT_EQ(source.fault_bits() & kDisconnected, 0u);
+  ASSERT_TRUE(peer.send_scan(200));
+  int after = 0;
+  run_cycles(&board, 200, &after);
+  EXPECT_EQ(after, 1);
+  ::unlink(link.c_str());
+  ::rmdir(dir);
+}
+
+}  // namespace
+}  // namespace hal_linux
