@@ -14,7 +14,9 @@ namespace fw {
 
 Status MapImageFile::open(const char* path) {
   close();
-  const int fd = ::open(path, O_RDONLY | O_CLOEXEC);
+  // O_NONBLOCK: a FIFO given as the map would block open() until a writer appears; this way open
+  // returns at once and the regular-file check below refuses it (no effect on regular files).
+  const int fd = ::open(path, O_RDONLY | O_CLOEXEC | O_NONBLOCK);
   if (fd < 0) return Status::error(Errc::kIoError, "map image '%s': cannot open: %s", path, std::strerror(errno));
   struct stat st {};
   if (::fstat(fd, &st) != 0) {
