@@ -57,6 +57,7 @@ Result<void*> StartupArena::allocate(std::size_t bytes, std::size_t alignment, c
                          bytes, capacity_ - used_, capacity_);
   }
   used_ += pad + bytes;
+  if (used_ > peak_) peak_ = used_;
   return reinterpret_cast<void*>(aligned);
 }
 

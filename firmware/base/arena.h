@@ -39,6 +39,16 @@ class StartupArena {
     return p;
   }
 
+  // Start-up scratch, stack-like: note mark() before temporary allocations and rewind(mark) when they
+  // are no longer needed (e.g. the map loader's distance-transform buffers); everything allocated
+  // since the mark is forgotten, so only trivially destructible data belongs there. The capacity must
+  // cover the peak (peak_used()), not just used().
+  std::size_t mark() const { return used_; }
+  void rewind(std::size_t mark) {
+    if (!sealed_ && mark <= used_) used_ = mark;
+  }
+  std::size_t peak_used() const { return peak_; }
+
   void seal() { sealed_ = true; }
   bool sealed() const { return sealed_; }
   std::size_t capacity() const { return capacity_; }
@@ -48,6 +58,7 @@ class StartupArena {
   unsigned char* base_ = nullptr;
   std::size_t capacity_ = 0;
   std::size_t used_ = 0;
+  std::size_t peak_ = 0;
   bool sealed_ = false;
   bool mapped_ = false;
 };

@@ -98,6 +98,25 @@ TEST(ArenaTest, BumpAllocationThenSealed) {
   EXPECT_EQ(FaultCatcher::count, 1);
 }
 
+TEST(ArenaTest, RewindReleasesScratchAndKeepsThePeak) {
+  alignas(64) static unsigned char block[1024];
+  StartupArena arena;
+  ASSERT_TRUE(arena.init(block, sizeof(block), "rewind-arena").is_ok());
+  ASSERT_TRUE(arena.allocate_array<float>(10, "kept"));
+  const std::size_t mark = arena.mark();
+  ASSERT_TRUE(arena.allocate_array<float>(200, "scratch"));
+  EXPECT_EQ(arena.peak_used(), 840u);
+  arena.rewind(mark);
+  EXPECT_EQ(arena.used(), 40u);
+  EXPECT_EQ(arena.peak_used(), 840u);
+  arena.rewind(mark + 100);  // forward is ignored
+  EXPECT_EQ(arena.used(), 40u);
+  ASSERT_TRUE(arena.allocate_array<float>(200, "again"));  // the space is reused
+  arena.seal();
+  arena.rewind(mark);  // sealed: nothing is released
+  EXPECT_EQ(arena.used(), 840u);
+}
+
 TEST(ArenaTest, MappedBlock) {
   StartupArena arena;
   ASSERT_TRUE(arena.init_mapped(1 << 20, false, "mapped-arena").is_ok());

@@ -53,4 +53,34 @@ struct GridGeometry {
   float size_y() const { return static_cast<float>(height) * resolution; }
 };
 
+// What float world coordinates can represent. A float has 24 significant bits, so its spacing at |x|
+// is at most |x|·2^-23; a grid reaching 2^19 cells from the world origin still resolves 1/16 of a cell
+// there (a 0.05 m map: ±26 km). Beyond that cell centres and scan end-points collapse onto each other
+// (an origin of -1e38 puts every cell on the same float) — such a map is refused, not compiled or
+// loaded. The resolution bounds only exclude nonsense (0.1 mm .. 1 km cells).
+constexpr double kMinGridResolutionM = 1e-4;
+constexpr double kMaxGridResolutionM = 1e3;
+constexpr double kMaxGridReachCells = 524288.0;  // 2^19
+
+enum class GridExtentProblem { kNone, kResolution, kOrigin, kReach };
+
+// Largest |world coordinate| of the grid's corners (metres); inf/NaN when not finite.
+inline double grid_reach_m(double resolution, double origin_x, double origin_y, double width, double height) {
+  const double x1 = origin_x + width * resolution, y1 = origin_y + height * resolution;
+  return std::fmax(std::fmax(std::fabs(origin_x), std::fabs(x1)), std::fmax(std::fabs(origin_y), std::fabs(y1)));
+}
+
+// Checked in double, before any conversion to float (origin 1e39 is finite as a double, inf as a float).
+inline GridExtentProblem check_grid_extent(double resolution, double origin_x, double origin_y, double width,
+                                           double height) {
+  if (!(resolution >= kMinGridResolutionM && resolution <= kMaxGridResolutionM)) return GridExtentProblem::kResolution;
+  if (!std::isfinite(origin_x) || !std::isfinite(origin_y)) return GridExtentProblem::kOrigin;
+  const double reach = grid_reach_m(resolution, origin_x, origin_y, width, height);
+  if (!(reach <= kMaxGridReachCells * resolution)) return GridExtentProblem::kReach;
+  return GridExtentProblem::kNone;
+}
+inline GridExtentProblem check_grid_extent(const GridGeometry& g) {
+  return check_grid_extent(g.resolution, g.origin_x, g.origin_y, g.width, g.height);
+}
+
 }  // namespace fw

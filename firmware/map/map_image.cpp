@@ -5,6 +5,7 @@
 
 #include "firmware/base/memory_report.h"
 #include "firmware/map/crc32.h"
+#include "firmware/map/edt.h"
 
 // The format is little-endian; bulk arrays are copied with memcpy, so the host must be too (x86-64,
 // aarch64 and armhf all are). A big-endian port would add byte swapping here.
@@ -108,6 +109,113 @@ Status required_section(const std::uint8_t* bytes, std::size_t count, MapSection
   return Status::ok();
 }
 
+// The parts of the format that carry no data must be zero (map_image.h): each table entry's reserved
+// word and every byte not covered by a section (alignment padding). Sections start 16-byte aligned.
+// A writer that puts anything there is not one this firmware knows: refuse rather than ignore it.
+Status check_reserved_fields(const std::uint8_t* bytes, std::size_t count, const char* name) {
+  for (std::size_t i = 0; i < count; ++i) {
+    const std::uint8_t* e = bytes + kMapImageHeaderBytes + i * kMapSectionEntryBytes;
+    const MapSectionInfo s = entry(bytes, i);
+    const std::uint32_t reserved = rd_u32(e + 28);
+    if (reserved != 0) {
+      return Status::error(Errc::kCorruptData, "%s: section %zu (%s): reserved field is 0x%08x, must be 0", name, i,
+                           map_section_name(s.type), reserved);
+    }
+    if (s.offset % kMapSectionAlignment != 0) {
+      return Status::error(Errc::kCorruptData, "%s: section %zu (%s): offset %llu is not %zu-byte aligned", name, i,
+                           map_section_name(s.type), static_cast<unsigned long long>(s.offset), kMapSectionAlignment);
+    }
+  }
+  return Status::ok();
+}
+
+// Checked after the section sizes (load_map_image), so that a section shorter than its geometry is
+// reported as such rather than as the stray byte it leaves uncovered.
+Status check_padding(const std::uint8_t* bytes, std::size_t size, std::size_t count, const char* name) {
+  std::uint32_t order[kMaxMapSections];
+  for (std::size_t i = 0; i < count; ++i) {
+    const MapSectionInfo s = entry(bytes, i);
+    // Insertion sort by offset (at most kMaxMapSections entries).
+    std::size_t j = i;
+    while (j > 0 && entry(bytes, order[j - 1]).offset > s.offset) {
+      order[j] = order[j - 1];
+      --j;
+    }
+    order[j] = static_cast<std::uint32_t>(i);
+  }
+  std::uint64_t pos = kMapImageHeaderBytes + static_cast<std::uint64_t>(count) * kMapSectionEntryBytes;
+  for (std::size_t k = 0; k <= count; ++k) {
+    const std::uint64_t next = k < count ? entry(bytes, order[k]).offset : size;
+    for (std::uint64_t b = pos; b < next; ++b) {
+      if (bytes[b] != 0) {
+        return Status::error(Errc::kCorruptData, "%s: byte %llu between sections is 0x%02x (padding must be zero)",
+                             name, static_cast<unsigned long long>(b), bytes[b]);
+      }
+    }
+    if (k < count) {
+      const MapSectionInfo s = entry(bytes, order[k]);
+      if (s.offset + s.size > pos) pos = s.offset + s.size;
+    }
+  }
+  return Status::ok();
+}
+
+// The distance field is the map's exact EDT (map_image.h). A wrong one passes every CRC and
+// plausibility test above yet steers RBSM, MCL and the tracker to wrong poses, so it is recomputed
+// here from the occupancy — the same separable transform (edt.h) the host writer uses — into `out`
+// (the arena copy, which this fills) and compared cell by cell. Squared distances are integers in
+// cells², exact in float below 2^24 (4096 cells), so there the stored metres must be bit-identical to
+// sqrt(d²)·resolution on any IEEE CPU; beyond (a wall more than 4096 cells away) the transform itself
+// rounds, and a few float ulps (4e-7 relative) are allowed. Scratch: 16 bytes per cell of the longer
+// side, taken from the arena and released before returning.
+Status recompute_distance_field(const GridGeometry& geometry, const std::uint8_t* occ_bytes,
+                                const std::uint8_t* dist_bytes, StartupArena& arena, float* out, const char* name) {
+  const std::size_t w = geometry.width, h = geometry.height, cells = w * h;
+  const std::size_t n = w > h ? w : h;
+  const std::size_t scratch_mark = arena.mark();
+  Result<int*> v = arena.allocate_array<int>(n, "map distance check scratch");
+  Result<float*> z = v ? arena.allocate_array<float>(n + 1, "map distance check scratch") : Result<float*>(v.status());
+  Result<float*> f = z ? arena.allocate_array<float>(n, "map distance check scratch") : z;
+  Result<float*> d = f ? arena.allocate_array<float>(n, "map distance check scratch") : f;
+  if (!d) {
+    arena.rewind(scratch_mark);
+    return Status::error(Errc::kCapacityExceeded, "%s: no arena room to verify the distance field: %s", name,
+                         d.status().message());
+  }
+  for (std::size_t i = 0; i < cells; ++i) out[i] = occ_bytes[i] == kCellOccupied ? 0.0f : kEdtInf;
+  const EdtScratch scratch{*v, *z, *f, *d, n};
+  const std::size_t dims[2] = {h, w};
+  squared_edt<2>(out, dims, scratch);
+  arena.rewind(scratch_mark);
+  constexpr float kExactBelow = 16777216.0f;  // 2^24 cells²
+  for (std::size_t i = 0; i < cells; ++i) {
+    const float d2 = out[i];
+    const float expected = std::sqrt(d2) * geometry.resolution;
+    const float stored = rd_f32(dist_bytes + 4 * i);
+    const bool ok = d2 < kExactBelow ? stored == expected : std::fabs(stored - expected) <= 4e-7f * expected;
+    if (!ok) {
+      return Status::error(Errc::kCorruptData,
+                           "%s: distance field cell %zu (x %zu, y %zu) is %.9g m, the occupied cells put it at %.9g m "
+                           "(the distance field does not belong to this map)",
+                           name, i, i % w, i / w, static_cast<double>(stored), static_cast<double>(expected));
+    }
+    out[i] = stored;
+  }
+  return Status::ok();
+}
+
+const char* grid_extent_message(GridExtentProblem p) {
+  switch (p) {
+    case GridExtentProblem::kNone: return "ok";
+    case GridExtentProblem::kResolution: return "resolution is outside [0.0001, 1000] m";
+    case GridExtentProblem::kOrigin: return "origin is not finite";
+    case GridExtentProblem::kReach:
+      return "the grid reaches more than 2^19 cells from the world origin, where float coordinates are coarser "
+             "than 1/16 of a cell";
+  }
+  return "invalid";
+}
+
 }  // namespace
 
 const char* map_section_name(MapSectionType type) {
@@ -123,12 +231,15 @@ const char* map_section_name(MapSectionType type) {
   return "unknown";
 }
 
-Status verify_map_image(const std::uint8_t* bytes, std::size_t size, const char* name) {
+namespace {
+
+Status verify_except_padding(const std::uint8_t* bytes, std::size_t size, const char* name) {
   std::size_t count = 0;
   FW_RETURN_IF_ERROR(check_structure(bytes, size, name, &count));
   if (rd_u32(bytes + 24) != 0) {
     return Status::error(Errc::kUnsupported, "%s: unknown header flags 0x%x", name, rd_u32(bytes + 24));
   }
+  FW_RETURN_IF_ERROR(check_reserved_fields(bytes, count, name));
   for (std::size_t i = 0; i < count; ++i) {
     const MapSectionInfo s = entry(bytes, i);
     const std::uint32_t c = crc32(bytes + s.offset, static_cast<std::size_t>(s.size));
@@ -149,10 +260,17 @@ Status verify_map_image(const std::uint8_t* bytes, std::size_t size, const char*
   return Status::ok();
 }
 
+}  // namespace
+
+Status verify_map_image(const std::uint8_t* bytes, std::size_t size, const char* name) {
+  FW_RETURN_IF_ERROR(verify_except_padding(bytes, size, name));
+  return check_padding(bytes, size, map_section_count(bytes, size), name);
+}
+
 Status load_map_image(const std::uint8_t* bytes, std::size_t size, StartupArena& arena, GlobalMap* out,
                       const char* name) {
   if (out == nullptr) return Status::error(Errc::kInvalidArgument, "%s: no output map", name);
-  FW_RETURN_IF_ERROR(verify_map_image(bytes, size, name));
+  FW_RETURN_IF_ERROR(verify_except_padding(bytes, size, name));
   const std::size_t count = map_section_count(bytes, size);
 
   MapSectionInfo geo, occ, dist, pts;
@@ -187,6 +305,18 @@ Status load_map_image(const std::uint8_t* bytes, std::size_t size, StartupArena&
   if (!std::isfinite(max_distance) || max_distance < 0.0f) {
     return Status::error(Errc::kCorruptData, "%s: geometry: max distance is not a finite non-negative number", name);
   }
+  const std::uint32_t geometry_reserved = rd_u32(g + 28);
+  if (geometry_reserved != 0) {
+    return Status::error(Errc::kCorruptData, "%s: geometry: reserved field is 0x%08x, must be 0", name,
+                         geometry_reserved);
+  }
+  const GridExtentProblem extent = check_grid_extent(geometry);
+  if (extent != GridExtentProblem::kNone) {
+    return Status::error(Errc::kCorruptData, "%s: geometry: %s (resolution %g m, origin (%g, %g), %ux%u cells)", name,
+                         grid_extent_message(extent), static_cast<double>(geometry.resolution),
+                         static_cast<double>(geometry.origin_x), static_cast<double>(geometry.origin_y),
+                         geometry.width, geometry.height);
+  }
   const std::uint64_t cells = static_cast<std::uint64_t>(geometry.width) * geometry.height;
   if (occ.size != cells) {
     return Status::error(Errc::kCorruptData, "%s: occupancy section is %llu bytes, geometry %ux%u needs %llu", name,
@@ -203,6 +333,7 @@ Status load_map_image(const std::uint8_t* bytes, std::size_t size, StartupArena&
                          static_cast<unsigned long long>(pts.size), num_points,
                          static_cast<unsigned long long>(num_points) * 8u);
   }
+  FW_RETURN_IF_ERROR(check_padding(bytes, size, count, name));
 
   // Contents: occupancy codes, distance 0 exactly on occupied cells, finite non-negative elsewhere.
   const std::uint8_t* occ_bytes = bytes + occ.offset;
@@ -228,6 +359,9 @@ Status load_map_image(const std::uint8_t* bytes, std::size_t size, StartupArena&
     if (o == kCellOccupied) ++occupied;
     if (d > max_seen) max_seen = d;
   }
+  if (occupied == 0) {
+    return Status::error(Errc::kCorruptData, "%s: the map has no occupied cells (nothing to localize against)", name);
+  }
   if (occupied != num_points) {
     return Status::error(Errc::kCorruptData, "%s: geometry says %u occupied points, occupancy has %llu", name,
                          num_points, static_cast<unsigned long long>(occupied));
@@ -236,7 +370,14 @@ Status load_map_image(const std::uint8_t* bytes, std::size_t size, StartupArena&
     return Status::error(Errc::kCorruptData, "%s: geometry max distance %g, distance field max %g", name,
                          static_cast<double>(max_distance), static_cast<double>(max_seen));
   }
+  // Points: one per occupied cell, at its centre, in row-major order. Strictly increasing cell indices
+  // plus the count check above make that a one-to-one map onto the occupied cells (a duplicated point
+  // would weigh its wall twice in every match and leave another cell without one). "At the centre"
+  // allows a quarter cell: the writer's float arithmetic may differ from ours in the last bit (fused
+  // multiply-add on another CPU), and the extent check bounds that bit to 1/16 of a cell.
   const std::uint8_t* pts_bytes = bytes + pts.offset;
+  std::size_t previous_cell = 0;
+  const float centre_tolerance = 0.25f * geometry.resolution;
   for (std::uint32_t i = 0; i < num_points; ++i) {
     const float x = rd_f32(pts_bytes + 8u * i);
     const float y = rd_f32(pts_bytes + 8u * i + 4);
@@ -246,21 +387,48 @@ Status load_map_image(const std::uint8_t* bytes, std::size_t size, StartupArena&
       return Status::error(Errc::kCorruptData, "%s: occupied point %u (%g, %g) is not inside an occupied cell", name, i,
                            static_cast<double>(x), static_cast<double>(y));
     }
+    const std::size_t cell = geometry.index(cx, cy);
+    if (i > 0 && cell == previous_cell) {
+      return Status::error(Errc::kCorruptData, "%s: occupied point %u (%g, %g) duplicates point %u (cell %d, %d)", name,
+                           i, static_cast<double>(x), static_cast<double>(y), i - 1, cx, cy);
+    }
+    if (i > 0 && cell < previous_cell) {
+      return Status::error(Errc::kCorruptData,
+                           "%s: occupied point %u (%g, %g) is out of row-major order (cell %d, %d comes before the "
+                           "previous point's cell): a duplicate or an unsorted list",
+                           name, i, static_cast<double>(x), static_cast<double>(y), cx, cy);
+    }
+    const Point2f c = geometry.cell_center(cx, cy);
+    if (!(std::fabs(x - c.x()) <= centre_tolerance && std::fabs(y - c.y()) <= centre_tolerance)) {
+      return Status::error(Errc::kCorruptData, "%s: occupied point %u (%g, %g) is not at the centre (%g, %g) of its cell",
+                           name, i, static_cast<double>(x), static_cast<double>(y), static_cast<double>(c.x()),
+                           static_cast<double>(c.y()));
+    }
+    previous_cell = cell;
   }
 
-  // Valid: copy into the start-up arena (the image buffer may be unmapped afterwards).
+  // Copy into the start-up arena (the image buffer may be unmapped afterwards). Everything is released
+  // again (rewind) if the distance field turns out wrong: nothing stays allocated for a bad image.
+  const std::size_t arena_mark = arena.mark();
   Result<std::uint8_t*> occ_mem = arena.allocate_array<std::uint8_t>(static_cast<std::size_t>(cells), "map occupancy");
   if (!occ_mem) return occ_mem.status();
   Result<float*> dist_mem = arena.allocate_array<float>(static_cast<std::size_t>(cells), "map distance field");
-  if (!dist_mem) return dist_mem.status();
-  Point2f* points = nullptr;
-  if (num_points > 0) {
-    Result<Point2f*> pts_mem = arena.allocate_array<Point2f>(num_points, "map occupied points");
-    if (!pts_mem) return pts_mem.status();
-    points = *pts_mem;
+  if (!dist_mem) {
+    arena.rewind(arena_mark);
+    return dist_mem.status();
+  }
+  Result<Point2f*> pts_mem = arena.allocate_array<Point2f>(num_points, "map occupied points");
+  if (!pts_mem) {
+    arena.rewind(arena_mark);
+    return pts_mem.status();
+  }
+  Point2f* points = *pts_mem;
+  const Status field = recompute_distance_field(geometry, occ_bytes, dist_bytes, arena, *dist_mem, name);
+  if (!field) {
+    arena.rewind(arena_mark);
+    return field;
   }
   std::memcpy(*occ_mem, occ_bytes, static_cast<std::size_t>(cells));
-  std::memcpy(*dist_mem, dist_bytes, static_cast<std::size_t>(cells) * 4u);
   for (std::uint32_t i = 0; i < num_points; ++i) {
     points[i] = Point2f(rd_f32(pts_bytes + 8u * i), rd_f32(pts_bytes + 8u * i + 4));
   }
@@ -279,6 +447,18 @@ Status load_map_image(const std::uint8_t* bytes, std::size_t size, StartupArena&
   out->num_points = num_points;
   out->max_distance_m = max_distance;
   return Status::ok();
+}
+
+std::size_t map_image_arena_bytes(const std::uint8_t* bytes, std::size_t size) {
+  std::size_t len = 0;
+  const std::uint8_t* g = find_section(bytes, size, MapSectionType::kGeometry, &len);
+  if (g == nullptr || len != kMapGeometryBytes) return 0;
+  const std::uint64_t w = rd_u32(g + 12), h = rd_u32(g + 16), points = rd_u32(g + 20);
+  const std::uint64_t cells = w * h, longer = w > h ? w : h;
+  // occupancy + distance field + points + scratch (int v, float z/f/d) + alignment of each array.
+  const std::uint64_t bytes_needed = cells * (1 + sizeof(float)) + points * sizeof(Point2f) + (longer + 1) * 16 + 8 * 16;
+  return bytes_needed > static_cast<std::uint64_t>(static_cast<std::size_t>(-1)) ? 0
+                                                                                 : static_cast<std::size_t>(bytes_needed);
 }
 
 std::size_t map_section_count(const std::uint8_t* bytes, std::size_t size) {

@@ -23,6 +23,8 @@
 //   kOccupancy      width*height u8, row 0 = lowest y (0 free, 1..99 scaled, 100 occupied, 255 unknown)
 //   kDistanceField  width*height f32 metres to the nearest occupied cell (exact EDT, 0 on occupied)
 //   kOccupiedPoints num_points × (f32 x, f32 y): centres of the occupied cells, row-major order
+// Reserved fields and the padding between sections are zero; the grid must satisfy
+// check_grid_extent() (grid_geometry.h: float coordinates resolve its cells).
 #pragma once
 
 #include <cstddef>
@@ -69,12 +71,20 @@ struct MapSectionInfo {
 // CRC); does not interpret the sections. `name` (e.g. the file path) prefixes every message.
 Status verify_map_image(const std::uint8_t* bytes, std::size_t size, const char* name = "map image");
 
-// Full validation (verify_map_image + the four map sections: sizes consistent with the geometry,
-// finite floats, occupancy codes, distance 0 exactly on occupied cells, points inside occupied
-// cells), then copies the arrays into `arena` and fills `out`. Nothing is allocated unless the
-// whole image is valid. Registers the copied bytes with MemoryReport under module "map".
+// Full validation (verify_map_image + the four map sections: sizes consistent with the geometry, a
+// representable grid extent, finite floats, occupancy codes, at least one occupied cell, exactly one
+// point at the centre of each occupied cell in row-major order, reserved fields zero, and the distance
+// field equal to the exact EDT of the occupied cells, recomputed here), then copies the arrays into
+// `arena` and fills `out`. Nothing stays allocated unless the whole image is valid. The recomputation
+// needs map_image_arena_bytes() of arena at its peak (scratch released before returning) and costs
+// about as much as the writer's EDT (see sim/map/README.md for figures). Registers the copied bytes
+// with MemoryReport under module "map".
 Status load_map_image(const std::uint8_t* bytes, std::size_t size, StartupArena& arena, GlobalMap* out,
                       const char* name = "map image");
+
+// Arena bytes load_map_image needs at its peak for this image (the three arrays, the distance check's
+// scratch and alignment padding); 0 when the structure or the geometry section is malformed.
+std::size_t map_image_arena_bytes(const std::uint8_t* bytes, std::size_t size);
 
 // Payload of the first section of `type`, or nullptr (absent, or header/table malformed). Checks only
 // the structure (bounds), not the CRCs: call it on an image load_map_image/verify_map_image accepted.

@@ -26,8 +26,11 @@ void set32(std::vector<std::uint8_t>* b, std::size_t at, std::uint32_t v) {
   for (int i = 0; i < 4; ++i) (*b)[at + i] = static_cast<std::uint8_t>(v >> (8 * i));
 }
 
+// Deliberate defects written with honest CRCs (issue 13: the loader used to accept each of them).
+enum class Tweak { kNone, kWrongDistance, kDuplicatePoint, kGeometryReserved, kEntryReserved, kFarOrigin };
+
 // 4 x 3 grid at 0.5 m, origin (1, -1); occupied cells (0,0) and (3,2); (1,2) unknown.
-std::vector<std::uint8_t> hand_made_image(std::uint32_t version = kMapImageVersion) {
+std::vector<std::uint8_t> hand_made_image(std::uint32_t version = kMapImageVersion, Tweak tweak = Tweak::kNone) {
   const std::uint32_t w = 4, h = 3;
   std::vector<std::uint8_t> occ(w * h, kCellFree);
   occ[0] = kCellOccupied;
@@ -40,23 +43,26 @@ std::vector<std::uint8_t> hand_made_image(std::uint32_t version = kMapImageVersi
       const float d2a = static_cast<float>(x * x + y * y);
       const float d2b = static_cast<float>((3 - static_cast<int>(x)) * (3 - static_cast<int>(x)) +
                                            (2 - static_cast<int>(y)) * (2 - static_cast<int>(y)));
-      const float d = std::sqrt(std::min(d2a, d2b)) * 0.5f;
+      float d = std::sqrt(std::min(d2a, d2b)) * 0.5f;
+      // Cell (1,1): 0.707 m from both walls; 0.75 m is plausible, consistent with "0 only on
+      // occupied cells" and below the maximum — but not this map's distance.
+      if (tweak == Tweak::kWrongDistance && x == 1 && y == 1) d = 0.75f;
       maxd = std::max(maxd, d);
       f32(&dist, d);
     }
   }
   f32(&pts, 1.25f);
   f32(&pts, -0.75f);
-  f32(&pts, 2.75f);
-  f32(&pts, 0.25f);
+  f32(&pts, tweak == Tweak::kDuplicatePoint ? 1.25f : 2.75f);
+  f32(&pts, tweak == Tweak::kDuplicatePoint ? -0.75f : 0.25f);
   f32(&geo, 0.5f);
-  f32(&geo, 1.0f);
+  f32(&geo, tweak == Tweak::kFarOrigin ? -1e38f : 1.0f);
   f32(&geo, -1.0f);
   u32(&geo, w);
   u32(&geo, h);
   u32(&geo, 2);
   f32(&geo, maxd);
-  u32(&geo, 0);
+  u32(&geo, tweak == Tweak::kGeometryReserved ? 7 : 0);
   const std::vector<std::uint8_t>* payloads[4] = {&geo, &occ, &dist, &pts};
   std::vector<std::uint8_t> img(kMapImageHeaderBytes + 4 * kMapSectionEntryBytes, 0);
   std::memcpy(img.data(), kMapImageMagic, 8);
@@ -72,6 +78,7 @@ std::vector<std::uint8_t> hand_made_image(std::uint32_t version = kMapImageVersi
     set32(&img, e + 8, static_cast<std::uint32_t>(off));
     set32(&img, e + 16, static_cast<std::uint32_t>(payloads[i]->size()));
     set32(&img, e + 24, crc32(payloads[i]->data(), payloads[i]->size()));
+    if (tweak == Tweak::kEntryReserved && i == 1) set32(&img, e + 28, 1);
   }
   set32(&img, 16, static_cast<std::uint32_t>(img.size()));
   set32(&img, 28, crc32(img.data(), img.size()));
@@ -96,6 +103,33 @@ TEST(MapImageFormatTest, LoadsHandMadeImage) {
   EXPECT_EQ(m.distance_at(1.75f, -0.75f, -1.0f), 0.5f);
   EXPECT_EQ(m.max_distance_m, 1.0f);  // cells (3,0) and (0,2): 2 cells from the nearest wall
   EXPECT_EQ(arena.used(), 12u + 12u * 4u + 2u * 8u);  // occupancy, distances, points
+}
+
+TEST(MapImageFormatTest, RejectsWrongDistanceDuplicatesReservedFieldsAndFarOrigins) {
+  alignas(16) static unsigned char storage[4096];
+  struct Case {
+    Tweak tweak;
+    const char* expect;
+  };
+  const Case cases[] = {
+      {Tweak::kWrongDistance, "distance field cell 5 (x 1, y 1) is 0.75 m, the occupied cells put it at 0.707106"},
+      {Tweak::kDuplicatePoint, "occupied point 1 (1.25, -0.75) duplicates point 0"},
+      {Tweak::kGeometryReserved, "geometry: reserved field is 0x00000007, must be 0"},
+      {Tweak::kEntryReserved, "section 1 (occupancy): reserved field is 0x00000001, must be 0"},
+      {Tweak::kFarOrigin, "geometry: the grid reaches more than 2^19 cells"},
+  };
+  for (const Case& c : cases) {
+    const std::vector<std::uint8_t> img = hand_made_image(kMapImageVersion, c.tweak);
+    StartupArena arena;
+    ASSERT_TRUE(arena.init(storage, sizeof(storage), "test").is_ok());
+    GlobalMap m;
+    const Status st = load_map_image(img.data(), img.size(), arena, &m, "hand.mmap");
+    ASSERT_FALSE(st.is_ok()) << c.expect;
+    EXPECT_EQ(st.code(), Errc::kCorruptData);
+    EXPECT_NE(std::strstr(st.message(), "hand.mmap: "), nullptr) << st.message();
+    EXPECT_NE(std::strstr(st.message(), c.expect), nullptr) << "'" << st.message() << "' lacks '" << c.expect << "'";
+    EXPECT_EQ(arena.used(), 0u) << "a rejected image keeps nothing in the arena";
+  }
 }
 
 TEST(MapImageFormatTest, BilinearDistanceAndGradient) {

@@ -21,6 +21,7 @@
 #include "sim/io/relations.h"
 #ifdef MMLFW_HAVE_SIM_MAP
 #include "sim/io/ros_map.h"
+#include "sim/common/cli_main.h"
 #endif
 
 namespace {
@@ -98,7 +99,7 @@ bool pgm_roundtrip(const std::string& dir, const sim::CarmenLog& corrected) {
 
 }  // namespace
 
-int main(int argc, char** argv) {
+static int run_main(int argc, char** argv) {
   const std::string out = argc > 1 ? argv[1] : "build/bench/sim.json";
   std::printf("bench_sim: data from %s\n", sim::data_dir().c_str());
   sim::BenchJson json;
@@ -218,4 +219,8 @@ int main(int argc, char** argv) {
 #endif
 
   return json.write(out) ? 0 : 1;
+}
+
+int main(int argc, char** argv) {
+  return sim::guarded_main("bench_sim", [&] { return run_main(argc, argv); });
 }

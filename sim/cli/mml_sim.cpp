@@ -6,6 +6,7 @@
 #include "firmware/base/fault.h"
 #include "sim/cli/sim_args.h"
 #include "sim/cli/sim_runner.h"
+#include "sim/common/cli_main.h"
 
 namespace {
 void fatal_fault(fw::Fault fault, std::uint32_t bits) {
@@ -16,7 +17,7 @@ void fatal_fault(fw::Fault fault, std::uint32_t bits) {
 }
 }  // namespace
 
-int main(int argc, char** argv) {
+static int run_main(int argc, char** argv) {
   fw::set_fault_handler(&fatal_fault);
   std::vector<std::string> args(argv + 1, argv + argc);
   sim::SimConfig cfg;
@@ -47,4 +48,8 @@ int main(int argc, char** argv) {
   std::fflush(stderr);
   std::printf("%s\n", sim::summary_line(result.summary).c_str());
   return 0;
+}
+
+int main(int argc, char** argv) {
+  return sim::guarded_main("mml-sim", [&] { return run_main(argc, argv); });
 }

@@ -63,6 +63,7 @@ source:
   --log FILE              CARMEN log (plain or gzip) to replay
   --reference FILE        *.corrected-poses.txt: ground truth for the log's scans
   --map FILE.yaml         ROS map_server map for the log (the localizer's global map)
+  --max-log-mib N         refuse a log larger than N MiB, plain or inflated (default 512; stops gzip bombs)
 run:
   --localizer NAME        localizer (default mml-track, the firmware's; --list shows all)
   --opt KEY=VALUE         localizer option (repeatable), e.g. --opt anchor=truth for odom
@@ -135,6 +136,13 @@ bool parse_sim_args(const std::vector<std::string>& args, SimConfig* cfg, SimArg
       if (!value(&cfg->reference_path)) return false;
     } else if (a == "--map") {
       if (!value(&cfg->map_yaml)) return false;
+    } else if (a == "--max-log-mib") {
+      if (!value(&v) || !parse_u64(a, v, 1ull << 20, &n, err)) return false;
+      if (n == 0) {
+        *err = "--max-log-mib: must be at least 1";
+        return false;
+      }
+      cfg->max_log_bytes = static_cast<std::uint64_t>(n) << 20;
     } else if (a == "--localizer") {
       if (!value(&cfg->localizer)) return false;
     } else if (a == "--opt") {

@@ -1,4 +1,5 @@
 #include <gtest/gtest.h>
+#include <sys/stat.h>
 
 #include <unistd.h>
 
@@ -59,6 +60,18 @@ TEST(SimArgs, MalformedArgumentsGiveAClearError) {
   EXPECT_NE(parse_error({"--world", "small-office", "--kidnap-at", "0"}).find("--kidnap-at"), std::string::npos);
   EXPECT_NE(parse_error({"--dataset", "intel", "--world", "small-office"}).find("exclude each other"),
             std::string::npos);
+  EXPECT_NE(parse_error({"--log", "x.clf", "--max-log-mib", "0"}).find("--max-log-mib"), std::string::npos);
+  EXPECT_NE(parse_error({"--log", "x.clf", "--max-log-mib", "9999999"}).find("--max-log-mib"), std::string::npos);
+}
+
+TEST(SimArgs, MaxLogMibSetsTheReadCap) {
+  SimConfig cfg;
+  SimArgsAction action;
+  std::string err;
+  ASSERT_TRUE(parse_sim_args({"--log", "x.clf"}, &cfg, &action, &err)) << err;
+  EXPECT_EQ(cfg.max_log_bytes, kDefaultMaxLogBytes);
+  ASSERT_TRUE(parse_sim_args({"--log", "x.clf", "--max-log-mib", "3"}, &cfg, &action, &err)) << err;
+  EXPECT_EQ(cfg.max_log_bytes, 3u << 20);
 }
 
 TEST(SimArgs, ParsesAFullCommandLine) {
@@ -192,6 +205,27 @@ TEST(SimRunner, BadInputsAreClearErrors) {
   cfg.log_path = d + "/bad.clf";
   EXPECT_FALSE(run_simulation(cfg, &r, &err));
   EXPECT_NE(err.find("bad.clf"), std::string::npos) << err;
+  // Issue 13: a map whose origin float coordinates cannot resolve, a FIFO as map image (blocked).
+  {
+    std::ofstream f(d + "/good.clf");
+    f << "FLASER 3 1.0 2.0 3.0 0 0 0 0 0 0 1.0 host 1.0\n";
+    std::ofstream p(d + "/m.pgm", std::ios::binary);
+    p << "P5\n2 1\n255\n" << '\0' << '\xfe';
+    std::ofstream y(d + "/far.yaml");
+    y << "image: m.pgm\nresolution: 0.05\norigin: [-1e38, -1e38, 0]\nnegate: 0\noccupied_thresh: 0.65\n"
+         "free_thresh: 0.196\n";
+    std::ofstream z(d + "/fifo.yaml");
+    z << "image: fifo.pgm\nresolution: 0.05\norigin: [0, 0, 0]\nnegate: 0\noccupied_thresh: 0.65\n"
+         "free_thresh: 0.196\n";
+  }
+  cfg.log_path = d + "/good.clf";
+  cfg.map_yaml = d + "/far.yaml";
+  EXPECT_FALSE(run_simulation(cfg, &r, &err));
+  EXPECT_NE(err.find("far.yaml: field 'origin'"), std::string::npos) << err;
+  ASSERT_EQ(::mkfifo((d + "/fifo.pgm").c_str(), 0600), 0);
+  cfg.map_yaml = d + "/fifo.yaml";
+  EXPECT_FALSE(run_simulation(cfg, &r, &err));
+  EXPECT_NE(err.find("not a regular file (a FIFO)"), std::string::npos) << err;
   std::filesystem::remove_all(d);
 }
 

@@ -22,6 +22,7 @@
 #include "hal_sim/sim_hal.h"
 #include "sim/io/carmen_log.h"
 #include "sim/io/datasets.h"
+#include "sim/io/log_replay.h"
 #include "sim/io/reference_trajectory.h"
 #include "sim/map/global_maps.h"
 #include "sim/map/map_image_writer.h"
@@ -63,6 +64,7 @@ bool load_log_frames(const SimConfig& cfg, std::vector<Frame>* frames, std::size
   // The whole log is read even with --steps: the reference is chained from corrected poses that
   // may lie beyond the first N scans (aces: the first corrected pose is not at scan 0).
   CarmenReadOptions ro;
+  ro.max_bytes = cfg.max_log_bytes;
   if (!read_carmen_log(cfg.log_path, ro, &log, err)) return false;
   if (log.scans.empty()) {
     *err = "log '" + cfg.log_path + "' contains no laser scans";
@@ -99,7 +101,7 @@ bool load_log_frames(const SimConfig& cfg, std::vector<Frame>* frames, std::size
     }
     last_ts = ts_scan;
     f.t = ts_scan - t0;
-    auto to_ns = [&](double ts) { return static_cast<std::uint64_t>(std::llround((ts - t0 + 1.0) * 1e9)); };
+    auto to_ns = [&](double ts) { return seconds_to_ns(ts - t0 + 1.0); };
     // Scans that carry the odometry at their own time stamp (FLASER, RLASER, ROBOTLASER1) are paired
     // with exactly that; separate ODOM records are used only for scans without it (RAWLASER). Mixing
     // both would feed the loop out-of-order samples: in intel, ODOM records are stamped up to 0.4 s

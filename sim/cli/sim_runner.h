@@ -15,6 +15,7 @@
 #include "firmware/base/se2.h"
 #include "hal/msg/pose_estimate.h"
 #include "sim/cli/localizer_factory.h"
+#include "sim/io/carmen_log.h"
 #include "sim/world/raster.h"
 #include "sim/world/synthetic_run.h"
 
@@ -27,6 +28,7 @@ struct SimConfig {
   std::string log_path;        // CARMEN log (plain or .gz)
   std::string reference_path;  // *.corrected-poses.txt for a log (ground truth)
   std::string map_yaml;        // ROS map for a log replay (optional)
+  std::uint64_t max_log_bytes = kDefaultMaxLogBytes;  // --max-log-mib: cap on the log, plain or inflated
   // Empty: "mml-track" when it is registered (the product, firmware/app/system.h), else "odom".
   std::string localizer;
   std::map<std::string, std::string> localizer_options;

@@ -5,6 +5,7 @@
 #include <fstream>
 
 #include "sim/devices/candump_log.h"
+#include "sim/io/log_replay.h"
 
 namespace sim {
 
@@ -25,7 +26,7 @@ bool build_can_traffic(const CarmenLog& log, const CanTrafficOptions& o, std::ve
   const double t0 = log.scans[o.first_scan].ipc_timestamp - 1.0;
   const double t_end = log.scans[last - 1].ipc_timestamp;
   summary->sensor_t0 = t0;
-  auto sensor_ns = [&](double ipc) { return static_cast<std::uint64_t>(std::llround((ipc - t0) * 1e9)); };
+  auto sensor_ns = [&](double ipc) { return seconds_to_ns(ipc - t0); };
   auto replay_t = [&](double ipc) { return o.start_time + (ipc - t0) / o.speed; };
 
   struct Item {

@@ -1,5 +1,7 @@
 #include "sim/devices/candump_log.h"
 
+#include "sim/io/file_io.h"
+
 #include <cstdio>
 #include <cstdlib>
 #include <fstream>
@@ -102,6 +104,8 @@ bool parse_candump_line(const std::string& line, CanLogLine* out, std::string* e
 }
 
 bool read_candump_log(const std::string& path, std::vector<CanLogLine>* out, std::string* error) {
+  // Regular files only (a FIFO would block, /dev/zero never end), at most 1 GiB.
+  if (!check_regular_file(path, std::uint64_t(1) << 30, nullptr, error)) return false;
   std::ifstream in(path);
   if (!in) { *error = path + ": cannot open"; return false; }
   std::string line;

@@ -1,6 +1,10 @@
 #include "sim/devices/candump_log.h"
 
 #include <gtest/gtest.h>
+#include <sys/stat.h>
+#include <unistd.h>
+
+#include <cstdio>
 
 #include "sim/devices/can_traffic.h"
 #include "sim/io/datasets.h"
@@ -84,6 +88,21 @@ TEST(CanTraffic, RoundTripThroughTheDecoderWithFaults) {
     EXPECT_EQ(odom, s.odometry_sent);
     EXPECT_GT(odom, 50u);
   }
+}
+
+// Issue 13 (same class as the map and log readers): a FIFO blocked the reader forever, /dev/zero
+// was read as one endless line.
+TEST(CandumpLog, FifoAndDeviceAreRefused) {
+  std::vector<CanLogLine> lines;
+  std::string err;
+  EXPECT_FALSE(read_candump_log("/dev/zero", &lines, &err));
+  EXPECT_NE(err.find("/dev/zero: not a regular file (a character device)"), std::string::npos) << err;
+  const std::string fifo = ::testing::TempDir() + "/candump_fifo_" + std::to_string(::getpid()) + ".log";
+  std::remove(fifo.c_str());
+  ASSERT_EQ(::mkfifo(fifo.c_str(), 0600), 0);
+  EXPECT_FALSE(read_candump_log(fifo, &lines, &err));
+  EXPECT_NE(err.find("not a regular file (a FIFO)"), std::string::npos) << err;
+  std::remove(fifo.c_str());
 }
 
 }  // namespace

@@ -24,6 +24,7 @@
 #include "sim/devices/candump_log.h"
 #include "sim/io/datasets.h"
 #include "sim/io/reference_trajectory.h"
+#include "sim/common/cli_main.h"
 
 namespace {
 
@@ -80,7 +81,7 @@ std::uint64_t mono_ns() {
 
 }  // namespace
 
-int main(int argc, char** argv) {
+static int run_main(int argc, char** argv) {
   if (argc < 2) return usage("missing command");
   const std::string cmd = argv[1];
   Args a;
@@ -216,4 +217,8 @@ int main(int argc, char** argv) {
     return 0;
   }
   return usage(("unknown command '" + cmd + "'").c_str());
+}
+
+int main(int argc, char** argv) {
+  return sim::guarded_main("mml-candev", [&] { return run_main(argc, argv); });
 }

@@ -19,6 +19,7 @@
 #include "hal_serial/termios_port.h"
 #include "sim/io/carmen_log.h"
 #include "sim/io/datasets.h"
+#include "sim/common/cli_main.h"
 
 namespace {
 int usage(const std::string& m) {
@@ -40,7 +41,7 @@ void sleep_until(double t) {
 }
 }  // namespace
 
-int main(int argc, char** argv) {
+static int run_main(int argc, char** argv) {
   std::map<std::string, std::string> kv;
   for (int i = 1; i < argc; ++i) {
     std::string k = argv[i];
@@ -126,4 +127,8 @@ int main(int argc, char** argv) {
   std::printf("{\"requested\": %s, \"telegrams_sent\": %zu, \"corrupted\": %zu, \"garbage_bursts\": %zu, \"rate_hz\": %.1f}\n",
               requested ? "true" : "false", sent, corrupted, garbage_sent, rate);
   return 0;
+}
+
+int main(int argc, char** argv) {
+  return sim::guarded_main("mml-sickdev", [&] { return run_main(argc, argv); });
 }

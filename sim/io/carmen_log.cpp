@@ -1,5 +1,7 @@
 #include "sim/io/carmen_log.h"
 
+#include "sim/io/file_io.h"
+
 #include <sys/stat.h>
 #include <zlib.h>
 
@@ -66,6 +68,17 @@ class LineParser {
     }
     return true;
   }
+  // A finite number with |v| ≤ limit (plausibility bound; see carmen_log.h).
+  bool num_in(size_t i, const char* what, double limit, const char* unit, double* v) {
+    if (!num(i, what, v)) return false;
+    if (!(std::fabs(*v) <= limit)) {
+      char lim[32];
+      std::snprintf(lim, sizeof(lim), "%g", limit);
+      return fail(std::string("field ") + std::to_string(i + 1) + " (" + what + ") is " + show(tok_[i]) + unit +
+                  ", outside the plausible ±" + lim + unit);
+    }
+    return true;
+  }
   bool numf(size_t i, const char* what, float* v) {
     double d;
     if (!num(i, what, &d)) return false;
@@ -94,17 +107,23 @@ class LineParser {
       float r;
       if (!numf(first + static_cast<size_t>(k), "range reading", &r)) return false;
       if (r < 0.0f) return fail("range reading " + std::to_string(k) + " is negative: " + show(tok_[first + k]));
+      if (r > static_cast<float>(kMaxLaserRangeM)) {
+        return fail("range reading " + std::to_string(k) + " is " + show(tok_[first + k]) +
+                    " m, beyond the plausible 1000 m of a laser scanner");
+      }
       (*out)[static_cast<size_t>(k)] = r;
     }
     return true;
   }
   bool pose(size_t i, const char* what, fw::Se2d* p) {
-    return num(i, what, &p->x) && num(i + 1, what, &p->y) && num(i + 2, what, &p->theta);
+    return num_in(i, what, kMaxAbsPositionM, " m", &p->x) && num_in(i + 1, what, kMaxAbsPositionM, " m", &p->y) &&
+           num_in(i + 2, what, kMaxAbsAngleRad, " rad", &p->theta);
   }
   // "ipc_timestamp ipc_hostname logger_timestamp" at the end of the line.
   bool stamps(double* ipc, double* logger) {
     const size_t n = tok_.size();
-    return num(n - 3, "ipc_timestamp", ipc) && num(n - 1, "logger_timestamp", logger);
+    return num_in(n - 3, "ipc_timestamp", kMaxAbsTimestampS, " s", ipc) &&
+           num_in(n - 1, "logger_timestamp", kMaxAbsTimestampS, " s", logger);
   }
   bool fail(const std::string& m) {
     *why_ = m;
@@ -168,7 +187,21 @@ bool parse_laser_head(const std::vector<std::string_view>& t, CarmenScan* s, siz
     double r;
     if (!p.num(rem_at + 1 + static_cast<size_t>(k), "remission", &r)) return false;
   }
-  if (maxr <= 0.0) return p.fail("maximum_range must be positive");
+  // Geometry the scan is projected with: a maximum range that fits a float and a laser, a positive
+  // resolution (zero put every beam on one bearing; negative ones are not in the format), at most a
+  // full turn of beams, start angle and field of view within a turn.
+  constexpr double kTurn = 2.0 * kPi + 1e-3;  // + print rounding of 2π
+  auto bad = [&](size_t field, const char* what, const std::string& why) {
+    return p.fail(std::string("field ") + std::to_string(field + 1) + " (" + what + ") is " + show(t[field]) + ": " + why);
+  };
+  if (!(maxr > 0.0)) return bad(5, "maximum_range", "maximum_range must be positive");
+  if (maxr > kMaxLaserRangeM) return bad(5, "maximum_range", "beyond the plausible 1000 m of a laser scanner");
+  if (!(res > 0.0)) return bad(4, "angular_resolution", "must be positive");
+  if (n > 1 && res * static_cast<double>(n - 1) > kTurn) {
+    return bad(4, "angular_resolution", std::to_string(n) + " beams at this spacing span more than a full turn");
+  }
+  if (std::fabs(start) > kTurn) return bad(2, "start_angle", "more than a full turn");
+  if (std::fabs(fov) > kTurn) return bad(3, "field_of_view", "more than a full turn");
   s->angle_min = static_cast<float>(start);
   s->angle_increment = static_cast<float>(res);
   s->max_range = static_cast<float>(maxr);
@@ -199,8 +232,9 @@ bool parse_rawlaser(const std::vector<std::string_view>& t, CarmenScan* s, std::
 bool parse_odom(const std::vector<std::string_view>& t, CarmenOdom* o, std::string* why) {
   LineParser p(t, why);
   double accel;
-  return p.fields(10, "ODOM") && p.pose(1, "x y theta", &o->pose) && p.num(4, "tv", &o->tv) &&
-         p.num(5, "rv", &o->rv) && p.num(6, "accel", &accel) && p.stamps(&o->ipc_timestamp, &o->logger_timestamp);
+  return p.fields(10, "ODOM") && p.pose(1, "x y theta", &o->pose) && p.num_in(4, "tv", kMaxAbsSpeed, " m/s", &o->tv) &&
+         p.num_in(5, "rv", kMaxAbsSpeed, " rad/s", &o->rv) && p.num(6, "accel", &accel) &&
+         p.stamps(&o->ipc_timestamp, &o->logger_timestamp);
 }
 
 bool parse_param(const std::vector<std::string_view>& t, std::pair<std::string, std::string>* kv, std::string* why) {
@@ -222,6 +256,12 @@ bool parse_param(const std::vector<std::string_view>& t, std::pair<std::string, 
     if (i > 2) kv->second += ' ';
     kv->second.append(t[i]);
   }
+  // The laser maxima become the FLASER/RLASER max_range (float): same bounds as a ROBOTLASER1's.
+  if ((kv->first == "robot_front_laser_max" || kv->first == "robot_rear_laser_max") &&
+      parse_double(kv->second, &d) && !(d > 0.0 && d <= kMaxLaserRangeM)) {
+    *why = "PARAM " + kv->first + " " + show(kv->second) + " is not a plausible maximum range (0, 1000] m";
+    return false;
+  }
   return true;
 }
 
@@ -237,82 +277,99 @@ size_t CarmenLog::count(const std::string& type) const {
   return n;
 }
 
-bool read_file_maybe_gz(const std::string& path, std::string* data, std::string* error) {
-  data->clear();
-  struct stat st;
-  if (::stat(path.c_str(), &st) != 0) {
-    *error = path + ": cannot open: " + std::strerror(errno);
+namespace {
+
+std::string mib_text(std::uint64_t bytes) {
+  if (bytes % (std::uint64_t(1) << 20) == 0) return std::to_string(bytes >> 20) + " MiB";
+  return std::to_string(bytes) + " bytes";
+}
+
+// Inflates a gzip file held in memory: every member (gzip -d concatenates members), nothing after the
+// last one (zlib's gzread silently ignores trailing bytes: a log with garbage appended read as good),
+// at most max_bytes of output (a 13 MB bomb of 3 GB of newlines is stopped at the cap, not inflated).
+bool inflate_gzip(const std::string& path, const std::string& gz, std::uint64_t max_bytes, std::string* out,
+                  std::string* error) {
+  z_stream zs{};
+  if (inflateInit2(&zs, 15 + 16) != Z_OK) {
+    *error = path + ": cannot initialise zlib";
     return false;
   }
-  if (!S_ISREG(st.st_mode)) {
-    *error = path + ": not a regular file";
-    return false;
-  }
-  FILE* probe = std::fopen(path.c_str(), "rb");
-  if (!probe) {
-    *error = path + ": cannot open: " + std::strerror(errno);
-    return false;
-  }
-  unsigned char magic[2] = {0, 0};
-  const size_t got = std::fread(magic, 1, 2, probe);
-  const bool gz = got == 2 && magic[0] == 0x1f && magic[1] == 0x8b;
-  if (!gz) {
-    std::fseek(probe, 0, SEEK_END);
-    const long size = std::ftell(probe);
-    std::fseek(probe, 0, SEEK_SET);
-    if (size < 0) {
-      std::fclose(probe);
-      *error = path + ": cannot determine file size";
-      return false;
-    }
-    data->resize(static_cast<size_t>(size));
-    const size_t rd = size > 0 ? std::fread(data->data(), 1, data->size(), probe) : 0;
-    const bool ok = rd == data->size() && !std::ferror(probe);
-    std::fclose(probe);
-    if (!ok) {
-      *error = path + ": read error";
-      return false;
-    }
-    return true;
-  }
-  std::fclose(probe);
-  gzFile f = gzopen(path.c_str(), "rb");
-  if (!f) {
-    *error = path + ": cannot open gzip stream";
-    return false;
-  }
-  gzbuffer(f, 1 << 17);
-  constexpr size_t kChunk = 1 << 20;
+  const unsigned char* in = reinterpret_cast<const unsigned char*>(gz.data());
+  std::size_t in_left = gz.size();
+  constexpr std::size_t kChunk = std::size_t(1) << 20;
+  std::string msg;
   for (;;) {
-    const size_t old = data->size();
-    data->resize(old + kChunk);
-    const int n = gzread(f, data->data() + old, static_cast<unsigned>(kChunk));
-    if (n < 0) {
-      int code;
-      const char* msg = gzerror(f, &code);
-      *error = path + ": corrupt gzip data: " + (msg ? msg : "unknown zlib error");
-      gzclose(f);
-      data->clear();
-      return false;
+    if (zs.avail_in == 0 && in_left > 0) {
+      const std::size_t n = std::min<std::size_t>(in_left, std::size_t(1) << 30);
+      zs.next_in = const_cast<unsigned char*>(in);
+      zs.avail_in = static_cast<uInt>(n);
+      in += n;
+      in_left -= n;
     }
-    data->resize(old + static_cast<size_t>(n));
-    if (n == 0) break;
+    if (out->size() >= max_bytes + 1) {
+      msg = path + ": inflates to more than " + mib_text(max_bytes) +
+            " (the limit for one file; not a log, or raise the limit with --max-log-mib)";
+      break;
+    }
+    const std::size_t old = out->size();
+    const std::size_t room = static_cast<std::size_t>(std::min<std::uint64_t>(kChunk, max_bytes + 1 - old));
+    out->resize(old + room);
+    zs.next_out = reinterpret_cast<unsigned char*>(out->data() + old);
+    zs.avail_out = static_cast<uInt>(room);
+    const int rc = inflate(&zs, Z_NO_FLUSH);
+    out->resize(old + room - zs.avail_out);
+    if (rc == Z_STREAM_END) {
+      const std::size_t rest = zs.avail_in + in_left;
+      if (rest == 0) break;  // done: the input ends with this member
+      const std::size_t at = gz.size() - rest;
+      if (rest >= 2 && static_cast<unsigned char>(gz[at]) == 0x1f && static_cast<unsigned char>(gz[at + 1]) == 0x8b) {
+        inflateReset(&zs);  // another gzip member follows
+        continue;
+      }
+      msg = path + ": " + std::to_string(rest) + " bytes of trailing garbage after the gzip stream (from byte " +
+            std::to_string(at) + " of " + std::to_string(gz.size()) + ")";
+      break;
+    }
+    if (rc == Z_BUF_ERROR && zs.avail_in == 0 && in_left == 0) {
+      msg = path + ": corrupt or truncated gzip data: unexpected end of file";
+      break;
+    }
+    if (rc != Z_OK && rc != Z_BUF_ERROR) {
+      msg = path + ": corrupt gzip data: " + (zs.msg ? zs.msg : "zlib error " + std::to_string(rc));
+      break;
+    }
   }
-  int code = Z_OK;
-  const char* msg = gzerror(f, &code);
-  if (code != Z_OK && code != Z_STREAM_END) {
-    *error = path + ": corrupt or truncated gzip data: " + (msg ? msg : "unknown zlib error");
-    gzclose(f);
-    data->clear();
-    return false;
-  }
-  const int rc = gzclose(f);
-  if (rc != Z_OK) {
-    *error = path + ": corrupt or truncated gzip data (gzclose " + std::to_string(rc) + ")";
-    data->clear();
+  inflateEnd(&zs);
+  if (!msg.empty()) {
+    *error = msg;
+    out->clear();
     return false;
   }
   return true;
+}
+
+}  // namespace
+
+bool read_file_maybe_gz(const std::string& path, std::string* data, std::string* error) {
+  return read_file_maybe_gz(path, kDefaultMaxLogBytes, data, error);
+}
+
+bool read_file_maybe_gz(const std::string& path, std::uint64_t max_bytes, std::string* data, std::string* error) {
+  data->clear();
+  // The compressed file is bounded by the same cap (it is never larger than what it inflates to,
+  // short of a broken file); only regular files are opened (a FIFO would block, /dev/zero never end).
+  std::string raw;
+  if (!read_regular_file(path, max_bytes, &raw, error)) {
+    if (error->find("more than the limit") != std::string::npos) *error += " (raise it with --max-log-mib)";
+    return false;
+  }
+  const bool gz = raw.size() >= 2 && static_cast<unsigned char>(raw[0]) == 0x1f &&
+                  static_cast<unsigned char>(raw[1]) == 0x8b;
+  if (!gz) {
+    *data = std::move(raw);
+    return true;
+  }
+  return inflate_gzip(path, raw, max_bytes, data, error);
 }
 
 bool parse_carmen_log(const std::string& name, const char* data, size_t size, const CarmenReadOptions& options,
@@ -335,6 +392,28 @@ bool parse_carmen_log(const std::string& name, const char* data, size_t size, co
     ++line_no;
     const char* q = p;
     p = eol + 1;
+    if (static_cast<size_t>(eol - q) > options.max_line_bytes) {
+      // Not tokenized: a multi-gigabyte line would otherwise become gigabytes of token views.
+      const std::string msg = name + ":" + std::to_string(line_no) + ": line of " + std::to_string(eol - q) +
+                              " bytes, longer than the limit of " + std::to_string(options.max_line_bytes) +
+                              " (not a CARMEN log?)";
+      if (!options.skip_bad_lines) {
+        *error = msg;
+        out->lines = line_no;
+        return false;
+      }
+      ++out->bad_lines;
+      if (out->bad_line_messages.size() < kMaxBadLineMessages) out->bad_line_messages.push_back(msg);
+      // A dropped scan line still counts (indices keep matching the file's scan ordinals).
+      const char* h = q;
+      while (h < eol && is_space(*h)) ++h;
+      const std::string_view head(h, static_cast<size_t>(std::min<ptrdiff_t>(eol - h, 12)));
+      if (head.rfind("FLASER", 0) == 0 || head.rfind("RLASER", 0) == 0 || head.rfind("ROBOTLASER1", 0) == 0 ||
+          head.rfind("RAWLASER", 0) == 0) {
+        ++scan_records;
+      }
+      continue;
+    }
     while (q < eol && is_space(*q)) ++q;
     if (q == eol) continue;
     if (*q == '#') {
@@ -434,7 +513,7 @@ bool parse_carmen_log(const std::string& name, const char* data, size_t size, co
 
 bool read_carmen_log(const std::string& path, const CarmenReadOptions& options, CarmenLog* out, std::string* error) {
   std::string data;
-  if (!read_file_maybe_gz(path, &data, error)) {
+  if (!read_file_maybe_gz(path, options.max_bytes, &data, error)) {
     *out = CarmenLog();
     out->path = path;
     return false;

@@ -5,9 +5,11 @@
 //
 // Strict by default: a malformed line (wrong field count for the beam count it declares, non-numeric
 // or non-finite number, negative range, truncated line) makes read_carmen_log return false with an
-// error "path:line: problem". With skip_bad_lines the line is dropped, counted in bad_lines and its
-// message kept in bad_line_messages (first 100). A missing file or corrupt gzip stream is always an
-// error.
+// error "path:line: problem" (also: a line longer than max_line_bytes, a value outside the plausible
+// bounds below, an angular resolution ≤ 0 or a scan spanning more than a full turn). With
+// skip_bad_lines the line is dropped, counted in bad_lines and its message kept in bad_line_messages
+// (first 100). A missing file, a path that is not a regular file, a corrupt gzip stream, trailing bytes
+// after it and more than max_bytes of data are always errors.
 //
 // Scan geometry: ROBOTLASER1 / RAWLASER carry start angle, resolution and maximum range. FLASER /
 // RLASER carry none, so it follows from the beam count n (README): n even → spacing π/n from -π/2
@@ -62,9 +64,26 @@ struct CarmenLog {
   size_t count(const std::string& type) const;  // scan records of that type ("FLASER", …)
 };
 
+// Caps against hostile or broken files (the logs of ../shared/data inflate to ≤ 18 MB with lines of
+// ≤ 2.3 kB). Over the byte cap the read fails with a message naming the file and the cap; a longer line
+// is a malformed line (file:line).
+constexpr std::uint64_t kDefaultMaxLogBytes = std::uint64_t(512) << 20;  // inflated (or plain) size
+constexpr size_t kDefaultMaxLineBytes = size_t(1) << 20;
+
+// Plausible values: a field beyond them is malformed (file:line, field), even though finite — a
+// maximum range of 1e300 m would become an infinite float, a timestamp of 1e300 s a replay that never
+// ends. The bounds are far outside anything real (Unix time in 2286, 1000 km, a 1 km laser).
+constexpr double kMaxAbsTimestampS = 1e10;
+constexpr double kMaxAbsPositionM = 1e6;
+constexpr double kMaxAbsAngleRad = 1e4;
+constexpr double kMaxLaserRangeM = 1000.0;
+constexpr double kMaxAbsSpeed = 1000.0;  // ODOM tv (m/s), rv (rad/s)
+
 struct CarmenReadOptions {
   bool skip_bad_lines = false;
   size_t max_scans = 0;  // 0 = all; reading stops after this many scan records
+  std::uint64_t max_bytes = kDefaultMaxLogBytes;  // file size, and inflated size of a .gz
+  size_t max_line_bytes = kDefaultMaxLineBytes;
 };
 
 // Reads a CARMEN log (plain or .gz). On failure returns false and sets *error to "path:line: …"
@@ -92,7 +111,10 @@ struct CarmenWriteOptions {
 bool write_carmen_log(const std::string& path, const CarmenLog& log, const CarmenWriteOptions& options,
                       std::string* error);
 
-// Reads a whole file (plain or gzip, detected by the 1f 8b magic) into memory.
+// Reads a whole regular file (plain or gzip, detected by the 1f 8b magic; every gzip member, and an
+// error for anything after the last) into memory; at most max_bytes (default kDefaultMaxLogBytes) of
+// file and of inflated data.
 bool read_file_maybe_gz(const std::string& path, std::string* data, std::string* error);
+bool read_file_maybe_gz(const std::string& path, std::uint64_t max_bytes, std::string* data, std::string* error);
 
 }  // namespace sim

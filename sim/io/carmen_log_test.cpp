@@ -3,9 +3,11 @@
 #include "sim/io/carmen_log.h"
 
 #include <gtest/gtest.h>
+#include <sys/stat.h>
 #include <unistd.h>
 #include <zlib.h>
 
+#include <chrono>
 #include <cmath>
 #include <cstdio>
 #include <fstream>
@@ -42,9 +44,18 @@ const char* kRobotLaser =
     "ROBOTLASER1 0 -1.570796 3.141593 0.017453 81.900000 0.010000 0 3 1.0 2.0 81.910 0 "
     "0.1 0.2 0.3 1.1 1.2 1.3 0.0 0.0 0.0 0.0 0.0 1232658478.161285 zoidberg2 -0.055208\n";
 
+// kRobotLaser with the first occurrence of `field` replaced by `value`.
+std::string robot_laser(const std::string& field, const std::string& value) {
+  std::string s = kRobotLaser;
+  const size_t at = s.find(" " + field + " ");
+  if (at != std::string::npos) s.replace(at + 1, field.size(), value);
+  return s;
+}
+
 bool parse(const std::string& text, CarmenLog* log, std::string* err, bool skip = false) {
   CarmenReadOptions o;
   o.skip_bad_lines = skip;
+  o.max_line_bytes = 4096;
   return parse_carmen_log("mem.clf", text.data(), text.size(), o, log, err);
 }
 
@@ -174,6 +185,24 @@ TEST(CarmenLog, MalformedLinesAreErrorsNamingFileAndLine) {
       {"binary", std::string("FLA\x01\x02" "SER 3\n"), "not a CARMEN message"},
       {"PARAM without value", "PARAM lonely\n", "PARAM"},
       {"NEFF non-numeric", "NEFF x\n", "NEFF"},
+      // Issue 13: finite but impossible values were accepted (1e300 m became an infinite float range,
+      // resolution 0 put every beam on one bearing, 1e300 s timestamps replayed forever).
+      {"ROBOTLASER1 max range 1e300", robot_laser("81.900000", "1e300"), "field 6 (maximum_range) is '1e300'"},
+      {"ROBOTLASER1 max range 5 km", robot_laser("81.900000", "5000"), "beyond the plausible 1000 m"},
+      {"ROBOTLASER1 zero resolution", robot_laser("0.017453", "0"), "field 5 (angular_resolution) is '0': must be positive"},
+      {"ROBOTLASER1 negative resolution", robot_laser("0.017453", "-0.017453"), "angular_resolution"},
+      {"ROBOTLASER1 beams over a turn", robot_laser("0.017453", "4.0"), "span more than a full turn"},
+      {"ROBOTLASER1 start angle", robot_laser("-1.570796", "-100"), "field 3 (start_angle)"},
+      {"ROBOTLASER1 timestamp 1e300", robot_laser("1232658478.161285", "1e300"), "(ipc_timestamp) is '1e300' s"},
+      {"FLASER logger timestamp 1e300", flaser_line(180).replace(flaser_line(180).size() - 5, 4, "1e300"),
+       "(logger_timestamp) is '1e300' s, outside the plausible ±1e+10 s"},
+      {"FLASER range 2 km", flaser_line(180, "2000"), "beyond the plausible 1000 m"},
+      {"FLASER pose 1e300", "FLASER 1 1.0 1e300 2.0 0.5 1.1 2.1 0.6 100.25 host 0.25\n", "(x y theta) is '1e300' m"},
+      {"ODOM tv 1e300", "ODOM 1 2 3 1e300 0 0 5.0 host 5.0\n", "(tv) is '1e300' m/s"},
+      {"PARAM laser max 1e300", "PARAM robot_front_laser_max 1e300 host 0.5\n",
+       "robot_front_laser_max '1e300' is not a plausible maximum range"},
+      {"line over the cap", "FLASER 3 " + std::string(5000, ' ') + "1 2 3 0 0 0 0 0 0 1 h 1\n",
+       "bytes, longer than the limit of 4096"},
   };
   for (const auto& c : cases) {
     SCOPED_TRACE(c.name);
@@ -332,6 +361,94 @@ TEST(CarmenLog, CorruptGzipIsAnError) {
     EXPECT_NE(err.find("gzip"), std::string::npos) << err;
   }
   std::remove(gz.c_str());
+}
+
+// gzip of `repeat` copies of `chunk`, compressed in memory (a bomb when the chunk is newlines).
+std::string gzip_of(const std::string& chunk, size_t repeat = 1) {
+  z_stream zs{};
+  EXPECT_EQ(deflateInit2(&zs, 9, Z_DEFLATED, 15 + 16, 9, Z_DEFAULT_STRATEGY), Z_OK);
+  std::string out;
+  char buf[1 << 16];
+  for (size_t i = 0; i <= repeat; ++i) {
+    const bool last = i == repeat;
+    zs.next_in = reinterpret_cast<Bytef*>(const_cast<char*>(chunk.data()));
+    zs.avail_in = last ? 0 : static_cast<uInt>(chunk.size());
+    do {
+      zs.next_out = reinterpret_cast<Bytef*>(buf);
+      zs.avail_out = sizeof(buf);
+      deflate(&zs, last ? Z_FINISH : Z_NO_FLUSH);
+      out.append(buf, sizeof(buf) - zs.avail_out);
+    } while (zs.avail_out == 0);
+  }
+  deflateEnd(&zs);
+  return out;
+}
+
+// Issue 13: a 13 MB gzip of 3 GB of newlines was inflated whole. Here 64 MiB of newlines (about 64 KB
+// compressed) against an 8 MiB cap: the read stops at the cap with a message naming the file and the
+// limit, quickly and without holding the 64 MiB.
+TEST(CarmenLog, GzipBombIsStoppedAtTheCap) {
+  const std::string bomb = gzip_of(std::string(1 << 20, '\\n'), 64);
+  ASSERT_LT(bomb.size(), 1u << 20);
+  const std::string gz = temp_path("bomb.clf.gz");
+  write_text(gz, bomb);
+  CarmenReadOptions o;
+  o.max_bytes = 8u << 20;
+  CarmenLog log;
+  std::string err;
+  const auto t0 = std::chrono::steady_clock::now();
+  EXPECT_FALSE(read_carmen_log(gz, o, &log, &err));
+  EXPECT_LT(std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count(), 10.0);
+  EXPECT_NE(err.find(gz + ": inflates to more than 8 MiB"), std::string::npos) << err;
+  EXPECT_NE(err.find("--max-log-mib"), std::string::npos) << err;
+  // The default cap is finite and above every real log (≤ 18 MB inflated).
+  EXPECT_EQ(CarmenReadOptions{}.max_bytes, kDefaultMaxLogBytes);
+  EXPECT_GE(kDefaultMaxLogBytes, 256u << 20);
+  EXPECT_LT(kDefaultMaxLogBytes, 4ull << 30);
+  // A plain file over the cap is refused by its size, before it is read.
+  const std::string plain = temp_path("big.clf");
+  write_text(plain, std::string(2 << 20, '\n'));
+  o.max_bytes = 1u << 20;
+  EXPECT_FALSE(read_carmen_log(plain, o, &log, &err));
+  EXPECT_NE(err.find("more than the limit of 1048576 bytes (1 MiB)"), std::string::npos) << err;
+  std::remove(gz.c_str());
+  std::remove(plain.c_str());
+}
+
+// Issue 13: bytes after the end of the gzip stream were silently ignored (zlib's gzread). Further
+// gzip members are data (gzip -d concatenates them); anything else is an error.
+TEST(CarmenLog, TrailingGarbageAfterGzipIsAnError) {
+  const std::string a = flaser_line(180), b = "ODOM 1 2 3 0 0 0 5.0 host 5.0\n";
+  const std::string gz = temp_path("t.clf.gz");
+  CarmenLog log;
+  std::string err;
+  write_text(gz, gzip_of(a) + gzip_of(b));
+  ASSERT_TRUE(read_carmen_log(gz, {}, &log, &err)) << err;
+  EXPECT_EQ(log.scans.size(), 1u);
+  EXPECT_EQ(log.odom.size(), 1u);
+  const std::string good = gzip_of(a);
+  for (const std::string& tail : {std::string("garbage\n"), std::string(1, '\0'), std::string("\x1f")}) {
+    write_text(gz, good + tail);
+    EXPECT_FALSE(read_carmen_log(gz, {}, &log, &err)) << tail.size();
+    EXPECT_NE(err.find(gz + ": " + std::to_string(tail.size()) + " bytes of trailing garbage after the gzip stream"),
+              std::string::npos)
+        << err;
+    EXPECT_NE(err.find("from byte " + std::to_string(good.size())), std::string::npos) << err;
+  }
+  std::remove(gz.c_str());
+}
+
+TEST(CarmenLog, FifoAndDeviceAreRefusedWithoutBlocking) {
+  const std::string fifo = temp_path("fifo.clf");
+  std::remove(fifo.c_str());
+  ASSERT_EQ(::mkfifo(fifo.c_str(), 0600), 0);
+  CarmenLog log;
+  std::string err;
+  EXPECT_FALSE(read_carmen_log(fifo, {}, &log, &err));
+  EXPECT_NE(err.find(fifo + ": not a regular file (a FIFO)"), std::string::npos) << err;
+  EXPECT_FALSE(read_carmen_log("/dev/zero", {}, &log, &err));
+  EXPECT_NE(err.find("character device"), std::string::npos) << err;
+  std::remove(fifo.c_str());
 }
 
 TEST(CarmenLog, WriteReadRoundTripIsExact) {

@@ -51,12 +51,17 @@ std::vector<ReplayEvent> make_replay_events(const CarmenLog& log, const ReplayOp
   std::uint64_t prev = 0;
   for (const auto& it : items) {
     ReplayEvent e = it.e;
-    const double dt = std::max(0.0, it.t - t0);
-    e.t_ns = std::max(prev, static_cast<std::uint64_t>(std::llround(dt * 1e9)));
+    e.t_ns = std::max(prev, seconds_to_ns(it.t - t0));
     prev = e.t_ns;
     out.push_back(e);
   }
   return out;
+}
+
+std::uint64_t seconds_to_ns(double seconds) {
+  if (!(seconds > 0.0)) return 0;
+  if (seconds >= 9.0e9) return 9000000000000000000ull;
+  return static_cast<std::uint64_t>(std::llround(seconds * 1e9));
 }
 
 hal::Odometry to_odometry(const CarmenOdom& odom, std::uint64_t timestamp_ns) {

@@ -40,6 +40,11 @@ struct ReplayOptions {
 
 std::vector<ReplayEvent> make_replay_events(const CarmenLog& log, const ReplayOptions& options = {});
 
+// Seconds → nanoseconds for replay clocks, clamped to [0, 9e18] ns (285 years): the reader accepts
+// timestamps up to ±1e10 s, and a span of 2e10 s would overflow llround (undefined behaviour).
+// NaN gives 0.
+std::uint64_t seconds_to_ns(double seconds);
+
 hal::Odometry to_odometry(const CarmenOdom& odom, std::uint64_t timestamp_ns);
 hal::Odometry to_odometry(const CarmenScan& scan, std::uint64_t timestamp_ns);  // the scan's odom pose
 // Message of one event (kind must match).

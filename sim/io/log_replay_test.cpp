@@ -2,6 +2,7 @@
 
 #include <gtest/gtest.h>
 
+#include <cmath>
 #include <string>
 
 namespace sim {
@@ -60,6 +61,29 @@ TEST(LogReplay, OdometryFromScansWhenNoOdomRecords) {
   ReplayOptions no_odo;
   no_odo.include_odometry = false;
   EXPECT_EQ(make_replay_events(log, no_odo).size(), 2u);
+}
+
+// Issue 13: timestamps at the readers' bounds (±1e10 s) span 2e10 s, which overflowed llround
+// (undefined behaviour) when converted to replay nanoseconds; the clock is clamped and monotone.
+TEST(LogReplay, ExtremeTimestampsAreClampedNotOverflowed) {
+  const std::string text = flaser(-1e10, 1) + flaser(1e10, 2) + flaser(1e10, 3);
+  CarmenLog log;
+  std::string err;
+  ASSERT_TRUE(parse_carmen_log("m", text.data(), text.size(), {}, &log, &err)) << err;
+  const auto ev = make_replay_events(log);
+  ASSERT_EQ(ev.size(), 6u);
+  EXPECT_EQ(ev.front().t_ns, 0u);
+  EXPECT_EQ(ev.back().t_ns, 9000000000000000000ull);
+  for (size_t i = 1; i < ev.size(); ++i) EXPECT_GE(ev[i].t_ns, ev[i - 1].t_ns);
+  EXPECT_EQ(seconds_to_ns(1.5), 1500000000ull);
+  EXPECT_EQ(seconds_to_ns(-3.0), 0u);
+  EXPECT_EQ(seconds_to_ns(std::nan("")), 0u);
+  EXPECT_EQ(seconds_to_ns(1e300), 9000000000000000000ull);
+  // Beyond the bounds the reader refuses the log (file:line, field).
+  const std::string bad = flaser(1, 1) + flaser(1e11, 2);
+  EXPECT_FALSE(parse_carmen_log("m", bad.data(), bad.size(), {}, &log, &err));
+  EXPECT_NE(err.find("m:2: "), std::string::npos) << err;
+  EXPECT_NE(err.find("ipc_timestamp"), std::string::npos) << err;
 }
 
 }  // namespace

@@ -5,11 +5,14 @@
 //                                                    "t x y theta" at every scan (raw odometry or reference)
 //   mml-carmen eval RELATIONS TRAJECTORY [--tolerance S]           Kümmerle et al. 2009 metric
 //   mml-carmen dataset NAME                          metric of raw odometry and reference (../shared/data)
+//   --max-log-mib N   (any command reading a log) refuse logs larger than N MiB, plain or inflated
+//                     (default 512: a gzip bomb is stopped there with a message, not inflated)
 // Exit status 0 on success, 1 on bad input (message names the file and line), 2 on usage errors.
 #include <chrono>
 #include <cstdio>
 #include <cstdlib>
 #include <cstring>
+#include <cstdint>
 #include <map>
 #include <string>
 #include <vector>
@@ -18,6 +21,7 @@
 #include "sim/io/datasets.h"
 #include "sim/io/reference_trajectory.h"
 #include "sim/io/relations.h"
+#include "sim/common/cli_main.h"
 
 namespace {
 
@@ -27,7 +31,8 @@ int usage() {
                "       mml-carmen convert IN OUT [--skip-bad-lines] [--max-scans N]\n"
                "       mml-carmen trajectory LOG OUT [--reference CORRECTED_POSES | --reference-relations RELATIONS]\n"
                "       mml-carmen eval RELATIONS TRAJECTORY [--tolerance SECONDS]\n"
-               "       mml-carmen dataset NAME   (intel, fr079, aces, fr-clinic, mit-killian)\n");
+               "       mml-carmen dataset NAME   (intel, fr079, aces, fr-clinic, mit-killian)\n"
+               "options for every command reading a log: --max-log-mib N (default 512)\n");
   return 2;
 }
 
@@ -43,6 +48,7 @@ struct Args {
   double tolerance = 1e-4;
   std::string reference;
   std::string reference_relations;
+  std::uint64_t max_log_bytes = sim::kDefaultMaxLogBytes;
   bool ok = true;
 };
 
@@ -70,6 +76,16 @@ Args parse_args(int argc, char** argv) {
       const char* v = value("--tolerance");
       a.tolerance = std::strtod(v, &end);
       if (!a.ok || *v == 0 || *end != 0 || !(a.tolerance >= 0)) a.ok = false;
+    } else if (s == "--max-log-mib") {
+      char* end = nullptr;
+      const char* v = value("--max-log-mib");
+      const unsigned long long mib = std::strtoull(v, &end, 10);
+      if (!a.ok || *v == 0 || *v == '-' || *end != 0 || mib == 0 || mib > (1ull << 20)) {
+        std::fprintf(stderr, "mml-carmen: --max-log-mib '%s' is not a size in MiB (1 .. 1048576)\n", v);
+        a.ok = false;
+      } else {
+        a.max_log_bytes = static_cast<std::uint64_t>(mib) << 20;
+      }
     } else if (s == "--reference") {
       a.reference = value("--reference");
     } else if (s == "--reference-relations") {
@@ -88,6 +104,7 @@ bool load(const std::string& path, const Args& a, sim::CarmenLog* log, std::stri
   sim::CarmenReadOptions o;
   o.skip_bad_lines = a.skip;
   o.max_scans = a.max_scans;
+  o.max_bytes = a.max_log_bytes;
   const bool ok = sim::read_carmen_log(path, o, log, err);
   if (ok && log->bad_lines > 0) {
     std::fprintf(stderr, "mml-carmen: %s: skipped %zu bad lines\n", path.c_str(), log->bad_lines);
@@ -206,7 +223,7 @@ int cmd_dataset(const Args& a) {
 
 }  // namespace
 
-int main(int argc, char** argv) {
+static int run_main(int argc, char** argv) {
   if (argc < 2) return usage();
   const std::string cmd = argv[1];
   const Args a = parse_args(argc, argv);
@@ -217,4 +234,8 @@ int main(int argc, char** argv) {
   if (cmd == "eval") return cmd_eval(a);
   if (cmd == "dataset") return cmd_dataset(a);
   return usage();
+}
+
+int main(int argc, char** argv) {
+  return sim::guarded_main("mml-carmen", [&] { return run_main(argc, argv); });
 }

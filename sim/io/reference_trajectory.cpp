@@ -13,6 +13,8 @@ namespace sim {
 namespace {
 
 constexpr double kRad2Deg = 180.0 / 3.14159265358979323846;
+// A billion scans is 150 days of a 75 Hz laser; a larger index is a corrupt file, not a log.
+constexpr unsigned long long kMaxFlaserIndex = 1000000000ull;
 
 bool parse_double(std::string_view tok, double* v) {
   const char* b = tok.data();
@@ -75,7 +77,7 @@ bool read_corrected_poses(const std::string& path, std::vector<CorrectedPose>* o
     const char* q = p;
     p = eol + 1;
     tok.clear();
-    while (q < eol) {
+    while (q < eol && tok.size() <= 6) {
       while (q < eol && (*q == ' ' || *q == '\t' || *q == '\r')) ++q;
       if (q == eol) break;
       const char* b = q;
@@ -86,7 +88,7 @@ bool read_corrected_poses(const std::string& path, std::vector<CorrectedPose>* o
     const std::string where = path + ":" + std::to_string(line_no) + ": ";
     if (tok.size() != 6) {
       *error = where + "expected 6 fields (flaser_index ipc_timestamp logger_timestamp x y theta), found " +
-               std::to_string(tok.size());
+               (tok.size() > 6 ? std::string("more") : std::to_string(tok.size()));
       return false;
     }
     CorrectedPose c;
@@ -96,6 +98,11 @@ bool read_corrected_poses(const std::string& path, std::vector<CorrectedPose>* o
       *error = where + "flaser_index is not a non-negative integer: '" + std::string(tok[0].substr(0, 40)) + "'";
       return false;
     }
+    if (idx > kMaxFlaserIndex) {
+      *error = where + "flaser_index " + std::to_string(idx) + " is not a plausible scan index (at most " +
+               std::to_string(kMaxFlaserIndex) + ")";
+      return false;
+    }
     c.flaser_index = static_cast<size_t>(idx);
     double v[5];
     static const char* kNames[5] = {"ipc_timestamp", "logger_timestamp", "x", "y", "theta"};
@@ -103,6 +110,14 @@ bool read_corrected_poses(const std::string& path, std::vector<CorrectedPose>* o
       if (!parse_double(tok[static_cast<size_t>(i) + 1], &v[i])) {
         *error = where + kNames[i] + " is not a finite number: '" +
                  std::string(tok[static_cast<size_t>(i) + 1].substr(0, 40)) + "'";
+        return false;
+      }
+      const double limit = i < 2 ? kMaxAbsTimestampS : i < 4 ? kMaxAbsPositionM : kMaxAbsAngleRad;
+      if (!(std::fabs(v[i]) <= limit)) {
+        char lim[32];
+        std::snprintf(lim, sizeof(lim), "%g", limit);
+        *error = where + kNames[i] + " is " + std::string(tok[static_cast<size_t>(i) + 1].substr(0, 40)) +
+                 ", outside the plausible ±" + lim + (i < 2 ? " s" : i < 4 ? " m" : " rad");
         return false;
       }
     }

@@ -43,7 +43,8 @@ struct CorrectedPose {
 };
 
 // Reads "flaser_index ipc_timestamp logger_timestamp x y theta" rows ('#' comments skipped); indices
-// must be strictly increasing. Errors name "path:line".
+// must be strictly increasing and at most 1e9, timestamps and poses within the bounds of carmen_log.h.
+// Errors name "path:line".
 bool read_corrected_poses(const std::string& path, std::vector<CorrectedPose>* out, std::string* error);
 
 // Ground truth at every raw scan (raw.scans order): chain odometry from the nearest corrected poses

@@ -24,6 +24,12 @@ bool parse_double(std::string_view tok, double* v) {
 
 constexpr double kRad2Deg = 180.0 / 3.14159265358979323846;
 
+std::string format_limit(double v) {
+  char b[32];
+  std::snprintf(b, sizeof(b), "%g", v);
+  return b;
+}
+
 // Sorted index of the trajectory for nearest-timestamp lookup.
 class TimeIndex {
  public:
@@ -87,7 +93,8 @@ bool read_relations(const std::string& path, std::vector<Relation>* out, std::st
     const char* q = p;
     p = eol + 1;
     tok.clear();
-    while (q < eol) {
+    // At most one token past the 8 expected is kept: a huge line costs no huge token list.
+    while (q < eol && tok.size() <= 8) {
       while (q < eol && (*q == ' ' || *q == '\t' || *q == '\r')) ++q;
       if (q == eol) break;
       const char* b = q;
@@ -97,7 +104,8 @@ bool read_relations(const std::string& path, std::vector<Relation>* out, std::st
     if (tok.empty() || tok[0][0] == '#') continue;
     const std::string where = path + ":" + std::to_string(line_no) + ": ";
     if (tok.size() != 8) {
-      *error = where + "expected 8 fields (t1 t2 x y z roll pitch yaw), found " + std::to_string(tok.size());
+      *error = where + "expected 8 fields (t1 t2 x y z roll pitch yaw), found " +
+               (tok.size() > 8 ? std::string("more") : std::to_string(tok.size()));
       return false;
     }
     double v[8];
@@ -112,6 +120,15 @@ bool read_relations(const std::string& path, std::vector<Relation>* out, std::st
     if (v[4] != 0.0 || v[5] != 0.0 || v[6] != 0.0) {
       *error = where + "z, roll and pitch must be 0 for a 2D relation";
       return false;
+    }
+    const double limits[8] = {kMaxAbsTimestampS, kMaxAbsTimestampS, kMaxAbsPositionM, kMaxAbsPositionM, 0, 0, 0,
+                              kMaxAbsAngleRad};
+    for (int i : {0, 1, 2, 3, 7}) {
+      if (!(std::fabs(v[i]) <= limits[i])) {
+        *error = where + "field " + kNames[i] + " is " + std::string(tok[static_cast<size_t>(i)].substr(0, 40)) +
+                 ", outside the plausible ±" + format_limit(limits[i]) + (i < 2 ? " s" : i < 4 ? " m" : " rad");
+        return false;
+      }
     }
     Relation r;
     r.t1 = v[0];
@@ -203,7 +220,7 @@ bool read_trajectory(const std::string& path, Trajectory* out, std::string* erro
     const char* q = p;
     p = eol + 1;
     tok.clear();
-    while (q < eol) {
+    while (q < eol && tok.size() <= 4) {
       while (q < eol && sep(*q)) ++q;
       if (q == eol) break;
       const char* b = q;
@@ -213,7 +230,8 @@ bool read_trajectory(const std::string& path, Trajectory* out, std::string* erro
     if (tok.empty() || tok[0][0] == '#') continue;
     const std::string where = path + ":" + std::to_string(line_no) + ": ";
     if (tok.size() != 4) {
-      *error = where + "expected 4 fields (t x y theta), found " + std::to_string(tok.size());
+      *error = where + "expected 4 fields (t x y theta), found " +
+               (tok.size() > 4 ? std::string("more") : std::to_string(tok.size()));
       return false;
     }
     double v[4];
@@ -221,6 +239,12 @@ bool read_trajectory(const std::string& path, Trajectory* out, std::string* erro
     for (int i = 0; i < 4; ++i) {
       if (!parse_double(tok[static_cast<size_t>(i)], &v[i])) {
         *error = where + kNames[i] + " is not a finite number: '" + std::string(tok[static_cast<size_t>(i)].substr(0, 40)) + "'";
+        return false;
+      }
+      const double limit = i == 0 ? kMaxAbsTimestampS : i < 3 ? kMaxAbsPositionM : kMaxAbsAngleRad;
+      if (!(std::fabs(v[i]) <= limit)) {
+        *error = where + kNames[i] + " is " + std::string(tok[static_cast<size_t>(i)].substr(0, 40)) +
+                 ", outside the plausible ±" + format_limit(limit) + (i == 0 ? " s" : i < 3 ? " m" : " rad");
         return false;
       }
     }

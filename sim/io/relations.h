@@ -22,7 +22,8 @@ struct Relation {
 };
 
 // Reads "t1 t2 x y z roll pitch yaw" lines ('#' comments and blank lines skipped). z, roll and pitch
-// must be 0 (2D data); errors name "path:line".
+// must be 0 (2D data); timestamps, x, y and yaw finite and within the plausible bounds of carmen_log.h
+// (±1e10 s, ±1e6 m, ±1e4 rad); errors name "path:line" and the field.
 bool read_relations(const std::string& path, std::vector<Relation>* out, std::string* error);
 // Writes relations in the same format (timestamps with 6 decimals, values shortest round-trip).
 bool write_relations(const std::string& path, const std::vector<Relation>& rel, std::string* error);
@@ -60,7 +61,7 @@ std::vector<RelationError> relation_errors(const std::vector<Relation>& relation
 std::string to_string(const RelationsMetric& m);
 
 // Plain trajectory files for tools: one "t x y theta" per line (blanks or commas between fields,
-// '#' comments). Errors name "path:line". The writer prints t with 6 decimals (like the logs' ipc
+// '#' comments; values within the bounds of carmen_log.h). Errors name "path:line". The writer prints t with 6 decimals (like the logs' ipc
 // timestamps, so relation lookups with the default tolerance still match) and poses shortest
 // round-trip.
 bool read_trajectory(const std::string& path, Trajectory* out, std::string* error);

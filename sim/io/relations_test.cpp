@@ -42,6 +42,11 @@ TEST(Relations, MalformedInputIsAnErrorNamingFileAndLine) {
       {"non-numeric", "1 2 1 0 0 0 0 0.5\n1 2 x 0 0 0 0 0\n", "field x is not a finite number"},
       {"NaN", "1 2 1 0 0 0 0 0.5\n1 2 1 nan 0 0 0 0\n", "field y is not a finite number"},
       {"3D", "1 2 1 0 0 0 0 0.5\n1 2 1 0 0.5 0 0 0\n", "z, roll and pitch must be 0"},
+      // Issue 13: finite but absurd values were accepted.
+      {"t1 1e300", "1 2 1 0 0 0 0 0.5\n1e300 2 1 0 0 0 0 0\n", "field t1 is 1e300, outside the plausible ±1e+10 s"},
+      {"x 1e300", "1 2 1 0 0 0 0 0.5\n1 2 1e300 0 0 0 0 0\n", "field x is 1e300, outside the plausible ±1e+06 m"},
+      {"yaw 1e300", "1 2 1 0 0 0 0 0.5\n1 2 1 0 0 0 0 -1e300\n", "field yaw is -1e300"},
+      {"many fields", "1 2 1 0 0 0 0 0.5\n1 2 1 0 0 0 0 0 0 0 0\n", "expected 8 fields (t1 t2 x y z roll pitch yaw), found more"},
   };
   for (const auto& c : cases) {
     SCOPED_TRACE(c.name);
@@ -149,6 +154,18 @@ TEST(Relations, TrajectoryFileRoundTripAndErrors) {
   write_text(p, "1 2 3 inf\n");
   EXPECT_FALSE(read_trajectory(p, &back, &err));
   EXPECT_NE(err.find(p + ":1: theta is not a finite number"), std::string::npos) << err;
+  // Issue 13: finite but absurd values, and a line of a million fields (kept to 5 tokens, not 16 MB).
+  write_text(p, "1e300 2 3 0\n");
+  EXPECT_FALSE(read_trajectory(p, &back, &err));
+  EXPECT_NE(err.find(p + ":1: t is 1e300, outside the plausible ±1e+10 s"), std::string::npos) << err;
+  write_text(p, "1 2 -3e7 0\n");
+  EXPECT_FALSE(read_trajectory(p, &back, &err));
+  EXPECT_NE(err.find(p + ":1: y is -3e7, outside the plausible ±1e+06 m"), std::string::npos) << err;
+  std::string huge;
+  for (int i = 0; i < 1000000; ++i) huge += "1 ";
+  write_text(p, huge + "\n");
+  EXPECT_FALSE(read_trajectory(p, &back, &err));
+  EXPECT_NE(err.find(p + ":1: expected 4 fields (t x y theta), found more"), std::string::npos) << err;
   std::remove(p.c_str());
 }
 
@@ -240,6 +257,12 @@ TEST(ReferenceTrajectory, CorruptedPosesFileIsAnError) {
       {"1 0 0 1 2 3\n2 0 0 1 2\n", "expected 6 fields"},
       {"1 0 0 1 2 3\n-2 0 0 1 2 3\n", "flaser_index"},
       {"1 0 0 1 2 3\n2 0 0 1 nan 3\n", "y is not a finite number"},
+      // Issue 13: absurd index, timestamps and poses.
+      {"1 0 0 1 2 3\n1000000000000000000 0 0 1 2 3\n", "flaser_index 1000000000000000000 is not a plausible scan index"},
+      {"1 0 0 1 2 3\n2 1e300 0 1 2 3\n", "ipc_timestamp is 1e300, outside the plausible ±1e+10 s"},
+      {"1 0 0 1 2 3\n2 0 -1e300 1 2 3\n", "logger_timestamp is -1e300"},
+      {"1 0 0 1 2 3\n2 0 0 1e7 2 3\n", "x is 1e7, outside the plausible ±1e+06 m"},
+      {"1 0 0 1 2 3\n2 0 0 1 2 3e5\n", "theta is 3e5, outside the plausible ±10000 rad"},
   };
   for (const auto& c : cases) {
     const std::string p = temp_path("cp.txt");

@@ -1,6 +1,9 @@
 #include "sim/io/ros_map.h"
 
+#include "sim/io/file_io.h"
+
 #include <cerrno>
+#include <algorithm>
 #include <charconv>
 #include <cmath>
 #include <cstdio>
@@ -54,15 +57,10 @@ std::string format_double(double v) {
   return s;
 }
 
-bool read_whole_file(const std::string& path, std::string* data, std::string* error) {
-  std::ifstream in(path, std::ios::binary);
-  if (!in) return fail(error, path + ": cannot open: " + std::strerror(errno));
-  std::ostringstream ss;
-  ss << in.rdbuf();
-  if (in.bad()) return fail(error, path + ": read error");
-  *data = ss.str();
-  return true;
-}
+// PGM pixel budget: 2^28 cells (16384 × 16384; a 0.05 m map of 819 m square). The firmware holds 5
+// bytes per cell in its arena, so this is already more than any robot loads; it keeps a forged header
+// from making the host tools allocate gigabytes.
+constexpr long long kMaxPgmCells = 1LL << 28;
 
 // PGM header tokenizer: whitespace and '#' comments between tokens.
 struct PgmCursor {
@@ -104,7 +102,7 @@ std::string resolve_image_path(const std::string& yaml_path, const std::string& 
 
 bool read_pgm(const std::string& path, RosMap* out, std::string* error) {
   std::string d;
-  if (!read_whole_file(path, &d, error)) return false;
+  if (!read_regular_file(path, kMaxMapFileBytes, &d, error)) return false;
   if (d.size() < 2 || d[0] != 'P' || (d[1] != '2' && d[1] != '5')) {
     return fail(error, path + ": bad magic (expected PGM 'P2' or 'P5')");
   }
@@ -122,7 +120,28 @@ bool read_pgm(const std::string& path, RosMap* out, std::string* error) {
     return fail(error, path + ": PGM header: maxval " + std::to_string(maxval) +
                            " not supported (8-bit PGM only, 1..255)");
   }
+  if (w * h > kMaxPgmCells) {
+    return fail(error, path + ": PGM header: size " + std::to_string(w) + "x" + std::to_string(h) + " is " +
+                           std::to_string(w * h) + " pixels, more than the limit of " + std::to_string(kMaxPgmCells));
+  }
   const std::size_t n = static_cast<std::size_t>(w) * static_cast<std::size_t>(h);
+  // The declared size must fit the data actually there before anything is allocated for it: P5 holds
+  // one byte per pixel after exactly one whitespace byte, P2 at least a digit and a separator each.
+  const std::size_t rest = d.size() - std::min(d.size(), c.pos);
+  if (!ascii) {
+    if (rest == 0 || !std::isspace(static_cast<unsigned char>(d[c.pos]))) {
+      return fail(error, path + ": PGM header: no whitespace after maxval");
+    }
+    if (rest - 1 < n) {
+      return fail(error, path + ": truncated P5 data: " + std::to_string(rest - 1) + " of " + std::to_string(n) +
+                             " pixel bytes (header says " + std::to_string(w) + "x" + std::to_string(h) + ")");
+    }
+  }
+  if (ascii && rest < 2 * n) {
+    return fail(error, path + ": truncated or malformed P2 data: " + std::to_string(rest) + " bytes cannot hold " +
+                           std::to_string(n) + " pixels (header says " + std::to_string(w) + "x" + std::to_string(h) +
+                           ")");
+  }
   std::vector<std::uint8_t> pixels(n);
   if (ascii) {
     for (std::size_t i = 0; i < n; ++i) {
@@ -138,15 +157,7 @@ bool read_pgm(const std::string& path, RosMap* out, std::string* error) {
       pixels[i] = static_cast<std::uint8_t>(v);
     }
   } else {
-    // Exactly one whitespace byte separates maxval from the raster.
-    if (c.pos >= d.size() || !std::isspace(static_cast<unsigned char>(d[c.pos]))) {
-      return fail(error, path + ": PGM header: no whitespace after maxval");
-    }
-    ++c.pos;
-    if (d.size() - c.pos < n) {
-      return fail(error, path + ": truncated P5 data: " + std::to_string(d.size() - c.pos) + " of " +
-                             std::to_string(n) + " pixel bytes");
-    }
+    ++c.pos;  // exactly one whitespace byte separates maxval from the raster (checked above)
     std::memcpy(pixels.data(), d.data() + c.pos, n);
     for (std::size_t i = 0; i < n; ++i) {
       if (pixels[i] > maxval) {
@@ -170,8 +181,7 @@ bool write_pgm(const std::string& path, const RosMap& map, std::string* error) {
                            std::to_string(map.height));
   }
   if (map.maxval < 1 || map.maxval > 255) return fail(error, path + ": cannot write PGM: maxval out of 1..255");
-  std::ofstream o(path, std::ios::binary | std::ios::trunc);
-  if (!o) return fail(error, path + ": cannot create: " + std::strerror(errno));
+  std::ostringstream o;
   o << (map.pgm_ascii ? "P2" : "P5") << "\n" << map.width << " " << map.height << "\n" << map.maxval << "\n";
   if (map.pgm_ascii) {
     for (int y = 0; y < map.height; ++y) {
@@ -183,9 +193,7 @@ bool write_pgm(const std::string& path, const RosMap& map, std::string* error) {
   } else {
     o.write(reinterpret_cast<const char*>(map.pixels.data()), static_cast<std::streamsize>(map.pixels.size()));
   }
-  o.close();
-  if (!o) return fail(error, path + ": write failed");
-  return true;
+  return write_file_atomic(path, o.str(), error);
 }
 
 bool validate_ros_map(const RosMap& m, const std::string& name, std::string* error) {
@@ -195,6 +203,28 @@ bool validate_ros_map(const RosMap& m, const std::string& name, std::string* err
   }
   for (int i = 0; i < 3; ++i) {
     if (!std::isfinite(m.origin[i])) return fail(error, name + ": field 'origin': component " + std::to_string(i) + " not finite");
+  }
+  // Float world coordinates must still resolve the cells (firmware/map/grid_geometry.h): an origin of
+  // -1e38 or a 1e-30 m resolution would compile into a map whose points all collapse onto one.
+  const double cells_w = std::max(m.width, 1), cells_h = std::max(m.height, 1);
+  switch (fw::check_grid_extent(m.resolution, m.origin[0], m.origin[1], cells_w, cells_h)) {
+    case fw::GridExtentProblem::kNone:
+      break;
+    case fw::GridExtentProblem::kResolution:
+      return fail(error, name + ": field 'resolution': " + format_double(m.resolution) +
+                             " m is outside the supported [" + format_double(fw::kMinGridResolutionM) + ", " +
+                             format_double(fw::kMaxGridResolutionM) + "] m");
+    case fw::GridExtentProblem::kOrigin:
+    case fw::GridExtentProblem::kReach: {
+      const double reach = fw::grid_reach_m(m.resolution, m.origin[0], m.origin[1], cells_w, cells_h);
+      return fail(error, name + ": field 'origin': [" + format_double(m.origin[0]) + ", " + format_double(m.origin[1]) +
+                             "] with " + std::to_string(static_cast<long long>(cells_w)) + "x" +
+                             std::to_string(static_cast<long long>(cells_h)) + " cells of " +
+                             format_double(m.resolution) + " m reaches " + format_double(reach) +
+                             " m from the world origin; float coordinates resolve 1/16 of a cell only up to " +
+                             format_double(fw::kMaxGridReachCells * m.resolution) +
+                             " m (2^19 cells) — every point would collapse onto its neighbours");
+    }
   }
   if (!(m.occupied_thresh >= 0.0 && m.occupied_thresh <= 1.0)) {
     return fail(error, name + ": field 'occupied_thresh': must be in [0, 1] (got " + format_double(m.occupied_thresh) + ")");
@@ -219,7 +249,7 @@ bool validate_ros_map(const RosMap& m, const std::string& name, std::string* err
 
 bool read_ros_map(const std::string& yaml_path, RosMap* out, std::string* error) {
   std::string text;
-  if (!read_whole_file(yaml_path, &text, error)) return false;
+  if (!read_regular_file(yaml_path, kMaxTextConfigBytes, &text, error)) return false;
   std::map<std::string, std::string> kv;
   std::istringstream in(text);
   std::string line;
@@ -310,10 +340,17 @@ bool read_ros_map(const std::string& yaml_path, RosMap* out, std::string* error)
   m.pixels.assign(1, 0);
   if (!validate_ros_map(m, yaml_path, error)) return false;
   const std::string image_path = resolve_image_path(yaml_path, m.image);
-  if (!std::filesystem::exists(image_path)) {
+  std::error_code ec;
+  if (!std::filesystem::exists(image_path, ec)) {
     return fail(error, yaml_path + ": field 'image': file '" + image_path + "' does not exist");
   }
+  std::string why;
+  if (!check_regular_file(image_path, kMaxMapFileBytes, nullptr, &why)) {
+    return fail(error, yaml_path + ": field 'image': " + why);
+  }
   if (!read_pgm(image_path, &m, error)) return false;
+  // Again with the image's size: the extent depends on it.
+  if (!validate_ros_map(m, yaml_path, error)) return false;
   *out = std::move(m);
   return true;
 }
@@ -323,8 +360,7 @@ bool write_ros_map(const std::string& yaml_path, const RosMap& map, std::string*
   if (m.image.empty()) m.image = std::filesystem::path(yaml_path).stem().string() + ".pgm";
   if (!validate_ros_map(m, yaml_path, error)) return false;
   if (!write_pgm(resolve_image_path(yaml_path, m.image), m, error)) return false;
-  std::ofstream o(yaml_path, std::ios::trunc);
-  if (!o) return fail(error, yaml_path + ": cannot create: " + std::strerror(errno));
+  std::ostringstream o;
   o << "image: " << m.image << "\n"
     << "resolution: " << format_double(m.resolution) << "\n"
     << "origin: [" << format_double(m.origin[0]) << ", " << format_double(m.origin[1]) << ", "
@@ -333,9 +369,7 @@ bool write_ros_map(const std::string& yaml_path, const RosMap& map, std::string*
     << "occupied_thresh: " << format_double(m.occupied_thresh) << "\n"
     << "free_thresh: " << format_double(m.free_thresh) << "\n"
     << "mode: " << m.mode << "\n";
-  o.close();
-  if (!o) return fail(error, yaml_path + ": write failed");
-  return true;
+  return write_file_atomic(yaml_path, o.str(), error);
 }
 
 bool ros_map_to_grid(const RosMap& m, OccupancyGrid* out, std::string* error) {

@@ -1,11 +1,14 @@
 #include "sim/io/ros_map.h"
 
 #include <gtest/gtest.h>
+#include <sys/stat.h>
 #include <unistd.h>
 
 #include <filesystem>
 #include <fstream>
 #include <sstream>
+
+#include "tests/alloc_counter.h"
 
 namespace sim {
 namespace {
@@ -238,6 +241,115 @@ TEST_F(RosMapTest, MalformedPgmIsRejectedWithReason) {
   std::string err;
   EXPECT_FALSE(read_ros_map(path("x.yaml"), &m, &err));
   EXPECT_NE(err.find("truncated"), std::string::npos) << err;
+}
+
+// Issue 13: a 16000x16000 header over 1 KB of data made read_pgm allocate the 256 MB raster before
+// finding the data missing (100000x100000: 10 GB). The declared size is now checked against the
+// bytes actually there, and against a cap, before anything is allocated for it.
+TEST_F(RosMapTest, PgmHeaderBombIsRejectedBeforeAllocating) {
+  struct Case {
+    std::string data;
+    const char* expect;
+  };
+  const std::string kilobyte(1024, '\x7f');
+  const Case cases[] = {
+      {"P5\n16000 16000\n255\n" + kilobyte, "truncated P5 data: 1024 of 256000000 pixel bytes"},
+      {"P2\n16000 16000\n255\n" + std::string(1024, '1'), "truncated or malformed P2 data"},
+      {"P5\n100000 100000\n255\n" + kilobyte, "more than the limit of 268435456"},
+      {"P2\n100000 100000\n255\n" + kilobyte, "more than the limit of 268435456"},
+  };
+  for (const Case& c : cases) {
+    write_text("bomb.pgm", c.data);
+    RosMap m;
+    std::string err;
+    const bool counting = mmlfw_test::AllocCounter::available();
+    if (counting) mmlfw_test::AllocCounter::begin();
+    const bool ok = read_pgm(path("bomb.pgm"), &m, &err);
+    const long bytes = counting ? (mmlfw_test::AllocCounter::end(), mmlfw_test::AllocCounter::bytes()) : 0;
+    EXPECT_FALSE(ok);
+    EXPECT_NE(err.find("bomb.pgm"), std::string::npos) << err;
+    EXPECT_NE(err.find(c.expect), std::string::npos) << "error '" << err << "' lacks '" << c.expect << "'";
+    EXPECT_LT(bytes, 1 << 20) << "allocated before checking the data: " << c.data.substr(0, 20);
+  }
+}
+
+// Issue 13: `origin: [-1e38, -1e38, 0]` compiled (every cell centre rounds to the same float);
+// resolutions and origins that float coordinates cannot resolve are refused naming the field.
+TEST_F(RosMapTest, AbsurdOriginOrResolutionIsRejectedNamingTheField) {
+  write_text("ok.pgm", "P5\n2 1\n255\n\x01\x02");
+  const std::string tail = "negate: 0\noccupied_thresh: 0.65\nfree_thresh: 0.196\n";
+  struct Case {
+    const char* head;
+    const char* expect;
+  };
+  const Case bad[] = {
+      {"resolution: 0.05\norigin: [-1e38, -1e38, 0]\n", "field 'origin'"},
+      {"resolution: 0.05\norigin: [1e39, 0, 0]\n", "field 'origin'"},  // finite double, infinite float
+      {"resolution: 0.05\norigin: [0, 30000, 0]\n", "2^19 cells"},      // ±26 km at 5 cm
+      {"resolution: 1e-30\norigin: [0, 0, 0]\n", "field 'resolution'"},
+      {"resolution: 1e30\norigin: [0, 0, 0]\n", "field 'resolution'"},
+      {"resolution: 0.05\norigin: [0, 0, nan]\n", "field 'origin'"},
+  };
+  for (const Case& c : bad) {
+    write_text("m.yaml", std::string("image: ok.pgm\n") + c.head + tail);
+    RosMap m;
+    std::string err;
+    EXPECT_FALSE(read_ros_map(path("m.yaml"), &m, &err)) << c.head;
+    EXPECT_NE(err.find("m.yaml: "), std::string::npos) << err;
+    EXPECT_NE(err.find(c.expect), std::string::npos) << "error '" << err << "' lacks '" << c.expect << "'";
+  }
+  // Large but representable: a 5 cm map 20 km from the world origin still loads.
+  write_text("m.yaml", "image: ok.pgm\nresolution: 0.05\norigin: [-20000, 20000, 0]\n" + tail);
+  RosMap m;
+  std::string err;
+  EXPECT_TRUE(read_ros_map(path("m.yaml"), &m, &err)) << err;
+  // The extent depends on the image size too: the same origin with a wide image is refused.
+  RosMap wide = sample();  // 7x4 cells of 0.05 m
+  wide.origin[0] = 26214.1;  // + 7 cells = 26214.45 m > 2^19 cells = 26214.4 m
+  EXPECT_FALSE(validate_ros_map(wide, "w.yaml", &err));
+  EXPECT_NE(err.find("w.yaml: field 'origin'"), std::string::npos) << err;
+  EXPECT_NE(err.find("7x4 cells"), std::string::npos) << err;
+  wide.width = 1;  // + 1 cell = 26214.15 m
+  wide.pixels.resize(4);
+  EXPECT_TRUE(validate_ros_map(wide, "w.yaml", &err)) << err;
+}
+
+// Issue 13: `image: /dev/zero` read forever, a FIFO as YAML or image blocked forever, a directory
+// threw from the stream. Only regular files are opened (checked with stat first).
+TEST_F(RosMapTest, ImageOrYamlThatIsNotARegularFileIsAnError) {
+  const std::string tail = "resolution: 0.05\norigin: [0, 0, 0]\nnegate: 0\noccupied_thresh: 0.65\nfree_thresh: 0.196\n";
+  ASSERT_EQ(::mkfifo(path("fifo.pgm").c_str(), 0600), 0);
+  fs::create_directory(path("dir.pgm"));
+  struct Case {
+    std::string image;
+    const char* expect;
+  };
+  const Case cases[] = {
+      {"/dev/zero", "field 'image': /dev/zero: not a regular file (a character device)"},
+      {path("fifo.pgm"), "not a regular file (a FIFO)"},
+      {"dir.pgm", "not a regular file (a directory)"},
+  };
+  for (const Case& c : cases) {
+    write_text("m.yaml", "image: " + c.image + "\n" + tail);
+    RosMap m;
+    std::string err;
+    EXPECT_FALSE(read_ros_map(path("m.yaml"), &m, &err)) << c.image;
+    EXPECT_NE(err.find("m.yaml: "), std::string::npos) << err;
+    EXPECT_NE(err.find(c.expect), std::string::npos) << "error '" << err << "' lacks '" << c.expect << "'";
+  }
+  RosMap m;
+  std::string err;
+  ASSERT_EQ(::mkfifo(path("fifo.yaml").c_str(), 0600), 0);
+  EXPECT_FALSE(read_ros_map(path("fifo.yaml"), &m, &err));
+  EXPECT_NE(err.find("fifo.yaml: not a regular file (a FIFO)"), std::string::npos) << err;
+  EXPECT_FALSE(read_ros_map(dir_.string(), &m, &err));
+  EXPECT_NE(err.find("a directory"), std::string::npos) << err;
+  EXPECT_FALSE(read_pgm("/dev/zero", &m, &err));
+  EXPECT_NE(err.find("character device"), std::string::npos) << err;
+  // A YAML larger than any map description (1 MiB) is not read whole.
+  write_text("huge.yaml", "image: ok.pgm\n" + std::string((1 << 20) + 1, '#'));
+  EXPECT_FALSE(read_ros_map(path("huge.yaml"), &m, &err));
+  EXPECT_NE(err.find("more than the limit"), std::string::npos) << err;
 }
 
 TEST_F(RosMapTest, NonZeroYawRejectedForGrids) {

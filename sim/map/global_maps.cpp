@@ -11,6 +11,7 @@
 
 #include "sim/io/carmen_log.h"
 #include "sim/io/datasets.h"
+#include "sim/io/file_io.h"
 #include "sim/io/relations.h"
 #include "sim/map/map_image_writer.h"
 #include "sim/map/png_writer.h"
@@ -45,11 +46,11 @@ std::string build_signature(const std::string& ds, const OccupancyBuildOptions& 
   return s.str();
 }
 
+// The cache's parameter file; anything but a small regular file (missing, a FIFO someone put in
+// MMLFW_MAP_DIR, …) reads as "" and the map is rebuilt.
 std::string read_text(const std::string& path) {
-  std::ifstream in(path);
-  std::stringstream ss;
-  ss << in.rdbuf();
-  return ss.str();
+  std::string text, err;
+  return read_regular_file(path, std::uint64_t(1) << 20, &text, &err) ? text : std::string();
 }
 
 }  // namespace

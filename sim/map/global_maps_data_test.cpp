@@ -45,7 +45,7 @@ TEST(GlobalMapsDataTest, IntelMapIsConsistentWithItsScans) {
   std::vector<std::uint8_t> image;
   ASSERT_TRUE(compile_map_image(map, &image, &err)) << err;
   fw::StartupArena arena;
-  ASSERT_TRUE(arena.init_mapped(image.size() + 4096, false, "test").is_ok());
+  ASSERT_TRUE(arena.init_mapped(fw::map_image_arena_bytes(image.data(), image.size()), false, "test").is_ok());
   fw::GlobalMap gm;
   const fw::Status s = fw::load_map_image(image.data(), image.size(), arena, &gm, "intel");
   ASSERT_TRUE(s.is_ok()) << s.message();
@@ -125,7 +125,7 @@ TEST(GlobalMapsDataTest, FrClinicRelationGraphTrajectory) {
     std::vector<std::uint8_t> image;
     ASSERT_TRUE(compile_map_image(map, &image, &err)) << err;
     fw::StartupArena arena;
-    ASSERT_TRUE(arena.init_mapped(image.size() + 4096, false, "test").is_ok());
+    ASSERT_TRUE(arena.init_mapped(fw::map_image_arena_bytes(image.data(), image.size()), false, "test").is_ok());
     fw::GlobalMap gm;
     const fw::Status s = fw::load_map_image(image.data(), image.size(), arena, &gm, "fr-clinic");
     ASSERT_TRUE(s.is_ok()) << s.message();

@@ -1,9 +1,11 @@
 // Compiled map image: host writer + firmware loader together (the loader is firmware code; its
 // tests live here because they need the host writer).
 #include <gtest/gtest.h>
+#include <sys/stat.h>
 #include <unistd.h>
 #include <zlib.h>
 
+#include <algorithm>
 #include <cmath>
 #include <cstring>
 #include <filesystem>
@@ -326,6 +328,185 @@ TEST(MapImageTest, BadFloatsAndInconsistentContentsAreRejected) {
   put_f(&b, geo + 24, 99.0f);
   refresh_crcs(&b);
   expect_rejected(b, "max distance");
+}
+
+void put_f32(std::vector<std::uint8_t>* b, std::size_t at, float f) {
+  std::uint32_t u;
+  std::memcpy(&u, &f, 4);
+  wr32(b, at, u);
+}
+float get_f32(const std::vector<std::uint8_t>& b, std::size_t at) {
+  const std::uint32_t u = rd32(b, at);
+  float f;
+  std::memcpy(&f, &u, 4);
+  return f;
+}
+std::size_t payload(const std::vector<std::uint8_t>& b, fw::MapSectionType t) { return rd32(b, section_entry(b, t) + 8); }
+// Keeps the geometry's max distance equal to the field's (so that check does not catch the edit first).
+void fix_max_distance(std::vector<std::uint8_t>* b) {
+  const std::size_t dist = payload(*b, fw::MapSectionType::kDistanceField);
+  const std::size_t cells = rd32(*b, section_entry(*b, fw::MapSectionType::kDistanceField) + 16) / 4;
+  float m = 0.0f;
+  for (std::size_t i = 0; i < cells; ++i) m = std::max(m, get_f32(*b, dist + 4 * i));
+  put_f32(b, payload(*b, fw::MapSectionType::kGeometry) + 24, m);
+}
+
+// Issue 13: the loader accepted a distance field that is not the map's (only "0 exactly on occupied
+// cells" was checked), with CRCs made honest. It is now recomputed and compared cell by cell.
+TEST(MapImageTest, WrongDistanceFieldIsRejected) {
+  const OccupancyGrid g = test_grid();
+  const std::vector<std::uint8_t> good = image_of(g);
+  const std::size_t dist = payload(good, fw::MapSectionType::kDistanceField);
+  const std::size_t cell = g.geometry.index(9, 9);  // free, 9 cells from the walls x = 0 and y = 0
+  ASSERT_EQ(get_f32(good, dist + 4 * cell), std::sqrt(81.0f) * 0.1f);
+  // One cell a little off (still positive and finite).
+  std::vector<std::uint8_t> b = good;
+  put_f32(&b, dist + 4 * cell, 1.0f);
+  fix_max_distance(&b);
+  refresh_crcs(&b);
+  expect_rejected(b, "distance field cell 369 (x 9, y 9) is 1 m, the occupied cells put it at 0.9");
+  // One ulp off.
+  b = good;
+  put_f32(&b, dist + 4 * cell, std::nextafter(get_f32(good, dist + 4 * cell), 1.0f));
+  fix_max_distance(&b);
+  refresh_crcs(&b);
+  expect_rejected(b, "does not belong to this map");
+  // The whole field of another map with the same size and maximum: the same walls shifted by a cell.
+  OccupancyGrid shifted = g;
+  for (int y = 0; y < 30; ++y) {
+    for (int x = 0; x < 40; ++x) shifted.cells[g.geometry.index(x, y)] = g.cells[g.geometry.index(x == 20 ? 21 : x == 21 ? 20 : x, y)];
+  }
+  const std::vector<std::uint8_t> other = image_of(shifted);
+  const std::size_t other_dist = payload(other, fw::MapSectionType::kDistanceField);
+  b = good;
+  bool differs = false;
+  for (std::size_t i = 0; i < g.cells.size(); ++i) {
+    if (g.cells[i] == fw::kCellOccupied) continue;  // keep 0 exactly on this map's walls
+    const float d = get_f32(other, other_dist + 4 * i);
+    if (d == 0.0f) continue;
+    differs = differs || d != get_f32(b, dist + 4 * i);
+    put_f32(&b, dist + 4 * i, d);
+  }
+  ASSERT_TRUE(differs);
+  fix_max_distance(&b);
+  refresh_crcs(&b);
+  expect_rejected(b, "does not belong to this map");
+}
+
+// Issue 13: duplicated occupied points were accepted (each lay "inside an occupied cell"; only the
+// count was compared). Points are one per occupied cell, at its centre, in row-major order.
+TEST(MapImageTest, DuplicateMisorderedOrOffCentrePointsAreRejected) {
+  const std::vector<std::uint8_t> good = image_of(test_grid());
+  const std::size_t pts = payload(good, fw::MapSectionType::kOccupiedPoints);
+  std::vector<std::uint8_t> b = good;
+  wr32(&b, pts + 8, rd32(b, pts));  // point 1 := point 0 (count unchanged, point 1's cell left without one)
+  wr32(&b, pts + 12, rd32(b, pts + 4));
+  refresh_crcs(&b);
+  expect_rejected(b, "occupied point 1 (-1.95, 1.05) duplicates point 0");
+  b = good;
+  const std::size_t last = pts + 8 * (rd32(b, payload(b, fw::MapSectionType::kGeometry) + 20) - 1);
+  wr32(&b, last, rd32(b, pts));  // the last point repeats the first: not adjacent, out of order
+  wr32(&b, last + 4, rd32(b, pts + 4));
+  refresh_crcs(&b);
+  expect_rejected(b, "out of row-major order");
+  b = good;
+  for (int k = 0; k < 8; ++k) std::swap(b[pts + k], b[pts + 8 + k]);  // two points swapped
+  refresh_crcs(&b);
+  expect_rejected(b, "occupied point 1");
+  b = good;
+  put_f32(&b, pts, get_f32(b, pts) + 0.04f);  // still inside its 0.1 m cell, but not at its centre
+  refresh_crcs(&b);
+  expect_rejected(b, "is not at the centre (-1.95, 1.05) of its cell");
+}
+
+// Issue 13: non-zero reserved fields (geometry word 7, each section entry's last word) and padding
+// were ignored: an image from an unknown writer loaded as if it meant nothing.
+TEST(MapImageTest, NonZeroReservedFieldsAndPaddingAreRejected) {
+  const std::vector<std::uint8_t> good = image_of(test_grid());
+  std::vector<std::uint8_t> b = good;
+  wr32(&b, payload(b, fw::MapSectionType::kGeometry) + 28, 1);
+  refresh_crcs(&b);
+  expect_rejected(b, "geometry: reserved field is 0x00000001, must be 0");
+  b = good;
+  wr32(&b, section_entry(b, fw::MapSectionType::kDistanceField) + 28, 0xdead);
+  refresh_crcs(&b);
+  expect_rejected(b, "section 2 (distance field): reserved field is 0x0000dead, must be 0");
+  // Padding between two sections of 3 and 1 bytes (the map sections happen to need none).
+  MapImageWriter w;
+  std::string err;
+  ASSERT_TRUE(w.set_grid(test_grid(), &err)) << err;
+  ASSERT_TRUE(w.add_section(fw::MapSectionType::kRelationTable2D, {1, 2, 3}, 1, &err)) << err;
+  ASSERT_TRUE(w.add_section(fw::MapSectionType::kUser, {4}, 1, &err)) << err;
+  const std::vector<std::uint8_t> padded = w.bytes();
+  b = padded;
+  const std::size_t pad = payload(b, fw::MapSectionType::kRelationTable2D) + 3;
+  ASSERT_LT(pad, payload(b, fw::MapSectionType::kUser));
+  Loaded ok;
+  load(b, &ok);
+  ASSERT_TRUE(ok.status.is_ok()) << ok.status.message();
+  b[pad] = 0x5a;
+  refresh_crcs(&b);
+  expect_rejected(b, "between sections is 0x5a (padding must be zero)");
+  // Header flags (already refused before issue 13; kept here with its siblings).
+  b = good;
+  wr32(&b, 24, 2);
+  refresh_crcs(&b);
+  expect_rejected(b, "unknown header flags 0x2");
+}
+
+// Issue 13: the geometry of `origin: [-1e38, -1e38, 0]` (every cell centre the same float) loaded.
+TEST(MapImageTest, GeometryFloatsCannotResolveIsRejected) {
+  const std::vector<std::uint8_t> good = image_of(test_grid());
+  const std::size_t geo = payload(good, fw::MapSectionType::kGeometry);
+  std::vector<std::uint8_t> b = good;
+  put_f32(&b, geo + 4, -1e38f);
+  put_f32(&b, geo + 8, -1e38f);
+  refresh_crcs(&b);
+  expect_rejected(b, "geometry: the grid reaches more than 2^19 cells from the world origin");
+  b = good;
+  put_f32(&b, geo, 1e-30f);
+  refresh_crcs(&b);
+  expect_rejected(b, "geometry: resolution is outside [0.0001, 1000] m");
+  // The writer refuses such a grid before making an image of it.
+  OccupancyGrid g = test_grid();
+  g.geometry.origin_x = -1e38f;
+  MapImageWriter w;
+  std::string err;
+  EXPECT_FALSE(w.set_grid(g, &err));
+  EXPECT_NE(err.find("cannot resolve the cells"), std::string::npos) << err;
+}
+
+TEST(MapImageTest, ArenaBytesCoverThePeakAndScratchIsReleased) {
+  const std::vector<std::uint8_t> bytes = image_of(test_grid());
+  const std::size_t need = fw::map_image_arena_bytes(bytes.data(), bytes.size());
+  ASSERT_GT(need, 0u);
+  fw::StartupArena arena;
+  ASSERT_TRUE(arena.init_mapped(need, false, "exact").is_ok());
+  fw::GlobalMap m;
+  const fw::Status st = fw::load_map_image(bytes.data(), bytes.size(), arena, &m, "x.mmap");
+  ASSERT_TRUE(st.is_ok()) << st.message();
+  EXPECT_LE(arena.peak_used(), need);
+  EXPECT_GT(arena.peak_used(), arena.used());  // the distance check's scratch came and went
+  EXPECT_EQ(arena.used(), 1200u + 1200u * 4u + m.num_points * sizeof(fw::Point2f));
+  EXPECT_EQ(fw::map_image_arena_bytes(bytes.data(), 10), 0u);
+  fw::MemoryReport::instance().clear();
+}
+
+// Issue 13: a FIFO given as the firmware's map blocked open() forever; /dev/zero and a directory are
+// refused the same way (not a regular file), with the path in the message.
+TEST(MapImageTest, MapFileThatIsNotARegularFileIsRefusedWithoutBlocking) {
+  const std::string fifo =
+      (std::filesystem::temp_directory_path() / ("map_image_fifo_" + std::to_string(::getpid()) + ".mmap")).string();
+  std::filesystem::remove(fifo);
+  ASSERT_EQ(::mkfifo(fifo.c_str(), 0600), 0);
+  for (const std::string& path : {fifo, std::string("/dev/zero"), std::filesystem::temp_directory_path().string()}) {
+    fw::MapImageFile f;
+    const fw::Status st = f.open(path.c_str());
+    ASSERT_FALSE(st.is_ok()) << path;
+    EXPECT_NE(std::strstr(st.message(), path.c_str()), nullptr) << st.message();
+    EXPECT_NE(std::strstr(st.message(), "not a regular file"), nullptr) << st.message();
+  }
+  std::filesystem::remove(fifo);
 }
 
 TEST(MapImageTest, LoadingDoesNotTouchTheHeap) {

@@ -5,11 +5,13 @@
 #include <algorithm>
 #include <cerrno>
 #include <cmath>
+#include <cstdio>
 #include <cstring>
 #include <fstream>
 #include <iterator>
 
 #include "firmware/map/edt.h"
+#include "sim/io/file_io.h"
 
 namespace sim {
 namespace {
@@ -97,6 +99,15 @@ bool MapImageWriter::set_grid(const OccupancyGrid& grid, std::string* error) {
   const fw::GridGeometry& geo = grid.geometry;
   if (!std::isfinite(geo.resolution) || !(geo.resolution > 0.0f)) return fail(error, "map image: resolution must be > 0");
   if (!std::isfinite(geo.origin_x) || !std::isfinite(geo.origin_y)) return fail(error, "map image: origin not finite");
+  if (fw::check_grid_extent(geo) != fw::GridExtentProblem::kNone) {
+    char buf[256];
+    std::snprintf(buf, sizeof(buf),
+                  "map image: resolution %g m, origin (%g, %g), %ux%u cells: float coordinates cannot resolve the "
+                  "cells (resolution outside [1e-4, 1e3] m or the grid reaching beyond 2^19 cells from the origin)",
+                  static_cast<double>(geo.resolution), static_cast<double>(geo.origin_x),
+                  static_cast<double>(geo.origin_y), geo.width, geo.height);
+    return fail(error, buf);
+  }
   if (geo.width == 0 || geo.height == 0 || grid.cells.size() != geo.cell_count()) {
     return fail(error, "map image: grid size inconsistent with its geometry");
   }
@@ -192,20 +203,11 @@ bool compile_map_image(const RosMap& map, std::vector<std::uint8_t>* out, std::s
 }
 
 bool read_file_bytes(const std::string& path, std::vector<std::uint8_t>* out, std::string* error) {
-  std::ifstream in(path, std::ios::binary);
-  if (!in) return fail(error, path + ": cannot open: " + std::strerror(errno));
-  out->assign(std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>());
-  if (in.bad()) return fail(error, path + ": read error");
-  return true;
+  return read_regular_file(path, kMaxMapFileBytes, out, error);
 }
 
 bool write_file_bytes(const std::string& path, const std::vector<std::uint8_t>& bytes, std::string* error) {
-  std::ofstream o(path, std::ios::binary | std::ios::trunc);
-  if (!o) return fail(error, path + ": cannot create: " + std::strerror(errno));
-  o.write(reinterpret_cast<const char*>(bytes.data()), static_cast<std::streamsize>(bytes.size()));
-  o.close();
-  if (!o) return fail(error, path + ": write failed");
-  return true;
+  return write_file_atomic(path, bytes.data(), bytes.size(), error);
 }
 
 }  // namespace sim

@@ -40,6 +40,8 @@ bool distance_field_m(const OccupancyGrid& grid, std::vector<float>* out, std::s
 
 // One-call helpers.
 bool compile_map_image(const RosMap& map, std::vector<std::uint8_t>* out, std::string* error);
+// Regular files only, at most kMaxMapFileBytes (sim/io/file_io.h); writes go to a temporary file
+// renamed over `path` when complete (a failure leaves `path` as it was).
 bool read_file_bytes(const std::string& path, std::vector<std::uint8_t>* out, std::string* error);
 bool write_file_bytes(const std::string& path, const std::vector<std::uint8_t>& bytes, std::string* error);
 

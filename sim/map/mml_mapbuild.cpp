@@ -15,6 +15,7 @@
 #include "sim/io/carmen_log.h"
 #include "sim/map/global_maps.h"
 #include "sim/map/map_image_writer.h"
+#include "sim/common/cli_main.h"
 
 namespace {
 
@@ -26,9 +27,11 @@ int usage() {
 }
 
 bool write_all(const std::string& dir, const std::string& name, const sim::RosMap& map, std::string* err) {
+  // The image first: a map that does not compile leaves no files at all (each file is written
+  // through a temporary renamed over it, so none is left half-written either).
   std::vector<std::uint8_t> image;
-  return sim::write_ros_map(dir + "/" + name + ".yaml", map, err) &&
-         sim::write_map_png(dir + "/" + name + ".png", map, err) && sim::compile_map_image(map, &image, err) &&
+  return sim::compile_map_image(map, &image, err) && sim::write_ros_map(dir + "/" + name + ".yaml", map, err) &&
+         sim::write_map_png(dir + "/" + name + ".png", map, err) &&
          sim::write_file_bytes(dir + "/" + name + ".mmap", image, err);
 }
 
@@ -42,7 +45,7 @@ void print_stats(const std::string& name, const sim::RosMap& m, const sim::Occup
 
 }  // namespace
 
-int main(int argc, char** argv) {
+static int run_main(int argc, char** argv) {
   std::string dataset, log_path, name, out = sim::map_cache_dir();
   double resolution = 0.0, max_range = 0.0;
   for (int i = 1; i < argc; ++i) {
@@ -130,4 +133,8 @@ int main(int argc, char** argv) {
                 ds.c_str());
   }
   return rc;
+}
+
+int main(int argc, char** argv) {
+  return sim::guarded_main("mml-mapbuild", [&] { return run_main(argc, argv); });
 }

@@ -5,6 +5,9 @@
 //                                   (Sec. 5.5.2) for mmlfw's `seed`/`mml_preset`, so the robot
 //                                   skips filling it at start-up
 //   mml-mapc --info IMAGE.mmap      validate with the firmware loader and print the section table
+// Inputs must be regular files (a FIFO, device or directory is an error naming it); OUT is written
+// only after the image passed the firmware loader, through a temporary file renamed over it.
+#include <chrono>
 #include <cstdio>
 #include <cstdlib>
 #include <cstring>
@@ -15,6 +18,7 @@
 #include "firmware/map/map_image.h"
 #include "sim/map/map_image_writer.h"
 #include "sim/map/relation_table_builder.h"
+#include "sim/common/cli_main.h"
 
 namespace {
 
@@ -25,22 +29,28 @@ int usage() {
   return 2;
 }
 
-// Loads with the firmware loader (same code as on the robot) and prints a summary.
-int check_and_print(const std::string& path, const std::vector<std::uint8_t>& bytes) {
-  fw::StartupArena arena;
-  fw::Status st = arena.init_mapped(bytes.size() + 4096, false, "mml-mapc");
+// Loads with the firmware loader (same code as on the robot: every check, the distance field
+// recomputed) into an arena of the size the firmware would need.
+bool check_image(const std::string& path, const std::vector<std::uint8_t>& bytes, fw::StartupArena* arena,
+                 fw::GlobalMap* map, double* load_ms) {
+  const std::size_t need = fw::map_image_arena_bytes(bytes.data(), bytes.size());
+  fw::Status st = arena->init_mapped(need > 0 ? need : 4096, false, "mml-mapc");
+  const auto t0 = std::chrono::steady_clock::now();
+  if (st) st = fw::load_map_image(bytes.data(), bytes.size(), *arena, map, path.c_str());
+  *load_ms = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
   if (!st) {
     std::fprintf(stderr, "mml-mapc: %s\n", st.message());
-    return 1;
+    return false;
   }
-  fw::GlobalMap map;
-  st = fw::load_map_image(bytes.data(), bytes.size(), arena, &map, path.c_str());
-  if (!st) {
-    std::fprintf(stderr, "mml-mapc: %s\n", st.message());
-    return 1;
-  }
+  return true;
+}
+
+void print_summary(const std::string& path, const std::vector<std::uint8_t>& bytes, const fw::GlobalMap& map,
+                   const fw::StartupArena& arena, double load_ms) {
   const fw::GridGeometry& g = map.geometry;
   std::printf("%s: %zu bytes, version %u\n", path.c_str(), bytes.size(), fw::kMapImageVersion);
+  std::printf("  verified and loaded by the firmware loader in %.1f ms (arena peak %zu bytes)\n", load_ms,
+              arena.peak_used());
   std::printf("  grid %ux%u at %.4g m, origin (%.4f, %.4f), extent %.1f x %.1f m\n", g.width, g.height,
               static_cast<double>(g.resolution), static_cast<double>(g.origin_x), static_cast<double>(g.origin_y),
               static_cast<double>(g.size_x()), static_cast<double>(g.size_y()));
@@ -52,7 +62,6 @@ int check_and_print(const std::string& path, const std::vector<std::uint8_t>& by
     std::printf("  section %zu: %-18s v%u offset %10llu size %10llu crc 0x%08x\n", i, fw::map_section_name(s.type),
                 s.version, static_cast<unsigned long long>(s.offset), static_cast<unsigned long long>(s.size), s.crc);
   }
-  return 0;
 }
 
 }  // namespace
@@ -65,7 +74,7 @@ bool parse_u64(const char* text, std::uint64_t lo, std::uint64_t hi, std::uint64
   return true;
 }
 
-int main(int argc, char** argv) {
+static int run_main(int argc, char** argv) {
   std::string err;
   if (argc == 3 && std::strcmp(argv[1], "--info") == 0) {
     std::vector<std::uint8_t> bytes;
@@ -73,7 +82,12 @@ int main(int argc, char** argv) {
       std::fprintf(stderr, "mml-mapc: %s\n", err.c_str());
       return 1;
     }
-    return check_and_print(argv[2], bytes);
+    fw::StartupArena arena;
+    fw::GlobalMap map;
+    double ms = 0;
+    if (!check_image(argv[2], bytes, &arena, &map, &ms)) return 1;
+    print_summary(argv[2], bytes, map, arena, ms);
+    return 0;
   }
   bool table = false;
   sim::RelationTableBuild build;
@@ -120,10 +134,24 @@ int main(int argc, char** argv) {
                 static_cast<unsigned long long>(rep.triples), rep.map_points,
                 static_cast<unsigned long long>(build.seed), build.preset, rep.seconds, rep.section_bytes);
   }
+  // Verified before anything is written, then written to a temporary file renamed over OUT: a compile
+  // that fails at any point leaves no output (and an older OUT untouched).
   const std::vector<std::uint8_t> bytes = writer.bytes();
+  fw::StartupArena arena;
+  fw::GlobalMap loaded;
+  double ms = 0;
+  if (!check_image(files[1], bytes, &arena, &loaded, &ms)) {
+    std::fprintf(stderr, "mml-mapc: %s not written\n", files[1].c_str());
+    return 1;
+  }
   if (!sim::write_file_bytes(files[1], bytes, &err)) {
     std::fprintf(stderr, "mml-mapc: %s\n", err.c_str());
     return 1;
   }
-  return check_and_print(files[1], bytes);
+  print_summary(files[1], bytes, loaded, arena, ms);
+  return 0;
+}
+
+int main(int argc, char** argv) {
+  return sim::guarded_main("mml-mapc", [&] { return run_main(argc, argv); });
 }

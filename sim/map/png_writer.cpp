@@ -2,6 +2,8 @@
 
 #include <png.h>
 
+#include "sim/io/file_io.h"
+
 #include <cerrno>
 #include <cstdio>
 #include <cstring>
@@ -18,21 +20,25 @@ bool write_png(const std::string& path, int width, int height, int channels, con
       pixels.size() != static_cast<std::size_t>(width) * height * channels) {
     return fail("write_png: size/channels inconsistent with the pixel buffer");
   }
-  std::FILE* f = std::fopen(path.c_str(), "wb");
-  if (f == nullptr) return fail(std::string("cannot create: ") + std::strerror(errno));
+  // Encoded in memory, then written through a temporary file renamed over `path` (file_io.h): a
+  // failure leaves no truncated picture behind.
+  std::string encoded;
   png_structp png = png_create_write_struct(PNG_LIBPNG_VER_STRING, nullptr, nullptr, nullptr);
   png_infop info = png ? png_create_info_struct(png) : nullptr;
   if (png == nullptr || info == nullptr) {
     png_destroy_write_struct(&png, &info);
-    std::fclose(f);
     return fail("libpng initialisation failed");
   }
   if (setjmp(png_jmpbuf(png))) {
     png_destroy_write_struct(&png, &info);
-    std::fclose(f);
     return fail("libpng write error");
   }
-  png_init_io(png, f);
+  png_set_write_fn(
+      png, &encoded,
+      [](png_structp p, png_bytep data, png_size_t n) {
+        static_cast<std::string*>(png_get_io_ptr(p))->append(reinterpret_cast<const char*>(data), n);
+      },
+      [](png_structp) {});
   png_set_IHDR(png, info, static_cast<png_uint_32>(width), static_cast<png_uint_32>(height), 8,
                channels == 1 ? PNG_COLOR_TYPE_GRAY : PNG_COLOR_TYPE_RGB, PNG_INTERLACE_NONE,
                PNG_COMPRESSION_TYPE_DEFAULT, PNG_FILTER_TYPE_DEFAULT);
@@ -42,8 +48,7 @@ bool write_png(const std::string& path, int width, int height, int channels, con
   }
   png_write_end(png, nullptr);
   png_destroy_write_struct(&png, &info);
-  if (std::fclose(f) != 0) return fail("close failed");
-  return true;
+  return write_file_atomic(path, encoded, error);
 }
 
 }  // namespace sim

@@ -10,8 +10,9 @@
 #include <string>
 
 #include "sim/eval/mml_eval/localize_eval.h"
+#include "sim/common/cli_main.h"
 
-int main(int argc, char** argv) {
+static int run_main(int argc, char** argv) {
   if (argc < 2) {
     std::fprintf(stderr, "usage: bench_localize OUTPUT.json\n");
     return 2;
@@ -27,4 +28,8 @@ int main(int argc, char** argv) {
     return 1;
   }
   return json.write(argv[1]) ? 0 : 1;
+}
+
+int main(int argc, char** argv) {
+  return sim::guarded_main("bench_localize", [&] { return run_main(argc, argv); });
 }

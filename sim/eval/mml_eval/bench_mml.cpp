@@ -7,8 +7,9 @@
 #include <string>
 
 #include "sim/eval/mml_eval/mml_eval_run.h"
+#include "sim/common/cli_main.h"
 
-int main(int argc, char** argv) {
+static int run_main(int argc, char** argv) {
   if (argc < 2) {
     std::fprintf(stderr, "usage: bench_mml OUTPUT.json\n");
     return 2;
@@ -29,4 +30,8 @@ int main(int argc, char** argv) {
     return 1;
   }
   return json.write(argv[1]) ? 0 : 1;
+}
+
+int main(int argc, char** argv) {
+  return sim::guarded_main("bench_mml", [&] { return run_main(argc, argv); });
 }

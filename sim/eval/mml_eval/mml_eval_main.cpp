@@ -26,6 +26,7 @@
 
 #include "sim/eval/mml_eval/localize_eval.h"
 #include "sim/eval/mml_eval/mml_eval_run.h"
+#include "sim/common/cli_main.h"
 
 namespace {
 std::vector<std::string> split(const std::string& s) {
@@ -41,7 +42,7 @@ int usage(const char* msg) {
 }
 }  // namespace
 
-int main(int argc, char** argv) {
+static int run_main(int argc, char** argv) {
   sim::mmleval::EvalPlan plan;
   plan.out_dir = "build/eval/mml";
   plan.trial_mit = plan.trial;
@@ -126,4 +127,8 @@ int main(int argc, char** argv) {
   json.write(plan.out_dir + "/mml_eval.json");
   std::printf("wrote %s/{mml_eval.json,summary.md,*.svg,*.png}\n", plan.out_dir.c_str());
   return 0;
+}
+
+int main(int argc, char** argv) {
+  return sim::guarded_main("mml-eval", [&] { return run_main(argc, argv); });
 }

@@ -11,6 +11,7 @@
 
 #include "sim/common/bench_json.h"
 #include "sim/eval/pransam_eval/pransam_eval_lib.h"
+#include "sim/common/cli_main.h"
 
 using namespace sim::pransam_eval;
 
@@ -38,7 +39,7 @@ int fail(const std::string& e) {
 }
 }  // namespace
 
-int main(int argc, char** argv) {
+static int run_main(int argc, char** argv) {
   if (argc < 2) return fail("usage: bench_pransam OUT.json");
   sim::BenchJson json;
   std::string err;
@@ -198,4 +199,8 @@ int main(int argc, char** argv) {
     json.add("pransam3d_ms_p50", r.p50());
   }
   return json.write(argv[1]) ? 0 : 1;
+}
+
+int main(int argc, char** argv) {
+  return sim::guarded_main("bench_pransam", [&] { return run_main(argc, argv); });
 }

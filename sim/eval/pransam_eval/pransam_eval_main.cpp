@@ -13,6 +13,7 @@
 
 #include "sim/eval/pransam_eval/pransam_eval_lib.h"
 #include "sim/map/map_image_writer.h"
+#include "sim/common/cli_main.h"
 
 using namespace sim::pransam_eval;
 
@@ -37,7 +38,7 @@ int usage() {
 }
 }  // namespace
 
-int main(int argc, char** argv) {
+static int run_main(int argc, char** argv) {
   if (argc < 2) return usage();
   const std::string cmd = argv[1];
   const auto a = parse(argc, argv, 2);
@@ -142,4 +143,8 @@ int main(int argc, char** argv) {
               p.fuzzy ? "fuzzy" : "hard", r.correct, r.wrong, r.nothing, r.n, 100.0 * r.success(), r.below_thres,
               r.correct_below_thres, r.p50(), r.p99(), r.mean_iterations());
   return 0;
+}
+
+int main(int argc, char** argv) {
+  return sim::guarded_main("mml-pransam-eval", [&] { return run_main(argc, argv); });
 }

@@ -12,6 +12,7 @@
 
 #include "sim/common/bench_json.h"
 #include "sim/eval/rbsm/rbsm_eval_lib.h"
+#include "sim/common/cli_main.h"
 
 namespace {
 
@@ -32,7 +33,7 @@ double stddev(const std::vector<double>& v) {
 
 }  // namespace
 
-int main(int argc, char** argv) {
+static int run_main(int argc, char** argv) {
   if (argc < 2) {
     std::fprintf(stderr, "usage: bench_rbsm OUT.json\n");
     return 2;
@@ -165,4 +166,8 @@ int main(int argc, char** argv) {
            std::chrono::duration<double>(std::chrono::steady_clock::now() - t_start).count());
   if (!json.write(argv[1])) return 1;
   return all_ok ? 0 : 1;
+}
+
+int main(int argc, char** argv) {
+  return sim::guarded_main("bench_rbsm", [&] { return run_main(argc, argv); });
 }

@@ -17,6 +17,7 @@
 #include <vector>
 
 #include "sim/eval/rbsm/rbsm_eval_lib.h"
+#include "sim/common/cli_main.h"
 
 namespace {
 
@@ -55,7 +56,7 @@ bool write_traj(const std::string& path, const sim::CarmenLog& log, const std::v
 
 }  // namespace
 
-int main(int argc, char** argv) {
+static int run_main(int argc, char** argv) {
   if (argc < 3) return usage();
   const std::string cmd = argv[1], ds = argv[2];
   int seeds = 20, particles = 1000, workers = 1;
@@ -243,4 +244,8 @@ int main(int argc, char** argv) {
   std::printf("%s rbsm over %d seeds: trans %.4f ± %.4f m, rot %.3f ± %.3f deg (odom %.4f m %.3f deg)\n", ds.c_str(),
               seeds, mean(tm), stddev(tm), mean(rm), stddev(rm), mo.trans_mean, mo.rot_mean_deg);
   return 0;
+}
+
+int main(int argc, char** argv) {
+  return sim::guarded_main("mml-rbsm-eval", [&] { return run_main(argc, argv); });
 }
