@@ -191,8 +191,8 @@ bool parse_laser_head(const std::vector<std::string_view>& t, CarmenScan* s, siz
   // resolution (zero put every beam on one bearing; negative ones are not in the format), at most a
   // full turn of beams, start angle and field of view within a turn.
   constexpr double kTurn = 2.0 * kPi + 1e-3;  // + print rounding of 2π
-  auto bad = [&](size_t field, const char* what, const std::string& why) {
-    return p.fail(std::string("field ") + std::to_string(field + 1) + " (" + what + ") is " + show(t[field]) + ": " + why);
+  auto bad = [&](size_t field, const char* what, const std::string& reason) {
+    return p.fail(std::string("field ") + std::to_string(field + 1) + " (" + what + ") is " + show(t[field]) + ": " + reason);
   };
   if (!(maxr > 0.0)) return bad(5, "maximum_range", "maximum_range must be positive");
   if (maxr > kMaxLaserRangeM) return bad(5, "maximum_range", "beyond the plausible 1000 m of a laser scanner");

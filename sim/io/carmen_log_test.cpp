@@ -388,7 +388,7 @@ std::string gzip_of(const std::string& chunk, size_t repeat = 1) {
 // compressed) against an 8 MiB cap: the read stops at the cap with a message naming the file and the
 // limit, quickly and without holding the 64 MiB.
 TEST(CarmenLog, GzipBombIsStoppedAtTheCap) {
-  const std::string bomb = gzip_of(std::string(1 << 20, '\\n'), 64);
+  const std::string bomb = gzip_of(std::string(1 << 20, '\n'), 64);
   ASSERT_LT(bomb.size(), 1u << 20);
   const std::string gz = temp_path("bomb.clf.gz");
   write_text(gz, bomb);
