@@ -27,6 +27,7 @@ Status PoseTracker::init(const TrackOptions& options, const GlobalMap& map) {
   options_ = options;
   map_ = map;
   k_ = ProtectionFactors::for_risk(options.integrity_risk);
+  odometry_check_.configure(options.odometry_window);
   initialized_ = true;
   reset();
   return Status::ok();
@@ -43,6 +44,7 @@ void PoseTracker::reset() {
   unsupported_ = faulty_ = outside_ = 0;
   consistent_since_fault_ = 0;
   had_fault_ = false;
+  odometry_check_.clear();
   last_ = TrackStep();
 }
 
@@ -76,6 +78,7 @@ void PoseTracker::predict_to(const Se2f& odom) {
   const Eigen::Matrix3f g = pose_.jacobian_compose_second();
   pose_ = pose_.compose(delta);
   cov_ = f * cov_ * f.transpose() + g * q * g.transpose();
+  odometry_check_.advance(delta, q);
   cov_ = 0.5f * (cov_ + cov_.transpose()).eval();
 }
 
@@ -140,6 +143,7 @@ TrackStep PoseTracker::step(const Point2f* points, std::size_t n, const Se2f& od
   Eigen::Vector3f e = Eigen::Vector3f::Zero();
   if (odom_jump) {
     v = ScanVerdict::kContradicting;  // the pose cannot be carried across a non-physical increment
+    out.large_fault = true;
   } else if (a.points > 0 && a.unknown_fraction() > o.outside_map_fraction) {
     v = ScanVerdict::kOutsideMap;
   } else if (a.inliers + a.contradicting < o.min_points) {
@@ -160,6 +164,7 @@ TrackStep PoseTracker::step(const Point2f* points, std::size_t n, const Se2f& od
       v = ScanVerdict::kContradicting;
     } else if (out.innovation_chi2 > o.innovation_chi2 && outside_bound(e, pred_pl)) {
       innovation_fault = true;
+      out.large_fault = std::hypot(e(0), e(1)) > o.alert_limit_m || std::fabs(e(2)) > o.alert_limit_rad;
       // A significant innovation is a fault only when the scan fix lies outside what the prediction
       // promises (its protection level): within it, the published bound already covers the
       // disagreement, and the scan is fused (measurement models of real scans are never exact).
@@ -186,31 +191,51 @@ TrackStep PoseTracker::step(const Point2f* points, std::size_t n, const Se2f& od
         rival_significantly_better(map_, alias_points_, m, a.pose, u.rival, o.alias_clip_m, a.independent,
                                    o.alias_z)) {
       v = ScanVerdict::kContradicting;  // the scan says the robot is elsewhere
+      out.large_fault = std::hypot(u.rival.x - a.pose.x, u.rival.y - a.pose.y) > o.alert_limit_m ||
+                        std::fabs(wrap_angle(u.rival.theta - a.pose.theta)) > o.alert_limit_rad;
     } else if (!u.unique) {
       v = ScanVerdict::kAmbiguous;      // fused (odometry keeps the mode), never `localized`
+    }
+  }
+  // The update this scan would make; tested against the odometry over the last fused scans first.
+  const float scan_bias_xy = map_.geometry.resolution + a.rms_m;
+  const float scan_bias_theta = scan_bias_xy / std::fmax(a.lever_m, 1.0f);
+  bool fuse = false;
+  Se2f fused_pose = pose_;
+  Eigen::Matrix3f fused_cov = cov_;
+  if (v == ScanVerdict::kSupported || v == ScanVerdict::kAmbiguous) {
+    const Se2f since = odom_at_fuse_.between(odom);
+    const bool moved = !fused_once_ || !predict || std::hypot(since.x, since.y) >= o.update_min_d_m ||
+                       std::fabs(since.theta) >= o.update_min_a_rad;
+    // x = x⁻ + P⁺ H e (information-form Kalman update, linearised at the scan fix).
+    const Eigen::Vector3f dx = p_post * (a.information * e);
+    if (moved && dx.allFinite()) {
+      fuse = true;
+      fused_pose = Se2f(pred.x + dx(0), pred.y + dx(1), wrap_angle(pred.theta + dx(2)));
+      fused_cov = 0.5f * (p_post + p_post.transpose());
+      out.odometry_chi2 = odometry_check_.max_chi2(fused_pose, fused_cov, scan_bias_xy, scan_bias_theta);
+      if (out.odometry_chi2 > o.innovation_chi2) {
+        v = ScanVerdict::kContradicting;  // the scans hold the pose where the wheels say it is not
+        out.large_fault = true;           // a slow slide: its size is unknown, assume the worst
+        fuse = false;
+      }
     }
   }
   out.verdict = v;
 
   if (v == ScanVerdict::kSupported || v == ScanVerdict::kAmbiguous) {
-    const Se2f since = odom_at_fuse_.between(odom);
-    const bool moved = !fused_once_ || !predict || std::hypot(since.x, since.y) >= o.update_min_d_m ||
-                       std::fabs(since.theta) >= o.update_min_a_rad;
-    if (moved) {
-      // x = x⁻ + P⁺ H e (information-form Kalman update, linearised at the scan fix).
-      const Eigen::Vector3f dx = p_post * (a.information * e);
-      if (dx.allFinite()) {
-        pose_ = Se2f(pred.x + dx(0), pred.y + dx(1), wrap_angle(pred.theta + dx(2)));
-        cov_ = 0.5f * (p_post + p_post.transpose());
-        odom_at_fuse_ = odom;
-        fused_once_ = true;
-        out.fused = true;
-      }
+    if (fuse) {
+      pose_ = fused_pose;
+      cov_ = fused_cov;
+      odom_at_fuse_ = odom;
+      fused_once_ = true;
+      out.fused = true;
+      odometry_check_.push(pose_, cov_, scan_bias_xy, scan_bias_theta);
     }
     // The map's own error does not average out over scans: one cell of quantisation plus the
     // scan's residual RMS (how far the map's walls are from where this scan sees them).
-    bias_xy_m_ = map_.geometry.resolution + a.rms_m;
-    bias_theta_rad_ = bias_xy_m_ / std::fmax(a.lever_m, 1.0f);
+    bias_xy_m_ = scan_bias_xy;
+    bias_theta_rad_ = scan_bias_theta;
     unsupported_ = 0;
     faulty_ = 0;
     outside_ = 0;
@@ -233,6 +258,7 @@ TrackStep PoseTracker::step(const Point2f* points, std::size_t n, const Se2f& od
       cov_(1, 1) += exy2;
       cov_(2, 2) += e(2) * e(2);
       cov_ = 0.5f * (cov_ + cov_.transpose()).eval();
+      odometry_check_.widen(exy2, e(2) * e(2));
     }
     if (v == ScanVerdict::kContradicting) {
       ++faulty_;

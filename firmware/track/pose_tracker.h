@@ -4,7 +4,8 @@
 //   predict   x⁻ = x ⊕ Δodom, P⁻ = F P Fᵀ + G Q(Δ) Gᵀ (odometry noise grows with the motion);
 //   align     the scan on the distance field from x⁻ (scan_alignment.h) → x_s, information H;
 //   check     fault detection on the residuals: too few end-points explained by the map, or a scan
-//             fix that disagrees with the prediction (χ² of the innovation), or a rival pose along
+//             fix that disagrees with the prediction (χ² of the innovation), a fused pose that
+//             disagrees with the odometry over the last fused scans (odometry_consistency.h), a rival pose along
 //             a weak axis that explains the scan better (alias check), contradicts the pose; a
 //             rival that explains it as well makes it ambiguous (not `localized`, still tracked);
 //             most end-points in unknown space means outside the map; too few points says nothing;
@@ -25,6 +26,7 @@
 #include "firmware/base/se2.h"
 #include "firmware/base/status.h"
 #include "firmware/map/global_map.h"
+#include "firmware/track/odometry_consistency.h"
 #include "firmware/track/protection_level.h"
 #include "firmware/track/scan_alignment.h"
 #include "firmware/track/track_options.h"
@@ -50,8 +52,13 @@ struct TrackStep {
   ScanVerdict verdict = ScanVerdict::kUninformative;
   bool fused = false;
   bool lost = false;            // the track is given up: go back to global localization
+  // A contradiction larger than the alert limits (an odometry jump, a scan fix or a better rival
+  // beyond them, the odometry disagreeing over the window): the robot may have been carried
+  // anywhere, so local evidence alone can no longer make the pose `localized` (tracked_localizer.h).
+  bool large_fault = false;
   std::uint32_t unsupported_steps = 0, faulty_steps = 0, outside_steps = 0;
   float innovation_chi2 = 0.0f;
+  float odometry_chi2 = 0.0f;   // odometry consistency over the window (0 = not tested)
   float alias_cost = 0.0f, alias_rival_cost = 1.0f;  // alias check (1 = not run)
   ScanAlignment alignment;
 };
@@ -76,6 +83,7 @@ class PoseTracker {
   // which halves its cost at the 360 points of the alignment and keeps one point = 1/180 of the cost.
   static constexpr std::size_t kAliasMaxPoints = 180;
   Point2f alias_points_[kAliasMaxPoints];
+  OdometryConsistency odometry_check_;
   TrackOptions options_;
   GlobalMap map_;
   ProtectionFactors k_;

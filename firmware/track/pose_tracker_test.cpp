@@ -294,6 +294,46 @@ TEST(PoseTrackerTest, BetterRivalAlongWeakAxisIsNeverLocalized) {
   }
 }
 
+// A scan matcher that holds the pose back: every scan is taken at one spot (the map lacks what
+// would move the fix), while the wheels say the robot drives on at 3 cm a scan — each step within
+// the per-scan innovation bound. The odometry consistency over the window contradicts the pose (a
+// large fault: tracked_localizer.h withholds `localized` until MML isolates the pose again) before
+// the wheels are 0.5 m (the alert limit) away; without it the same scans stay `localized` while the
+// odometry runs 1.2 m ahead and no large fault is ever raised.
+TEST(PoseTrackerTest, PoseHeldBackAgainstTheOdometryIsContradicted) {
+  const Se2f held(4.0f, 3.0f, 0.0f);
+  for (const std::uint32_t window : {16u, 0u}) {
+    PoseTracker t;
+    TrackOptions o;
+    o.odometry_window = window;
+    ASSERT_TRUE(t.init(o, testing::room_map().map).is_ok());
+    RandomStream rng(31, 0);
+    t.start(held, small_cov(), Se2f());
+    int large = 0, localized_beyond_limit = 0, first_fault = -1, localized_before_fault = 0;
+    for (int i = 0; i < 40; ++i) {
+      const Se2f odom(0.03f * static_cast<float>(i), 0.0f, 0.0f);
+      const auto pts = testing::scan_at(testing::room(), held, &rng);
+      const TrackStep s = t.step(pts.data(), pts.size(), odom, i > 0);
+      if (s.lost) break;
+      if (s.large_fault) {
+        ++large;
+        if (first_fault < 0) first_fault = i;
+      }
+      const bool loc = s.status == hal::LocalizationStatus::kLocalized;
+      localized_beyond_limit += odom.x > o.alert_limit_m && loc;
+      localized_before_fault += first_fault < 0 && loc;
+    }
+    if (window > 0) {
+      EXPECT_GT(large, 0);
+      EXPECT_GE(localized_before_fault, 3) << "a few centimetres behind is within the bound";
+      EXPECT_LE(0.03f * static_cast<float>(first_fault), o.alert_limit_m) << "large fault at step " << first_fault;
+    } else {
+      EXPECT_EQ(large, 0);
+      EXPECT_GT(localized_beyond_limit, 10) << "the per-scan tests alone do not see the slide";
+    }
+  }
+}
+
 TEST(PoseTrackerTest, BadOptionsNameTheField) {
   TrackOptions o;
   o.alert_limit_m = -1.0f;

@@ -54,6 +54,9 @@ Status TrackOptions::validate() const {
     return Status::error(Errc::kInvalidArgument, "TrackOptions.cross_check_steps = %u out of range [0, 1000000]",
                          cross_check_steps);
   }
+  if (odometry_window > 32) {
+    return Status::error(Errc::kInvalidArgument, "TrackOptions.odometry_window = %u out of range [0, 32]", odometry_window);
+  }
   if (recovery_steps > 10000) {
     return Status::error(Errc::kInvalidArgument, "TrackOptions.recovery_steps = %u out of range [0, 10000]", recovery_steps);
   }

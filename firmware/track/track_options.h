@@ -52,6 +52,11 @@ struct TrackOptions {
   // χ²(3) at 1 − 1e-3: scan fix vs odometry prediction; a fault only when the fix also lies outside
   // the prediction's protection level.
   float innovation_chi2 = 16.27f;
+  // Odometry consistency over a window (odometry_consistency.h): each fused pose is tested against
+  // the last `odometry_window` fused poses carried forward by the odometry and its noise model, at
+  // the same χ² as the innovation. Catches a scan matcher that holds the pose back a little at every
+  // scan while the wheels say the robot drives on. 0 = off; at most 32.
+  std::uint32_t odometry_window = 16;
   float outside_map_fraction = 0.5f;      // end-points in unknown space beyond this: outside the map
   std::uint32_t max_faulty_steps = 5;     // consecutive contradicting scans → back to global mode
   std::uint32_t max_outside_steps = 5;    // consecutive outside-map scans → back to global mode

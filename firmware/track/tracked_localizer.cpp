@@ -18,8 +18,9 @@ Status TrackedLocalizer::init(const TrackOptions& options, const GlobalMap& map,
 void TrackedLocalizer::reset() {
   tracker_.reset();
   if (mml_ != nullptr) mml_->reset();
-  fixes_ = fix_rejections_ = tracks_lost_ = cross_check_switches_ = 0;
+  fixes_ = fix_rejections_ = tracks_lost_ = cross_check_switches_ = confirmations_ = 0;
   cross_check_left_ = 0;
+  unconfirmed_ = false;
 }
 
 // End-points within the tracker's range, evenly subsampled to at most align.max_points (beam order
@@ -65,6 +66,13 @@ Status TrackedLocalizer::step(const hal::LaserScan& scan, const hal::Odometry& o
     out->timestamp_ns = scan.timestamp_ns;
     out->scan_id = scan.scan_id;
     publish_track(ts, out);
+    if (ts.large_fault && !ts.lost && tracker_.options().cross_check_steps > 0) {
+      // The robot may have been carried anywhere (a kidnap into a twin corridor fits every local
+      // test): the pose needs MML's word again, from a local map that starts after the fault.
+      unconfirmed_ = true;
+      mml_->reset();
+      cross_check_left_ = tracker_.options().cross_check_steps;
+    }
     if (!ts.lost) return cross_check(scan, odom, wheel, n, ts, out);
     {
       // The track is given up: global localization from a fresh local map, starting with this scan.
@@ -99,6 +107,7 @@ bool TrackedLocalizer::start_from_fix(const hal::PoseEstimate& g, const Se2f& wh
   const TrackStep ts = tracker_.step(pts_, n, wheel, /*predict=*/false);
   if (ts.status == hal::LocalizationStatus::kLocalized && !ts.lost) {
     ++fixes_;
+    unconfirmed_ = false;  // MML has just isolated this pose
     publish_track(ts, out);
     return true;
   }
@@ -114,7 +123,8 @@ Status TrackedLocalizer::cross_check(const hal::LaserScan& scan, const hal::Odom
                                      std::size_t n, const TrackStep& ts, hal::PoseEstimate* out) {
   const std::uint32_t budget = tracker_.options().cross_check_steps;
   if (budget == 0) return Status::ok();
-  if (ts.status != hal::LocalizationStatus::kLocalized) {
+  if (unconfirmed_) out->status = hal::LocalizationStatus::kAmbiguous;  // until MML agrees
+  if (ts.status != hal::LocalizationStatus::kLocalized || unconfirmed_) {
     if (cross_check_left_ == 0) mml_->reset();  // a fresh local map from this scan on
     cross_check_left_ = budget;                 // runs on for `budget` scans after the last doubt
   }
@@ -126,7 +136,14 @@ Status TrackedLocalizer::cross_check(const hal::LaserScan& scan, const hal::Odom
   cross_check_left_ = 0;
   const float d = std::hypot(g.x - ts.pose.x, g.y - ts.pose.y);
   const float dth = std::fabs(wrap_angle(g.theta - ts.pose.theta));
-  if (d <= ts.pl.xy_m && dth <= ts.pl.theta_rad) return Status::ok();  // MML isolates the tracked pose
+  if (d <= ts.pl.xy_m && dth <= ts.pl.theta_rad) {  // MML isolates the tracked pose
+    if (unconfirmed_) {
+      unconfirmed_ = false;
+      ++confirmations_;
+      out->status = ts.status;  // the tracker's own verdict on this scan stands again
+    }
+    return Status::ok();
+  }
   // MML isolates a pose the track does not contain: the track sat in a look-alike.
   ++cross_check_switches_;
   ++tracks_lost_;

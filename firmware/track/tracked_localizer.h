@@ -10,6 +10,10 @@
 // track's protection level, the track sat in a look-alike (a kidnap into a twin corridor with the
 // wheels still is invisible to every local test) and MML's fix, confirmed by the tracker as any fix,
 // replaces it. If MML isolates the tracked pose, the search stops.
+// Confirmation after a large fault (extension): a contradiction beyond the alert limits (the robot
+// may have been carried; see TrackStep::large_fault) restarts that search from a fresh local map and
+// withholds `localized` until MML isolates the tracked pose (or replaces it): the tracker's tests are
+// local and cannot see that a look-alike 35 m away fits as well as the place it came from.
 // PoseEstimate.mode says which one is active; protection_xy_m / protection_theta_rad are set on
 // every `localized` pose. Never allocates in step(); both parts live in static storage.
 #pragma once
@@ -41,6 +45,9 @@ class TrackedLocalizer final : public Localizer {
   std::uint32_t tracks_lost() const { return tracks_lost_; }
   std::uint32_t cross_check_switches() const { return cross_check_switches_; }  // tracks replaced by MML
   bool cross_checking() const { return cross_check_left_ > 0; }
+  // A large fault (TrackStep::large_fault) was seen and MML has not yet isolated the tracked pose.
+  bool awaiting_confirmation() const { return unconfirmed_; }
+  std::uint32_t confirmations() const { return confirmations_; }  // tracked poses MML confirmed
 
  private:
   std::size_t scan_points(const hal::LaserScan& scan);
@@ -54,6 +61,8 @@ class TrackedLocalizer final : public Localizer {
   Point2f pts_[hal::LaserScan::kMaxBeams];
   std::uint32_t fixes_ = 0, fix_rejections_ = 0, tracks_lost_ = 0, cross_check_switches_ = 0;
   std::uint32_t cross_check_left_ = 0;  // scans the background search still runs (0 = idle)
+  std::uint32_t confirmations_ = 0;
+  bool unconfirmed_ = false;
 };
 
 }  // namespace track
