@@ -4,6 +4,7 @@
 #include <Eigen/LU>
 #include <cmath>
 
+#include "firmware/base/sym2_eigen.h"
 #include "firmware/map/distance_sample.h"
 #include "firmware/mml/pose_uniqueness.h"
 
@@ -117,6 +118,35 @@ bool outside_bound(const Eigen::Vector3f& e, const ProtectionLevel& pl) {
 }
 }  // namespace
 
+// Gauss-Newton from the prediction; when the prediction is too uncertain for its capture range, also
+// from the best pose of a correlative search over the prediction's window (correlative_search.h),
+// keeping whichever result explains the scan better (the prediction's on a tie).
+ScanAlignment PoseTracker::align_from_prediction(const Point2f* points, std::size_t n, const Se2f& pred,
+                                                 TrackStep* out) {
+  const TrackOptions& o = options_;
+  ScanAlignment a = align_scan(map_, points, n, pred, o.align);
+  if (!o.search.enabled || n == 0) return a;
+  const Sym2Eigen exy = sym2_eigen(cov_(0, 0), cov_(0, 1), cov_(1, 1));
+  const float sxy = std::sqrt(std::fmax(exy.lambda_max, 0.0f));
+  const float sth = std::sqrt(std::fmax(cov_(2, 2), 0.0f));
+  if (!(sxy > o.search.trigger_sigma_xy_m || sth > o.search.trigger_sigma_theta_rad)) return a;
+  CorrelativeWindow w;
+  w.xy_m = std::fmin(o.search.window_sigmas * sxy, o.search.max_window_xy_m);
+  w.theta_rad = std::fmin(o.search.window_sigmas * sth, o.search.max_window_theta_rad);
+  const CorrelativeResult cr =
+      correlative_search(map_, points, n, pred, w, o.search, search_scratch_, kSearchScratch);
+  out->search_candidates = cr.candidates;
+  if (cr.candidates == 0 || !(cr.score > cr.seed_score)) return a;
+  const ScanAlignment b = align_scan(map_, points, n, cr.pose, o.align);
+  const float sa = fit_score(map_, points, n, a.pose, o.search.clip_m);
+  const float sb = fit_score(map_, points, n, b.pose, o.search.clip_m);
+  if (sb > sa) {
+    out->search_moved = true;
+    return b;
+  }
+  return a;
+}
+
 TrackStep PoseTracker::step(const Point2f* points, std::size_t n, const Se2f& odom, bool predict) {
   TrackStep out;
   if (!active_) {
@@ -133,7 +163,7 @@ TrackStep PoseTracker::step(const Point2f* points, std::size_t n, const Se2f& od
   }
   const Se2f pred = pose_;
   const ProtectionLevel pred_pl = protection_level(cov_, k_, bias_xy_m_, bias_theta_rad_);
-  out.alignment = align_scan(map_, points, n, pred, o.align);
+  out.alignment = align_from_prediction(points, n, pred, &out);
   const ScanAlignment& a = out.alignment;
 
   // Verdict of this scan on the pose (fault detection).

@@ -27,6 +27,7 @@
 #include "firmware/base/status.h"
 #include "firmware/map/global_map.h"
 #include "firmware/track/odometry_consistency.h"
+#include "firmware/track/correlative_search.h"
 #include "firmware/track/protection_level.h"
 #include "firmware/track/scan_alignment.h"
 #include "firmware/track/track_options.h"
@@ -60,6 +61,8 @@ struct TrackStep {
   float innovation_chi2 = 0.0f;
   float odometry_chi2 = 0.0f;   // odometry consistency over the window (0 = not tested)
   float alias_cost = 0.0f, alias_rival_cost = 1.0f;  // alias check (1 = not run)
+  std::uint32_t search_candidates = 0;  // correlative pre-search (0 = not run: prediction tight)
+  bool search_moved = false;            // the alignment started from the search's best pose
   ScanAlignment alignment;
 };
 
@@ -79,6 +82,9 @@ class PoseTracker {
 
  private:
   void predict_to(const Se2f& odom);
+  ScanAlignment align_from_prediction(const Point2f* points, std::size_t n, const Se2f& pred, TrackStep* out);
+  static constexpr std::size_t kSearchScratch = 2 * 1081;
+  Point2f search_scratch_[kSearchScratch];
   // The alias check refines ~30 rivals: it uses at most this many end-points (evenly subsampled),
   // which halves its cost at the 360 points of the alignment and keeps one point = 1/180 of the cost.
   static constexpr std::size_t kAliasMaxPoints = 180;

@@ -30,8 +30,28 @@ Status ScanAlignOptions::validate() const {
   return Status::ok();
 }
 
+Status CorrelativeSearchOptions::validate() const {
+  FW_RETURN_IF_ERROR(check_range("search.trigger_sigma_xy_m", trigger_sigma_xy_m, 0.0f, 100.0f));
+  FW_RETURN_IF_ERROR(check_range("search.trigger_sigma_theta_rad", trigger_sigma_theta_rad, 0.0f, 3.2f));
+  FW_RETURN_IF_ERROR(check_range("search.window_sigmas", window_sigmas, 0.1f, 10.0f));
+  FW_RETURN_IF_ERROR(check_range("search.max_window_xy_m", max_window_xy_m, 0.0f, 10.0f));
+  FW_RETURN_IF_ERROR(check_range("search.max_window_theta_rad", max_window_theta_rad, 0.0f, 3.2f));
+  FW_RETURN_IF_ERROR(check_range("search.linear_step_m", linear_step_m, 0.005f, 1.0f));
+  FW_RETURN_IF_ERROR(check_range("search.angular_step_rad", angular_step_rad, 0.001f, 0.5f));
+  FW_RETURN_IF_ERROR(check_range("search.clip_m", clip_m, 0.01f, 2.0f));
+  if (max_points < 10 || max_points > 1081) {
+    return Status::error(Errc::kInvalidArgument, "TrackOptions.search.max_points = %u out of range [10, 1081]", max_points);
+  }
+  if (max_candidates < 1 || max_candidates > 1000000) {
+    return Status::error(Errc::kInvalidArgument, "TrackOptions.search.max_candidates = %u out of range [1, 1000000]",
+                         max_candidates);
+  }
+  return Status::ok();
+}
+
 Status TrackOptions::validate() const {
   FW_RETURN_IF_ERROR(align.validate());
+  FW_RETURN_IF_ERROR(search.validate());
   FW_RETURN_IF_ERROR(check_range("odom_trans_per_m", odom_trans_per_m, 0.0f, 10.0f));
   FW_RETURN_IF_ERROR(check_range("odom_trans_per_rad", odom_trans_per_rad, 0.0f, 10.0f));
   FW_RETURN_IF_ERROR(check_range("odom_rot_per_rad", odom_rot_per_rad, 0.0f, 10.0f));

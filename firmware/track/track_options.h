@@ -28,8 +28,28 @@ struct ScanAlignOptions {
   Status validate() const;
 };
 
+// Correlative pre-search of the tracker (correlative_search.h): run when the odometry prediction is
+// too uncertain for Gauss-Newton alone; the window is window_sigmas × the prediction's σ, capped.
+struct CorrelativeSearchOptions {
+  bool enabled = true;
+  // The search runs when the prediction's σ exceeds either trigger: below them Gauss-Newton's
+  // capture range (twice the outlier distance in its first iterations) covers the window.
+  float trigger_sigma_xy_m = 0.10f;
+  float trigger_sigma_theta_rad = 0.035f;  // 2°
+  float window_sigmas = 3.0f;              // half-width of the window in prediction σ
+  float max_window_xy_m = 1.0f;            // caps: beyond them the track is as good as lost
+  float max_window_theta_rad = 0.35f;      // 20°
+  float linear_step_m = 0.10f;             // coarse grid; Gauss-Newton refines from the best cell
+  float angular_step_rad = 0.0175f;        // 1°
+  float clip_m = 0.20f;                    // truncated score: ≥ the grid's worst offset at 10 m
+  std::uint32_t max_points = 90;           // end-points scored per candidate (evenly subsampled)
+  std::uint32_t max_candidates = 20000;    // steps are coarsened until the window fits
+  Status validate() const;
+};
+
 struct TrackOptions {
   ScanAlignOptions align;
+  CorrelativeSearchOptions search;
   // Odometry noise (AMCL's α1..α4 and their defaults, 0.2): σ_trans = a_tt·|Δs| + a_tr·|Δθ|,
   // σ_rot = a_rr·|Δθ| + a_rt·|Δs|. Too tight a model makes good scans fail the innovation test
   // (availability), never a wrong pose pass it: the fit test does not depend on it.
