@@ -118,14 +118,18 @@ bool outside_bound(const Eigen::Vector3f& e, const ProtectionLevel& pl) {
 }
 }  // namespace
 
-// Gauss-Newton from the prediction; when the prediction is too uncertain for its capture range, also
-// from the best pose of a correlative search over the prediction's window (correlative_search.h),
-// keeping whichever result explains the scan better (the prediction's on a tie).
+// Gauss-Newton from the prediction; while recovering from a fault with a prediction too uncertain for
+// its capture range, also from the best pose of a correlative search over the prediction's window
+// (correlative_search.h), kept only when it explains the scan clearly better.
 ScanAlignment PoseTracker::align_from_prediction(const Point2f* points, std::size_t n, const Se2f& pred,
                                                  TrackStep* out) {
   const TrackOptions& o = options_;
   ScanAlignment a = align_scan(map_, points, n, pred, o.align);
-  if (!o.search.enabled || n == 0) return a;
+  // Only while recovering from a fault: the covariance was widened by the size of a disagreement,
+  // so the prediction may lie beyond Gauss-Newton's capture range. On a healthy track the AMCL-style
+  // model's σ is large on long steps (fr101: 10° per 0.7 m) while the odometry is good, and a search
+  // there costs time and can trade the right minimum for a coarse-grid neighbour.
+  if (!o.search.enabled || n == 0 || !had_fault_ || consistent_since_fault_ >= o.recovery_steps) return a;
   const Sym2Eigen exy = sym2_eigen(cov_(0, 0), cov_(0, 1), cov_(1, 1));
   const float sxy = std::sqrt(std::fmax(exy.lambda_max, 0.0f));
   const float sth = std::sqrt(std::fmax(cov_(2, 2), 0.0f));
@@ -140,7 +144,7 @@ ScanAlignment PoseTracker::align_from_prediction(const Point2f* points, std::siz
   const ScanAlignment b = align_scan(map_, points, n, cr.pose, o.align);
   const float sa = fit_score(map_, points, n, a.pose, o.search.clip_m);
   const float sb = fit_score(map_, points, n, b.pose, o.search.clip_m);
-  if (sb > sa) {
+  if (sb > sa + o.search.min_score_gain) {
     out->search_moved = true;
     return b;
   }

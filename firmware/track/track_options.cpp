@@ -39,6 +39,7 @@ Status CorrelativeSearchOptions::validate() const {
   FW_RETURN_IF_ERROR(check_range("search.linear_step_m", linear_step_m, 0.005f, 1.0f));
   FW_RETURN_IF_ERROR(check_range("search.angular_step_rad", angular_step_rad, 0.001f, 0.5f));
   FW_RETURN_IF_ERROR(check_range("search.clip_m", clip_m, 0.01f, 2.0f));
+  FW_RETURN_IF_ERROR(check_range("search.min_score_gain", min_score_gain, 0.0f, 1.0f));
   if (max_points < 10 || max_points > 1081) {
     return Status::error(Errc::kInvalidArgument, "TrackOptions.search.max_points = %u out of range [10, 1081]", max_points);
   }

@@ -32,8 +32,9 @@ struct ScanAlignOptions {
 // too uncertain for Gauss-Newton alone; the window is window_sigmas × the prediction's σ, capped.
 struct CorrelativeSearchOptions {
   bool enabled = true;
-  // The search runs when the prediction's σ exceeds either trigger: below them Gauss-Newton's
-  // capture range (twice the outlier distance in its first iterations) covers the window.
+  // The search runs while the track recovers from a fault (its covariance widened) and the
+  // prediction's σ exceeds either trigger: below them Gauss-Newton's capture range (twice the
+  // outlier distance in its first iterations) covers the window.
   float trigger_sigma_xy_m = 0.10f;
   float trigger_sigma_theta_rad = 0.035f;  // 2°
   float window_sigmas = 3.0f;              // half-width of the window in prediction σ
@@ -44,6 +45,9 @@ struct CorrelativeSearchOptions {
   float clip_m = 0.20f;                    // truncated score: ≥ the grid's worst offset at 10 m
   std::uint32_t max_points = 90;           // end-points scored per candidate (evenly subsampled)
   std::uint32_t max_candidates = 20000;    // steps are coarsened until the window fits
+  // The searched alignment replaces the one from the prediction only when its mean truncated score
+  // is higher by this much (a few end-points more on the walls, not quantisation noise).
+  float min_score_gain = 0.02f;
   Status validate() const;
 };
 
