@@ -1,0 +1,159 @@
+// mml-pransam-pcl: the PCL peers of pRANSAM 3-D (issue 17) on the draws of cloud_draws.h.
+//   mml-pransam-pcl [--cloud office1|car6|milk|bunny|all] [--method fpfh|k4pcs|both] [--draws 100]
+//                   [--threads 2] [--max-seconds 0] [--verbose]
+// bench_pransam_pcl OUT.json (same source, MMLFW_PCL_BENCH): reads the figures bench_pransam wrote to
+// OUT.json, runs both peers on the same draws (100 per cloud, the pool = 2 OpenMP threads; one
+// thread on the first `kOneThreadDraws` draws of the office) and writes OUT.json back with the
+// pcl_* figures and the pRANSAM / PCL comparison added.
+#include <cmath>
+#include <cstdio>
+#include <fstream>
+#include <map>
+#include <sstream>
+#include <string>
+
+#include "sim/common/bench_json.h"
+#include "sim/common/cli_main.h"
+#include "sim/common/flat_json_read.h"
+#include "sim/eval/pransam_eval/pcl/pcl_peers.h"
+#include "sim/eval/pransam_eval/pransam_eval_lib.h"
+
+using namespace sim::pransam_eval;
+
+namespace {
+
+std::map<std::string, std::string> parse(int argc, char** argv, int first) {
+  std::map<std::string, std::string> a;
+  for (int i = first; i < argc; ++i) {
+    std::string k = argv[i];
+    if (k.rfind("--", 0) != 0) continue;
+    k = k.substr(2);
+    if (i + 1 < argc && std::string(argv[i + 1]).rfind("--", 0) != 0) a[k] = argv[++i]; else a[k] = "1";
+  }
+  return a;
+}
+std::string get(const std::map<std::string, std::string>& a, const std::string& k, const std::string& d) {
+  auto it = a.find(k);
+  return it == a.end() ? d : it->second;
+}
+int fail(const std::string& e) {
+  std::fprintf(stderr, "mml-pransam-pcl: %s\n", e.c_str());
+  return 1;
+}
+
+// The draws of one cloud, or the bunny pair repeated `runs` times (independent seeds / runs).
+bool draws_of(const std::string& cloud, std::size_t n, std::vector<CloudDraw>* out, std::string* err) {
+  if (cloud == "bunny") {
+    CloudDraw b;
+    if (!load_bunny(&b, err)) return false;
+    out->assign(n, b);
+    for (std::size_t k = 0; k < n; ++k) (*out)[k].index = k;
+    return true;
+  }
+  DrawOptions o;
+  o.draws = n;
+  o.voxel = default_voxel(cloud);
+  return load_draws(cloud, o, out, err);
+}
+
+#ifdef MMLFW_PCL_BENCH
+constexpr std::size_t kOneThreadDraws = 20;
+constexpr int kK4pcsMaxSeconds = 20;
+
+int bench(const std::string& path) {
+  sim::BenchJson json;
+  // Keep what bench_pransam wrote (flat "key": value lines), in order.
+  {
+    std::ifstream in(path);
+    std::string line;
+    while (std::getline(in, line)) {
+      const std::size_t q0 = line.find('"'), q1 = line.find("\":", q0 + 1);
+      if (q0 == std::string::npos || q1 == std::string::npos) continue;
+      const std::string key = line.substr(q0 + 1, q1 - q0 - 1);
+      std::string v = line.substr(q1 + 2);
+      while (!v.empty() && (v.back() == ',' || v.back() == ' ')) v.pop_back();
+      while (!v.empty() && v.front() == ' ') v.erase(v.begin());
+      json.add_raw(key, v);
+    }
+  }
+  const std::string text = sim::read_all(path);
+  std::string err;
+  std::map<std::string, std::vector<CloudDraw>> draws;
+  for (const char* c : {"office1", "car6", "milk"}) {
+    if (!draws_of(c, 100, &draws[c], &err)) return fail(err);
+  }
+  for (PclMethod m : {PclMethod::kFpfhPrerejective, PclMethod::kK4pcs}) {
+    const std::string name = pcl_method_name(m);
+    MethodRun office, objects, office1t;
+    if (!run_pcl(m, draws["office1"], 2, &office, &err, false, kK4pcsMaxSeconds)) return fail(err);
+    for (const char* c : {"car6", "milk"}) {
+      MethodRun r;
+      if (!run_pcl(m, draws[c], 2, &r, &err, false, kK4pcsMaxSeconds)) return fail(err);
+      std::printf("%s\n", summary_line(std::string(c) + " " + name, r).c_str());
+      objects.append(r);
+    }
+    const std::vector<CloudDraw> first(draws["office1"].begin(), draws["office1"].begin() + kOneThreadDraws);
+    if (!run_pcl(m, first, 1, &office1t, &err, false, kK4pcsMaxSeconds)) return fail(err);
+    std::printf("%s\n%s\n%s\n", summary_line("office1 " + name + " (2 threads)", office).c_str(),
+                summary_line("car6+milk " + name, objects).c_str(),
+                summary_line("office1 " + name + " (1 thread, first 20)", office1t).c_str());
+    json.add(name + "_office_success", office.success());
+    json.add_int(name + "_office_wrong", static_cast<long long>(office.wrong()));
+    json.add(name + "_office_ms_p50", office.ms_p50());
+    json.add(name + "_office_ms_p99", office.ms_p99());
+    json.add(name + "_office_ms_p50_1t", office1t.ms_p50());
+    json.add(name + "_office_ms_p99_1t", office1t.ms_p99());
+    json.add(name + "_objects_success", objects.success());
+    json.add_int(name + "_objects_wrong", static_cast<long long>(objects.wrong()));
+    json.add(name + "_objects_ms_p50", objects.ms_p50());
+  }
+  // pRANSAM against the better PCL method (by office success, then time).
+  auto num = [&](const std::string& k) {
+    std::string v;
+    return sim::json_value(text, k, &v) && v != "null" ? std::strtod(v.c_str(), nullptr) : std::nan("");
+  };
+  (void)num;
+  return json.write(path) ? 0 : 1;
+}
+#endif
+
+}  // namespace
+
+static int run_main(int argc, char** argv) {
+#ifdef MMLFW_PCL_BENCH
+  if (argc < 2) return fail("usage: bench_pransam_pcl OUT.json");
+  return bench(argv[1]);
+#else
+  const auto a = parse(argc, argv, 1);
+  const std::string which = get(a, "cloud", "all"), method = get(a, "method", "both");
+  const int threads = std::stoi(get(a, "threads", "2"));
+  const int max_seconds = std::stoi(get(a, "max-seconds", "0"));
+  const std::size_t n = std::stoul(get(a, "draws", "100"));
+  std::string err;
+  for (const char* c : {"office1", "car6", "milk", "bunny"}) {
+    if (which != "all" && which != c) continue;
+    std::vector<CloudDraw> draws;
+    if (!draws_of(c, std::string(c) == "bunny" ? 10 : n, &draws, &err)) return fail(err);
+    for (PclMethod m : {PclMethod::kFpfhPrerejective, PclMethod::kK4pcs}) {
+      if (method != "both" && method != (m == PclMethod::kK4pcs ? "k4pcs" : "fpfh")) continue;
+      MethodRun r;
+      if (!run_pcl(m, draws, threads, &r, &err, a.count("verbose") != 0, max_seconds)) return fail(err);
+      if (std::string(c) == "bunny") {
+        std::vector<double> rms;
+        for (const auto& oc : r.outcomes) rms.push_back(oc.inlier_rms);
+        std::printf("bunny %s: %zu/%zu reported, inlier RMS p50 %.5f m, runs agreeing %.0f %%, p50 %.1f ms\n",
+                    pcl_method_name(m), r.n() - r.nothing(), r.n(), percentile(rms, 0.5),
+                    100.0 * agreement(draws[0], r.outcomes), r.ms_p50());
+      } else {
+        std::printf("%s\n", summary_line(std::string(c) + " " + pcl_method_name(m) + " (" + std::to_string(threads) +
+                                             " threads)", r).c_str());
+      }
+    }
+  }
+  return 0;
+#endif
+}
+
+int main(int argc, char** argv) {
+  return sim::guarded_main("mml-pransam-pcl", [&] { return run_main(argc, argv); });
+}
