@@ -53,16 +53,13 @@ bool make_office_draws(const PcdCloud& office, const DrawOptions& o, std::vector
     *error = office.path + ": only " + std::to_string(raw.size()) + " finite points for the office draws";
     return false;
   }
-  // Slab ranges from the 1 % / 99 % quantiles per axis (a few stray far points would waste width).
-  float lo[2], hi[2];
+  // Sorted coordinates per image axis: the slabs are cut at point quantiles, so that the drawn
+  // overlap is the share of A's points that B also holds (the frame's density is far from uniform).
+  std::vector<float> sorted[2];
   for (int a = 0; a < 2; ++a) {
-    std::vector<float> v;
-    v.reserve(raw.size());
-    for (const auto& p : raw) v.push_back(p(a));
-    std::nth_element(v.begin(), v.begin() + v.size() / 100, v.end());
-    lo[a] = v[v.size() / 100];
-    std::nth_element(v.begin(), v.begin() + v.size() * 99 / 100, v.end());
-    hi[a] = v[v.size() * 99 / 100];
+    sorted[a].reserve(raw.size());
+    for (const auto& p : raw) sorted[a].push_back(p(a));
+    std::sort(sorted[a].begin(), sorted[a].end());
   }
   for (std::size_t k = 0; k < o.draws; ++k) {
     fw::RandomStream r(o.seed, 1000 + k);
@@ -73,16 +70,17 @@ bool make_office_draws(const PcdCloud& office, const DrawOptions& o, std::vector
     d.scene_sensor_known = true;
     const int axis = r.uniform01f() < 0.5f ? 0 : 1;
     const float ov = r.uniform(o.overlap_min, o.overlap_max);
-    // Two slabs of width w overlapping by ov·w exactly cover [lo, hi]: (2 − ov)·w = hi − lo.
-    const float w = (hi[axis] - lo[axis]) / (2.0f - ov);
-    const bool scene_left = r.uniform01f() < 0.5f;
-    const float a0 = scene_left ? lo[axis] : hi[axis] - w;        // scene slab
-    const float b0 = scene_left ? hi[axis] - w : lo[axis];        // model slab
+    // Both slabs hold a share s of the points, one from each end: overlap (2s − 1)/s = ov.
+    const float share = 1.0f / (2.0f - ov);
+    const std::vector<float>& v = sorted[axis];
+    const float low_cut = v[static_cast<std::size_t>(share * static_cast<float>(v.size() - 1))];
+    const float high_cut = v[static_cast<std::size_t>((1.0f - share) * static_cast<float>(v.size() - 1))];
+    const bool scene_low = r.uniform01f() < 0.5f;
     std::vector<Eigen::Vector3f> a, b;
     std::size_t a_in_b = 0;
     for (const auto& p : raw) {
-      const bool in_a = p(axis) >= a0 && p(axis) < a0 + w;
-      const bool in_b = p(axis) >= b0 && p(axis) < b0 + w;
+      const bool in_low = p(axis) <= low_cut, in_high = p(axis) >= high_cut;
+      const bool in_a = scene_low ? in_low : in_high, in_b = scene_low ? in_high : in_low;
       if (in_a) a.push_back(p);
       if (in_b) b.push_back(p);
       if (in_a && in_b) ++a_in_b;
@@ -120,6 +118,7 @@ bool make_object_draws(const PcdCloud& object, const std::string& name, const Dr
     d.index = k;
     d.voxel = o.voxel;
     d.model = model;
+    d.scene_sensor_known = true;  // the scan's VIEWPOINT (its frame's origin), moved with it
     // Cut by a random plane: keep the points below the keep-fraction quantile along a random direction.
     Eigen::Vector3f n(r.gaussianf(0, 1), r.gaussianf(0, 1), r.gaussianf(0, 1));
     n.normalize();

@@ -1,7 +1,8 @@
 // The draws of the real 3-D experiments (issue 17) on ../shared/data/pcl3d, shared by pRANSAM and
 // the PCL peers so that every method sees exactly the same clouds:
 //  - office1 (organized RGB-D frame, 254,456 finite points): two overlapping slabs of the frame
-//    along a random image axis (x or y), each of width w, overlapping by o·w with o ~ U[0.60, 0.80];
+//    along a random image axis (x or y), cut at point quantiles so that each holds the same number
+//    of points and a share o ~ U[0.60, 0.80] of the scene's points lies in the model slab too;
 //    the scene slab A is moved by a uniformly random rotation (the full SO(3), random unit
 //    quaternion) and a translation in [-1, 1]³ m, with Gaussian noise σ = 0.1 voxel per axis; both
 //    slabs are then voxel-downsampled separately (independent samplings of the same surfaces);

@@ -84,6 +84,14 @@ bool run_pransam3d(const std::vector<CloudDraw>& draws, const Pransam3dConfig& c
     p.refine_iterations = config.refine_iterations;
     p.refine_min_quality = config.refine_min_quality;
     p.refine_cutoff = 2.0f * d.voxel;
+    if (config.free_space && d.scene_sensor_known) {
+      p.scene_origin_is_sensor = true;
+      for (int a = 0; a < 3; ++a) p.scene_sensor[a] = d.scene_sensor(a);
+      p.free_space_min_quality = config.free_space_min_quality;
+      p.free_space_margin = config.free_space_margin_voxels * d.voxel;
+      p.free_space_block_radius = config.free_space_block_voxels * d.voxel;
+      p.max_blocked_fraction = config.max_blocked;
+    }
     fw::pransam::MatchResult<3> r;
     const double t0 = now_ms();
     s = matcher->set_model(d.model.data(), d.model.size(), d.cloud.c_str());
@@ -97,9 +105,10 @@ bool run_pransam3d(const std::vector<CloudDraw>& draws, const Pransam3dConfig& c
     pm.build(&d.model, 3.0f * d.voxel);
     CloudOutcome oc = score_answer(d, pm, rot, tr, reported, ms);
     if (verbose) {
-      std::printf("  %s #%zu |A| %zu |B| %zu ov %.2f: %.1f ms it %llu coll %llu Ω %.3f %s  err %.4f m %.2f°  rms %.4f\n",
+      std::printf("  %s #%zu |A| %zu |B| %zu ov %.2f: %.1f ms it %llu coll %llu fs-rej %llu Ω %.3f %s  err %.4f m %.2f°  rms %.4f\n",
                   d.cloud.c_str(), d.index, d.scene.size(), d.model.size(), d.overlap, ms,
                   static_cast<unsigned long long>(r.stats.iterations), static_cast<unsigned long long>(r.stats.collisions),
+                  static_cast<unsigned long long>(r.stats.free_space_rejected),
                   r.best_valid ? r.best.quality : 0.0f,
                   reported ? (oc.correct || !d.has_truth ? "reported" : "REPORTED-WRONG") : (oc.correct ? "missed(correct)" : "nothing"),
                   oc.trans_err, oc.rot_err_deg, oc.inlier_rms);

@@ -52,6 +52,11 @@ Pransam3dConfig config_3d(const std::map<std::string, std::string>& a) {
   c.refine_iterations = static_cast<std::uint32_t>(std::stoul(get(a, "refine", std::to_string(c.refine_iterations))));
   c.refine_min_quality = std::stof(get(a, "refine-min", std::to_string(c.refine_min_quality)));
   c.seed = std::stoull(get(a, "seed", "1"));
+  c.free_space = a.count("free-space") != 0;
+  c.free_space_min_quality = std::stof(get(a, "fs-min", std::to_string(c.free_space_min_quality)));
+  c.free_space_block_voxels = std::stof(get(a, "fs-block", std::to_string(c.free_space_block_voxels)));
+  c.free_space_margin_voxels = std::stof(get(a, "fs-margin", std::to_string(c.free_space_margin_voxels)));
+  c.max_blocked = std::stof(get(a, "max-blocked", std::to_string(c.max_blocked)));
   return c;
 }
 
