@@ -5,13 +5,26 @@ set -euo pipefail
 cd "$(dirname "$0")/.."
 ROOT=$(pwd)
 bash scripts/setup.sh >/dev/null
+# The pRANSAM benchmark compares with PCL (FPFH + SampleConsensusPrerejective, K-4PCS): Debian's
+# libpcl-dev, installed here only when missing (the normal build and the tests never need it).
+if [ "${1:-}" = "" ] || [ "${1:-}" = "pransam" ]; then
+  if ! dpkg-query -W -f='${Status}' libpcl-dev 2>/dev/null | grep -q "install ok installed"; then
+    echo "bench: installing libpcl-dev for the PCL comparison"
+    SUDO=""; if [ "$(id -u)" -ne 0 ]; then SUDO="sudo"; fi
+    export DEBIAN_FRONTEND=noninteractive
+    $SUDO apt-get update -qq
+    $SUDO apt-get install -y -qq --no-install-recommends libpcl-dev
+  fi
+fi
 cmake --preset release >/dev/null
 cmake --build --preset release -j "$(nproc)"
 mkdir -p build/bench
 export MMLFW_DATA_DIR=${MMLFW_DATA_DIR:-$(cd "$ROOT/.." && pwd)/shared/data}
 
 # Each benchmark is an executable build/release/bench/bench_NAME taking the JSON output path.
-mapfile -t available < <(ls build/release/bench 2>/dev/null | sed -n 's/^bench_\(.*\)$/\1/p' | sort)
+# pransam_pcl is not a benchmark of its own: bench_pransam runs first, then it adds the PCL peers'
+# figures to build/bench/pransam.json (issue 17).
+mapfile -t available < <(ls build/release/bench 2>/dev/null | sed -n 's/^bench_\(.*\)$/\1/p' | grep -v '^pransam_pcl$' | sort)
 if [ $# -ge 1 ]; then names=("$1"); else names=("${available[@]}"); fi
 if [ ${#names[@]} -eq 0 ]; then echo "bench.sh: no benchmarks built" >&2; exit 1; fi
 for n in "${names[@]}"; do
@@ -21,5 +34,12 @@ for n in "${names[@]}"; do
   fi
   echo "=== bench $n ==="
   "$exe" "build/bench/$n.json"
+  if [ "$n" = "pransam" ]; then
+    if [ -x build/release/bench/bench_pransam_pcl ]; then
+      build/release/bench/bench_pransam_pcl "build/bench/$n.json"
+    else
+      echo "bench.sh: bench_pransam_pcl not built (PCL not found): no pcl_* figures" >&2
+    fi
+  fi
   echo "--- build/bench/$n.json"; cat "build/bench/$n.json"; echo
 done

@@ -294,8 +294,11 @@ void Matcher<D>::refine(Hypothesis<D>* h) const {
 
 template <int D>
 float Matcher<D>::blocked_fraction(const Hypothesis<D>& h) const {
-  const Point<D> origin = h.translation;  // the sensor (A's origin) in B
+  Point<D> sensor;
+  for (int a = 0; a < D; ++a) sensor(a) = params_.scene_sensor[a];
+  const Point<D> origin = h.apply(sensor);  // the sensor (A's origin unless given) in B
   const float res = field_.options().resolution;
+  const float block = params_.free_space_block_radius > 0.0f ? params_.free_space_block_radius : 0.5f * res;
   std::uint32_t blocked_n = 0;
   for (std::uint32_t i = 0; i < scene_n_; ++i) {
     const Point<D> p = h.rotation * scene_[i] + h.translation;
@@ -306,11 +309,23 @@ float Matcher<D>::blocked_fraction(const Hypothesis<D>& h) const {
     // Sphere tracing on B's distance field: a step never jumps over a point of B; the beam is
     // blocked when it enters a cell that holds a point of B.
     const Point<D> dir = ray / len;
-    float s = 0.0f;
-    while (s < free_len) {
+    // Start where the beam enters the field's box (a 3-D sensor usually sees B from outside it).
+    float s = 0.0f, s_exit = free_len;
+    for (int a = 0; a < D; ++a) {
+      const float lo = field_.origin()(a), hi = lo + static_cast<float>(field_.dim(a)) * res;
+      if (dir(a) == 0.0f) {
+        if (origin(a) < lo || origin(a) > hi) s = s_exit + 1.0f;  // parallel outside: never enters
+        continue;
+      }
+      float t0 = (lo - origin(a)) / dir(a), t1 = (hi - origin(a)) / dir(a);
+      if (t0 > t1) { const float tmp = t0; t0 = t1; t1 = tmp; }
+      if (t0 > s) s = t0;
+      if (t1 < s_exit) s_exit = t1;
+    }
+    while (s < s_exit) {
       const float d = field_.distance(origin + dir * s);
       if (!(d < 1e30f)) break;  // left the field: free
-      if (d < 0.5f * res) { ++blocked_n; break; }
+      if (d < block) { ++blocked_n; break; }
       s += d - 0.75f * res > 0.5f * res ? d - 0.75f * res : 0.5f * res;
     }
   }
@@ -367,7 +382,13 @@ void Matcher<D>::run_worker(int w) {
       ++st.stats.refined;
       q = rate(h, 0.0f, 0, &complete, &st.stats.point_checks);
     }
-    if (params_.scene_origin_is_sensor && q >= thres && blocked_fraction(h) > params_.max_blocked_fraction) {
+    // Free-space gate: 2-D tests what reaches Ω_thres; the 3-D extension tests from
+    // free_space_min_quality whatever would become the best (or be collected).
+    const bool gate = params_.free_space_min_quality < 0.0f
+                          ? q >= thres
+                          : q >= params_.free_space_min_quality && (collect ? q >= thres : !st.best_valid || q > st.best.quality) &&
+                                (collect || q > round_bound_);
+    if (params_.scene_origin_is_sensor && gate && blocked_fraction(h) > params_.max_blocked_fraction) {
       ++st.stats.free_space_rejected;
       continue;  // beams through walls of B: impossible pose whatever Ω says
     }

@@ -81,6 +81,19 @@ struct MatchParams {
   bool scene_origin_is_sensor = false;
   float free_space_margin = 0.3f;
   float max_blocked_fraction = 0.1f;
+  // 3-D extension of the free-space test (issue 17, not in the dissertation): the sensor need not
+  // be A's origin (a cut of an RGB-D frame moved by an unknown transform knows where its camera is
+  // in its own frame): its position in A's frame (first D values used). And the test may apply
+  // from a lower quality: with free_space_min_quality ≥ 0 every hypothesis with Ω ≥ that value
+  // that would become the best (or, collecting, reach Ω_thres) is tested, so a near-symmetric flip
+  // of an object (a milk carton turned by 180° fits its own surface) or a slide along a wall cannot
+  // become the answer that is reported. < 0 (default): only Ω ≥ Ω_thres, as in 2-D.
+  float scene_sensor[3] = {0.0f, 0.0f, 0.0f};
+  float free_space_min_quality = -1.0f;
+  // A beam is blocked where it comes closer than this to a point of B (metres; 0 = half a field
+  // cell, the 2-D grid). A sampled 3-D surface has gaps of a point spacing: a beam crossing it
+  // between points passes up to ~0.7 spacing from the nearest one.
+  float free_space_block_radius = 0.0f;
   float refine_min_quality = 0.6f;
   float refine_cutoff = 0.4f;
 };

@@ -25,6 +25,8 @@ class BenchJson {
   void add_int(const std::string& key, long long value) { put(key, std::to_string(value)); }
   void add_bool(const std::string& key, bool value) { put(key, value ? "true" : "false"); }
   void add_string(const std::string& key, const std::string& value) { put(key, "\"" + value + "\""); }
+  // An already formatted JSON value (merging a file another benchmark wrote).
+  void add_raw(const std::string& key, const std::string& json) { put(key, json); }
 
   bool write(const std::string& path) const {
     std::ofstream out(path);

@@ -1,0 +1,125 @@
+#include "sim/eval/pransam_eval/pransam3d_real.h"
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <cstdio>
+#include <memory>
+
+#include "firmware/base/arena.h"
+#include "firmware/base/worker_pool.h"
+#include "firmware/pransam/matcher.h"
+
+namespace sim::pransam_eval {
+
+namespace {
+double now_ms() {
+  return std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now().time_since_epoch()).count();
+}
+}  // namespace
+
+bool run_pransam3d(const std::vector<CloudDraw>& draws, const Pransam3dConfig& config, int pool_threads,
+                   MethodRun* out, std::string* error, bool verbose) {
+  out->method = "pransam";
+  out->outcomes.clear();
+  if (draws.empty()) return true;
+  // Size the matcher once for the largest draw (cells of the model's box + the ε_s margin).
+  std::size_t max_scene = 3, max_model = 3, max_cells = 0;
+  std::uint32_t max_axis = 0;
+  for (const CloudDraw& d : draws) {
+    max_scene = std::max(max_scene, d.scene.size());
+    max_model = std::max(max_model, d.model.size());
+    Eigen::Vector3f lo = d.model[0], hi = d.model[0];
+    for (const auto& p : d.model) {
+      lo = lo.cwiseMin(p);
+      hi = hi.cwiseMax(p);
+    }
+    const float res = config.field_voxels * d.voxel;
+    const Eigen::Vector3f cells = (hi - lo) / res + Eigen::Vector3f::Constant(2.0f * (config.eps_soft_voxels / config.field_voxels) + 8.0f);
+    max_cells = std::max(max_cells, static_cast<std::size_t>(cells.prod()) + 1024);
+    max_axis = std::max(max_axis, static_cast<std::uint32_t>(cells.maxCoeff()) + 16);
+  }
+  fw::pransam::MatcherOptions o;
+  o.num_workers = config.workers;
+  o.max_scene_points = static_cast<std::uint32_t>(max_scene);
+  o.max_model_points = static_cast<std::uint32_t>(max_model);
+  o.field.max_cells = max_cells;
+  o.field.max_axis = max_axis;
+  o.max_batch = 1024;
+  o.collect_capacity = 64;
+  const std::size_t bytes = 2 * fw::pransam::kNumSlots * 12 + max_cells * 5 + (max_scene + max_model) * 64 +
+                            static_cast<std::size_t>(o.num_workers) * (std::size_t(1) << 20) + (std::size_t(64) << 20);
+  fw::StartupArena arena;
+  fw::Status s = arena.init_mapped(bytes, false, "pransam3d eval");
+  std::unique_ptr<fw::WorkerPool> pool;
+  if (s.is_ok() && pool_threads > 0) {
+    pool = std::make_unique<fw::WorkerPool>();
+    fw::WorkerPoolOptions po;
+    po.num_workers = pool_threads;
+    s = pool->start(po);
+  }
+  // The contact field's metric options depend on the voxel: one matcher per voxel size, set up at
+  // the first draw of that size (the experiments use one size per cloud).
+  auto matcher = std::make_unique<fw::pransam::Matcher<3>>();
+  float matcher_voxel = -1.0f;
+  for (const CloudDraw& d : draws) {
+    if (!s.is_ok()) break;
+    if (d.voxel != matcher_voxel) {
+      if (matcher_voxel > 0.0f) {
+        *error = "pransam3d: draws of different voxel sizes in one run";
+        return false;
+      }
+      o.field.resolution = config.field_voxels * d.voxel;
+      o.field.eps_hard = config.eps_hard_voxels * d.voxel;
+      o.field.eps_soft = config.eps_soft_voxels * d.voxel;
+      s = matcher->init(o, arena, pool.get());
+      matcher_voxel = d.voxel;
+      if (!s.is_ok()) break;
+    }
+    fw::pransam::MatchParams p;
+    p.seed = config.seed * 1000003ull + d.index;
+    p.max_iterations = config.max_iterations;
+    p.omega_thres = config.omega_stop;
+    p.max_extent = config.extent_voxels * d.voxel;
+    p.refine_iterations = config.refine_iterations;
+    p.refine_min_quality = config.refine_min_quality;
+    p.refine_cutoff = 2.0f * d.voxel;
+    if (config.free_space && d.scene_sensor_known) {
+      p.scene_origin_is_sensor = true;
+      for (int a = 0; a < 3; ++a) p.scene_sensor[a] = d.scene_sensor(a);
+      p.free_space_min_quality = config.free_space_min_quality;
+      p.free_space_margin = config.free_space_margin_voxels * d.voxel;
+      p.free_space_block_radius = config.free_space_block_voxels * d.voxel;
+      p.max_blocked_fraction = config.max_blocked;
+    }
+    fw::pransam::MatchResult<3> r;
+    const double t0 = now_ms();
+    s = matcher->set_model(d.model.data(), d.model.size(), d.cloud.c_str());
+    if (s.is_ok()) s = matcher->match(d.scene.data(), d.scene.size(), p, &r);
+    const double ms = now_ms() - t0;
+    if (!s.is_ok()) break;
+    const bool reported = r.best_valid && r.best.quality >= config.omega_thres;
+    const Eigen::Matrix3f rot = r.best_valid ? r.best.rotation : Eigen::Matrix3f::Identity();
+    const Eigen::Vector3f tr = r.best_valid ? r.best.translation : Eigen::Vector3f::Zero();
+    PlaneModel pm;
+    pm.build(&d.model, 3.0f * d.voxel);
+    CloudOutcome oc = score_answer(d, pm, rot, tr, reported, ms);
+    if (verbose) {
+      std::printf("  %s #%zu |A| %zu |B| %zu ov %.2f: %.1f ms it %llu coll %llu fs-rej %llu Ω %.3f %s  err %.4f m %.2f°  rms %.4f\n",
+                  d.cloud.c_str(), d.index, d.scene.size(), d.model.size(), d.overlap, ms,
+                  static_cast<unsigned long long>(r.stats.iterations), static_cast<unsigned long long>(r.stats.collisions),
+                  static_cast<unsigned long long>(r.stats.free_space_rejected),
+                  r.best_valid ? r.best.quality : 0.0f,
+                  reported ? (oc.correct || !d.has_truth ? "reported" : "REPORTED-WRONG") : (oc.correct ? "missed(correct)" : "nothing"),
+                  oc.trans_err, oc.rot_err_deg, oc.inlier_rms);
+    }
+    out->outcomes.push_back(oc);
+  }
+  if (!s.is_ok()) {
+    *error = s.message();
+    return false;
+  }
+  return true;
+}
+
+}  // namespace sim::pransam_eval
