@@ -334,6 +334,49 @@ TEST(PoseTrackerTest, PoseHeldBackAgainstTheOdometryIsContradicted) {
   }
 }
 
+// After a wheel slip the prediction lies 0.7 m and 14° from the robot, beyond Gauss-Newton's capture
+// range: the fault widens the covariance and the correlative pre-search over the widened window puts
+// the next scan back on the robot (correlative_search.h). The slip itself is never published
+// `localized`.
+TEST(PoseTrackerTest, CorrelativeSearchRecoversAfterASlipBeyondTheCaptureRange) {
+  const Se2f truth(4.5f, 4.0f, 0.3f);
+  const Se2f slip(0.0f, 0.7f, 0.244f);  // the wheels claim a sideways jump and a 14° turn
+  for (const bool search : {true, false}) {
+    PoseTracker t;
+    TrackOptions o;
+    o.search.enabled = search;
+    ASSERT_TRUE(t.init(o, room_map().map).is_ok());
+    RandomStream rng(41, 0);
+    t.start(truth, small_cov(), Se2f());
+    auto pts = testing::scan_at(room(), truth, &rng);
+    t.step(pts.data(), pts.size(), Se2f(), false);
+    pts = testing::scan_at(room(), truth, &rng);
+    const TrackStep s1 = t.step(pts.data(), pts.size(), slip);
+    EXPECT_EQ(s1.verdict, ScanVerdict::kContradicting);
+    EXPECT_NE(s1.status, hal::LocalizationStatus::kLocalized);
+    EXPECT_EQ(s1.search_candidates, 0u) << "the first scan after the slip is aligned from the prediction only";
+    // The robot stands where it was; the wheels stay where they claimed to be.
+    float err = 0.0f;
+    bool ran = false;
+    for (int i = 0; i < 3; ++i) {
+      pts = testing::scan_at(room(), truth, &rng);
+      const TrackStep s = t.step(pts.data(), pts.size(), slip);
+      ran = ran || s.search_candidates > 0;
+      err = err_xy(s.pose, truth);
+      if (s.status == hal::LocalizationStatus::kLocalized) {
+        EXPECT_LT(err, o.alert_limit_m) << "search " << search << " step " << i;
+      }
+    }
+    if (search) {
+      EXPECT_TRUE(ran);
+      EXPECT_LT(err, 0.03f) << "the search found the robot again";
+    } else {
+      EXPECT_FALSE(ran);
+      EXPECT_GT(err, 0.3f) << "Gauss-Newton alone stays in the wrong basin (else this test shows nothing)";
+    }
+  }
+}
+
 TEST(PoseTrackerTest, BadOptionsNameTheField) {
   TrackOptions o;
   o.alert_limit_m = -1.0f;
