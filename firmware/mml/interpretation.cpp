@@ -43,6 +43,7 @@ void Interpreter::reset() {
   soft_active_ = false;
   blind_steps_ = 0;
   consistent_streak_ = 0;
+  pooled_support_ = 0;
 }
 
 float Interpreter::circular_mean(const float* angles, std::size_t n) {
@@ -316,6 +317,7 @@ Status Interpreter::interpret(const InterpretInput& in, InterpretResult* out) {
     }
     soft_active_ = false;
     consistent_streak_ = 0;
+    pooled_support_ = 0;
     if (can_predict) {  // keep x_prev moving with the robot so the next d² is meaningful
       prev_pose_ = pred.pose;
       prev_cov_ = pred.cov;
@@ -334,7 +336,8 @@ Status Interpreter::interpret(const InterpretInput& in, InterpretResult* out) {
   h.pose = Se2f(cb.x, cb.y, cb.theta);
   h.cov = cluster_cov(cb);
   out->best_rating = cb.rating;
-  out->c_rating = cb.rating > options_.delta_r && cb.size() >= options_.min_cluster_hypotheses;
+  const bool rating_alone = cb.rating > options_.delta_r;
+  out->c_rating = rating_alone && cb.size() >= options_.min_cluster_hypotheses;
 
   // Eq. 5.11–5.14.
   if (can_predict) {
@@ -360,8 +363,25 @@ Status Interpreter::interpret(const InterpretInput& in, InterpretResult* out) {
     out->sigma_med = median_of(v, n);
     out->c_median = out->sigma_med < options_.xi_med;
   }
-  const bool hard = out->c_rating && out->c_mahalanobis && out->c_median;  // Eq. 5.17
   consistent_streak_ = out->c_mahalanobis && out->c_median ? consistent_streak_ + 1 : 0;
+  // Extension (pooled support): the Bollinger threshold (Eq. 5.18–5.21) settles just below the mean
+  // quality of what it lets through, so once converged each step passes only 1–3 hypotheses and a
+  // cluster never reaches min_cluster_hypotheses in one step (fr079: the right cluster alone, rated
+  // 1.0 and consistent with the odometry for 100 steps, never localized). Each step's pRANSAM run
+  // is an independent draw, so the members of the best cluster are pooled over the current run of
+  // consecutive steps in which it was alone above δ_r and consistent (d², σ_med): a step with a
+  // rival rated higher than 1 − δ_r, an inconsistent step or a step without hypotheses starts the
+  // pool again. Off: the members of one step must reach the minimum alone.
+  if (options_.pool_cluster_support && rating_alone && out->c_mahalanobis && out->c_median) {
+    pooled_support_ += static_cast<std::uint32_t>(cb.size());
+  } else {
+    pooled_support_ = 0;
+  }
+  out->pooled_support = pooled_support_;
+  if (options_.pool_cluster_support && rating_alone && pooled_support_ >= options_.min_cluster_hypotheses) {
+    out->c_rating = true;
+  }
+  const bool hard = out->c_rating && out->c_mahalanobis && out->c_median;  // Eq. 5.17
   // Extension: entering `localized` (not in soft mode) needs the consistency part of Eq. 5.17
   // (d² and σ_med) in `confirm_steps` consecutive steps, the rating in the last one. σ_med
   // (Eq. 5.16) is a median: right after a jump, a wrong cluster tracked for half of the τ_m window

@@ -54,6 +54,7 @@ struct InterpretResult {
   float d2 = -1.0f;          // Mahalanobis distance of Eq. 5.14 (−1: not available)
   float sigma_med = -1.0f;   // Eq. 5.16 (−1: too few samples)
   bool c_rating = false, c_mahalanobis = false, c_median = false, soft = false;
+  std::uint32_t pooled_support = 0;  // best-cluster members pooled over the consistent run (extension)
   float omega_thres_next = 0.7f;  // matching threshold for the next pRANSAM call (Eq. 5.21)
   float omega_unknown = -1.0f;    // Ω' of Eq. 5.37 (−1: not evaluated)
   bool have_pose = false;
@@ -118,6 +119,7 @@ class Interpreter {
   bool soft_active_ = false;
   std::uint32_t blind_steps_ = 0;
   std::uint32_t consistent_streak_ = 0;  // consecutive steps meeting d² and σ_med (entry confirmation)
+  std::uint32_t pooled_support_ = 0;     // best-cluster members pooled over consistent steps
 };
 
 }  // namespace mml

@@ -146,6 +146,49 @@ TEST(InterpreterTest, SymmetricStaysAmbiguous) {
   }
 }
 
+// A converged Bollinger threshold lets 1–2 hypotheses through per step. Pooled over the consistent
+// steps in which the cluster is alone, they reach min_cluster_hypotheses and the pose localizes;
+// without pooling one step never holds five members. Twin places alternating between steps (a
+// single hypothesis each time, one twin or the other) never pool: each switch fails d².
+TEST(InterpreterTest, PooledSupportLocalizesASparseButConsistentCluster) {
+  for (const bool pool : {true, false}) {
+    static Interpreter it;
+    MmlOptions o;
+    o.pool_cluster_support = pool;
+    ASSERT_TRUE(it.init(o).is_ok());
+    RandomStream rng(15, 0);
+    Se2f truth(2, 3, 0.3f);
+    const Se2f step(0.3f, 0.0f, 0.05f);
+    int localized = 0;
+    for (int t = 0; t < 20; ++t) {
+      const auto h = blob(truth.x, truth.y, truth.theta, 1 + t % 2, 0.02f, 0.9f, &rng);
+      const InterpretResult r = run(&it, h, step, t > 0);
+      localized += r.status == hal::LocalizationStatus::kLocalized;
+      if (r.status == hal::LocalizationStatus::kLocalized) {
+        EXPECT_TRUE(pool);
+        EXPECT_GE(r.pooled_support, o.min_cluster_hypotheses);
+        EXPECT_NEAR(r.pose.x, truth.x, 0.05f);
+      }
+      truth = truth.compose(step);
+    }
+    if (pool) EXPECT_GT(localized, 10); else EXPECT_EQ(localized, 0);
+  }
+  static Interpreter twins;
+  ASSERT_TRUE(twins.init(MmlOptions()).is_ok());
+  RandomStream rng(16, 0);
+  Se2f a(2, 3, 0.0f), b(12, 3, 3.14159f);
+  const Se2f step(0.3f, 0.0f, 0.0f);
+  for (int t = 0; t < 30; ++t) {
+    const Se2f& p = (t / 2) % 2 ? b : a;  // two steps in one twin, two in the other
+    const auto h = blob(p.x, p.y, p.theta, 2, 0.02f, 0.9f, &rng);
+    const InterpretResult r = run(&twins, h, step, t > 0);
+    EXPECT_NE(r.status, hal::LocalizationStatus::kLocalized) << t;
+    EXPECT_LT(r.pooled_support, 5u) << t;
+    a = a.compose(step);
+    b = b.compose(step);
+  }
+}
+
 // A single cluster that jumps (inconsistent with odometry) fails the Mahalanobis test.
 TEST(InterpreterTest, JumpingClusterFailsMahalanobis) {
   static Interpreter it;

@@ -42,6 +42,9 @@ struct MmlOptions {
   // Extension: a cluster of one or two hypotheses gets r = 1 when it is alone, which says nothing;
   // the rating test also needs this many members.
   std::uint32_t min_cluster_hypotheses = 5;
+  // Extension: the members may be pooled over consecutive steps in which the best cluster was alone
+  // above δ_r and consistent (d², σ_med) — see interpretation.cpp. Off: one step must hold them all.
+  bool pool_cluster_support = true;
   float xi_r2 = 8.0f;           // d²(r_h, R_h) < ξ_r² (χ² quantile, 3 dof)
   float xi_med = 10.0f;         // σ_med < ξ_med
   std::uint32_t tau_m = 10;     // window of d² values for the median test (Eq. 5.15–5.16)
