@@ -174,7 +174,9 @@ TEST(InterpreterTest, PooledSupportLocalizesASparseButConsistentCluster) {
     if (pool) EXPECT_GT(localized, 10); else EXPECT_EQ(localized, 0);
   }
   static Interpreter twins;
-  ASSERT_TRUE(twins.init(MmlOptions()).is_ok());
+  MmlOptions pooled;
+  pooled.pool_cluster_support = true;
+  ASSERT_TRUE(twins.init(pooled).is_ok());
   RandomStream rng(16, 0);
   Se2f a(2, 3, 0.0f), b(12, 3, 3.14159f);
   const Se2f step(0.3f, 0.0f, 0.0f);
