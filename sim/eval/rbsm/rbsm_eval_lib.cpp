@@ -15,6 +15,8 @@ namespace sim {
 
 const char* matcher_name(MatcherKind kind) { return kind == MatcherKind::kRbsm ? "rbsm" : "icp"; }
 
+std::vector<MatcherKind> icp_baselines() { return {MatcherKind::kIcp}; }
+
 MatcherConfig default_matcher_config() {
   MatcherConfig c;
   c.rbsm.grid.resolution = 0.05f;
@@ -102,6 +104,12 @@ class TimedMatcher final : public fw::ScanMatcher {
   std::vector<double>* cpu_ms_;
 };
 
+double thread_cpu_now_ms() {
+  timespec ts;
+  clock_gettime(CLOCK_THREAD_CPUTIME_ID, &ts);
+  return static_cast<double>(ts.tv_sec) * 1e3 + static_cast<double>(ts.tv_nsec) * 1e-6;
+}
+
 uint64_t stamp_ns(const CarmenScan& s) {
   return static_cast<uint64_t>(std::llround(std::max(0.0, s.logger_timestamp) * 1e9));
 }
@@ -133,7 +141,9 @@ bool run_scan_matching_odometry(const CarmenLog& log, MatcherKind kind, const Ma
     odom.theta = static_cast<float>(cs.odom.theta);
     fw::Se2f pose;
     fw::ScanMatchResult res;
+    const double c0 = thread_cpu_now_ms();
     st = front->step(*scan, odom, &pose, &res);
+    out->scan_cpu_ms.push_back(thread_cpu_now_ms() - c0);
     if (st.is_ok() && res.iterations > 0) {
       out->iterations.push_back(res.iterations);
       if (!res.converged) ++out->not_converged;
@@ -145,6 +155,13 @@ bool run_scan_matching_odometry(const CarmenLog& log, MatcherKind kind, const Ma
     out->poses.push_back(pose.cast<double>());
   }
   return true;
+}
+
+double cpu_ms_per_scan(const OdometryRun& run) {
+  if (run.scan_cpu_ms.empty()) return std::nan("");
+  double s = 0;
+  for (double v : run.scan_cpu_ms) s += v;
+  return s / static_cast<double>(run.scan_cpu_ms.size());
 }
 
 double percentile(std::vector<double> v, double p) {

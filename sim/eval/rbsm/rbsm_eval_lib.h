@@ -21,6 +21,8 @@ namespace sim {
 
 enum class MatcherKind { kRbsm, kIcp };
 const char* matcher_name(MatcherKind kind);
+// The ICP baselines the tools report beside RBSM.
+std::vector<MatcherKind> icp_baselines();
 
 struct MatcherConfig {
   fw::RbsmOptions rbsm;
@@ -55,6 +57,8 @@ struct OdometryRun {
   std::vector<double> match_ms;    // wall time of each match() call
   std::vector<double> match_cpu_ms;  // CPU time of the calling thread (robust on a loaded machine;
                                      // excludes pool workers)
+  std::vector<double> scan_cpu_ms;   // CPU time of the whole step per scan (points, match and the map
+                                     // update, i.e. integrate()); every scan, including the first
   std::vector<uint32_t> iterations;  // per match (RBSM rounds / ICP iterations)
   size_t not_converged = 0;        // matches that hit the iteration cap
   size_t failures = 0;             // scans the matcher refused (pose = odometry prediction)
@@ -63,6 +67,9 @@ struct OdometryRun {
 // Scan-matching odometry over the first max_scans scans (0 = all).
 bool run_scan_matching_odometry(const CarmenLog& log, MatcherKind kind, const MatcherConfig& config, size_t max_scans,
                                 OdometryRun* out, std::string* error);
+
+// Mean of scan_cpu_ms: CPU per scan including the map update (the throughput figure).
+double cpu_ms_per_scan(const OdometryRun& run);
 
 struct ErrorSummary {
   size_t n = 0;
