@@ -13,6 +13,7 @@
 
 #include <Eigen/Cholesky>
 #include <Eigen/Core>
+#include <Eigen/Eigenvalues>
 #include <cmath>
 #include <cstdint>
 
@@ -55,6 +56,30 @@ struct PointToLineSystem {
     g(1) += reg_xy * offset(1);
     g(2) += reg_th * offset(2);
     *dx = -a.ldlt().solve(g);
+    return dx->allFinite();
+  }
+
+  // Gauss–Newton step restricted to the directions the terms constrain (degeneracy-aware, after
+  // Zhang, Kaess & Singh, ICRA 2016): with θ scaled by `length_m` (a typical lever, so 1 rad and
+  // length_m metres weigh alike), directions whose eigenvalue is below min_ratio × the largest are
+  // left where they are — along a corridor's axis the walls say nothing, and a free GN step there
+  // follows noise. False when degenerate in every direction or not finite.
+  bool solve_constrained(Eigen::Vector3d* dx, double length_m, double min_ratio) const {
+    const Eigen::Vector3d scale(1.0, 1.0, 1.0 / length_m);
+    const Eigen::Matrix3d hs = scale.asDiagonal() * h * scale.asDiagonal();
+    const Eigen::Vector3d bs = scale.asDiagonal() * b;
+    Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> es(hs);
+    if (es.info() != Eigen::Success) return false;
+    const Eigen::Vector3d lambda = es.eigenvalues();  // ascending
+    const double floor = min_ratio * lambda(2);
+    if (!(lambda(2) > 0.0)) return false;
+    Eigen::Vector3d step = Eigen::Vector3d::Zero();
+    for (int k = 0; k < 3; ++k) {
+      if (!(lambda(k) > floor)) continue;
+      const Eigen::Vector3d v = es.eigenvectors().col(k);
+      step -= v * (v.dot(bs) / lambda(k));
+    }
+    *dx = scale.asDiagonal() * step;
     return dx->allFinite();
   }
 };

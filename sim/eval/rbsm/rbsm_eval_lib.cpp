@@ -13,9 +13,16 @@
 
 namespace sim {
 
-const char* matcher_name(MatcherKind kind) { return kind == MatcherKind::kRbsm ? "rbsm" : "icp"; }
+const char* matcher_name(MatcherKind kind) {
+  switch (kind) {
+    case MatcherKind::kRbsm: return "rbsm";
+    case MatcherKind::kIcp: return "trimmed-icp";
+    case MatcherKind::kPlIcp: return "pl-icp";
+  }
+  return "?";
+}
 
-std::vector<MatcherKind> icp_baselines() { return {MatcherKind::kIcp}; }
+std::vector<MatcherKind> icp_baselines() { return {MatcherKind::kPlIcp, MatcherKind::kIcp}; }
 
 MatcherConfig default_matcher_config() {
   MatcherConfig c;
@@ -26,6 +33,7 @@ MatcherConfig default_matcher_config() {
   c.rbsm.min_iterations = 3;  // the firmware default, explicit here (see RbsmOptions)
   c.icp.grid = c.rbsm.grid;
   c.icp.max_range = 15.0f;
+  c.plicp.max_range = 15.0f;
   c.front.scan.max_range = 15.0f;
   return c;
 }
@@ -33,8 +41,9 @@ MatcherConfig default_matcher_config() {
 std::unique_ptr<MatcherInstance> MatcherInstance::create(MatcherKind kind, const MatcherConfig& config,
                                                          std::string* error) {
   std::unique_ptr<MatcherInstance> m(new MatcherInstance());
-  const size_t bytes = (kind == MatcherKind::kRbsm ? fw::Rbsm::required_arena_bytes(config.rbsm)
-                                                   : fw::TrimmedIcp::required_arena_bytes(config.icp)) + 4096;
+  const size_t bytes = (kind == MatcherKind::kRbsm  ? fw::Rbsm::required_arena_bytes(config.rbsm)
+                        : kind == MatcherKind::kIcp ? fw::TrimmedIcp::required_arena_bytes(config.icp)
+                                                    : 0) + 4096;
   m->block_.assign(bytes, 0);
   fw::Status st = m->arena_.init(m->block_.data(), m->block_.size(), matcher_name(kind));
   if (st.is_ok() && kind == MatcherKind::kRbsm) {
@@ -50,6 +59,10 @@ std::unique_ptr<MatcherInstance> MatcherInstance::create(MatcherKind kind, const
       st = m->rbsm_->init(config.rbsm, m->arena_, m->pool_.get());
       m->matcher_ = m->rbsm_.get();
     }
+  } else if (st.is_ok() && kind == MatcherKind::kPlIcp) {
+    m->plicp_ = std::make_unique<fw::PlIcp>();
+    st = m->plicp_->init(config.plicp);
+    m->matcher_ = m->plicp_.get();
   } else if (st.is_ok()) {
     m->icp_ = std::make_unique<fw::TrimmedIcp>();
     st = m->icp_->init(config.icp, m->arena_);

@@ -10,6 +10,7 @@
 #include <vector>
 
 #include "firmware/base/worker_pool.h"
+#include "firmware/icp/pl_icp.h"
 #include "firmware/icp/trimmed_icp.h"
 #include "firmware/rbsm/rbsm.h"
 #include "firmware/rbsm/scan_matching_odometry.h"
@@ -19,14 +20,18 @@
 
 namespace sim {
 
-enum class MatcherKind { kRbsm, kIcp };
+// kIcp: the dissertation's trimmed ICP (scan → end-point map, Sec. 2.4); kPlIcp: PL-ICP (Censi
+// 2008) laser-to-laser like CSM, the honest ICP baseline of issue 15.
+enum class MatcherKind { kRbsm, kIcp, kPlIcp };
+// "rbsm", "trimmed-icp", "pl-icp" (file names and printouts).
 const char* matcher_name(MatcherKind kind);
-// The ICP baselines the tools report beside RBSM.
+// The ICP baselines the tools report beside RBSM: PL-ICP, then trimmed ICP.
 std::vector<MatcherKind> icp_baselines();
 
 struct MatcherConfig {
   fw::RbsmOptions rbsm;
   fw::TrimmedIcpOptions icp;
+  fw::PlIcpOptions plicp;
   fw::ScanMatchingOdometryOptions front;
   int workers = 1;  // >1: RBSM sampling/weighting over a fw::WorkerPool
 };
@@ -48,6 +53,7 @@ class MatcherInstance {
   fw::StartupArena arena_;
   std::unique_ptr<fw::Rbsm> rbsm_;
   std::unique_ptr<fw::TrimmedIcp> icp_;
+  std::unique_ptr<fw::PlIcp> plicp_;
   std::unique_ptr<fw::WorkerPool> pool_;
   fw::ScanMatcher* matcher_ = nullptr;
 };

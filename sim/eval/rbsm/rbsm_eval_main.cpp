@@ -8,7 +8,8 @@
 //   mml-rbsm-eval pairwise DATASET [--pairs N] [--seeds N] [--particles N]
 //   --set KEY=VALUE overrides the matcher configuration (max_range, resolution, size_log2, subcell_log2,
 //     shrink, accept_ratio, min_iterations, max_iterations, sigma_xy2, sigma_psi2, hill_climbing, mahalanobis,
-//     min_translation, min_rotation_deg, icp_max_corr); --no-maps skips the PNGs.
+//     min_translation, min_rotation_deg, icp_max_corr, refine (0: pure Alg. 1), refine_radius, refine_iterations,
+//     refine_gate, refine_eigen, refine_score_loss, plicp_max_corr, plicp_kf_dist, plicp_kf_deg, plicp_trim); --no-maps skips the PNGs.
 //     consecutive corrected-scan pairs, guess perturbed by N(0, 10 cm, 6°): mean/p95/max errors.
 #include <algorithm>
 #include <cmath>
@@ -99,8 +100,8 @@ static int run_main(int argc, char** argv) {
       return usage();
     }
   }
-  if (seeds < 1 || particles < 1 || workers < 1) {
-    std::fprintf(stderr, "mml-rbsm-eval: --seeds, --particles and --workers must be positive\n");
+  if (seeds < 0 || particles < 1 || workers < 1) {
+    std::fprintf(stderr, "mml-rbsm-eval: --particles and --workers must be positive, --seeds >= 0 (0: baselines only)\n");
     return 2;
   }
   std::string err;
@@ -175,6 +176,26 @@ static int run_main(int argc, char** argv) {
       cfg.front.min_rotation_rad = static_cast<float>(v * M_PI / 180.0);
     } else if (key == "icp_max_corr") {
       cfg.icp.max_correspondence_m = static_cast<float>(v);
+    } else if (key == "refine") {
+      cfg.rbsm.refine = v != 0;
+    } else if (key == "refine_radius") {
+      cfg.rbsm.refine_radius_cells = static_cast<uint32_t>(v);
+    } else if (key == "refine_iterations") {
+      cfg.rbsm.refine_iterations = static_cast<uint32_t>(v);
+    } else if (key == "refine_score_loss") {
+      cfg.rbsm.refine_max_score_loss = static_cast<float>(v);
+    } else if (key == "refine_eigen") {
+      cfg.rbsm.refine_min_eigen_ratio = static_cast<float>(v);
+    } else if (key == "refine_gate") {
+      cfg.rbsm.refine_gate_cells = static_cast<float>(v);
+    } else if (key == "plicp_max_corr") {
+      cfg.plicp.max_correspondence_m = static_cast<float>(v);
+    } else if (key == "plicp_kf_dist") {
+      cfg.plicp.keyframe_translation_m = static_cast<float>(v);
+    } else if (key == "plicp_kf_deg") {
+      cfg.plicp.keyframe_rotation_rad = static_cast<float>(v * M_PI / 180.0);
+    } else if (key == "plicp_trim") {
+      cfg.plicp.trim_fraction = static_cast<float>(v);
     } else {
       std::fprintf(stderr, "mml-rbsm-eval: --set: unknown key '%s'\n", key.c_str());
       return 2;
@@ -187,10 +208,10 @@ static int run_main(int argc, char** argv) {
       std::fprintf(stderr, "mml-rbsm-eval: %s: no reference poses (%s)\n", ds.c_str(), err.c_str());
       return 1;
     }
-    for (sim::MatcherKind k : {sim::MatcherKind::kRbsm, sim::MatcherKind::kIcp}) {
+    for (sim::MatcherKind k : {sim::MatcherKind::kRbsm, sim::MatcherKind::kPlIcp, sim::MatcherKind::kIcp}) {
       std::vector<double> te, re, ms;
       size_t fails = 0;
-      const int runs = k == sim::MatcherKind::kIcp ? 1 : seeds;  // ICP is deterministic
+      const int runs = k != sim::MatcherKind::kRbsm ? 1 : seeds;  // ICP is deterministic
       for (int s = 1; s <= runs; ++s) {
         sim::PairwiseResult r;
         cfg.rbsm.seed = static_cast<uint64_t>(s);
@@ -216,7 +237,8 @@ static int run_main(int argc, char** argv) {
 
   std::vector<sim::Relation> rel;
   if (d.relations.empty() || !sim::read_relations(d.relations, &rel, &err)) {
-    std::fprintf(stderr, "mml-rbsm-eval: %s: no relations (%s)\n", ds.c_str(), err.c_str());
+    std::fprintf(stderr, "mml-rbsm-eval: %s: no relations (%s)\n", ds.c_str(),
+                 d.relations.empty() ? "give --relations PATH" : err.c_str());
     return 1;
   }
   std::system(("mkdir -p '" + out_dir + "'").c_str());
@@ -289,6 +311,7 @@ static int run_main(int argc, char** argv) {
       sim::write_map_png(out_dir + "/" + ds + "_rbsm_worst.png", log, run.poses, nullptr, 0.05, 15.0f, 1, &err);
     }
   }
+  if (seeds == 0) return 0;
   std::printf("%s rbsm over %d seeds: trans %.4f ± %.4f m, rot %.3f ± %.3f deg (odom %.4f m %.3f deg) | short (<= 10 s) "
               "trans %.4f m rot %.3f deg | long (> 10 s) trans %.4f m rot %.3f deg | %.3f ms CPU/scan\n",
               ds.c_str(), seeds, mean(tm), stddev(tm), mean(rm), stddev(rm), mo.all.trans_mean, mo.all.rot_mean_deg,
