@@ -479,6 +479,7 @@ Status Rbsm::match(const Point2f* points, std::size_t count, const Se2f& guess, 
   // The particle set stays centred on Alg. 1's estimate: the next motion step (last ⊖ guess) then
   // carries it onto the refined pose ⊕ u_t, so the refinement is not applied twice.
   const Se2f alg1_estimate = out->pose;
+  out->unrefined_pose = alg1_estimate;
   if (options_.refine && best_w > 0) {
     std::uint32_t used = 0;
     Se2f refined;

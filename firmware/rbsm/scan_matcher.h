@@ -23,6 +23,7 @@ struct ScanMatchResult {
   bool converged = false;        // stop rule met before the iteration cap
   bool map_was_empty = false;    // nothing to match against: pose = initial guess
   bool refined = false;          // RBSM: the continuous refinement (extension) moved the pose
+  Se2f unrefined_pose;           // RBSM: x̂_t of Alg. 1 before the refinement (= pose when not refined)
 };
 
 class ScanMatcher {
