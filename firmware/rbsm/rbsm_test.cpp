@@ -356,6 +356,7 @@ TEST(ScanMatchingOdometryTest, TracksBiasedOdometryAndFillsLocalMapFragments) {
   // Drive east along the L's arm; the odometry over-reports translation by 8 % and drifts 0.5°/step.
   fw::Se2f truth(-1.0f, 0.0f, 0.0f), odom(10.0f, 5.0f, 1.0f);
   auto scan = std::make_unique<hal::LaserScan>();
+  std::uint32_t refined_steps = 0;
   for (std::uint32_t k = 0; k < 25; ++k) {
     if (k > 0) {
       const fw::Se2f step(0.2f, 0.0f, 0.0f);
@@ -381,8 +382,17 @@ TEST(ScanMatchingOdometryTest, TracksBiasedOdometryAndFillsLocalMapFragments) {
     od.y = odom.y;
     od.theta = odom.theta;
     fw::Se2f pose;
-    ASSERT_TRUE(front.step(*scan, od, &pose).is_ok()) << "step " << k;
+    fw::ScanMatchResult res;
+    ASSERT_TRUE(front.step(*scan, od, &pose, &res).is_ok()) << "step " << k;
+    // The reported pose is the matcher's (refined) one; the front end's pose() agrees with it.
+    EXPECT_EQ(pose.x, res.pose.x);
+    EXPECT_NEAR(front.pose().x, pose.x, 1e-5f);
+    EXPECT_NEAR(front.pose().theta, pose.theta, 1e-6f);
+    if (k > 0) refined_steps += res.refined ? 1 : 0;
   }
+  // The refinement (extension of Alg. 1, on by default) ran on most steps; the chain stays on
+  // Alg. 1's estimate (ScanMatchingOdometryOptions::chain_on_refined).
+  EXPECT_GE(refined_steps, 20u);
   // The front end starts at the origin; compare displacements from the first pose (-1, 0, 0).
   const fw::Se2f est = front.pose();
   EXPECT_NEAR(est.x, truth.x + 1.0f, 0.05f);

@@ -9,7 +9,7 @@
 //   --set KEY=VALUE overrides the matcher configuration (max_range, resolution, size_log2, subcell_log2,
 //     shrink, accept_ratio, min_iterations, max_iterations, sigma_xy2, sigma_psi2, hill_climbing, mahalanobis,
 //     min_translation, min_rotation_deg, icp_max_corr, refine (0: pure Alg. 1), refine_radius, refine_iterations,
-//     refine_gate, refine_eigen, refine_score_loss, plicp_max_corr, plicp_kf_dist, plicp_kf_deg, plicp_trim); --no-maps skips the PNGs.
+//     refine_gate, refine_eigen, refine_score_loss, chain_refined, plicp_max_corr, plicp_kf_dist, plicp_kf_deg, plicp_trim); --no-maps skips the PNGs.
 //     consecutive corrected-scan pairs, guess perturbed by N(0, 10 cm, 6°): mean/p95/max errors.
 #include <algorithm>
 #include <cmath>
@@ -182,6 +182,8 @@ static int run_main(int argc, char** argv) {
       cfg.rbsm.refine_radius_cells = static_cast<uint32_t>(v);
     } else if (key == "refine_iterations") {
       cfg.rbsm.refine_iterations = static_cast<uint32_t>(v);
+    } else if (key == "chain_refined") {
+      cfg.front.chain_on_refined = v != 0;
     } else if (key == "refine_score_loss") {
       cfg.rbsm.refine_max_score_loss = static_cast<float>(v);
     } else if (key == "refine_eigen") {
