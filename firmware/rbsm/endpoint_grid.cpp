@@ -325,4 +325,36 @@ bool EndpointGrid::nearest_occupied(float x, float y, float max_dist_m, float* n
   return found;
 }
 
+void EndpointGrid::local_scatter(float x, float y, std::int32_t radius, LocalScatter* out) const {
+  *out = LocalScatter{};
+  if (!initialized() || !centered_ || !std::isfinite(x) || !std::isfinite(y)) return;
+  if (radius < 0) radius = 0;
+  if (radius > 4) radius = 4;
+  std::int32_t gx, gy;
+  world_to_cell(x, y, &gx, &gy);
+  // Integer offsets (cells) from the query cell: exact sums, no cancellation.
+  std::int32_t n = 0, sx = 0, sy = 0, sxx = 0, sxy = 0, syy = 0;
+  const std::int32_t r2 = radius * radius + radius;  // a disc including the 4-neighbours of its rim
+  for (std::int32_t dy = -radius; dy <= radius; ++dy) {
+    for (std::int32_t dx = -radius; dx <= radius; ++dx) {
+      if (dx * dx + dy * dy > r2 || !occupied_cell(gx + dx, gy + dy)) continue;
+      ++n;
+      sx += dx;
+      sy += dy;
+      sxx += dx * dx;
+      sxy += dx * dy;
+      syy += dy * dy;
+    }
+  }
+  if (n == 0) return;
+  const float res = options_.resolution, inv = 1.0f / static_cast<float>(n);
+  const float mx = static_cast<float>(sx) * inv, my = static_cast<float>(sy) * inv;
+  out->count = static_cast<std::uint32_t>(n);
+  out->cx = (static_cast<float>(gx) + 0.5f + mx) * res;
+  out->cy = (static_cast<float>(gy) + 0.5f + my) * res;
+  out->sxx = (static_cast<float>(sxx) * inv - mx * mx) * res * res;
+  out->sxy = (static_cast<float>(sxy) * inv - mx * my) * res * res;
+  out->syy = (static_cast<float>(syy) * inv - my * my) * res * res;
+}
+
 }  // namespace fw

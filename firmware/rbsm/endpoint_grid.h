@@ -65,6 +65,15 @@ class EndpointGrid {
   // Nearest occupied cell centre within max_dist_m of (x, y) (exact search over rings of cells).
   bool nearest_occupied(float x, float y, float max_dist_m, float* nx, float* ny, float* dist2_m) const;
 
+  // The occupied cell centres within radius_cells (a disc, ≤ 4 cells) of the cell of (x, y): their
+  // count, centroid (world, m) and second moments about the centroid (m²). The local surface the
+  // accepted end-points were drawn from, for RBSM's point-to-line refinement (issue 15).
+  struct LocalScatter {
+    std::uint32_t count = 0;
+    float cx = 0, cy = 0, sxx = 0, sxy = 0, syy = 0;
+  };
+  void local_scatter(float x, float y, std::int32_t radius_cells, LocalScatter* out) const;
+
   // Storage index of sub-cell (sx, sy) (already masked to the window) in the tiled lookup: 8×8
   // sub-cells per 64-byte line, 8×8 lines per 4 KiB page, pages row-major. A particle cloud's
   // points for one beam then touch a few lines on one or two pages instead of one page per row

@@ -1,6 +1,7 @@
 #include "firmware/rbsm/rbsm.h"
 
 #include "firmware/base/memory_report.h"
+#include "firmware/scan/point_to_line.h"
 
 #include <cmath>
 
@@ -41,6 +42,24 @@ Status RbsmOptions::validate() const {
   }
   if (mahalanobis && (!(range_sigma > 0.0f) || !(bearing_sigma_deg > 0.0f) || !(map_point_sigma_cells > 0.0f))) {
     return Status::error(Errc::kInvalidArgument, "rbsm: Mahalanobis noise parameters must be positive");
+  }
+  if (refine) {
+    if (refine_iterations < 1 || refine_iterations > 100) {
+      return Status::error(Errc::kInvalidArgument, "rbsm: refine_iterations %u outside [1, 100]", refine_iterations);
+    }
+    if (refine_radius_cells < 1 || refine_radius_cells > 4) {
+      return Status::error(Errc::kInvalidArgument, "rbsm: refine_radius_cells %u outside [1, 4]", refine_radius_cells);
+    }
+    if (refine_min_cells < 2) return Status::error(Errc::kInvalidArgument, "rbsm: refine_min_cells must be at least 2");
+    if (!(refine_max_line_ratio > 0.0f && refine_max_line_ratio <= 1.0f) || !(refine_gate_cells > 0.0f) ||
+        !(refine_huber_cells > 0.0f) || !(refine_min_fraction >= 0.0f && refine_min_fraction <= 1.0f) ||
+        !(refine_max_shift_cells > 0.0f) || !(refine_max_shift_deg > 0.0f) ||
+        !(refine_min_eigen_ratio > 0.0f && refine_min_eigen_ratio < 1.0f) ||
+        !(refine_max_score_loss >= 0.0f && refine_max_score_loss <= 1.0f)) {
+      return Status::error(Errc::kInvalidArgument,
+                           "rbsm: refine thresholds invalid (line ratio in (0, 1], gate, huber, shifts > 0, "
+                           "min fraction in [0, 1], min eigen ratio in (0, 1))");
+    }
   }
   return grid.validate();
 }
@@ -281,6 +300,68 @@ void Rbsm::resample(std::uint64_t total) {
   }
 }
 
+// Extension of Alg. 1 (issue 15): point-to-line Gauss–Newton of x̂_t against the end-point map.
+// The end-point map M_t (Sec. 2.3) holds every accepted scan point as an occupied cell; the surface
+// a point should lie on is recovered locally as the line through the occupied cells around it
+// (centroid + principal axis of their scatter), which averages the cell quantisation that bounds
+// the particles' precision (Eq. 2.9 is a step function of the cell). Residual r = nᵀ(q − c), the
+// point-to-line distance; Huber-weighted, gated at refine_gate_cells; the solver is the one PL-ICP
+// and the tracker use (firmware/scan/point_to_line.h). The step is restricted to the directions the
+// surfaces constrain, so a corridor's axis stays where the particles put it (measured on aces
+// with a free step: whole-log error 0.17 → 0.51 m, long relations 1.3 → 5.5 m).
+bool Rbsm::refine(const Se2f& start, Se2f* out, std::uint32_t* used) const {
+  *out = start;
+  *used = 0;
+  const float res = grid_.resolution();
+  const float gate = options_.refine_gate_cells * res, huber = options_.refine_huber_cells * res;
+  const std::int32_t radius = static_cast<std::int32_t>(options_.refine_radius_cells);
+  const std::uint32_t min_used =
+      options_.min_points > static_cast<std::uint32_t>(options_.refine_min_fraction * static_cast<float>(num_points_))
+          ? options_.min_points
+          : static_cast<std::uint32_t>(options_.refine_min_fraction * static_cast<float>(num_points_));
+  double lever2 = 0.0;
+  for (std::uint32_t i = 0; i < num_points_; ++i) lever2 += static_cast<double>(px_[i]) * px_[i] + static_cast<double>(py_[i]) * py_[i];
+  const double lever = std::sqrt(lever2 / num_points_) > 1.0 ? std::sqrt(lever2 / num_points_) : 1.0;
+  Se2f t = start;
+  PointToLineSystem sys;
+  for (std::uint32_t it = 0; it < options_.refine_iterations; ++it) {
+    const float c = std::cos(t.theta), s = std::sin(t.theta);
+    sys.clear();
+    for (std::uint32_t i = 0; i < num_points_; ++i) {
+      const float qx = t.x + c * px_[i] - s * py_[i], qy = t.y + s * px_[i] + c * py_[i];
+      EndpointGrid::LocalScatter sc;
+      grid_.local_scatter(qx, qy, radius, &sc);
+      if (sc.count < options_.refine_min_cells) continue;
+      float nx, ny, ratio;
+      line_normal_from_scatter(sc.sxx, sc.sxy, sc.syy, &nx, &ny, &ratio);
+      if (ratio > options_.refine_max_line_ratio) continue;
+      const float r = nx * (qx - sc.cx) + ny * (qy - sc.cy);
+      const float ar = std::fabs(r);
+      if (ar > gate) continue;
+      const double w = ar <= huber ? 1.0 : static_cast<double>(huber) / ar;
+      sys.add(px_[i], py_[i], c, s, nx, ny, r, w);
+    }
+    *used = sys.used;
+    if (sys.used < min_used) return false;
+    // Only the directions the surfaces constrain move (a corridor's axis stays where the particles
+    // put it); θ is compared with translation over the RMS lever of the points.
+    Eigen::Vector3d dx;
+    if (!sys.solve_constrained(&dx, lever, options_.refine_min_eigen_ratio)) return false;
+    t = Se2f(t.x + static_cast<float>(dx(0)), t.y + static_cast<float>(dx(1)),
+             wrap_angle(t.theta + static_cast<float>(dx(2))));
+    // Converged: the step is far below the cell (measured: a looser stop, 1/50 cell, costs
+    // 5 % of the short-relation precision on fr079 and saves 3 % CPU).
+    if (dx.head<2>().norm() < 1e-3 * res && std::fabs(dx(2)) < 1e-5) break;
+  }
+  const float shift = std::hypot(t.x - start.x, t.y - start.y);
+  if (!(shift <= options_.refine_max_shift_cells * res) ||
+      !(std::fabs(wrap_angle(t.theta - start.theta)) <= options_.refine_max_shift_deg * kDegToRad)) {
+    return false;
+  }
+  *out = t;
+  return true;
+}
+
 Status Rbsm::match(const Point2f* points, std::size_t count, const Se2f& guess, ScanMatchResult* out) {
   if (!initialized_) return Status::error(Errc::kNotInitialized, "rbsm: match() before init()");
   if (out == nullptr) return Status::error(Errc::kInvalidArgument, "rbsm: null result");
@@ -395,6 +476,23 @@ Status Rbsm::match(const Point2f* points, std::size_t count, const Se2f& guess, 
   out->converged = converged;
   out->effective_ratio = ratio;
   out->pose = best_w > 0 ? best : guess;
+  // The particle set stays centred on Alg. 1's estimate: the next motion step (last ⊖ guess) then
+  // carries it onto the refined pose ⊕ u_t, so the refinement is not applied twice.
+  const Se2f alg1_estimate = out->pose;
+  out->unrefined_pose = alg1_estimate;
+  if (options_.refine && best_w > 0) {
+    std::uint32_t used = 0;
+    Se2f refined;
+    // Accepted only when Alg. 1's own likelihood (Eq. 2.8–2.9) does not drop by more than
+    // refine_max_score_loss: the refinement may polish x̂_t, not move it somewhere the particles
+    // would have scored worse.
+    if (refine(out->pose, &refined, &used) &&
+        static_cast<float>(weigh_single(refined.x, refined.y, std::cos(refined.theta), std::sin(refined.theta))) >=
+            (1.0f - options_.refine_max_score_loss) * static_cast<float>(best_w)) {
+      out->pose = refined;
+      out->refined = true;
+    }
+  }
   out->score = static_cast<float>(best_w) / (static_cast<float>(EndpointGrid::kLikelihoodMax) * num_points_);
   {
     const float c = std::cos(out->pose.theta), s = std::sin(out->pose.theta);
@@ -406,7 +504,7 @@ Status Rbsm::match(const Point2f* points, std::size_t count, const Se2f& guess, 
     out->matched_points = matched;
   }
   tracking_ = true;
-  last_estimate_ = out->pose;
+  last_estimate_ = alg1_estimate;
   return Status::ok();
 }
 

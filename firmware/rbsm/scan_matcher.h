@@ -22,6 +22,8 @@ struct ScanMatchResult {
   float effective_ratio = 0.0f;  // RBSM: M_eff / M at termination; ICP: trimmed rms error (m)
   bool converged = false;        // stop rule met before the iteration cap
   bool map_was_empty = false;    // nothing to match against: pose = initial guess
+  bool refined = false;          // RBSM: the continuous refinement (extension) moved the pose
+  Se2f unrefined_pose;           // RBSM: x̂_t of Alg. 1 before the refinement (= pose when not refined)
 };
 
 class ScanMatcher {

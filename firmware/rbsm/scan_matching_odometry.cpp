@@ -29,6 +29,7 @@ void ScanMatchingOdometry::reset(const Se2f& start) {
   start_ = start;
   pose_ = start;
   last_odom_ = odom_at_match_ = Se2f();
+  correction_ = Se2f();
   matches_ = failures_ = 0;
 }
 
@@ -48,27 +49,30 @@ Status ScanMatchingOdometry::step(const hal::LaserScan& scan, const hal::Odometr
   if (!started_) {
     last_odom_ = odom_at_match_ = o;
     pose_ = start_;
+    correction_ = Se2f();
     started_ = true;
   } else {
     pose_ = pose_.compose(last_odom_.between(o));  // prediction: last ⊕ u_t
     last_odom_ = o;
   }
-  res->pose = pose_;
+  res->pose = pose_.compose(correction_);
   const Se2f moved = odom_at_match_.between(o);
   const bool first = matches_ == 0;
   if (!first && std::hypot(moved.x, moved.y) < options_.min_translation_m &&
       std::fabs(moved.theta) < options_.min_rotation_rad) {
-    if (pose) *pose = pose_;
+    if (pose) *pose = pose_.compose(correction_);
     return Status::ok();
   }
   const Status st = matcher_->match(points_, pr.count, pose_, res);
   if (!st.is_ok()) {
     // Keep the odometry prediction; report which scan failed and why.
     ++failures_;
-    if (pose) *pose = pose_;
+    if (pose) *pose = pose_.compose(correction_);
     return Status::error(st.code(), "scan %u: %s", scan.scan_id, st.message());
   }
-  pose_ = res->pose;
+  const bool keep_chain = res->refined && !options_.chain_on_refined;
+  pose_ = keep_chain ? res->unrefined_pose : res->pose;
+  correction_ = keep_chain ? res->unrefined_pose.between(res->pose) : Se2f();
   odom_at_match_ = o;
   ++matches_;
   std::size_t n_new = 0;
@@ -77,7 +81,7 @@ Status ScanMatchingOdometry::step(const hal::LaserScan& scan, const hal::Odometr
     FW_RETURN_IF_ERROR(local_map_->update_pose(pose_));
     FW_RETURN_IF_ERROR(local_map_->add_points(new_cells_, n_new));
   }
-  if (pose) *pose = pose_;
+  if (pose) *pose = res->pose;
   return Status::ok();
 }
 

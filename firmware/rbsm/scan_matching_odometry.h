@@ -20,6 +20,12 @@ struct ScanMatchingOdometryOptions {
   ScanPointsOptions scan;            // range limit / beam stride for scan_to_points
   float min_translation_m = 0.0f;    // match only after this much odometry translation …
   float min_rotation_rad = 0.0f;     // … or rotation since the last match (0, 0: every scan)
+  // A matcher that refines its estimate (RBSM's extension of Alg. 1) reports the refined pose; the
+  // chain — the next prediction, the map insertion and the local map — stays on Alg. 1's x̂_t unless
+  // this is set. Measured (issue 15): chaining on the refined pose made RBSM lose the loop on 1 of
+  // 3 intel runs (whole-log 0.095 → 0.48 m) and on aces (0.17 → 0.4–0.5 m); the refinement polishes
+  // the output, Alg. 1's robustness keeps the map.
+  bool chain_on_refined = false;
   Status validate() const;
 };
 
@@ -32,7 +38,8 @@ class ScanMatchingOdometry {
   // Processes one scan with the odometry pose at its time; *pose receives the estimate.
   // `result` (optional) receives the matcher's report (iterations == 0 when matching was skipped).
   Status step(const hal::LaserScan& scan, const hal::Odometry& odom, Se2f* pose, ScanMatchResult* result = nullptr);
-  const Se2f& pose() const { return pose_; }
+  // The reported pose: the chain with the last refinement applied.
+  Se2f pose() const { return pose_.compose(correction_); }
   std::uint32_t matches() const { return matches_; }
   std::uint32_t failures() const { return failures_; }
 
@@ -44,7 +51,8 @@ class ScanMatchingOdometry {
   Point2f new_cells_[hal::LaserScan::kMaxBeams];
   bool started_ = false;
   Se2f start_;
-  Se2f pose_;
+  Se2f pose_;        // the chain (Alg. 1's estimate, or the refined one with chain_on_refined)
+  Se2f correction_;  // last refinement: chain → reported pose
   Se2f last_odom_;
   Se2f odom_at_match_;
   std::uint32_t matches_ = 0, failures_ = 0;

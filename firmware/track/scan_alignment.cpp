@@ -4,6 +4,7 @@
 #include <cmath>
 
 #include "firmware/map/distance_sample.h"
+#include "firmware/scan/point_to_line.h"
 
 namespace fw {
 namespace track {
@@ -33,32 +34,24 @@ ScanAlignment align_scan(const GlobalMap& map, const Point2f* points, std::size_
   // directions a scan does not see (along a corridor) at the seed instead of letting noise move them.
   const double reg_xy = 1.0 / (1.0 * 1.0), reg_th = 1.0 / (0.5 * 0.5);
   Se2f t = seed;
+  PointToLineSystem sys;  // shared with RBSM's refinement and PL-ICP (firmware/scan/point_to_line.h)
   for (std::uint32_t it = 0; it < o.iterations; ++it) {
     const float outlier = (it < o.iterations / 2) ? 2.0f * o.outlier_m : o.outlier_m;
     const float c = std::cos(t.theta), s = std::sin(t.theta);
-    Eigen::Matrix3d h = Eigen::Matrix3d::Zero();
-    Eigen::Vector3d b = Eigen::Vector3d::Zero();
-    std::uint32_t used = 0;
+    sys.clear();
     for (std::size_t i = 0; i < n; ++i) {
       const float px = points[i].x(), py = points[i].y();
       const float qx = t.x + c * px - s * py, qy = t.y + s * px + c * py;
       float d = 0.0f, gx = 0.0f, gy = 0.0f;
       if (!sample_distance<float>(map, qx, qy, &d, &gx, &gy) || d > outlier) continue;
-      ++used;
+      // On the distance field the residual is d itself and the line normal its gradient.
       const double w = d <= o.huber_m ? 1.0 : static_cast<double>(o.huber_m) / d;  // Huber IRLS weight
-      const Eigen::Vector3d j(gx, gy, gx * (-s * px - c * py) + gy * (c * px - s * py));
-      h += w * (j * j.transpose());
-      b += w * static_cast<double>(d) * j;
+      sys.add(px, py, c, s, gx, gy, d, w);
     }
-    if (used < 3) break;
-    h(0, 0) += reg_xy;
-    h(1, 1) += reg_xy;
-    h(2, 2) += reg_th;
-    b(0) += reg_xy * (t.x - seed.x);
-    b(1) += reg_xy * (t.y - seed.y);
-    b(2) += reg_th * wrap_angle(t.theta - seed.theta);
-    const Eigen::Vector3d dx = -h.ldlt().solve(b);
-    if (!dx.allFinite()) break;
+    if (sys.used < 3) break;
+    Eigen::Vector3d dx;
+    const Eigen::Vector3d offset(t.x - seed.x, t.y - seed.y, wrap_angle(t.theta - seed.theta));
+    if (!sys.solve(&dx, reg_xy, reg_th, offset)) break;
     t = Se2f(t.x + static_cast<float>(dx(0)), t.y + static_cast<float>(dx(1)),
              wrap_angle(t.theta + static_cast<float>(dx(2))));
     if (it >= o.iterations / 2 && dx.head<2>().norm() < 1e-4 && std::fabs(dx(2)) < 1e-5) break;

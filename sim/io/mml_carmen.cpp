@@ -3,7 +3,9 @@
 //   mml-carmen convert IN OUT [--skip-bad-lines] [--max-scans N]   re-write as FLASER/ODOM (.gz ok)
 //   mml-carmen trajectory LOG OUT [--reference CORRECTED_POSES | --reference-relations RELATIONS]
 //                                                    "t x y theta" at every scan (raw odometry or reference)
-//   mml-carmen eval RELATIONS TRAJECTORY [--tolerance S]           Kümmerle et al. 2009 metric
+//   mml-carmen eval RELATIONS TRAJECTORY [--tolerance S]           Kümmerle et al. 2009 metric, overall
+//                                                    (first line, as before) and split by relation length
+//                                                    (all / short ≤ 10 s / long > 10 s)
 //   mml-carmen dataset NAME                          metric of raw odometry and reference (../shared/data)
 //   --max-log-mib N   (any command reading a log) refuse logs larger than N MiB, plain or inflated
 //                     (default 512: a gzip bomb is stopped there with a message, not inflated)
@@ -184,8 +186,10 @@ int cmd_eval(const Args& a) {
   std::string err;
   if (!sim::read_relations(a.pos[0], &rel, &err)) return fail(err);
   if (!sim::read_trajectory(a.pos[1], &traj, &err)) return fail(err);
-  const sim::RelationsMetric m = sim::evaluate_relations(rel, traj, a.tolerance);
-  std::printf("%s\n", sim::to_string(m).c_str());
+  // Overall, then split by relation length (≤ 10 s: single-alignment precision; > 10 s: drift).
+  const sim::RelationsMetricSplit ms = sim::evaluate_relations_split(rel, traj, 10.0, a.tolerance);
+  const sim::RelationsMetric& m = ms.all;
+  std::printf("%s\n%s\n", sim::to_string(m).c_str(), sim::to_string(ms).c_str());
   return m.used > 0 ? 0 : fail("no relation could be evaluated (timestamps not in the trajectory)");
 }
 

@@ -204,6 +204,18 @@ RelationsMetric evaluate_relations(const std::vector<Relation>& relations, const
   return m;
 }
 
+RelationsMetricSplit evaluate_relations_split(const std::vector<Relation>& relations, const Trajectory& trajectory,
+                                              double split_s, double time_tolerance) {
+  RelationsMetricSplit m;
+  m.split_s = split_s;
+  std::vector<Relation> short_rel, long_rel;
+  for (const auto& r : relations) (std::fabs(r.t2 - r.t1) <= split_s ? short_rel : long_rel).push_back(r);
+  m.all = evaluate_relations(relations, trajectory, time_tolerance);
+  m.short_rel = evaluate_relations(short_rel, trajectory, time_tolerance);
+  m.long_rel = evaluate_relations(long_rel, trajectory, time_tolerance);
+  return m;
+}
+
 bool read_trajectory(const std::string& path, Trajectory* out, std::string* error) {
   out->clear();
   std::string data;
@@ -282,6 +294,16 @@ std::string to_string(const RelationsMetric& m) {
                 m.used, m.missing, m.trans_mean, m.trans_std, m.trans2_mean, m.trans2_std, m.trans_max,
                 m.rot_mean_deg, m.rot_std_deg, m.rot2_mean, m.rot2_std, m.rot_max_deg);
   return buf;
+}
+
+std::string to_string(const RelationsMetricSplit& m) {
+  char head[96];
+  std::string out = "all: " + to_string(m.all) + "\n";
+  std::snprintf(head, sizeof(head), "short (<= %g s): ", m.split_s);
+  out += head + to_string(m.short_rel) + "\n";
+  std::snprintf(head, sizeof(head), "long (> %g s): ", m.split_s);
+  out += head + to_string(m.long_rel);
+  return out;
 }
 
 }  // namespace sim

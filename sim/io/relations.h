@@ -60,6 +60,19 @@ std::vector<RelationError> relation_errors(const std::vector<Relation>& relation
 
 std::string to_string(const RelationsMetric& m);
 
+// The metric split by relation length (issue 15): relations whose timestamps are at most
+// split_s apart measure the precision of single alignments (scan-to-scan, short drift); the
+// longer ones measure accumulated drift. Kümmerle et al. report both kinds of relation in one
+// mean, which hides a matcher that is locally imprecise but globally consistent (or the reverse).
+struct RelationsMetricSplit {
+  double split_s = 10.0;
+  RelationsMetric all, short_rel, long_rel;  // |t2 − t1| ≤ split_s / > split_s
+};
+RelationsMetricSplit evaluate_relations_split(const std::vector<Relation>& relations, const Trajectory& trajectory,
+                                              double split_s = 10.0, double time_tolerance = 1e-4);
+// Three lines: "all: …", "short (<= 10 s, N): …", "long (> 10 s, N): …".
+std::string to_string(const RelationsMetricSplit& m);
+
 // Plain trajectory files for tools: one "t x y theta" per line (blanks or commas between fields,
 // '#' comments; values within the bounds of carmen_log.h). Errors name "path:line". The writer prints t with 6 decimals (like the logs' ipc
 // timestamps, so relation lookups with the default tolerance still match) and poses shortest

@@ -91,6 +91,30 @@ TEST(Relations, MetricOfKnownErrors) {
   EXPECT_NEAR(m.rot_max_deg, 2.0, 1e-9);
 }
 
+TEST(Relations, SplitByRelationLength) {
+  // Steps of 1 s along x with 1.1 m instead of 1 m: a relation over k steps is off by 0.1·k m.
+  // Short ones (k = 1, 10: ≤ 10 s) and long ones (k = 11, 20) are scored separately; the overall
+  // figure is the mean of all four.
+  Trajectory traj;
+  for (int i = 0; i <= 30; ++i) traj.push_back({100.0 + i, fw::Se2d(1.1 * i, 0, 0)});
+  std::vector<Relation> rel;
+  for (int k : {1, 10, 11, 20}) rel.push_back({100.0, 100.0 + k, fw::Se2d(1.0 * k, 0, 0)});
+  const RelationsMetricSplit m = evaluate_relations_split(rel, traj, 10.0);
+  EXPECT_EQ(m.short_rel.used, 2u);
+  EXPECT_EQ(m.long_rel.used, 2u);
+  EXPECT_EQ(m.all.used, 4u);
+  EXPECT_NEAR(m.short_rel.trans_mean, (0.1 + 1.0) / 2, 1e-9);
+  EXPECT_NEAR(m.long_rel.trans_mean, (1.1 + 2.0) / 2, 1e-9);
+  EXPECT_NEAR(m.all.trans_mean, (0.1 + 1.0 + 1.1 + 2.0) / 4, 1e-9);
+  // Reversed timestamps count by |t2 − t1|; a different split moves relations between the halves.
+  rel.push_back({110.0, 100.0, fw::Se2d(-10.0, 0, 0)});
+  EXPECT_EQ(evaluate_relations_split(rel, traj, 10.0).short_rel.used, 3u);
+  EXPECT_EQ(evaluate_relations_split(rel, traj, 5.0).short_rel.used, 1u);
+  const std::string text = to_string(evaluate_relations_split(rel, traj, 10.0));
+  EXPECT_NE(text.find("short (<= 10 s): used 3"), std::string::npos) << text;
+  EXPECT_NE(text.find("long (> 10 s): used 2"), std::string::npos) << text;
+}
+
 TEST(Relations, MetricIsFrameInvariantAndZeroOnOwnRelations) {
   // Relations derived from a trajectory score 0 on it, also after moving the whole trajectory
   // (the metric only sees relative motion) and after a write/read round trip.

@@ -1,6 +1,8 @@
 // bench_rbsm: per-match timing of RBSM (250/500/1000/2000 particles, one thread and over a 2-worker
-// fw::WorkerPool, median and p99) and the scan-matcher-only odometry accuracy on intel and fr079
-// (relations metric: RBSM averaged over kSeeds seeds, trimmed ICP, raw odometry), RBSM with Alg. 1's
+// fw::WorkerPool, median and p99) and the scan-matcher-only odometry accuracy on intel, fr079 and
+// aces (relations metric overall and split by relation length, ≤ 10 s / > 10 s (issue 15): RBSM
+// averaged over kSeeds seeds, the ICP baseline, raw odometry; CPU per scan including the map
+// update), RBSM with Alg. 1's
 // stop rule alone (one seed), and the pairwise experiment (150 pairs). Writes the flat JSON of
 // issue 4 to argv[1]. Wall-clock figures (ms) plus thread-CPU figures (cpu_ms: robust when the
 // machine is shared). Budget: < 10 min on 2 cores (7.2 min wall / 2.1 min CPU measured with load average ~10).
@@ -44,7 +46,7 @@ static int run_main(int argc, char** argv) {
   std::string err;
   json.add_int("rbsm_bench_seeds", kSeeds);
   bool all_ok = true;
-  for (const std::string ds : {"intel", "fr079"}) {
+  for (const std::string ds : {"intel", "fr079", "aces"}) {
     sim::EvalDataset d;
     sim::CarmenLog log;
     std::vector<sim::Relation> rel;
@@ -83,19 +85,37 @@ static int run_main(int argc, char** argv) {
     sim::CarmenLog& head = log;
     std::vector<fw::Se2d> odom;
     for (const auto& s : log.scans) odom.push_back(s.odom);
-    const auto mo = sim::evaluate_relations(rel, sim::make_trajectory(head, odom));
-    json.add(ds + "_trans_err_odom", mo.trans_mean);
-    json.add(ds + "_rot_err_odom", mo.rot_mean_deg);
-    sim::OdometryRun icp;
-    if (!sim::run_scan_matching_odometry(log, sim::MatcherKind::kIcp, cfg, 0, &icp, &err)) {
-      std::fprintf(stderr, "bench_rbsm: %s\n", err.c_str());
-      return 1;
+    // Issue 15: every figure overall and split by relation length (≤ 10 s: single-alignment
+    // precision; > 10 s: drift), all with the same scorer.
+    auto add_split = [&](const std::string& who, const sim::RelationsMetricSplit& m) {
+      json.add(ds + "_trans_err_" + who, m.all.trans_mean);
+      json.add(ds + "_rot_err_" + who, m.all.rot_mean_deg);
+      json.add(ds + "_short_trans_err_" + who, m.short_rel.trans_mean);
+      json.add(ds + "_short_rot_err_" + who, m.short_rel.rot_mean_deg);
+      json.add(ds + "_long_trans_err_" + who, m.long_rel.trans_mean);
+      json.add(ds + "_long_rot_err_" + who, m.long_rel.rot_mean_deg);
+    };
+    const auto mo = sim::evaluate_relations_split(rel, sim::make_trajectory(head, odom));
+    add_split("odom", mo);
+    // The ICP baselines: "icp" = PL-ICP laser-to-laser (the honest baseline, issue 15), "trimicp" =
+    // the dissertation's trimmed ICP against the end-point map (the figure "icp" meant before).
+    sim::RelationsMetricSplit mi;
+    for (sim::MatcherKind k : sim::icp_baselines()) {
+      const std::string who = k == sim::MatcherKind::kPlIcp ? "icp" : "trimicp";
+      sim::OdometryRun icp;
+      if (!sim::run_scan_matching_odometry(log, k, cfg, 0, &icp, &err)) {
+        std::fprintf(stderr, "bench_rbsm: %s\n", err.c_str());
+        return 1;
+      }
+      const auto m = sim::evaluate_relations_split(rel, sim::make_trajectory(head, icp.poses));
+      add_split(who, m);
+      json.add(ds + "_" + who + "_match_ms_p50", sim::percentile(icp.match_ms, 50));
+      json.add(who + "_cpu_ms_per_scan_" + ds, sim::cpu_ms_per_scan(icp));
+      json.add(ds + "_" + who + "_vs_odom_factor", mo.all.trans_mean / m.all.trans_mean);
+      std::printf("%s %s:\n%s\n", ds.c_str(), sim::matcher_name(k), sim::to_string(m).c_str());
+      if (k == sim::MatcherKind::kPlIcp) mi = m;
     }
-    const auto mi = sim::evaluate_relations(rel, sim::make_trajectory(head, icp.poses));
-    json.add(ds + "_trans_err_icp", mi.trans_mean);
-    json.add(ds + "_rot_err_icp", mi.rot_mean_deg);
-    json.add(ds + "_icp_match_ms_p50", sim::percentile(icp.match_ms, 50));
-    std::vector<double> tm, rm, tmax, ms, cpu_ms;
+    std::vector<double> tm, rm, tmax, ms, cpu_ms, scan_cpu, st, sr, lt, lr;
     size_t failures = 0;
     for (int s = 1; s <= kSeeds; ++s) {
       cfg.rbsm.seed = static_cast<uint64_t>(s);
@@ -104,27 +124,56 @@ static int run_main(int argc, char** argv) {
         std::fprintf(stderr, "bench_rbsm: %s\n", err.c_str());
         return 1;
       }
-      const auto m = sim::evaluate_relations(rel, sim::make_trajectory(head, run.poses));
-      tm.push_back(m.trans_mean);
-      rm.push_back(m.rot_mean_deg);
-      tmax.push_back(m.trans_max);
+      const auto m = sim::evaluate_relations_split(rel, sim::make_trajectory(head, run.poses));
+      std::printf("%s rbsm seed %d:\n%s\n", ds.c_str(), s, sim::to_string(m).c_str());
+      tm.push_back(m.all.trans_mean);
+      rm.push_back(m.all.rot_mean_deg);
+      tmax.push_back(m.all.trans_max);
+      st.push_back(m.short_rel.trans_mean);
+      sr.push_back(m.short_rel.rot_mean_deg);
+      lt.push_back(m.long_rel.trans_mean);
+      lr.push_back(m.long_rel.rot_mean_deg);
       ms.insert(ms.end(), run.match_ms.begin(), run.match_ms.end());
       cpu_ms.insert(cpu_ms.end(), run.match_cpu_ms.begin(), run.match_cpu_ms.end());
+      scan_cpu.push_back(sim::cpu_ms_per_scan(run));
       failures += run.failures;
     }
     json.add(ds + "_trans_err_rbsm", mean(tm));
     json.add(ds + "_trans_err_rbsm_std", stddev(tm));
     json.add(ds + "_rot_err_rbsm", mean(rm));
     json.add(ds + "_rot_err_rbsm_std", stddev(rm));
+    json.add(ds + "_short_trans_err_rbsm", mean(st));
+    json.add(ds + "_short_rot_err_rbsm", mean(sr));
+    json.add(ds + "_long_trans_err_rbsm", mean(lt));
+    json.add(ds + "_long_rot_err_rbsm", mean(lr));
     json.add(ds + "_trans_err_max_rbsm", mean(tmax));
-    json.add(ds + "_trans_err_max_icp", mi.trans_max);
-    json.add(ds + "_trans_err_max_odom", mo.trans_max);
+    json.add(ds + "_trans_err_max_icp", mi.all.trans_max);
+    json.add(ds + "_trans_err_max_odom", mo.all.trans_max);
     json.add_int(ds + "_rbsm_failures", static_cast<long long>(failures));
-    json.add_int(ds + "_relations_used", static_cast<long long>(mo.used));
+    json.add_int(ds + "_relations_used", static_cast<long long>(mo.all.used));
+    json.add_int(ds + "_short_relations_used", static_cast<long long>(mo.short_rel.used));
     json.add(ds + "_rbsm_match_ms_p50_full", sim::percentile(ms, 50));
     json.add(ds + "_rbsm_match_cpu_ms_p50_full", sim::percentile(cpu_ms, 50));
-    // Alg. 1's stop rule alone (min_iterations = 1), one seed: shows what the 3-round minimum buys.
+    // CPU per scan including the map update (integrate), mean over all scans and seeds.
+    json.add("rbsm_cpu_ms_per_scan_" + ds, mean(scan_cpu));
+    // Pure Alg. 1 (refine = false, the extension off), one seed: what the refinement changes.
     {
+      sim::MatcherConfig c = cfg;
+      c.rbsm.refine = false;
+      c.rbsm.seed = 1;
+      sim::OdometryRun run;
+      if (!sim::run_scan_matching_odometry(log, sim::MatcherKind::kRbsm, c, 0, &run, &err)) {
+        std::fprintf(stderr, "bench_rbsm: %s\n", err.c_str());
+        return 1;
+      }
+      const auto m = sim::evaluate_relations_split(rel, sim::make_trajectory(head, run.poses));
+      std::printf("%s rbsm pure Alg. 1 (no refinement), seed 1:\n%s\n", ds.c_str(), sim::to_string(m).c_str());
+      add_split("rbsm_alg1", m);
+      json.add("rbsm_alg1_cpu_ms_per_scan_" + ds, sim::cpu_ms_per_scan(run));
+    }
+    // Alg. 1's stop rule alone (min_iterations = 1), one seed: shows what the 3-round minimum buys
+    // (intel and fr079 only, as before: the bench has a time budget).
+    if (ds != "aces") {
       sim::MatcherConfig c = cfg;
       c.rbsm.min_iterations = 1;
       c.rbsm.seed = 1;
@@ -141,11 +190,12 @@ static int run_main(int argc, char** argv) {
     {
       std::vector<sim::CorrectedPose> ref;
       if (sim::read_corrected_poses(d.corrected_poses, &ref, &err)) {
-        for (sim::MatcherKind k : {sim::MatcherKind::kRbsm, sim::MatcherKind::kIcp}) {
+        for (sim::MatcherKind k : {sim::MatcherKind::kRbsm, sim::MatcherKind::kPlIcp, sim::MatcherKind::kIcp}) {
           sim::PairwiseResult pr;
           if (!sim::run_pairwise(log, ref, k, cfg, 150, 99, 0.10, 6.0, &pr, &err)) continue;
           const auto t = sim::summarize(pr.trans_err_m), r = sim::summarize(pr.rot_err_deg);
-          const std::string p = ds + "_pairwise_" + sim::matcher_name(k);
+          const std::string p = ds + "_pairwise_" +
+                                (k == sim::MatcherKind::kRbsm ? "rbsm" : k == sim::MatcherKind::kPlIcp ? "icp" : "trimicp");
           json.add(p + "_trans_mean", t.mean);
           json.add(p + "_trans_p95", t.p95);
           json.add(p + "_trans_max", t.max);

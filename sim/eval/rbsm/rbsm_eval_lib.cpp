@@ -13,7 +13,16 @@
 
 namespace sim {
 
-const char* matcher_name(MatcherKind kind) { return kind == MatcherKind::kRbsm ? "rbsm" : "icp"; }
+const char* matcher_name(MatcherKind kind) {
+  switch (kind) {
+    case MatcherKind::kRbsm: return "rbsm";
+    case MatcherKind::kIcp: return "trimmed-icp";
+    case MatcherKind::kPlIcp: return "pl-icp";
+  }
+  return "?";
+}
+
+std::vector<MatcherKind> icp_baselines() { return {MatcherKind::kPlIcp, MatcherKind::kIcp}; }
 
 MatcherConfig default_matcher_config() {
   MatcherConfig c;
@@ -24,6 +33,7 @@ MatcherConfig default_matcher_config() {
   c.rbsm.min_iterations = 3;  // the firmware default, explicit here (see RbsmOptions)
   c.icp.grid = c.rbsm.grid;
   c.icp.max_range = 15.0f;
+  c.plicp.max_range = 15.0f;
   c.front.scan.max_range = 15.0f;
   return c;
 }
@@ -31,8 +41,9 @@ MatcherConfig default_matcher_config() {
 std::unique_ptr<MatcherInstance> MatcherInstance::create(MatcherKind kind, const MatcherConfig& config,
                                                          std::string* error) {
   std::unique_ptr<MatcherInstance> m(new MatcherInstance());
-  const size_t bytes = (kind == MatcherKind::kRbsm ? fw::Rbsm::required_arena_bytes(config.rbsm)
-                                                   : fw::TrimmedIcp::required_arena_bytes(config.icp)) + 4096;
+  const size_t bytes = (kind == MatcherKind::kRbsm  ? fw::Rbsm::required_arena_bytes(config.rbsm)
+                        : kind == MatcherKind::kIcp ? fw::TrimmedIcp::required_arena_bytes(config.icp)
+                                                    : 0) + 4096;
   m->block_.assign(bytes, 0);
   fw::Status st = m->arena_.init(m->block_.data(), m->block_.size(), matcher_name(kind));
   if (st.is_ok() && kind == MatcherKind::kRbsm) {
@@ -48,6 +59,10 @@ std::unique_ptr<MatcherInstance> MatcherInstance::create(MatcherKind kind, const
       st = m->rbsm_->init(config.rbsm, m->arena_, m->pool_.get());
       m->matcher_ = m->rbsm_.get();
     }
+  } else if (st.is_ok() && kind == MatcherKind::kPlIcp) {
+    m->plicp_ = std::make_unique<fw::PlIcp>();
+    st = m->plicp_->init(config.plicp);
+    m->matcher_ = m->plicp_.get();
   } else if (st.is_ok()) {
     m->icp_ = std::make_unique<fw::TrimmedIcp>();
     st = m->icp_->init(config.icp, m->arena_);
@@ -102,6 +117,12 @@ class TimedMatcher final : public fw::ScanMatcher {
   std::vector<double>* cpu_ms_;
 };
 
+double thread_cpu_now_ms() {
+  timespec ts;
+  clock_gettime(CLOCK_THREAD_CPUTIME_ID, &ts);
+  return static_cast<double>(ts.tv_sec) * 1e3 + static_cast<double>(ts.tv_nsec) * 1e-6;
+}
+
 uint64_t stamp_ns(const CarmenScan& s) {
   return static_cast<uint64_t>(std::llround(std::max(0.0, s.logger_timestamp) * 1e9));
 }
@@ -133,7 +154,9 @@ bool run_scan_matching_odometry(const CarmenLog& log, MatcherKind kind, const Ma
     odom.theta = static_cast<float>(cs.odom.theta);
     fw::Se2f pose;
     fw::ScanMatchResult res;
+    const double c0 = thread_cpu_now_ms();
     st = front->step(*scan, odom, &pose, &res);
+    out->scan_cpu_ms.push_back(thread_cpu_now_ms() - c0);
     if (st.is_ok() && res.iterations > 0) {
       out->iterations.push_back(res.iterations);
       if (!res.converged) ++out->not_converged;
@@ -145,6 +168,13 @@ bool run_scan_matching_odometry(const CarmenLog& log, MatcherKind kind, const Ma
     out->poses.push_back(pose.cast<double>());
   }
   return true;
+}
+
+double cpu_ms_per_scan(const OdometryRun& run) {
+  if (run.scan_cpu_ms.empty()) return std::nan("");
+  double s = 0;
+  for (double v : run.scan_cpu_ms) s += v;
+  return s / static_cast<double>(run.scan_cpu_ms.size());
 }
 
 double percentile(std::vector<double> v, double p) {

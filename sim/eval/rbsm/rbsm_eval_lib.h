@@ -10,6 +10,7 @@
 #include <vector>
 
 #include "firmware/base/worker_pool.h"
+#include "firmware/icp/pl_icp.h"
 #include "firmware/icp/trimmed_icp.h"
 #include "firmware/rbsm/rbsm.h"
 #include "firmware/rbsm/scan_matching_odometry.h"
@@ -19,12 +20,18 @@
 
 namespace sim {
 
-enum class MatcherKind { kRbsm, kIcp };
+// kIcp: the dissertation's trimmed ICP (scan → end-point map, Sec. 2.4); kPlIcp: PL-ICP (Censi
+// 2008) laser-to-laser like CSM, the honest ICP baseline of issue 15.
+enum class MatcherKind { kRbsm, kIcp, kPlIcp };
+// "rbsm", "trimmed-icp", "pl-icp" (file names and printouts).
 const char* matcher_name(MatcherKind kind);
+// The ICP baselines the tools report beside RBSM: PL-ICP, then trimmed ICP.
+std::vector<MatcherKind> icp_baselines();
 
 struct MatcherConfig {
   fw::RbsmOptions rbsm;
   fw::TrimmedIcpOptions icp;
+  fw::PlIcpOptions plicp;
   fw::ScanMatchingOdometryOptions front;
   int workers = 1;  // >1: RBSM sampling/weighting over a fw::WorkerPool
 };
@@ -46,6 +53,7 @@ class MatcherInstance {
   fw::StartupArena arena_;
   std::unique_ptr<fw::Rbsm> rbsm_;
   std::unique_ptr<fw::TrimmedIcp> icp_;
+  std::unique_ptr<fw::PlIcp> plicp_;
   std::unique_ptr<fw::WorkerPool> pool_;
   fw::ScanMatcher* matcher_ = nullptr;
 };
@@ -55,6 +63,8 @@ struct OdometryRun {
   std::vector<double> match_ms;    // wall time of each match() call
   std::vector<double> match_cpu_ms;  // CPU time of the calling thread (robust on a loaded machine;
                                      // excludes pool workers)
+  std::vector<double> scan_cpu_ms;   // CPU time of the whole step per scan (points, match and the map
+                                     // update, i.e. integrate()); every scan, including the first
   std::vector<uint32_t> iterations;  // per match (RBSM rounds / ICP iterations)
   size_t not_converged = 0;        // matches that hit the iteration cap
   size_t failures = 0;             // scans the matcher refused (pose = odometry prediction)
@@ -63,6 +73,9 @@ struct OdometryRun {
 // Scan-matching odometry over the first max_scans scans (0 = all).
 bool run_scan_matching_odometry(const CarmenLog& log, MatcherKind kind, const MatcherConfig& config, size_t max_scans,
                                 OdometryRun* out, std::string* error);
+
+// Mean of scan_cpu_ms: CPU per scan including the map update (the throughput figure).
+double cpu_ms_per_scan(const OdometryRun& run);
 
 struct ErrorSummary {
   size_t n = 0;

@@ -1,0 +1,102 @@
+// Point-to-line Gauss–Newton normal equations for a 2-D rigid alignment: the one solver shared by
+// RBSM's final refinement (scan → local end-point map, issue 15), the PL-ICP baseline (scan → last
+// key scan, Censi 2008) and the tracker's distance-field alignment (scan → global map,
+// firmware/track/scan_alignment.cpp). All three minimise Σ w_i r_i² with a residual that is, to
+// first order, the distance of the transformed sensor point q_i = R(θ) p_i + t from a line through
+// c_i with unit normal n_i:  r_i = n_iᵀ(q_i − c_i)  (on a distance field: r = d(q), n = ∇d).
+// Its Jacobian with respect to (x, y, θ) is J_i = (n_x, n_y, n_ᵀ ∂q/∂θ), ∂q/∂θ = (−s p_x − c p_y,
+// c p_x − s p_y) — the point Jacobian J_x of Eq. 2.14 projected on the normal.
+// Accumulated in double (a few hundred terms of mixed magnitude), solved by LDLT with an optional
+// Levenberg pull towards a prior pose for the directions a scan does not constrain (a corridor's
+// axis). Header-only, no allocation; the callers own correspondence search, gating and weights.
+#pragma once
+
+#include <Eigen/Cholesky>
+#include <Eigen/Core>
+#include <Eigen/Eigenvalues>
+#include <cmath>
+#include <cstdint>
+
+namespace fw {
+
+struct PointToLineSystem {
+  Eigen::Matrix3d h = Eigen::Matrix3d::Zero();  // Σ w J Jᵀ
+  Eigen::Vector3d b = Eigen::Vector3d::Zero();  // Σ w r J
+  double cost = 0.0;                            // Σ w r²
+  std::uint32_t used = 0;
+
+  void clear() {
+    h.setZero();
+    b.setZero();
+    cost = 0.0;
+    used = 0;
+  }
+
+  // One term: sensor point (px, py), current rotation (c, s) = (cos θ, sin θ), normal (nx, ny)
+  // (unit, or the distance-field gradient), residual r, weight w (IRLS weight of a robust loss).
+  void add(float px, float py, float c, float s, float nx, float ny, float r, double w) {
+    const Eigen::Vector3d j(nx, ny, nx * (-s * px - c * py) + ny * (c * px - s * py));
+    h += w * (j * j.transpose());
+    b += w * static_cast<double>(r) * j;
+    cost += w * static_cast<double>(r) * r;
+    ++used;
+  }
+
+  // Gauss–Newton step dx = −(H + D)⁻¹ (b + D·offset), D = diag(reg_xy, reg_xy, reg_th) and
+  // `offset` = current pose − prior (θ wrapped by the caller): with D = 0 a plain GN step.
+  // False when the step is not finite (a degenerate system).
+  bool solve(Eigen::Vector3d* dx, double reg_xy = 0.0, double reg_th = 0.0,
+             const Eigen::Vector3d& offset = Eigen::Vector3d::Zero()) const {
+    Eigen::Matrix3d a = h;
+    Eigen::Vector3d g = b;
+    a(0, 0) += reg_xy;
+    a(1, 1) += reg_xy;
+    a(2, 2) += reg_th;
+    g(0) += reg_xy * offset(0);
+    g(1) += reg_xy * offset(1);
+    g(2) += reg_th * offset(2);
+    *dx = -a.ldlt().solve(g);
+    return dx->allFinite();
+  }
+
+  // Gauss–Newton step restricted to the directions the terms constrain (degeneracy-aware, after
+  // Zhang, Kaess & Singh, ICRA 2016): with θ scaled by `length_m` (a typical lever, so 1 rad and
+  // length_m metres weigh alike), directions whose eigenvalue is below min_ratio × the largest are
+  // left where they are — along a corridor's axis the walls say nothing, and a free GN step there
+  // follows noise. False when degenerate in every direction or not finite.
+  bool solve_constrained(Eigen::Vector3d* dx, double length_m, double min_ratio) const {
+    const Eigen::Vector3d scale(1.0, 1.0, 1.0 / length_m);
+    const Eigen::Matrix3d hs = scale.asDiagonal() * h * scale.asDiagonal();
+    const Eigen::Vector3d bs = scale.asDiagonal() * b;
+    Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> es(hs);
+    if (es.info() != Eigen::Success) return false;
+    const Eigen::Vector3d lambda = es.eigenvalues();  // ascending
+    const double floor = min_ratio * lambda(2);
+    if (!(lambda(2) > 0.0)) return false;
+    Eigen::Vector3d step = Eigen::Vector3d::Zero();
+    for (int k = 0; k < 3; ++k) {
+      if (!(lambda(k) > floor)) continue;
+      const Eigen::Vector3d v = es.eigenvectors().col(k);
+      step -= v * (v.dot(bs) / lambda(k));
+    }
+    *dx = scale.asDiagonal() * step;
+    return dx->allFinite();
+  }
+};
+
+// Unit normal of the best-fitting line through a point scatter (second moments about the centroid
+// sxx, sxy, syy): the eigenvector of the smaller eigenvalue of [[sxx, sxy], [sxy, syy]]. `*ratio`
+// receives λmin/λmax (0 = a perfect line, 1 = an isotropic blob).
+inline void line_normal_from_scatter(float sxx, float sxy, float syy, float* nx, float* ny, float* ratio) {
+  const float tr = 0.5f * (sxx + syy);
+  const float d = 0.5f * (sxx - syy);
+  const float root = std::sqrt(d * d + sxy * sxy);
+  const float lmax = tr + root, lmin = tr - root;
+  // Principal (line) direction angle φ = ½ atan2(2 sxy, sxx − syy); the normal is φ + 90°.
+  const float phi = 0.5f * std::atan2(2.0f * sxy, sxx - syy);
+  *nx = -std::sin(phi);
+  *ny = std::cos(phi);
+  *ratio = lmax > 0.0f ? lmin / lmax : 1.0f;
+}
+
+}  // namespace fw
