@@ -33,6 +33,7 @@ Status LocalizationLoop::init(hal::Hal& hal, Localizer& localizer, const Localiz
   stepped_ = false;
   counters_ = LoopCounters();
   health_ = hal::Health();
+  loop_dropped_scans_ = 0;
   estimate_ = hal::PoseEstimate();
   last_scan_ns_ = hal.clock->now_ns();
   laser_timed_out_ = false;
@@ -45,6 +46,9 @@ void LocalizationLoop::refresh_health(std::uint64_t now) {
   health_.fault_bits = (fault_bits() & kInternalFaultMask) | (hal_->laser->fault_bits() & hal::kHealthFaultMask) |
                        (laser_timed_out_ ? static_cast<std::uint32_t>(hal::HealthFault::kLaserTimeout) : 0u);
   health_.invalid_scans = hal_->laser->invalid_scans();
+  // Scans the source replaced by a newer one before the loop took them are lost too: HEALTH must
+  // account for every scan that arrived (a serial SICK stream faster than a slow step skips some).
+  health_.dropped_scans = loop_dropped_scans_ + hal_->laser->skipped_scans();
 }
 
 void LocalizationLoop::check_laser_silence(std::uint64_t now) {
@@ -188,7 +192,7 @@ Status LocalizationLoop::spin_once() {
       ++counters_.scans_received;
       has_pending_ = validate_scan(pending_);
       if (!has_pending_) {
-        ++health_.dropped_scans;
+        ++loop_dropped_scans_;
       } else {
         if (laser_timed_out_) {
           log(hal::LogLevel::kInfo, "laser: scans back after %llu ms: %s cleared",
@@ -214,7 +218,8 @@ Status LocalizationLoop::spin_once() {
   if (pairing == Pairing::kWait) return Status::ok();
   has_pending_ = false;
   if (pairing == Pairing::kDropped) {
-    ++health_.dropped_scans;
+    ++loop_dropped_scans_;
+    refresh_health(now);
     return Status::ok();
   }
 

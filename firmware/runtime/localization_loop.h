@@ -113,6 +113,7 @@ class LocalizationLoop {
   hal::Odometry paired_odom_;
   hal::PoseEstimate estimate_;
   hal::Health health_;
+  std::uint32_t loop_dropped_scans_ = 0;  // malformed or unpaired; health_.dropped_scans adds the source's skips
   LoopCounters counters_;
   std::uint64_t last_step_ns_ = 0;
   std::uint64_t last_scan_ns_ = 0;  // clock time of the last usable scan (or of init)

@@ -305,7 +305,8 @@ class FaultyLaser final : public hal::LaserScanSource {
   bool poll(hal::LaserScan*) override { return false; }
   std::uint32_t fault_bits() const override { return bits; }
   std::uint32_t invalid_scans() const override { return invalid; }
-  std::uint32_t bits = 0, invalid = 0;
+  std::uint32_t skipped_scans() const override { return skipped; }
+  std::uint32_t bits = 0, invalid = 0, skipped = 0;
 };
 
 TEST(LocalizationLoop, SourceFaultsAndInvalidScansReachHealth) {
@@ -321,6 +322,22 @@ TEST(LocalizationLoop, SourceFaultsAndInvalidScansReachHealth) {
   laser.bits = 0;
   ASSERT_TRUE(r.loop.spin_once().is_ok());
   EXPECT_EQ(r.loop.health().fault_bits, 0u);
+}
+
+// Issue 13 fault campaign (serial_laser_silence): a SICK stream of 200 scans at 75 Hz reached the
+// loop as 185 steps and HEALTH said dropped=0 — the driver keeps only the newest scan between two
+// polls and its replaced scans were counted nowhere the robot could see. They are dropped scans.
+TEST(LocalizationLoop, ScansTheSourceSkippedAreDroppedInHealth) {
+  Rig r;
+  FaultyLaser laser;
+  r.hal.laser = &laser;
+  ASSERT_TRUE(r.loop.init(r.hal, r.localizer).is_ok());
+  laser.skipped = 15;
+  ASSERT_TRUE(r.loop.spin_once().is_ok());
+  EXPECT_EQ(r.loop.health().dropped_scans, 15u);
+  laser.skipped = 16;
+  ASSERT_TRUE(r.loop.spin_once().is_ok());
+  EXPECT_EQ(r.loop.health().dropped_scans, 16u);
 }
 
 }  // namespace
