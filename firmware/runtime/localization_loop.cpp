@@ -34,6 +34,8 @@ Status LocalizationLoop::init(hal::Hal& hal, Localizer& localizer, const Localiz
   counters_ = LoopCounters();
   health_ = hal::Health();
   loop_dropped_scans_ = 0;
+  have_stepped_scan_ = false;
+  last_stepped_scan_ns_ = 0;
   estimate_ = hal::PoseEstimate();
   last_scan_ns_ = hal.clock->now_ns();
   laser_timed_out_ = false;
@@ -78,6 +80,7 @@ void LocalizationLoop::check_laser_silence(std::uint64_t now) {
 void LocalizationLoop::reset() {
   odom_.clear();
   has_pending_ = false;
+  have_stepped_scan_ = false;
   stepped_ = false;
   if (localizer_ != nullptr) localizer_->reset();
 }
@@ -115,6 +118,22 @@ void LocalizationLoop::drain_odometry() {
     }
     odom_.push_overwrite(o);  // the history is a window: the oldest sample falls out
   }
+}
+
+// A scan taken before the last one processed (reordered on the link, e.g. a CAN sender with two
+// queues) would make the localizer step back in time and the POSE scan ids go backwards (issue 13
+// fault campaign, can_out_of_order): it is dropped and counted. A scan older by more than the
+// largest odometry gap is not a reordering but a sensor clock that jumped back; it is accepted so
+// that the firmware follows the new clock instead of dropping every scan from then on.
+bool LocalizationLoop::in_time_order(const hal::LaserScan& scan) {
+  if (!have_stepped_scan_ || scan.timestamp_ns > last_stepped_scan_ns_ ||
+      last_stepped_scan_ns_ - scan.timestamp_ns > options_.max_odom_gap_ns) {
+    return true;
+  }
+  ++counters_.scans_out_of_order;
+  log(hal::LogLevel::kWarning, "scan %u dropped: taken %llu us before the last processed scan (out of order)",
+      scan.scan_id, static_cast<unsigned long long>((last_stepped_scan_ns_ - scan.timestamp_ns) / 1000));
+  return false;
 }
 
 bool LocalizationLoop::validate_scan(const hal::LaserScan& scan) {
@@ -190,7 +209,7 @@ Status LocalizationLoop::spin_once() {
     drain_odometry();
     while (!has_pending_ && hal_->laser->poll(&pending_)) {
       ++counters_.scans_received;
-      has_pending_ = validate_scan(pending_);
+      has_pending_ = validate_scan(pending_) && in_time_order(pending_);
       if (!has_pending_) {
         ++loop_dropped_scans_;
       } else {
@@ -224,6 +243,8 @@ Status LocalizationLoop::spin_once() {
   }
 
   Status status;
+  last_stepped_scan_ns_ = pending_.timestamp_ns;
+  have_stepped_scan_ = true;
   {
     const std::uint64_t t0 = perf_clock_->now_ns();
     status = localizer_->step(pending_, paired_odom_, &estimate_);

@@ -50,6 +50,7 @@ struct LoopCounters {
   std::uint64_t scans_received = 0;
   std::uint64_t scans_malformed = 0;
   std::uint64_t scans_unpaired = 0;  // no odometry within max_odom_gap_ns
+  std::uint64_t scans_out_of_order = 0;  // taken before the last processed scan (dropped)
   std::uint64_t scans_interpolated = 0;
   std::uint64_t scans_held = 0;      // paired with a held (not bracketing) odometry sample
   std::uint64_t step_errors = 0;
@@ -96,6 +97,7 @@ class LocalizationLoop {
   enum class Pairing { kWait, kPaired, kDropped };
   void drain_odometry();
   bool validate_scan(const hal::LaserScan& scan);
+  bool in_time_order(const hal::LaserScan& scan);
   Pairing pair(std::uint64_t now, hal::Odometry* out);
   void refresh_health(std::uint64_t now);
   void check_laser_silence(std::uint64_t now);
@@ -113,7 +115,9 @@ class LocalizationLoop {
   hal::Odometry paired_odom_;
   hal::PoseEstimate estimate_;
   hal::Health health_;
-  std::uint32_t loop_dropped_scans_ = 0;  // malformed or unpaired; health_.dropped_scans adds the source's skips
+  std::uint32_t loop_dropped_scans_ = 0;
+  std::uint64_t last_stepped_scan_ns_ = 0;  // timestamp of the last scan given to the localizer
+  bool have_stepped_scan_ = false;  // malformed or unpaired; health_.dropped_scans adds the source's skips
   LoopCounters counters_;
   std::uint64_t last_step_ns_ = 0;
   std::uint64_t last_scan_ns_ = 0;  // clock time of the last usable scan (or of init)

@@ -340,4 +340,35 @@ TEST(LocalizationLoop, ScansTheSourceSkippedAreDroppedInHealth) {
   EXPECT_EQ(r.loop.health().dropped_scans, 16u);
 }
 
+// Issue 13 fault campaign (can_out_of_order): two scans swapped on the link made the loop step the
+// older one after the newer and the POSE scan ids went backwards. The older one is now dropped and
+// counted; a much older scan (the sensor clock jumped back) is followed, not dropped for ever.
+TEST(LocalizationLoop, OutOfOrderScanIsDroppedButAClockJumpBackIsFollowed) {
+  Rig r;
+  fw::LocalizationLoopOptions opt;
+  opt.max_odom_gap_ns = 500 * kMs;
+  ASSERT_TRUE(r.loop.init(r.hal, r.localizer, opt).is_ok());
+  for (int i = 0; i <= 10; ++i) r.push_odom(i * 100 * kMs, 0.01f * i, 0.0f, 0.0f);
+  r.push_scan(800 * kMs, 3);
+  r.push_scan(700 * kMs, 2);  // taken before scan 3, arrives after it
+  r.push_scan(900 * kMs, 4);
+  r.clock.set_ns(1000 * kMs);
+  for (int i = 0; i < 4; ++i) ASSERT_TRUE(r.loop.spin_once().is_ok());
+  hal::PoseEstimate e;
+  ASSERT_TRUE(r.sink.pop(&e));
+  EXPECT_EQ(e.scan_id, 3u);
+  ASSERT_TRUE(r.sink.pop(&e));
+  EXPECT_EQ(e.scan_id, 4u);
+  EXPECT_FALSE(r.sink.pop(&e));
+  EXPECT_EQ(r.loop.counters().scans_out_of_order, 1u);
+  EXPECT_EQ(r.loop.health().dropped_scans, 1u);
+  EXPECT_EQ(r.loop.health().scans_processed, 2u);
+  // The sensor clock restarts near zero (900 ms back, beyond the 500 ms odometry gap): followed.
+  r.push_odom(5 * kMs, 0.0f, 0.0f, 0.0f);
+  r.push_scan(0, 5);
+  for (int i = 0; i < 3; ++i) ASSERT_TRUE(r.loop.spin_once().is_ok());
+  EXPECT_EQ(r.loop.counters().scans_out_of_order, 1u);
+  EXPECT_EQ(r.loop.health().dropped_scans + r.loop.health().scans_processed, 4u);
+}
+
 }  // namespace

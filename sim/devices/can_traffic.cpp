@@ -266,6 +266,7 @@ PoseScore score_pose_frames(const std::vector<hal::CanFrame>& frames, const std:
       }
       if (h.state > 2) s.violations.push_back("health state " + std::to_string(h.state) + " unknown");
       s.health_fault_bits_seen |= h.fault_bits;
+      if (have_health && prev_h.fault_bits != 0 && h.fault_bits == 0) ++s.health_fault_clears;
       prev_h = h;
       have_health = true;
     }

@@ -77,6 +77,7 @@ struct PoseScore {
   size_t first_localized_scan = 0;                    // scans (from first_scan) until the first `localized`
   size_t fault_updates = 0;  // the last pose repeated with status `fault` (laser-timeout); not in `poses`
   std::uint32_t health_fault_bits_seen = 0;  // OR of the fault bits of every health frame
+  size_t health_fault_clears = 0;            // health frames whose fault bits went from set to clear
 };
 
 // `reference[i]` = reference pose of log scan i (reference_at_every_scan); may be empty (no error

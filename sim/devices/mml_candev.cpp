@@ -221,7 +221,7 @@ static int run_main(int argc, char** argv) {
                   "\"health_timeouts\": %u, \"health_deadline_misses\": %u, \"health_bus_off\": %u, "
                   "\"health_error_frames\": %u, \"health_rx_dropped\": %u, \"health_scans_processed\": %u, "
                   "\"health_state\": %u, \"health_fault_bits\": %u, \"health_invalid_scans\": %u, "
-                  "\"fault_updates\": %zu, \"health_fault_bits_seen\": %u}",
+                  "\"fault_updates\": %zu, \"health_fault_bits_seen\": %u, \"health_fault_clears\": %zu}",
                   s.frames, s.poses, s.health, s.status_counts[0], s.status_counts[1], s.status_counts[2],
                   s.status_counts[3], s.status_counts[4], s.wrong_localized, s.scored, s.mean_err_m, s.max_err_m,
                   s.mean_err_localized_m, s.max_err_localized_m, s.first_localized_scan, s.violations.size(),
@@ -229,7 +229,7 @@ static int run_main(int argc, char** argv) {
                   s.last_health.timeouts, s.last_health.deadline_misses, s.last_health.bus_off,
                   s.last_health.error_frames, s.last_health.rx_dropped, s.last_health.scans_processed,
                   s.last_health.state, s.last_health.fault_bits, s.last_health.invalid_scans, s.fault_updates,
-                  s.health_fault_bits_seen);
+                  s.health_fault_bits_seen, s.health_fault_clears);
     std::printf("%s\n", buf);
     for (const auto& v : s.violations) std::fprintf(stderr, "protocol violation: %s\n", v.c_str());
     if (a.has("json")) {
