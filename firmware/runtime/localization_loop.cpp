@@ -136,6 +136,18 @@ bool LocalizationLoop::in_time_order(const hal::LaserScan& scan) {
   return false;
 }
 
+float LocalizationLoop::angle_diff_rad(float a, float b) {
+  float d = std::fmod(a - b, 6.2831853f);
+  if (d > 3.14159265f) d -= 6.2831853f;
+  if (d < -3.14159265f) d += 6.2831853f;
+  return d;
+}
+
+bool LocalizationLoop::odometry_discontinuous(const hal::Odometry& a, const hal::Odometry& b) const {
+  return !(std::hypot(b.x - a.x, b.y - a.y) <= options_.max_odom_sample_step_m &&
+           std::fabs(angle_diff_rad(b.theta, a.theta)) <= options_.max_odom_sample_step_rad);
+}
+
 bool LocalizationLoop::validate_scan(const hal::LaserScan& scan) {
   const bool ok = scan.beam_count > 0 && scan.beam_count <= hal::LaserScan::kMaxBeams &&
                   std::isfinite(scan.angle_min) && std::isfinite(scan.angle_increment) &&
@@ -191,6 +203,20 @@ LocalizationLoop::Pairing LocalizationLoop::pair(std::uint64_t now, hal::Odometr
   // Now odom_[i-1].t ≤ t ≤ odom_[i].t, or i == 0 and t == oldest.t.
   const hal::Odometry& a = i > 0 ? odom_[i - 1] : odom_[0];
   const hal::Odometry& b = odom_[i];
+  if (odometry_discontinuous(a, b)) {
+    // Issue 13 fault campaign (can_odom_jump): interpolating across a jump of the wheel odometry
+    // turned one 3 m jump into 0.9 m + 2.1 m, two increments the tracker found physical, and it
+    // published `localized` 3 m off. The sample nearest in time is held instead, so the whole jump
+    // reaches the localizer at one scan and is seen for what it is.
+    ++counters_.odom_discontinuities;
+    log(hal::LogLevel::kWarning, "scan %u: odometry jumps %.2f m / %.2f rad between two samples: not interpolated",
+        pending_.scan_id, static_cast<double>(std::hypot(b.x - a.x, b.y - a.y)),
+        static_cast<double>(std::fabs(angle_diff_rad(b.theta, a.theta))));
+    *out = (t - a.timestamp_ns <= b.timestamp_ns - t) ? a : b;
+    out->timestamp_ns = t;
+    ++counters_.scans_held;
+    return Pairing::kPaired;
+  }
   if (!interpolate_odometry(a, b, t, out).is_ok()) {
     raise_fault(Fault::kLogicError);  // the search above guarantees the bracket
     return Pairing::kDropped;

@@ -135,9 +135,9 @@ TEST(LocalizationLoop, RejectsBadOdometryAndMalformedScans) {
   ASSERT_TRUE(r.loop.init(r.hal, r.localizer).is_ok());
   r.push_odom(0, 0.0f, 0.0f, 0.0f);
   r.push_odom(100 * kMs, std::numeric_limits<float>::quiet_NaN(), 0.0f, 0.0f);
-  r.push_odom(50 * kMs, 5.0f, 0.0f, 0.0f);
-  r.push_odom(20 * kMs, 9.0f, 0.0f, 0.0f);  // older than 50 ms: rejected
-  r.push_odom(100 * kMs, 1.0f, 0.0f, 0.0f);
+  r.push_odom(50 * kMs, 0.5f, 0.0f, 0.0f);
+  r.push_odom(20 * kMs, 0.9f, 0.0f, 0.0f);  // older than 50 ms: rejected
+  r.push_odom(100 * kMs, 0.1f, 0.0f, 0.0f);
   hal::LaserScan bad;
   bad.timestamp_ns = 60 * kMs;
   bad.beam_count = hal::LaserScan::kMaxBeams + 1;
@@ -150,7 +150,8 @@ TEST(LocalizationLoop, RejectsBadOdometryAndMalformedScans) {
   EXPECT_EQ(r.loop.counters().odom_rejected, 2u);
   EXPECT_EQ(r.loop.counters().scans_malformed, 1u);
   EXPECT_EQ(r.loop.health().dropped_scans, 1u);
-  EXPECT_NEAR(r.loop.last_odometry().x, 3.0f, 1e-5f);  // halfway 50 → 100 ms: 5 → 1 m
+  // Halfway 50 → 100 ms: 0.5 → 0.1 m (samples a jump apart are not interpolated: see below).
+  EXPECT_NEAR(r.loop.last_odometry().x, 0.3f, 1e-5f);
 }
 
 // The loop's contract when a localizer fails: the error is returned, counted, logged and an
@@ -369,6 +370,29 @@ TEST(LocalizationLoop, OutOfOrderScanIsDroppedButAClockJumpBackIsFollowed) {
   for (int i = 0; i < 3; ++i) ASSERT_TRUE(r.loop.spin_once().is_ok());
   EXPECT_EQ(r.loop.counters().scans_out_of_order, 1u);
   EXPECT_EQ(r.loop.health().dropped_scans + r.loop.health().scans_processed, 4u);
+}
+
+// Issue 13 fault campaign (can_odom_jump): a 3 m jump of the wheel odometry between two samples was
+// interpolated into two "physical" increments and the tracker stayed `localized` 3 m off. A scan
+// between two samples a jump apart takes the nearer sample, so the jump arrives whole.
+TEST(LocalizationLoop, NoInterpolationAcrossAnOdometryJump) {
+  Rig r;
+  ASSERT_TRUE(r.loop.init(r.hal, r.localizer).is_ok());
+  r.push_odom(0, 0.0f, 0.0f, 0.0f);
+  r.push_odom(100 * kMs, 0.05f, 0.0f, 0.0f);
+  r.push_odom(200 * kMs, 3.05f, 0.0f, 0.0f);  // jump
+  r.push_odom(300 * kMs, 3.10f, 0.0f, 0.0f);
+  r.push_scan(50 * kMs, 1);   // ordinary motion: interpolated
+  r.push_scan(130 * kMs, 2);  // nearer the pre-jump sample
+  r.push_scan(180 * kMs, 3);  // nearer the post-jump sample
+  r.clock.set_ns(400 * kMs);
+  const float expect[3] = {0.025f, 0.05f, 3.05f};
+  for (float x : expect) {
+    ASSERT_TRUE(r.loop.spin_once().is_ok());
+    ASSERT_TRUE(r.loop.stepped());
+    EXPECT_NEAR(r.loop.last_odometry().x, x, 1e-6f);
+  }
+  EXPECT_EQ(r.loop.counters().odom_discontinuities, 2u);
 }
 
 }  // namespace

@@ -218,6 +218,7 @@ bool run_replay(const ReplayOptions& o, ReplayResult* r, std::string* error) {
         od.x = static_cast<float>(c.pose.x);
         od.y = static_cast<float>(c.pose.y);
         od.theta = static_cast<float>(c.pose.theta);
+        if (o.mutate_odometry) o.mutate_odometry(c.ipc_timestamp, &od);
         odom.push(od);
       }
       std::int64_t jitter_ns = 0;

@@ -15,6 +15,7 @@
 #include <vector>
 
 #include "hal/msg/laser_scan.h"
+#include "hal/msg/odometry.h"
 
 namespace mmlfw_hil {
 
@@ -50,6 +51,8 @@ struct ReplayOptions {
   // Fault campaign: called with each scan (log index) before it is fed; may corrupt it (NaN, inf,
   // zero readings, ...). The reference for scoring stays the log's.
   std::function<void(size_t log_index, hal::LaserScan* scan)> mutate_scan;
+  // Likewise for each odometry sample (its log time in seconds).
+  std::function<void(double log_time_s, hal::Odometry* odom)> mutate_odometry;
   // Soak (rate mode only): > 0 loops the scans [first_scan, first_scan + num_scans) until this much
   // wall time has passed; sensor time runs on across the wraps (the robot is carried back to the
   // start: a kidnapping the odometry sees as a jump). on_sample is called every sample_period_s.
