@@ -308,7 +308,8 @@ bool run_replay(const ReplayOptions& o, ReplayResult* r, std::string* error) {
   r->step_max_ms = step.max_ms;
   r->cycle_p99_ms = loop.perf_total().stats().p99_ms;
   r->deadline_misses = loop.health().deadline_misses;
-  r->scans_dropped += loop.health().dropped_scans;
+  // HEALTH dropped_scans includes the ring overflows counted above (SimLaserSource::skipped_scans).
+  r->scans_dropped = loop.health().dropped_scans;
   r->health_dropped = loop.health().dropped_scans;
   r->pending_at_end = laser.pending() + (loop.scan_pending() ? 1 : 0);
   r->achieved_rate_hz = wall > 0 ? static_cast<double>(r->scans_processed) / wall : 0;
