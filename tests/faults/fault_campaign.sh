@@ -76,10 +76,10 @@ if want serial_laser_silence; then
   recv=$(summary_num "$d/mmlfw.log" serial_scans); drop=$(summary_num "$d/mmlfw.log" dropped_scans)
   ok=0; [ "$to" -ge 1 ] && [ "$fp_" -ge 1 ] && [ "$back" -ge 1 ] && [ "$cleared" -ge 1 ] && [ "$proc" -ge 150 ] &&
     [ "$recv" = 200 ] && [ $((proc + drop)) = "$recv" ] && [ "$rc" = 0 ] && ok=1
-  last="$last; clear health lines after it $cleared; received $recv = processed $proc + dropped $drop"
+  acct="health lines without fault after it $cleared; received $recv = processed $proc + dropped $drop"
   result serial_laser_silence serial "laser silent 2 s: HEALTH laser-timeout + POSE status fault; cleared by the next scan, no restart" \
     $ok $(is_crash "$rc" && echo 1 || echo 0) $([ "$rc" = 137 ] && echo 1 || echo 0) 0 \
-    "timeout health lines $to, fault poses $fp_, cleared $back, last health '${last##*health }', exit $rc"
+    "laser-timeout health lines $to, fault poses $fp_, 'scans back' $back, $acct, exit $rc"
 fi
 
 if want serial_unplug_replug; then
@@ -99,10 +99,10 @@ if want serial_unplug_replug; then
   recv=$(summary_num "$d/mmlfw.log" serial_scans); drop=$(summary_num "$d/mmlfw.log" dropped_scans)
   ok=0; [ "$lost" -ge 1 ] && [ "$disc" -ge 1 ] && [ "$reo" -ge 1 ] && [ "$cleared" -ge 1 ] && [ "$recv" = 200 ] &&
     [ $((proc + drop)) = "$recv" ] && [ "$ticks" -le 40 ] && [ "$rc" = 0 ] && ok=1
-  last="$last; clear health lines after it $cleared; received $recv = processed $proc + dropped $drop"
+  acct="health lines without fault after it $cleared; received $recv = processed $proc + dropped $drop"
   result serial_unplug_replug serial "serial peer closes and returns: HEALTH laser-disconnected, no busy loop, reopened with back-off, scans resume without restart" \
     $ok $(is_crash "$rc" && echo 1 || echo 0) $([ "$rc" = 137 ] && echo 1 || echo 0) 0 \
-    "lost $lost, disconnected health lines $disc, reopened $reo, CPU while unplugged $ticks ticks/2 s, last health '${last##*health }', exit $rc"
+    "lost $lost, disconnected health lines $disc, reopened $reo, CPU while unplugged $ticks ticks/2 s, $acct, exit $rc"
 fi
 
 if want serial_corrupt_telegrams; then
