@@ -80,8 +80,12 @@ CaseResult scan_content_case(const std::string& name, float value, const char* w
     }
   }
   close(fd[0]);
+  // The pipe closes when the child exits (or the poll above gave up): give it 10 s to be reaped
+  // (checking at once raced with a child still exiting and called that a hang).
   int status = 0;
-  if (waitpid(pid, &status, WNOHANG) == 0) {
+  pid_t w = 0;
+  for (int i = 0; i < 100 && (w = waitpid(pid, &status, WNOHANG)) == 0; ++i) usleep(100'000);
+  if (w == 0) {
     c.hang = true;
     kill(pid, SIGKILL);
     waitpid(pid, &status, 0);

@@ -40,6 +40,10 @@ std::uint64_t mono_ns() {
 // Static storage as in mmlfw (firmware/app/mmlfw_main.cpp: `fw::LocalizationSystem g_system`; the
 // localizer objects themselves are placed in the start-up arena by the builder). Re-created per
 // run so that its objects are destroyed before the arena they live in is set up again.
+// The arena is declared first so that it is destroyed last: the localizer objects g_system owns
+// live in it. (As a function-local static it was destroyed before g_system at exit, and ASan found
+// ~TrackedLocalizer running on unmapped arena memory — the order mmlfw_main.cpp already keeps.)
+fw::StartupArena g_arena;
 std::optional<fw::LocalizationSystem> g_system;
 
 }  // namespace
@@ -76,7 +80,7 @@ bool run_replay(const ReplayOptions& o, ReplayResult* r, std::string* error) {
 
   g_system.reset();  // before its arena is set up again
   fw::MemoryReport::instance().clear();
-  static fw::StartupArena arena;
+  fw::StartupArena& arena = g_arena;
   fw::Status st = arena.init_mapped(256u << 20, false, "arena");
   if (!st) { *error = st.message(); return false; }
   fw::GlobalMap map{};
