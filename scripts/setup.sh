@@ -9,6 +9,7 @@ PACKAGES=(
   g++-aarch64-linux-gnu g++-arm-linux-gnueabihf qemu-user
   can-utils socat iproute2 kmod busybox-static user-mode-linux
   binutils file python3
+  clang libclang-rt-14-dev
 )
 
 missing=()

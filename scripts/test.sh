@@ -1,7 +1,10 @@
 #!/usr/bin/env bash
 # Runs every test: host release build + CTest (unit, data, symbol check, allocation counter,
-# HIL inside a user-mode Linux kernel), then the aarch64 cross build with its unit tests under
-# qemu-aarch64. Exit status is non-zero if anything fails.
+# HIL inside a user-mode Linux kernel), the aarch64 cross build with its unit tests under
+# qemu-aarch64, then the reliability stages: unit + data tests under ASan+UBSan, the threaded
+# determinism tests under TSan, and every libFuzzer target on its seeds and reproducers (a fixed
+# number of runs). Exit status is non-zero if anything fails. Each stage's outcome is recorded in
+# build/test-stages/STAGE.json (read by scripts/bench.sh faults); STAGES="release asan" runs a subset.
 set -euo pipefail
 cd "$(dirname "$0")/.."
 ROOT=$(pwd)
@@ -9,21 +12,76 @@ ROOT=$(pwd)
 bash scripts/setup.sh
 
 JOBS=${JOBS:-$(nproc)}
+STAGES=${STAGES:-release aarch64 asan tsan fuzz}
 export MMLFW_DATA_DIR=${MMLFW_DATA_DIR:-$(cd "$ROOT/.." && pwd)/shared/data}
 if [ ! -d "$MMLFW_DATA_DIR" ]; then
   echo "test.sh: NOTE: $MMLFW_DATA_DIR is absent; tests that need the real logs will be skipped"
 fi
+mkdir -p build/test-stages
+COMMIT=$(git rev-parse HEAD 2>/dev/null || echo unknown)
+DIRTY=$([ -n "$(git status --porcelain 2>/dev/null)" ] && echo true || echo false)
 
-echo "=== host (release) build ==="
-cmake --preset release >/dev/null
-cmake --build --preset release -j "$JOBS"
-echo "=== host (release) tests ==="
-ctest --preset release -j "$JOBS" --timeout 1200
+# stage NAME COMMAND...: runs the command, records passed/failed, its duration and the commit.
+stage() {
+  local name=$1; shift
+  local t0=$SECONDS rc=0
+  rm -f "build/test-stages/$name.json"
+  # A subshell outside any `||` context, so that `set -e` stops the stage at its first failure.
+  set +e
+  ( set -e; "$@" )
+  rc=$?
+  set -e
+  printf '{"stage": "%s", "passed": %s, "exit": %d, "seconds": %d, "commit": "%s", "dirty": %s, "date": "%s"}\n' \
+    "$name" "$([ $rc -eq 0 ] && echo true || echo false)" "$rc" "$((SECONDS - t0))" "$COMMIT" "$DIRTY" \
+    "$(date -u +%FT%TZ)" > "build/test-stages/$name.json"
+  echo "test.sh: stage $name $([ $rc -eq 0 ] && echo passed || echo FAILED) in $((SECONDS - t0)) s"
+  return $rc
+}
+wanted() { [[ " $STAGES " == *" $1 "* ]]; }
 
-echo "=== aarch64 cross build ==="
-cmake --preset aarch64 >/dev/null
-cmake --build --preset aarch64 -j "$JOBS"
-echo "=== aarch64 tests under qemu-aarch64 ==="
-ctest --preset aarch64 -j "$JOBS" --timeout 1200
+release() {
+  echo "=== host (release) build ==="
+  cmake --preset release >/dev/null
+  cmake --build --preset release -j "$JOBS"
+  echo "=== host (release) tests ==="
+  ctest --preset release -j "$JOBS" --timeout 1200
+}
+aarch64() {
+  echo "=== aarch64 cross build ==="
+  cmake --preset aarch64 >/dev/null
+  cmake --build --preset aarch64 -j "$JOBS"
+  echo "=== aarch64 tests under qemu-aarch64 ==="
+  ctest --preset aarch64 -j "$JOBS" --timeout 1200
+}
+# ASan + UBSan: every unit, data and rules test (not hil: the HIL scripts measure the release
+# binaries inside UML; not budget: timing under ASan says nothing about the firmware's budget).
+asan() {
+  echo "=== ASan+UBSan build ==="
+  cmake --preset asan >/dev/null
+  cmake --build --preset asan -j "$JOBS"
+  echo "=== ASan+UBSan tests (labels unit, data, rules) ==="
+  ASAN_OPTIONS=detect_leaks=1:abort_on_error=1 UBSAN_OPTIONS=print_stacktrace=1 \
+    ctest --preset asan -j "$JOBS" --timeout 1200 -L '^(unit|data|rules)$'
+}
+# TSan: the tests where threads meet (tests/CMakeLists.txt, label tsan); only their targets are built.
+tsan() {
+  echo "=== TSan build (threaded tests only) ==="
+  cmake --preset tsan >/dev/null
+  cmake --build --preset tsan -j "$JOBS" --target fw_base_test fw_pransam_test fw_mml_reset_test replay_budget_test
+  echo "=== TSan tests (label tsan) ==="
+  ctest --preset tsan -j 1 --timeout 1200 -L '^tsan$'
+}
+# libFuzzer: seeds from the real logs, every target over its seeds + committed reproducers + a
+# fixed number of mutations (tests/fuzz/CMakeLists.txt); scripts/bench.sh fuzz runs them for minutes.
+fuzz() {
+  echo "=== fuzz build (clang, libFuzzer + ASan/UBSan) ==="
+  cmake --preset fuzz >/dev/null
+  cmake --build --preset fuzz -j "$JOBS"
+  echo "=== fuzz smoke (label fuzz) ==="
+  ctest --preset fuzz -j "$JOBS" --timeout 600 -L '^fuzz$'
+}
 
-echo "test.sh: all test stages passed"
+for s in release aarch64 asan tsan fuzz; do
+  if wanted $s; then stage $s $s; fi
+done
+echo "test.sh: all test stages passed ($STAGES)"

@@ -1,7 +1,7 @@
 # Project-wide options and the one place where firmware/hal compile flags live.
 option(MMLFW_BUILD_HOST_TOOLS "Build sim/ host tools (off for cross builds)" ON)
 option(MMLFW_BUILD_BENCHMARKS "Build benchmarks (Google Benchmark / harness)" ON)
-set(MMLFW_SANITIZE "" CACHE STRING "Sanitizers: '', 'address' (ASan+UBSan) or 'thread'")
+set(MMLFW_SANITIZE "" CACHE STRING "Sanitizers: '', 'address' (ASan+UBSan), 'thread' or 'fuzzer' (libFuzzer + ASan/UBSan)")
 
 # Eigen is header-only; for cross builds the host copy under /usr/include/eigen3 is the same.
 find_path(EIGEN3_INCLUDE_DIR NAMES Eigen/Core PATHS /usr/include/eigen3 NO_CMAKE_FIND_ROOT_PATH)
@@ -21,6 +21,15 @@ if(MMLFW_SANITIZE STREQUAL "address")
   # -fno-sanitize=vptr: UBSan's vptr check needs typeinfo, which the -fno-rtti firmware/hal libraries
   # (e.g. hal_sim's polymorphic sources used from RTTI-enabled tests) do not emit: link errors otherwise.
   add_compile_options(-fsanitize=address,undefined -fno-sanitize=vptr -fno-omit-frame-pointer -fno-sanitize-recover=undefined)
+  add_link_options(-fsanitize=address,undefined)
+elseif(MMLFW_SANITIZE STREQUAL "fuzzer")
+  # libFuzzer targets (tests/fuzz, `fuzz` preset, clang only): every library carries the fuzzer's
+  # coverage instrumentation plus ASan+UBSan; only the fuzz executables link libFuzzer's main.
+  if(NOT CMAKE_CXX_COMPILER_ID STREQUAL "Clang")
+    message(FATAL_ERROR "MMLFW_SANITIZE=fuzzer needs clang (the fuzz preset sets it)")
+  endif()
+  add_compile_options(-fsanitize=fuzzer-no-link,address,undefined -fno-sanitize=vptr -fno-omit-frame-pointer
+                      -fno-sanitize-recover=undefined)
   add_link_options(-fsanitize=address,undefined)
 elseif(MMLFW_SANITIZE STREQUAL "thread")
   add_compile_options(-fsanitize=thread -fno-omit-frame-pointer)

@@ -33,6 +33,9 @@ Status LocalizationLoop::init(hal::Hal& hal, Localizer& localizer, const Localiz
   stepped_ = false;
   counters_ = LoopCounters();
   health_ = hal::Health();
+  loop_dropped_scans_ = 0;
+  have_stepped_scan_ = false;
+  last_stepped_scan_ns_ = 0;
   estimate_ = hal::PoseEstimate();
   last_scan_ns_ = hal.clock->now_ns();
   laser_timed_out_ = false;
@@ -45,6 +48,9 @@ void LocalizationLoop::refresh_health(std::uint64_t now) {
   health_.fault_bits = (fault_bits() & kInternalFaultMask) | (hal_->laser->fault_bits() & hal::kHealthFaultMask) |
                        (laser_timed_out_ ? static_cast<std::uint32_t>(hal::HealthFault::kLaserTimeout) : 0u);
   health_.invalid_scans = hal_->laser->invalid_scans();
+  // Scans the source replaced by a newer one before the loop took them are lost too: HEALTH must
+  // account for every scan that arrived (a serial SICK stream faster than a slow step skips some).
+  health_.dropped_scans = loop_dropped_scans_ + hal_->laser->skipped_scans();
 }
 
 void LocalizationLoop::check_laser_silence(std::uint64_t now) {
@@ -74,6 +80,7 @@ void LocalizationLoop::check_laser_silence(std::uint64_t now) {
 void LocalizationLoop::reset() {
   odom_.clear();
   has_pending_ = false;
+  have_stepped_scan_ = false;
   stepped_ = false;
   if (localizer_ != nullptr) localizer_->reset();
 }
@@ -111,6 +118,34 @@ void LocalizationLoop::drain_odometry() {
     }
     odom_.push_overwrite(o);  // the history is a window: the oldest sample falls out
   }
+}
+
+// A scan taken before the last one processed (reordered on the link, e.g. a CAN sender with two
+// queues) would make the localizer step back in time and the POSE scan ids go backwards (issue 13
+// fault campaign, can_out_of_order): it is dropped and counted. A scan older by more than the
+// largest odometry gap is not a reordering but a sensor clock that jumped back; it is accepted so
+// that the firmware follows the new clock instead of dropping every scan from then on.
+bool LocalizationLoop::in_time_order(const hal::LaserScan& scan) {
+  if (!have_stepped_scan_ || scan.timestamp_ns > last_stepped_scan_ns_ ||
+      last_stepped_scan_ns_ - scan.timestamp_ns > options_.max_odom_gap_ns) {
+    return true;
+  }
+  ++counters_.scans_out_of_order;
+  log(hal::LogLevel::kWarning, "scan %u dropped: taken %llu us before the last processed scan (out of order)",
+      scan.scan_id, static_cast<unsigned long long>((last_stepped_scan_ns_ - scan.timestamp_ns) / 1000));
+  return false;
+}
+
+float LocalizationLoop::angle_diff_rad(float a, float b) {
+  float d = std::fmod(a - b, 6.2831853f);
+  if (d > 3.14159265f) d -= 6.2831853f;
+  if (d < -3.14159265f) d += 6.2831853f;
+  return d;
+}
+
+bool LocalizationLoop::odometry_discontinuous(const hal::Odometry& a, const hal::Odometry& b) const {
+  return !(std::hypot(b.x - a.x, b.y - a.y) <= options_.max_odom_sample_step_m &&
+           std::fabs(angle_diff_rad(b.theta, a.theta)) <= options_.max_odom_sample_step_rad);
 }
 
 bool LocalizationLoop::validate_scan(const hal::LaserScan& scan) {
@@ -168,6 +203,20 @@ LocalizationLoop::Pairing LocalizationLoop::pair(std::uint64_t now, hal::Odometr
   // Now odom_[i-1].t ≤ t ≤ odom_[i].t, or i == 0 and t == oldest.t.
   const hal::Odometry& a = i > 0 ? odom_[i - 1] : odom_[0];
   const hal::Odometry& b = odom_[i];
+  if (odometry_discontinuous(a, b)) {
+    // Issue 13 fault campaign (can_odom_jump): interpolating across a jump of the wheel odometry
+    // turned one 3 m jump into 0.9 m + 2.1 m, two increments the tracker found physical, and it
+    // published `localized` 3 m off. The sample nearest in time is held instead, so the whole jump
+    // reaches the localizer at one scan and is seen for what it is.
+    ++counters_.odom_discontinuities;
+    log(hal::LogLevel::kWarning, "scan %u: odometry jumps %.2f m / %.2f rad between two samples: not interpolated",
+        pending_.scan_id, static_cast<double>(std::hypot(b.x - a.x, b.y - a.y)),
+        static_cast<double>(std::fabs(angle_diff_rad(b.theta, a.theta))));
+    *out = (t - a.timestamp_ns <= b.timestamp_ns - t) ? a : b;
+    out->timestamp_ns = t;
+    ++counters_.scans_held;
+    return Pairing::kPaired;
+  }
   if (!interpolate_odometry(a, b, t, out).is_ok()) {
     raise_fault(Fault::kLogicError);  // the search above guarantees the bracket
     return Pairing::kDropped;
@@ -186,9 +235,9 @@ Status LocalizationLoop::spin_once() {
     drain_odometry();
     while (!has_pending_ && hal_->laser->poll(&pending_)) {
       ++counters_.scans_received;
-      has_pending_ = validate_scan(pending_);
+      has_pending_ = validate_scan(pending_) && in_time_order(pending_);
       if (!has_pending_) {
-        ++health_.dropped_scans;
+        ++loop_dropped_scans_;
       } else {
         if (laser_timed_out_) {
           log(hal::LogLevel::kInfo, "laser: scans back after %llu ms: %s cleared",
@@ -214,11 +263,14 @@ Status LocalizationLoop::spin_once() {
   if (pairing == Pairing::kWait) return Status::ok();
   has_pending_ = false;
   if (pairing == Pairing::kDropped) {
-    ++health_.dropped_scans;
+    ++loop_dropped_scans_;
+    refresh_health(now);
     return Status::ok();
   }
 
   Status status;
+  last_stepped_scan_ns_ = pending_.timestamp_ns;
+  have_stepped_scan_ = true;
   {
     const std::uint64_t t0 = perf_clock_->now_ns();
     status = localizer_->step(pending_, paired_odom_, &estimate_);

@@ -36,6 +36,11 @@ struct LocalizationLoopOptions {
   std::uint64_t max_odom_gap_ns = 500'000'000;  // largest gap bridged by holding an odometry sample
   std::uint64_t step_deadline_ns = 0;           // Localizer::step longer than this counts a miss (0 = off)
   std::uint64_t laser_timeout_ns = 0;           // no usable scan for this long: laser-timeout (0 = off)
+  // Two consecutive odometry samples farther apart than this are a discontinuity (a jump or a reset
+  // of the wheel odometry, not motion: odometry comes at ≥ 10 Hz): a scan between them is paired with
+  // the nearer sample, never an interpolation across the jump.
+  float max_odom_sample_step_m = 1.0f;
+  float max_odom_sample_step_rad = 1.0f;
   // Clock for the perf counters. The simulator steps hal.clock (deterministic time domain) and
   // measures with a real monotonic clock here; nullptr = hal.clock.
   const hal::Clock* perf_clock = nullptr;
@@ -50,6 +55,8 @@ struct LoopCounters {
   std::uint64_t scans_received = 0;
   std::uint64_t scans_malformed = 0;
   std::uint64_t scans_unpaired = 0;  // no odometry within max_odom_gap_ns
+  std::uint64_t scans_out_of_order = 0;  // taken before the last processed scan (dropped)
+  std::uint64_t odom_discontinuities = 0;  // scans between two odometry samples a jump apart (held)
   std::uint64_t scans_interpolated = 0;
   std::uint64_t scans_held = 0;      // paired with a held (not bracketing) odometry sample
   std::uint64_t step_errors = 0;
@@ -96,6 +103,9 @@ class LocalizationLoop {
   enum class Pairing { kWait, kPaired, kDropped };
   void drain_odometry();
   bool validate_scan(const hal::LaserScan& scan);
+  bool in_time_order(const hal::LaserScan& scan);
+  bool odometry_discontinuous(const hal::Odometry& a, const hal::Odometry& b) const;
+  static float angle_diff_rad(float a, float b);
   Pairing pair(std::uint64_t now, hal::Odometry* out);
   void refresh_health(std::uint64_t now);
   void check_laser_silence(std::uint64_t now);
@@ -113,6 +123,9 @@ class LocalizationLoop {
   hal::Odometry paired_odom_;
   hal::PoseEstimate estimate_;
   hal::Health health_;
+  std::uint32_t loop_dropped_scans_ = 0;
+  std::uint64_t last_stepped_scan_ns_ = 0;  // timestamp of the last scan given to the localizer
+  bool have_stepped_scan_ = false;  // malformed or unpaired; health_.dropped_scans adds the source's skips
   LoopCounters counters_;
   std::uint64_t last_step_ns_ = 0;
   std::uint64_t last_scan_ns_ = 0;  // clock time of the last usable scan (or of init)

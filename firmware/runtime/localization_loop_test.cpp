@@ -135,9 +135,9 @@ TEST(LocalizationLoop, RejectsBadOdometryAndMalformedScans) {
   ASSERT_TRUE(r.loop.init(r.hal, r.localizer).is_ok());
   r.push_odom(0, 0.0f, 0.0f, 0.0f);
   r.push_odom(100 * kMs, std::numeric_limits<float>::quiet_NaN(), 0.0f, 0.0f);
-  r.push_odom(50 * kMs, 5.0f, 0.0f, 0.0f);
-  r.push_odom(20 * kMs, 9.0f, 0.0f, 0.0f);  // older than 50 ms: rejected
-  r.push_odom(100 * kMs, 1.0f, 0.0f, 0.0f);
+  r.push_odom(50 * kMs, 0.5f, 0.0f, 0.0f);
+  r.push_odom(20 * kMs, 0.9f, 0.0f, 0.0f);  // older than 50 ms: rejected
+  r.push_odom(100 * kMs, 0.1f, 0.0f, 0.0f);
   hal::LaserScan bad;
   bad.timestamp_ns = 60 * kMs;
   bad.beam_count = hal::LaserScan::kMaxBeams + 1;
@@ -150,7 +150,8 @@ TEST(LocalizationLoop, RejectsBadOdometryAndMalformedScans) {
   EXPECT_EQ(r.loop.counters().odom_rejected, 2u);
   EXPECT_EQ(r.loop.counters().scans_malformed, 1u);
   EXPECT_EQ(r.loop.health().dropped_scans, 1u);
-  EXPECT_NEAR(r.loop.last_odometry().x, 3.0f, 1e-5f);  // halfway 50 → 100 ms: 5 → 1 m
+  // Halfway 50 → 100 ms: 0.5 → 0.1 m (samples a jump apart are not interpolated: see below).
+  EXPECT_NEAR(r.loop.last_odometry().x, 0.3f, 1e-5f);
 }
 
 // The loop's contract when a localizer fails: the error is returned, counted, logged and an
@@ -305,7 +306,8 @@ class FaultyLaser final : public hal::LaserScanSource {
   bool poll(hal::LaserScan*) override { return false; }
   std::uint32_t fault_bits() const override { return bits; }
   std::uint32_t invalid_scans() const override { return invalid; }
-  std::uint32_t bits = 0, invalid = 0;
+  std::uint32_t skipped_scans() const override { return skipped; }
+  std::uint32_t bits = 0, invalid = 0, skipped = 0;
 };
 
 TEST(LocalizationLoop, SourceFaultsAndInvalidScansReachHealth) {
@@ -321,6 +323,76 @@ TEST(LocalizationLoop, SourceFaultsAndInvalidScansReachHealth) {
   laser.bits = 0;
   ASSERT_TRUE(r.loop.spin_once().is_ok());
   EXPECT_EQ(r.loop.health().fault_bits, 0u);
+}
+
+// Issue 13 fault campaign (serial_laser_silence): a SICK stream of 200 scans at 75 Hz reached the
+// loop as 185 steps and HEALTH said dropped=0 — the driver keeps only the newest scan between two
+// polls and its replaced scans were counted nowhere the robot could see. They are dropped scans.
+TEST(LocalizationLoop, ScansTheSourceSkippedAreDroppedInHealth) {
+  Rig r;
+  FaultyLaser laser;
+  r.hal.laser = &laser;
+  ASSERT_TRUE(r.loop.init(r.hal, r.localizer).is_ok());
+  laser.skipped = 15;
+  ASSERT_TRUE(r.loop.spin_once().is_ok());
+  EXPECT_EQ(r.loop.health().dropped_scans, 15u);
+  laser.skipped = 16;
+  ASSERT_TRUE(r.loop.spin_once().is_ok());
+  EXPECT_EQ(r.loop.health().dropped_scans, 16u);
+}
+
+// Issue 13 fault campaign (can_out_of_order): two scans swapped on the link made the loop step the
+// older one after the newer and the POSE scan ids went backwards. The older one is now dropped and
+// counted; a much older scan (the sensor clock jumped back) is followed, not dropped for ever.
+TEST(LocalizationLoop, OutOfOrderScanIsDroppedButAClockJumpBackIsFollowed) {
+  Rig r;
+  fw::LocalizationLoopOptions opt;
+  opt.max_odom_gap_ns = 500 * kMs;
+  ASSERT_TRUE(r.loop.init(r.hal, r.localizer, opt).is_ok());
+  for (int i = 0; i <= 10; ++i) r.push_odom(i * 100 * kMs, 0.01f * i, 0.0f, 0.0f);
+  r.push_scan(800 * kMs, 3);
+  r.push_scan(700 * kMs, 2);  // taken before scan 3, arrives after it
+  r.push_scan(900 * kMs, 4);
+  r.clock.set_ns(1000 * kMs);
+  for (int i = 0; i < 4; ++i) ASSERT_TRUE(r.loop.spin_once().is_ok());
+  hal::PoseEstimate e;
+  ASSERT_TRUE(r.sink.pop(&e));
+  EXPECT_EQ(e.scan_id, 3u);
+  ASSERT_TRUE(r.sink.pop(&e));
+  EXPECT_EQ(e.scan_id, 4u);
+  EXPECT_FALSE(r.sink.pop(&e));
+  EXPECT_EQ(r.loop.counters().scans_out_of_order, 1u);
+  EXPECT_EQ(r.loop.health().dropped_scans, 1u);
+  EXPECT_EQ(r.loop.health().scans_processed, 2u);
+  // The sensor clock restarts near zero (900 ms back, beyond the 500 ms odometry gap): followed.
+  r.push_odom(5 * kMs, 0.0f, 0.0f, 0.0f);
+  r.push_scan(0, 5);
+  for (int i = 0; i < 3; ++i) ASSERT_TRUE(r.loop.spin_once().is_ok());
+  EXPECT_EQ(r.loop.counters().scans_out_of_order, 1u);
+  EXPECT_EQ(r.loop.health().dropped_scans + r.loop.health().scans_processed, 4u);
+}
+
+// Issue 13 fault campaign (can_odom_jump): a 3 m jump of the wheel odometry between two samples was
+// interpolated into two "physical" increments and the tracker stayed `localized` 3 m off. A scan
+// between two samples a jump apart takes the nearer sample, so the jump arrives whole.
+TEST(LocalizationLoop, NoInterpolationAcrossAnOdometryJump) {
+  Rig r;
+  ASSERT_TRUE(r.loop.init(r.hal, r.localizer).is_ok());
+  r.push_odom(0, 0.0f, 0.0f, 0.0f);
+  r.push_odom(100 * kMs, 0.05f, 0.0f, 0.0f);
+  r.push_odom(200 * kMs, 3.05f, 0.0f, 0.0f);  // jump
+  r.push_odom(300 * kMs, 3.10f, 0.0f, 0.0f);
+  r.push_scan(50 * kMs, 1);   // ordinary motion: interpolated
+  r.push_scan(130 * kMs, 2);  // nearer the pre-jump sample
+  r.push_scan(180 * kMs, 3);  // nearer the post-jump sample
+  r.clock.set_ns(400 * kMs);
+  const float expect[3] = {0.025f, 0.05f, 3.05f};
+  for (float x : expect) {
+    ASSERT_TRUE(r.loop.spin_once().is_ok());
+    ASSERT_TRUE(r.loop.stepped());
+    EXPECT_NEAR(r.loop.last_odometry().x, x, 1e-6f);
+  }
+  EXPECT_EQ(r.loop.counters().odom_discontinuities, 2u);
 }
 
 }  // namespace

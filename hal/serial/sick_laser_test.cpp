@@ -35,6 +35,28 @@ void append_telegram(MemoryPort* port, const std::uint8_t* payload, std::size_t 
   port->in.insert(port->in.end(), buf, buf + len);
 }
 
+// Issue 13 fault campaign: two scans in one read — the driver hands out the newest and the one it
+// replaced is reported as skipped (HEALTH dropped_scans via the loop), not lost silently.
+TEST(SickLaser, ScanReplacedBeforePollIsReportedSkipped) {
+  MemoryPort port;
+  SickLaser laser;
+  laser.init(&port, nullptr, SickLaserOptions{});
+  MeasuredValues v;
+  v.count = 181;
+  std::uint8_t buf[kMaxTelegramBytes];
+  for (int k = 0; k < 2; ++k) {
+    for (int i = 0; i < 181; ++i) v.values[i] = static_cast<std::uint16_t>(300 + i + k);
+    const std::size_t n = encode_measured_values(v, buf, sizeof(buf));
+    port.in.insert(port.in.end(), buf, buf + n);
+  }
+  hal::LaserScan scan;
+  ASSERT_TRUE(laser.poll(&scan));
+  EXPECT_FLOAT_EQ(scan.ranges[0], 3.01f);  // the newer one
+  const hal::LaserScanSource& source = laser;
+  EXPECT_EQ(source.skipped_scans(), 1u);
+  EXPECT_FALSE(laser.poll(&scan));
+}
+
 TEST(SickLaser, CrcValidTelegramsWithImpossibleContentAreCounted) {
   MemoryPort port;
   SickLaser laser;

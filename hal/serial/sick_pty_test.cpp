@@ -36,7 +36,10 @@ class PtyPair {
     posix_spawn_file_actions_t fa;
     posix_spawn_file_actions_init(&fa);
     posix_spawn_file_actions_addopen(&fa, 2, (dir_ + "/socat.log").c_str(), O_WRONLY | O_CREAT, 0644);
-    if (posix_spawnp(&pid_, "socat", &fa, nullptr, const_cast<char**>(argv), environ) != 0) {
+    // The file actions own memory (LeakSanitizer found them never destroyed).
+    const int rc = posix_spawnp(&pid_, "socat", &fa, nullptr, const_cast<char**>(argv), environ);
+    posix_spawn_file_actions_destroy(&fa);
+    if (rc != 0) {
       *err = "socat not installed (apt-get install socat)";
       return false;
     }

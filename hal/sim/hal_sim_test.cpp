@@ -22,6 +22,8 @@ TEST(SimLaserSource, FifoOrderAndOverflowIsDroppedAndCounted) {
     EXPECT_EQ(ok, i < hal_sim::SimLaserSource::kCapacity) << i;
   }
   EXPECT_EQ(src.stats().dropped, 3u);
+  // What the loop puts into HEALTH dropped_scans (the soak accounts for every scan in HEALTH).
+  EXPECT_EQ(static_cast<const hal::LaserScanSource&>(src).skipped_scans(), 3u);
   EXPECT_EQ(src.stats().pushed, hal_sim::SimLaserSource::kCapacity);
   hal::LaserScan out;
   for (std::uint32_t i = 0; i < hal_sim::SimLaserSource::kCapacity; ++i) {

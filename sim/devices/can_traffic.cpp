@@ -2,12 +2,40 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstring>
 #include <fstream>
 
 #include "sim/devices/candump_log.h"
 #include "sim/io/log_replay.h"
 
 namespace sim {
+
+namespace {
+
+// range_max 0.01 m in the start payload, then the END frame's CRC recomputed over what is sent: a
+// scan intact on the wire whose content no scanner produces (the decoder must refuse it by name).
+void make_scan_impossible(std::vector<hal::CanFrame>* frames, bool fd) {
+  using namespace hal_can;
+  std::uint8_t start[kScanStartParts * kPartBytes];
+  const size_t first_data = fd ? 1 : kScanStartParts;
+  if (fd) {
+    put_u16((*frames)[0].data + 1 + 11, 1);
+    std::memcpy(start, (*frames)[0].data + 1, sizeof start);
+  } else {
+    put_u16((*frames)[1].data + 1 + (11 - kPartBytes), 1);  // offset 11 lies in part 1
+    for (size_t p = 0; p < kScanStartParts; ++p) std::memcpy(start + p * kPartBytes, (*frames)[p].data + 1, kPartBytes);
+  }
+  const size_t beams = get_u16(start + 2);
+  const size_t per = fd ? kFdRangesPerSegment : kClassicRangesPerSegment;
+  std::uint32_t crc = crc32_update(crc32_begin(), start, sizeof start);
+  for (size_t i = first_data, b0 = 0; i + 1 < frames->size(); ++i, b0 += per) {
+    const size_t nb = beams - b0 < per ? beams - b0 : per;
+    crc = crc32_update(crc, (*frames)[i].data + 2, 2 * nb);
+  }
+  put_u32(frames->back().data + 4, crc32_end(crc));
+}
+
+}  // namespace
 
 bool build_can_traffic(const CarmenLog& log, const CanTrafficOptions& o, std::vector<TimedFrame>* out,
                        CanTrafficSummary* summary, std::string* error) {
@@ -26,8 +54,21 @@ bool build_can_traffic(const CarmenLog& log, const CanTrafficOptions& o, std::ve
   const double t0 = log.scans[o.first_scan].ipc_timestamp - 1.0;
   const double t_end = log.scans[last - 1].ipc_timestamp;
   summary->sensor_t0 = t0;
-  auto sensor_ns = [&](double ipc) { return seconds_to_ns(ipc - t0); };
+  // Log time of scan k (counted from first_scan): where the campaign's faults begin.
+  auto scan_time = [&](size_t k, bool enabled) {
+    return enabled && o.first_scan + k < last ? log.scans[o.first_scan + k].ipc_timestamp : 1e300;
+  };
+  const double jump_t = scan_time(o.time_jump_at, o.time_jump_s != 0);
+  const double jump_base = o.time_jump_s < 0 ? -o.time_jump_s : 0.0;  // keeps the sensor clock positive
+  auto sensor_ns = [&](double ipc) {
+    return seconds_to_ns(ipc - t0 + jump_base + (ipc >= jump_t ? o.time_jump_s : 0.0));
+  };
   auto replay_t = [&](double ipc) { return o.start_time + (ipc - t0) / o.speed; };
+  const double silence_t = scan_time(o.silence_at, o.silence_s > 0);
+  const double odom_jump_t = scan_time(o.odom_jump_at, o.odom_jump_m != 0);
+  const double odom_reset_t = scan_time(o.odom_reset_at, o.odom_reset_at > 0);
+  bool have_reset_origin = false;
+  fw::Se2d reset_origin;
 
   struct Item {
     double ipc;
@@ -69,6 +110,15 @@ bool build_can_traffic(const CarmenLog& log, const CanTrafficOptions& o, std::ve
         od.y = static_cast<float>(s.odom.y);
         od.theta = static_cast<float>(s.odom.theta);
       }
+      if (it.ipc >= odom_reset_t) {
+        const fw::Se2d pose(od.x, od.y, od.theta);
+        if (!have_reset_origin) { reset_origin = pose; have_reset_origin = true; }
+        const fw::Se2d rel = reset_origin.inverse().compose(pose);
+        od.x = static_cast<float>(rel.x);
+        od.y = static_cast<float>(rel.y);
+        od.theta = static_cast<float>(rel.theta);
+      }
+      if (it.ipc >= odom_jump_t) od.x += static_cast<float>(o.odom_jump_m);
       fw::Status st = hal_can::encode_odometry(od, odom_tag++, o.fd, buf.data(), buf.size(), &n);
       if (!st.is_ok()) { *error = st.message(); return false; }
       for (size_t i = 0; i < n; ++i) out->push_back({t + i * 1e-6, buf[i], false});
@@ -76,6 +126,17 @@ bool build_can_traffic(const CarmenLog& log, const CanTrafficOptions& o, std::ve
       continue;
     }
     const size_t k = it.index - o.first_scan;
+    if (it.ipc >= silence_t && it.ipc < silence_t + o.silence_s) {
+      ++summary->scans_silenced;  // the laser says nothing (never sent)
+      continue;
+    }
+    // Swapped pair: each scan travels at the other's time, keeping its own sensor timestamp.
+    if (o.swap_every && k % o.swap_every == o.swap_every - 1 && it.index + 1 < last) {
+      t = replay_t(log.scans[it.index + 1].ipc_timestamp) + 1e-4;
+      ++summary->scans_swapped;
+    } else if (o.swap_every && k >= 1 && (k - 1) % o.swap_every == o.swap_every - 1) {
+      t = replay_t(log.scans[it.index - 1].ipc_timestamp) - 1e-4;
+    }
     if (o.bus_off_burst && o.bus_off_at && k == o.bus_off_at) {
       for (size_t b = 0; b < o.bus_off_burst; ++b) {
         TimedFrame ef;
@@ -107,6 +168,11 @@ bool build_can_traffic(const CarmenLog& log, const CanTrafficOptions& o, std::ve
     } else if (o.duplicate_every && k % o.duplicate_every == o.duplicate_every / 3) {
       frames.insert(frames.begin() + static_cast<long>(victim), frames[victim]);
       ++summary->scans_duplicated;
+      faulty = true;
+    }
+    if (!faulty && o.invalid_every && k % o.invalid_every == o.invalid_every - 1) {
+      make_scan_impossible(&frames, o.fd);
+      ++summary->scans_invalid;
       faulty = true;
     }
     for (size_t i = 0; i < frames.size(); ++i) out->push_back({t + i * 1e-6, frames[i], false});
@@ -199,6 +265,8 @@ PoseScore score_pose_frames(const std::vector<hal::CanFrame>& frames, const std:
         }
       }
       if (h.state > 2) s.violations.push_back("health state " + std::to_string(h.state) + " unknown");
+      s.health_fault_bits_seen |= h.fault_bits;
+      if (have_health && prev_h.fault_bits != 0 && h.fault_bits == 0) ++s.health_fault_clears;
       prev_h = h;
       have_health = true;
     }

@@ -32,11 +32,23 @@ struct CanTrafficOptions {
   size_t duplicate_every = 0; // send one data segment twice → duplicate
   size_t bus_off_at = 0;      // before scan k (k >= 1) inject an error-frame burst ...
   size_t bus_off_burst = 0;   // ... of this many bus-off error frames
+  // Fault campaign (scripts/bench.sh faults; scan indices k counted from first_scan, 0 = off unless noted):
+  size_t invalid_every = 0;   // scan k with k % every == every - 1: range_max 0.01 m, CRC recomputed
+                              // (intact on the wire, impossible in content → HEALTH invalid_scans)
+  size_t swap_every = 0;      // scans k and k+1 (k % every == every - 1) sent in swapped order
+  size_t silence_at = 0;      // from scan k on, no scan for silence_s seconds of log time (odometry goes on)
+  double silence_s = 0;
+  size_t odom_jump_at = 0;    // odometry from scan k on displaced by odom_jump_m along x
+  double odom_jump_m = 0;
+  size_t odom_reset_at = 0;   // odometry from scan k on restarts at (0, 0, 0) (a wheel controller reboot)
+  size_t time_jump_at = 0;    // sensor clock of scans and odometry from scan k on jumps by time_jump_s
+  double time_jump_s = 0;     //   (negative: backwards)
 };
 
 struct CanTrafficSummary {
   size_t scans_sent = 0, scans_intact = 0, scans_corrupted = 0, scans_missing_segment = 0, scans_duplicated = 0;
   size_t odometry_sent = 0, frames = 0, error_frames = 0;
+  size_t scans_invalid = 0, scans_swapped = 0, scans_silenced = 0;
   double duration_s = 0;        // replay duration
   double sensor_t0 = 0;         // log ipc time that maps to sensor time 1 s
 };
@@ -64,6 +76,8 @@ struct PoseScore {
   hal_can::HealthRecord last_health;
   size_t first_localized_scan = 0;                    // scans (from first_scan) until the first `localized`
   size_t fault_updates = 0;  // the last pose repeated with status `fault` (laser-timeout); not in `poses`
+  std::uint32_t health_fault_bits_seen = 0;  // OR of the fault bits of every health frame
+  size_t health_fault_clears = 0;            // health frames whose fault bits went from set to clear
 };
 
 // `reference[i]` = reference pose of log scan i (reference_at_every_scan); may be empty (no error

@@ -1,7 +1,10 @@
 // mml-candev: the CAN side of the simulator for hardware-in-the-loop runs.
 //   mml-candev log2can --dataset aces|--log PATH [--first N] [--count N] [--fd] [--iface vcan0]
 //                      [--speed S] [--corrupt-every K] [--drop-every K] [--dup-every K]
-//                      [--bus-off-at K --bus-off-burst N] --out replay.log
+//                      [--bus-off-at K --bus-off-burst N] [--invalid-every K] [--swap-every K]
+//                      [--silence-at K --silence-s S] [--odom-jump-at K --odom-jump-m M]
+//                      [--odom-reset-at K] [--time-jump-at K --time-jump-s S] --out replay.log
+//       (fault campaign options: sim/devices/can_traffic.h)
 //       → a candump log canplayer replays (`canplayer -I replay.log`); prints a JSON summary.
 //   mml-candev live ... --iface vcan0 (same options, no --out): sends the frames onto the interface
 //       with their timing (SocketCAN; needs a kernel with CAN).
@@ -95,10 +98,16 @@ static int run_main(int argc, char** argv) {
   }
   std::string err;
   double first = 0, count = 0, speed = 1, corrupt = 0, drop = 0, dup = 0, boff_at = 0, boff_n = 0, bound = 1.0;
+  double invalid = 0, swap = 0, silence_at = 0, silence_s = 0, jump_at = 0, jump_m = 0, reset_at = 0, tj_at = 0;
+  double tj_s = 0;
   if (!a.num("first", &first, &err) || !a.num("count", &count, &err) || !a.num("speed", &speed, &err) ||
       !a.num("corrupt-every", &corrupt, &err) || !a.num("drop-every", &drop, &err) ||
       !a.num("dup-every", &dup, &err) || !a.num("bus-off-at", &boff_at, &err) ||
-      !a.num("bus-off-burst", &boff_n, &err) || !a.num("bound", &bound, &err)) {
+      !a.num("bus-off-burst", &boff_n, &err) || !a.num("bound", &bound, &err) ||
+      !a.num("invalid-every", &invalid, &err) || !a.num("swap-every", &swap, &err) ||
+      !a.num("silence-at", &silence_at, &err) || !a.num("silence-s", &silence_s, &err) ||
+      !a.num("odom-jump-at", &jump_at, &err) || !a.num("odom-reset-at", &reset_at, &err) ||
+      !a.num("time-jump-at", &tj_at, &err)) {
     return usage(err.c_str());
   }
   sim::CarmenLog log;
@@ -120,6 +129,16 @@ static int run_main(int argc, char** argv) {
     o.duplicate_every = static_cast<size_t>(dup);
     o.bus_off_at = static_cast<size_t>(boff_at);
     o.bus_off_burst = static_cast<size_t>(boff_n);
+    o.invalid_every = static_cast<size_t>(invalid);
+    o.swap_every = static_cast<size_t>(swap);
+    o.silence_at = static_cast<size_t>(silence_at);
+    o.silence_s = silence_s;
+    o.odom_jump_at = static_cast<size_t>(jump_at);
+    o.odom_reset_at = static_cast<size_t>(reset_at);
+    o.time_jump_at = static_cast<size_t>(tj_at);
+    // Signed values (a.num accepts non-negative numbers only).
+    if (a.has("odom-jump-m")) o.odom_jump_m = std::strtod(a.get("odom-jump-m").c_str(), nullptr);
+    if (a.has("time-jump-s")) o.time_jump_s = std::strtod(a.get("time-jump-s").c_str(), nullptr);
     std::vector<sim::TimedFrame> frames;
     sim::CanTrafficSummary s;
     if (!sim::build_can_traffic(log, o, &frames, &s, &err)) {
@@ -155,9 +174,10 @@ static int run_main(int argc, char** argv) {
     }
     std::printf("{\"scans_sent\": %zu, \"scans_intact\": %zu, \"scans_corrupted\": %zu, \"scans_missing_segment\": %zu, "
                 "\"scans_duplicated\": %zu, \"odometry_sent\": %zu, \"frames\": %zu, \"error_frames\": %zu, "
-                "\"duration_s\": %.3f}\n",
+                "\"duration_s\": %.3f, \"scans_invalid\": %zu, \"scans_swapped\": %zu, \"scans_silenced\": %zu}\n",
                 s.scans_sent, s.scans_intact, s.scans_corrupted, s.scans_missing_segment, s.scans_duplicated,
-                s.odometry_sent, s.frames, s.error_frames, s.duration_s);
+                s.odometry_sent, s.frames, s.error_frames, s.duration_s, s.scans_invalid, s.scans_swapped,
+                s.scans_silenced);
     return 0;
   }
   if (cmd == "score") {
@@ -201,14 +221,15 @@ static int run_main(int argc, char** argv) {
                   "\"health_timeouts\": %u, \"health_deadline_misses\": %u, \"health_bus_off\": %u, "
                   "\"health_error_frames\": %u, \"health_rx_dropped\": %u, \"health_scans_processed\": %u, "
                   "\"health_state\": %u, \"health_fault_bits\": %u, \"health_invalid_scans\": %u, "
-                  "\"fault_updates\": %zu}",
+                  "\"fault_updates\": %zu, \"health_fault_bits_seen\": %u, \"health_fault_clears\": %zu}",
                   s.frames, s.poses, s.health, s.status_counts[0], s.status_counts[1], s.status_counts[2],
                   s.status_counts[3], s.status_counts[4], s.wrong_localized, s.scored, s.mean_err_m, s.max_err_m,
                   s.mean_err_localized_m, s.max_err_localized_m, s.first_localized_scan, s.violations.size(),
                   s.last_health.crc_errors, s.last_health.lost_segments, s.last_health.dropped_scans,
                   s.last_health.timeouts, s.last_health.deadline_misses, s.last_health.bus_off,
                   s.last_health.error_frames, s.last_health.rx_dropped, s.last_health.scans_processed,
-                  s.last_health.state, s.last_health.fault_bits, s.last_health.invalid_scans, s.fault_updates);
+                  s.last_health.state, s.last_health.fault_bits, s.last_health.invalid_scans, s.fault_updates,
+                  s.health_fault_bits_seen, s.health_fault_clears);
     std::printf("%s\n", buf);
     for (const auto& v : s.violations) std::fprintf(stderr, "protocol violation: %s\n", v.c_str());
     if (a.has("json")) {

@@ -5,6 +5,7 @@
 // --garbage-every K writes random bytes before every K-th telegram. Prints a JSON summary.
 //   mml-sickdev --device PATH --dataset aces|--log PATH [--first N] [--count N] [--rate 75]
 //               [--baud 500000] [--corrupt-every K] [--garbage-every K] [--wait 5]
+//               [--pause-at K --pause-s S]   (silent for S seconds before telegram K)
 #include <time.h>
 
 #include <cmath>
@@ -96,7 +97,11 @@ static int run_main(int argc, char** argv) {
   }
   std::mt19937 rng(1);
   size_t sent = 0, corrupted = 0, garbage_sent = 0;
-  const double t0 = now_s() + 0.05;
+  double t0 = now_s() + 0.05;
+  // Laser silence (fault campaign): before telegram number pause_at the scanner says nothing for
+  // pause_s seconds, then streams on at the rate.
+  const size_t pause_at = static_cast<size_t>(num("pause-at", 0));
+  const double pause_s = num("pause-s", 0);
   for (size_t i = first; i < log.scans.size() && sent < count; ++i) {
     const sim::CarmenScan& s = log.scans[i];
     hal_serial::MeasuredValues v;
@@ -120,6 +125,7 @@ static int run_main(int argc, char** argv) {
       buf[8 + rng() % (n - 10)] ^= 0x10;
       ++corrupted;
     }
+    if (pause_at > 0 && k == pause_at && pause_s > 0) t0 += pause_s;
     sleep_until(t0 + static_cast<double>(sent) / rate);
     if (port.write(buf, n) != static_cast<long>(n)) return usage("write to " + kv["device"] + " failed");
     ++sent;

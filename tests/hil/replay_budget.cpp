@@ -40,6 +40,10 @@ std::uint64_t mono_ns() {
 // Static storage as in mmlfw (firmware/app/mmlfw_main.cpp: `fw::LocalizationSystem g_system`; the
 // localizer objects themselves are placed in the start-up arena by the builder). Re-created per
 // run so that its objects are destroyed before the arena they live in is set up again.
+// The arena is declared first so that it is destroyed last: the localizer objects g_system owns
+// live in it. (As a function-local static it was destroyed before g_system at exit, and ASan found
+// ~TrackedLocalizer running on unmapped arena memory — the order mmlfw_main.cpp already keeps.)
+fw::StartupArena g_arena;
 std::optional<fw::LocalizationSystem> g_system;
 
 }  // namespace
@@ -76,7 +80,7 @@ bool run_replay(const ReplayOptions& o, ReplayResult* r, std::string* error) {
 
   g_system.reset();  // before its arena is set up again
   fw::MemoryReport::instance().clear();
-  static fw::StartupArena arena;
+  fw::StartupArena& arena = g_arena;
   fw::Status st = arena.init_mapped(256u << 20, false, "arena");
   if (!st) { *error = st.message(); return false; }
   fw::GlobalMap map{};
@@ -181,33 +185,50 @@ bool run_replay(const ReplayOptions& o, ReplayResult* r, std::string* error) {
   };
   size_t oi = 0;
   while (oi < log.odom.size() && log.odom[oi].ipc_timestamp < log_t0 - 0.5) ++oi;
-  size_t k = 0;
+  size_t k = 0;  // index into scan_t of the next scan to feed
+  size_t g = 0;  // scans fed over all loops (soak): scan g is due at t0 + g * period
+  const size_t oi_start = oi;
+  const bool soak = o.duration_s > 0 && !lockstep;
+  std::uint64_t next_sample_ns = t0 + static_cast<std::uint64_t>(o.sample_period_s * 1e9);
   std::mt19937_64 lose_rng(o.lose_seed);
   std::uniform_real_distribution<double> lose_draw(0.0, 1.0);
   const double to_ms = 1e-6;
   (void)to_ms;
-  const std::uint64_t end_ns = t0 + (lockstep ? 600'000'000'000ull : static_cast<std::uint64_t>((last - o.first_scan) * period * 1e9) + 3'000'000'000ull);
+  const std::uint64_t end_ns =
+      soak ? t0 + static_cast<std::uint64_t>(o.duration_s * 1e9)
+           : t0 + (lockstep ? 600'000'000'000ull
+                            : static_cast<std::uint64_t>((last - o.first_scan) * period * 1e9) + 3'000'000'000ull);
+  // Soak: one pass of the log lasts n * period; pass L runs L * n * period later in sensor time.
+  std::uint64_t loop_offset_ns = 0;
   while (true) {
     const std::uint64_t now = mono_ns();
+    if (soak && k >= scan_t.size() && now < end_ns) {
+      k = 0;
+      oi = oi_start;
+      ++r->loops;
+      loop_offset_ns = static_cast<std::uint64_t>(static_cast<double>(r->loops * scan_t.size()) * period * 1e9);
+    }
     // Push everything due.
-    while (k < scan_t.size() &&
+    while (k < scan_t.size() && (!soak || now < end_ns) &&
            (lockstep ? (laser.pending() == 0 && !loop.scan_pending() &&
                          loop.health().scans_processed + loop.health().dropped_scans + r->scans_dropped +
                                  r->scans_lost >= k)
-                     : now >= t0 + static_cast<std::uint64_t>(k * period * 1e9))) {
+                     : now >= t0 + static_cast<std::uint64_t>(static_cast<double>(g) * period * 1e9))) {
       const double tk = scan_t[k];
       while (oi < log.odom.size() && log.odom[oi].ipc_timestamp <= tk + 0.5 * (k + 1 < scan_t.size() ? scan_t[k + 1] - tk : 0)) {
         const sim::CarmenOdom& c = log.odom[oi++];
         hal::Odometry od;
-        od.timestamp_ns = warp(c.ipc_timestamp);
+        od.timestamp_ns = warp(c.ipc_timestamp) + loop_offset_ns;
         od.x = static_cast<float>(c.pose.x);
         od.y = static_cast<float>(c.pose.y);
         od.theta = static_cast<float>(c.pose.theta);
+        if (o.mutate_odometry) o.mutate_odometry(c.ipc_timestamp, &od);
         odom.push(od);
       }
       std::int64_t jitter_ns = 0;
       if (o.scan_time_jitter_ms > 0) jitter_ns = static_cast<std::int64_t>((2.0 * lose_draw(lose_rng) - 1.0) * o.scan_time_jitter_ms * 1e6);
-      hal::LaserScan s = sim::to_laser_scan(log.scans[o.first_scan + k], warp(tk) + jitter_ns);
+      hal::LaserScan s = sim::to_laser_scan(log.scans[o.first_scan + k], warp(tk) + loop_offset_ns + jitter_ns);
+      if (o.mutate_scan) o.mutate_scan(o.first_scan + k, &s);
       if (lockstep) stepped.set_ns(warp(k + 1 < scan_t.size() ? scan_t[k + 1] : tk));
       const bool lost_random = (o.lose_prob > 0 && lose_draw(lose_rng) < o.lose_prob) ||
                                std::find(o.lose_list.begin(), o.lose_list.end(), o.first_scan + k) != o.lose_list.end();
@@ -215,9 +236,24 @@ bool run_replay(const ReplayOptions& o, ReplayResult* r, std::string* error) {
         ++r->scans_lost;
       } else if (!laser.push(s)) {
         ++r->scans_dropped;
+        ++r->ring_overflows;
       }
       ++r->scans_fed;
       ++k;
+      ++g;
+    }
+    if (o.on_sample && now >= next_sample_ns) {
+      next_sample_ns += static_cast<std::uint64_t>(o.sample_period_s * 1e9);
+      ReplaySample smp;
+      smp.elapsed_s = static_cast<double>(now - t0) * 1e-9;
+      smp.scans_fed = r->scans_fed;
+      smp.scans_processed = r->scans_processed;
+      smp.health_dropped = loop.health().dropped_scans;
+      smp.ring_overflows = r->ring_overflows;
+      smp.localized = r->localized;
+      smp.wrong_localized = r->wrong_localized;
+      smp.loops = r->loops;
+      o.on_sample(smp);
     }
     loop.spin_once();
     // Lockstep: a scan waiting for odometry that will never come must see time pass (timeout).
@@ -243,6 +279,7 @@ bool run_replay(const ReplayOptions& o, ReplayResult* r, std::string* error) {
       }
       if (e.status == hal::LocalizationStatus::kLocalized) {
         if (r->first_localized_scan < 0) r->first_localized_scan = static_cast<long>(e.scan_id);
+        r->last_localized_scan = static_cast<long>(e.scan_id);
         ++r->localized;
         const size_t idx = e.scan_id;  // to_laser_scan: scan_id = log index
         if (idx < reference.size()) {
@@ -255,8 +292,9 @@ bool run_replay(const ReplayOptions& o, ReplayResult* r, std::string* error) {
         }
       }
     }
-    if (k >= scan_t.size() && laser.pending() == 0 && !loop.scan_pending()) break;
-    if (mono_ns() > end_ns) break;
+    if ((!soak || mono_ns() >= end_ns) && k >= scan_t.size() && laser.pending() == 0 && !loop.scan_pending()) break;
+    if (soak && mono_ns() >= end_ns && laser.pending() == 0 && !loop.scan_pending()) break;
+    if (mono_ns() > end_ns + (soak ? 3'000'000'000ull : 0)) break;
     if (!loop.stepped()) {
       timespec ts{0, 200'000};  // 0.2 ms: idle until the next scan is due
       nanosleep(&ts, nullptr);
@@ -274,7 +312,10 @@ bool run_replay(const ReplayOptions& o, ReplayResult* r, std::string* error) {
   r->step_max_ms = step.max_ms;
   r->cycle_p99_ms = loop.perf_total().stats().p99_ms;
   r->deadline_misses = loop.health().deadline_misses;
-  r->scans_dropped += loop.health().dropped_scans;
+  // HEALTH dropped_scans includes the ring overflows counted above (SimLaserSource::skipped_scans).
+  r->scans_dropped = loop.health().dropped_scans;
+  r->health_dropped = loop.health().dropped_scans;
+  r->pending_at_end = laser.pending() + (loop.scan_pending() ? 1 : 0);
   r->achieved_rate_hz = wall > 0 ? static_cast<double>(r->scans_processed) / wall : 0;
   return true;
 }

@@ -8,12 +8,23 @@
 #pragma once
 
 #include <cstddef>
+#include <functional>
 #include <map>
 #include <cstdint>
 #include <string>
 #include <vector>
 
+#include "hal/msg/laser_scan.h"
+#include "hal/msg/odometry.h"
+
 namespace mmlfw_hil {
+
+// Progress of a running replay (soak samples).
+struct ReplaySample {
+  double elapsed_s = 0;
+  size_t scans_fed = 0, scans_processed = 0, health_dropped = 0, ring_overflows = 0, localized = 0,
+         wrong_localized = 0, loops = 0;
+};
 
 struct ReplayOptions {
   std::string dataset = "aces";
@@ -37,12 +48,25 @@ struct ReplayOptions {
   // (HIL runs of one log differ by 1-2 cm in the paired odometry).
   double scan_time_jitter_ms = 0;
   bool trace = false;             // one line per processed scan on stdout (interpreter state, error)
+  // Fault campaign: called with each scan (log index) before it is fed; may corrupt it (NaN, inf,
+  // zero readings, ...). The reference for scoring stays the log's.
+  std::function<void(size_t log_index, hal::LaserScan* scan)> mutate_scan;
+  // Likewise for each odometry sample (its log time in seconds).
+  std::function<void(double log_time_s, hal::Odometry* odom)> mutate_odometry;
+  // Soak (rate mode only): > 0 loops the scans [first_scan, first_scan + num_scans) until this much
+  // wall time has passed; sensor time runs on across the wraps (the robot is carried back to the
+  // start: a kidnapping the odometry sees as a jump). on_sample is called every sample_period_s.
+  double duration_s = 0;
+  double sample_period_s = 10;
+  std::function<void(const ReplaySample&)> on_sample;
 };
+
 
 struct ReplayResult {
   std::string localizer;          // name of the localizer built (LocalizationSystem::name())
   size_t scans_fed = 0, scans_processed = 0, scans_dropped = 0, scans_lost = 0, localized = 0;
   long first_localized_scan = -1;  // log index of the first `localized` pose
+  long last_localized_scan = -1;   // log index of the last `localized` pose
   size_t after_first_fix = 0, localized_after_first_fix = 0;  // poses after the first `localized` one
   double availability = 0;         // localized_after_first_fix / after_first_fix
   size_t deadline_misses = 0;
@@ -56,6 +80,10 @@ struct ReplayResult {
   size_t map_width = 0, map_height = 0;
   double map_resolution = 0;
   int pin_warnings = 0;
+  size_t ring_overflows = 0;      // scans the simulated sensor could not hand over (ring full)
+  size_t health_dropped = 0;      // HEALTH dropped_scans at the end
+  size_t loops = 0;               // completed passes over the scans (soak)
+  size_t pending_at_end = 0;      // scans still queued or waiting when the replay stopped
 };
 
 bool run_replay(const ReplayOptions& options, ReplayResult* out, std::string* error);

@@ -21,6 +21,11 @@ class LaserScanSource {
   // it received intact but rejected as impossible; the loop puts both in the health frame.
   virtual std::uint32_t fault_bits() const { return 0; }
   virtual std::uint32_t invalid_scans() const { return 0; }
+  // Scans received intact but replaced by a newer one before poll() handed them out (the firmware
+  // skips to the newest scan when a step is slower than the sensor); the loop adds them to the
+  // health frame's dropped_scans. Sources that count such losses in their own health path (CanNode)
+  // leave this at 0.
+  virtual std::uint32_t skipped_scans() const { return 0; }
 };
 
 class OdometrySource {

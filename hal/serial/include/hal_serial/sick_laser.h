@@ -42,6 +42,7 @@ class SickLaser final : public hal::LaserScanSource {
   // laser-disconnected while the port is gone; CRC-valid telegrams with impossible content.
   std::uint32_t fault_bits() const override;
   std::uint32_t invalid_scans() const override { return stats_.bad_measurements; }
+  std::uint32_t skipped_scans() const override { return stats_.overwritten; }
   const SickParserStats& parser_stats() const { return parser_.stats(); }
   const SickLaserStats& stats() const { return stats_; }
 

@@ -32,6 +32,9 @@ class SimLaserSource final : public hal::LaserScanSource {
 
   std::size_t pending() const { return ring_.size(); }
   const RingStats& stats() const { return stats_; }
+  // Scans the sensor produced while the ring was full are lost to the firmware: HEALTH counts them
+  // (as CanNode counts its ring overflows), so a soak can account for every scan in HEALTH alone.
+  std::uint32_t skipped_scans() const override { return static_cast<std::uint32_t>(stats_.dropped); }
 
  private:
   fw::RingBuffer<hal::LaserScan, kCapacity> ring_;
