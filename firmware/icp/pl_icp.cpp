@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cmath>
 
+#include "firmware/icp/valid_points.h"
 #include "firmware/scan/point_to_line.h"
 
 namespace fw {
@@ -65,16 +66,7 @@ Status PlIcp::match(const Point2f* points, std::size_t count, const Se2f& guess,
                          static_cast<double>(guess.x), static_cast<double>(guess.y), static_cast<double>(guess.theta));
   }
   *out = ScanMatchResult{};
-  n_ = 0;
-  const float max_r2 = options_.max_range > 0.0f ? options_.max_range * options_.max_range : 0.0f;
-  for (std::size_t i = 0; i < count; ++i) {
-    const float px = points[i](0), py = points[i](1);
-    if (!std::isfinite(px) || !std::isfinite(py)) continue;
-    if (max_r2 > 0.0f && px * px + py * py > max_r2) continue;
-    px_[n_] = px;
-    py_[n_] = py;
-    ++n_;
-  }
+  n_ = copy_valid_points(points, count, options_.max_range, px_, py_);
   out->used_points = n_;
   out->pose = guess;
   if (n_ < options_.min_correspondences) {
