@@ -15,6 +15,7 @@
 #include <string>
 
 #include "sim/eval/pransam_eval/pransam3d_real.h"
+#include "sim/eval/pransam_eval/cli_args.h"
 #include "sim/eval/pransam_eval/pransam_eval_lib.h"
 #include "sim/map/map_image_writer.h"
 #include "sim/common/cli_main.h"
@@ -22,20 +23,6 @@
 using namespace sim::pransam_eval;
 
 namespace {
-std::map<std::string, std::string> parse(int argc, char** argv, int first) {
-  std::map<std::string, std::string> a;
-  for (int i = first; i < argc; ++i) {
-    std::string k = argv[i];
-    if (k.rfind("--", 0) != 0) continue;
-    k = k.substr(2);
-    if (i + 1 < argc && std::string(argv[i + 1]).rfind("--", 0) != 0) a[k] = argv[++i]; else a[k] = "1";
-  }
-  return a;
-}
-std::string get(const std::map<std::string, std::string>& a, const std::string& k, const std::string& d) {
-  auto it = a.find(k);
-  return it == a.end() ? d : it->second;
-}
 int usage() {
   std::fprintf(stderr, "usage: mml-pransam-eval scan-map|theorem1|3d|build-table [options] (see source header)\n");
   return 2;
