@@ -23,17 +23,22 @@ namespace {
 using Clock = std::chrono::steady_clock;
 
 // Master side of a pty, its slave reachable as `link`.
+// Like socat's `link=`, the name exists only while the peer is there: a dangling link to the freed
+// /dev/pts/N could be reopened by the board onto a pty another process (a parallel test) was given.
 struct Peer {
   int master = -1;
-  bool open(const std::string& link) {
+  std::string link;
+  bool open(const std::string& name) {
     master = ::posix_openpt(O_RDWR | O_NOCTTY);
     if (master < 0 || ::grantpt(master) != 0 || ::unlockpt(master) != 0) return false;
     const char* slave = ::ptsname(master);
     if (slave == nullptr) return false;
+    link = name;
     ::unlink(link.c_str());
     return ::symlink(slave, link.c_str()) == 0;
   }
   void close() {
+    if (!link.empty()) ::unlink(link.c_str());
     if (master >= 0) ::close(master);
     master = -1;
   }
