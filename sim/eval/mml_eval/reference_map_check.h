@@ -38,6 +38,9 @@ struct ReferenceMapCheckOptions {
   std::size_t max_points = 180;     // end-points used (evenly subsampled)
   std::size_t min_gain_points = 3;
   double min_gain_fraction = 0.03;
+  // Ties between equally good poses go to the one nearest the reference, a heading change counted
+  // as the shift it makes at this distance (m).
+  double lever_m = 1.0;
 };
 
 struct ReferenceMapFit {
