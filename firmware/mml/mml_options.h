@@ -43,12 +43,9 @@ struct MmlOptions {
   // the rating test also needs this many members.
   std::uint32_t min_cluster_hypotheses = 5;
   // Extension: the members may be pooled over consecutive steps in which the best cluster was alone
-  // above δ_r and consistent (d², σ_med) — see interpretation.cpp. Off: one step must hold them all.
-  // Off by default until the tracker's heading in fast turns is fixed: on, mml-track fixes far more
-  // often (fr079 first fix 0.31 → 1.0, availability 0.46 → 0.86) but then tracks through fast turns
-  // it used to sit out, where 5 steps of the bench were `localized` 5.4–5.8° off (fr-clinic,
-  // mit-killian; sim/eval/mml_eval/README.md).
-  bool pool_cluster_support = false;
+  // above δ_r and consistent (d², σ_med) — see interpretation.cpp. Off: one step must hold them all
+  // (the dissertation's rule; mml-eval --no-pool, mml-sim --opt pool=0).
+  bool pool_cluster_support = true;
   float xi_r2 = 8.0f;           // d²(r_h, R_h) < ξ_r² (χ² quantile, 3 dof)
   float xi_med = 10.0f;         // σ_med < ξ_med
   std::uint32_t tau_m = 10;     // window of d² values for the median test (Eq. 5.15–5.16)

@@ -72,6 +72,26 @@ UniquenessResult check_pose_uniqueness(const GlobalMap& map, const Point2f* poin
         if (cost < r.rival_cost) {
           r.rival_cost = cost;
           r.rival = rr.pose;
+          r.rival_turned = false;
+        }
+      }
+    }
+  }
+  // Rivals in heading, refined from the candidate's position turned both ways.
+  if (o.rotation_step_rad > 0.0f) {
+    for (float rot = o.rotation_step_rad; rot <= o.max_rotation_rad + 1e-6f; rot += o.rotation_step_rad) {
+      for (int sign = -1; sign <= 1; sign += 2) {
+        const Se2f seed(pose.x, pose.y, wrap_angle(pose.theta + static_cast<float>(sign) * rot));
+        const RefineResult rr = refine_pose(map, points, n, seed, ro);
+        ++r.rivals_tried;
+        if (std::fabs(wrap_angle(rr.pose.theta - pose.theta)) < o.min_separation_rad &&
+            std::hypot(rr.pose.x - pose.x, rr.pose.y - pose.y) < o.min_separation_m)
+          continue;
+        const float cost = truncated_scan_cost(map, points, n, rr.pose, o.clip_m);
+        if (cost < r.rival_cost) {
+          r.rival_cost = cost;
+          r.rival = rr.pose;
+          r.rival_turned = true;
         }
       }
     }

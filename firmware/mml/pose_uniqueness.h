@@ -22,6 +22,12 @@ struct UniquenessOptions {
   float shift_step_m = 0.4f;       // spacing of the seeds
   float min_separation_m = 0.4f;   // a refined rival closer than this is the candidate itself
   float margin = 0.01f;            // unique when every rival's cost exceeds the candidate's by more
+  // Rivals in heading: seeds turned by ±k·rotation_step_rad up to max_rotation_rad (0 = none). A
+  // track held at a wrong heading by clutter near the robot fits the near walls at either heading;
+  // the far walls, outliers at the held heading, pull the turned seed to where they fit.
+  float rotation_step_rad = 0.0f;
+  float max_rotation_rad = 0.0f;
+  float min_separation_rad = 0.035f;  // a refined rival turned less than this is the candidate
 };
 
 struct UniquenessResult {
@@ -30,6 +36,7 @@ struct UniquenessResult {
   float rival_cost = 1.0f;  // best rival's
   Se2f rival;
   std::uint32_t rivals_tried = 0;
+  bool rival_turned = false;  // the best rival came from a turned seed
 };
 
 // Mean of min(d, clip)² / clip² over the points (robot frame) placed at `pose`; points off the map

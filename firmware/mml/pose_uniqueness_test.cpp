@@ -61,6 +61,41 @@ TEST(PoseUniquenessTest, OffsetPoseLosesToTheTruePose) {
   EXPECT_LT(std::hypot(r.rival.x - truth.x, r.rival.y - truth.y), 0.2f) << r.rival.x << "," << r.rival.y;
 }
 
+UniquenessOptions with_heading_rivals() {
+  UniquenessOptions o;
+  o.rotation_step_rad = 0.0524f;  // 3°
+  o.max_rotation_rad = 0.21f;     // 12°
+  return o;
+}
+
+TEST(PoseUniquenessTest, HeadingRivalsLeaveTheTruePoseUnique) {
+  static GridWorld g = mcl::testing::unique_room();
+  static testing::OwnedGlobalMap gm(g);
+  static Point2f pts[1081];
+  for (const Se2f truth : {Se2f(2.5f, 6.5f, 0.0f), Se2f(4.5f, 2.8f, -1.57f), Se2f(7.0f, 3.0f, 0.7f)}) {
+    const std::size_t n = scan_points_at(g, truth, pts);
+    const UniquenessResult r = check_pose_uniqueness(gm.map, pts, n, truth, with_heading_rivals());
+    EXPECT_TRUE(r.unique) << truth.x << "," << truth.y << ": cost " << r.cost << " rival " << r.rival_cost;
+    EXPECT_EQ(r.rivals_tried, 2u * 2u * 7u + 2u * 4u);  // + 2 signs × 4 turns of 3° up to 12°
+  }
+}
+
+TEST(PoseUniquenessTest, PoseHeldAtAWrongHeadingLosesToATurnedRival) {
+  // The candidate has the right position but is turned 7° (a track held by walls near the robot):
+  // translation rivals alone keep its heading; a rival seeded turned back finds the truth.
+  static GridWorld g = mcl::testing::unique_room();
+  static testing::OwnedGlobalMap gm(g);
+  static Point2f pts[1081];
+  const Se2f truth(4.5f, 2.8f, 0.3f);
+  const std::size_t n = scan_points_at(g, truth, pts);
+  const Se2f turned(truth.x, truth.y, truth.theta + 0.122f);
+  const UniquenessResult r = check_pose_uniqueness(gm.map, pts, n, turned, with_heading_rivals());
+  EXPECT_FALSE(r.unique) << "cost " << r.cost << " rival " << r.rival_cost;
+  EXPECT_TRUE(r.rival_turned);
+  EXPECT_LT(r.rival_cost, r.cost);
+  EXPECT_LT(std::fabs(wrap_angle(r.rival.theta - truth.theta)), 0.02f) << r.rival.theta;
+}
+
 TEST(PoseUniquenessTest, PeriodicCorridorIsNotUnique) {
   static GridWorld g = periodic_corridor();
   static testing::OwnedGlobalMap gm(g);

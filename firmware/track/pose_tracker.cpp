@@ -219,6 +219,9 @@ TrackStep PoseTracker::step(const Point2f* points, std::size_t n, const Se2f& od
     uo.shift_step_m = o.alias_step_m;
     uo.min_separation_m = o.alias_min_separation_m;
     uo.margin = o.alias_margin;
+    uo.rotation_step_rad = o.alias_rotation_step_rad;
+    uo.max_rotation_rad = o.alias_max_rotation_rad;
+    uo.min_separation_rad = o.alias_min_separation_rad;
     const std::size_t stride = (n + kAliasMaxPoints - 1) / kAliasMaxPoints;
     std::size_t m = 0;
     for (std::size_t i = 0; i < n && m < kAliasMaxPoints; i += stride) alias_points_[m++] = points[i];
@@ -229,7 +232,8 @@ TrackStep PoseTracker::step(const Point2f* points, std::size_t n, const Se2f& od
         rival_significantly_better(map_, alias_points_, m, a.pose, u.rival, o.alias_clip_m, a.independent,
                                    o.alias_z)) {
       v = ScanVerdict::kContradicting;  // the scan says the robot is elsewhere
-      out.large_fault = std::hypot(u.rival.x - a.pose.x, u.rival.y - a.pose.y) > o.alert_limit_m;
+      out.large_fault = std::hypot(u.rival.x - a.pose.x, u.rival.y - a.pose.y) > o.alert_limit_m ||
+                        std::fabs(wrap_angle(u.rival.theta - a.pose.theta)) > o.alert_limit_rad;
     } else if (!u.unique) {
       v = ScanVerdict::kAmbiguous;      // fused (odometry keeps the mode), never `localized`
     }

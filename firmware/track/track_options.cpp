@@ -87,6 +87,9 @@ Status TrackOptions::validate() const {
   FW_RETURN_IF_ERROR(check_range("alias_clip_m", alias_clip_m, 0.01f, 2.0f));
   FW_RETURN_IF_ERROR(check_range("alias_margin", alias_margin, 0.0f, 1.0f));
   FW_RETURN_IF_ERROR(check_range("alias_z", alias_z, 0.0f, 100.0f));
+  FW_RETURN_IF_ERROR(check_range("alias_rotation_step_rad", alias_rotation_step_rad, 0.0f, 1.0f));
+  FW_RETURN_IF_ERROR(check_range("alias_max_rotation_rad", alias_max_rotation_rad, 0.0f, 3.1416f));
+  FW_RETURN_IF_ERROR(check_range("alias_min_separation_rad", alias_min_separation_rad, 0.0f, 1.0f));
   FW_RETURN_IF_ERROR(check_range("integrity_risk", integrity_risk, 1e-9f, 0.5f));
   FW_RETURN_IF_ERROR(check_range("alert_limit_m", alert_limit_m, 0.001f, 100.0f));
   FW_RETURN_IF_ERROR(check_range("alert_limit_rad", alert_limit_rad, 0.0001f, 3.2f));

@@ -101,6 +101,13 @@ struct TrackOptions {
   float alias_min_separation_m = 0.4f;
   float alias_clip_m = 0.15f;
   float alias_margin = 0.01f;
+  // Rivals in heading as well (seeds turned ±3°, ±6°, … ±12°): a rival turned ≥ 2° that fits as
+  // well makes the heading ambiguous, one that fits significantly better contradicts the pose
+  // (fr-clinic scan 5548: a track held 6–7° off by clutter near the robot while the far walls fit
+  // only at the true heading). 0 = translation rivals only.
+  float alias_rotation_step_rad = 0.0524f;
+  float alias_max_rotation_rad = 0.21f;
+  float alias_min_separation_rad = 0.035f;
   // A better rival contradicts only when a paired test of the per-point costs says so at this z
   // (3.09: one-sided 1e-3), the end-points counted once per correlation cell.
   float alias_z = 3.09f;

@@ -10,6 +10,7 @@
 #include <vector>
 
 #include "sim/common/bench_json.h"
+#include "firmware/mml/mml_options.h"
 #include "sim/eval/mml_eval/mml_eval.h"
 
 namespace sim::mmleval {
@@ -20,7 +21,7 @@ struct LocalizePlan {
   std::uint64_t seed = 1;
   int threads = 2;
   int mml_config = 3;
-  bool pool_cluster_support = false;  // --pool: MmlOptions::pool_cluster_support (extension, off)
+  bool pool_cluster_support = fw::mml::MmlOptions().pool_cluster_support;  // --no-pool / --pool (extension)
   TrialOptions step_rule;            // min_move_m / min_turn_rad (the suite's step rule)
   // Whole-log runs: kidnapped starts drawn over the first `whole_start_fraction` of the log's path,
   // each run continues to the END of the log (whole_max_steps = 0) or to that many steps.

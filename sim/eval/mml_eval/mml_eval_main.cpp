@@ -13,7 +13,7 @@
 //   mml-eval --localize [--datasets intel,fr101] [--whole-runs 3] [--steps 0] [--fix-trials 10]
 //            [--fix-steps 200] [--mcl-trials 3] [--mcl-datasets intel,fr079] [--kidnap-runs 2]
 //            [--kidnap-datasets intel,fr079,aces] [--no-unknown] [--seed 1] [--threads 2] [--out DIR]
-//            [--pool]   (MML best-cluster support pooled over consistent steps; extension, off)
+//            [--no-pool]   (MML best-cluster support not pooled over consistent steps: Eq. 5.17 per step)
 //   --steps 0 = whole-log runs continue to the end of the log (else at most that many steps).
 // Any building by path (implies --localize; only this building unless --datasets is given):
 //   mml-eval --log LOG.clf[.gz] --map MAP.yaml --reference POSES.txt|CORRECTED.log[.gz]
@@ -73,6 +73,7 @@ static int run_main(int argc, char** argv) {
     else if (a == "--name") files.name = str();
     else if (a == "--synthetic-odometry") files.synthetic_odometry = true;
     else if (a == "--pool") lp.pool_cluster_support = true;
+    else if (a == "--no-pool") lp.pool_cluster_support = false;
     else if (a == "--whole-runs") lp.whole_runs = next(0, 1000);
     else if (a == "--fix-trials") lp.fix_trials = next(0, 1000);
     else if (a == "--fix-steps") lp.fix_steps = next(1, 100000);

@@ -49,7 +49,7 @@ bool apply_local_map_options(const std::map<std::string, std::string>& o, const 
   if (!parse_int(o, "pool", 0, 1, &pool, who, err)) return false;
   cfg->mml.correct_local_map = correct != 0;
   cfg->mml.reduce_observations = reduce != 0;
-  cfg->mml.pool_cluster_support = pool != 0;  // MmlOptions::pool_cluster_support (extension, off)
+  cfg->mml.pool_cluster_support = pool != 0;  // MmlOptions::pool_cluster_support (extension, on)
   return true;
 }
 
