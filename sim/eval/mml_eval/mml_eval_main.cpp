@@ -14,6 +14,7 @@
 //            [--fix-steps 200] [--mcl-trials 3] [--mcl-datasets intel,fr079] [--kidnap-runs 2]
 //            [--kidnap-datasets intel,fr079,aces] [--no-unknown] [--seed 1] [--threads 2] [--out DIR]
 //            [--no-pool]   (MML best-cluster support not pooled over consistent steps: Eq. 5.17 per step)
+//   --help prints the usage.
 //   --steps 0 = whole-log runs continue to the end of the log (else at most that many steps).
 // Any building by path (implies --localize; only this building unless --datasets is given):
 //   mml-eval --log LOG.clf[.gz] --map MAP.yaml --reference POSES.txt|CORRECTED.log[.gz]
@@ -37,8 +38,21 @@ std::vector<std::string> split(const std::string& s) {
   while (std::getline(ss, x, ',')) if (!x.empty()) out.push_back(x);
   return out;
 }
+const char kUsage[] =
+    "usage: mml-eval [--datasets intel,aces] [--trials 10] [--mcl-trials N] [--steps 150] [--mit-steps 300]\n"
+    "                [--seed 1] [--threads 2] [--config 3] [--all-configs] [--mcl-particles 30000]\n"
+    "                [--mcl-particles-mit 120000] [--no-handoff] [--no-mcl] [--no-unknown] [--out build/eval/mml]\n"
+    "                [--correct] [--reduce] [--no-unique] [--compare-local-map-options]\n"
+    "       mml-eval --localize [--datasets intel,fr101] [--whole-runs 3] [--steps 0] [--fix-trials 10]\n"
+    "                [--fix-steps 200] [--mcl-trials 3] [--mcl-datasets intel,fr079] [--kidnap-runs 2]\n"
+    "                [--kidnap-datasets intel,fr079,aces] [--no-unknown] [--seed 1] [--threads 2] [--out DIR]\n"
+    "                [--no-pool]\n"
+    "       mml-eval --log LOG.clf[.gz] --map MAP.yaml --reference POSES.txt|CORRECTED.log[.gz]\n"
+    "                [--relations R] [--name NAME] [--synthetic-odometry]   (any building by path)\n"
+    "Datasets are read from ../shared/data (MMLFW_DATA_DIR). Definitions of every figure:\n"
+    "sim/eval/mml_eval/README.md.\n";
 int usage(const char* msg) {
-  std::fprintf(stderr, "mml-eval: %s\n(see the header of sim/eval/mml_eval/mml_eval_main.cpp for the flags)\n", msg);
+  std::fprintf(stderr, "mml-eval: %s\n%s", msg, kUsage);
   return 2;
 }
 }  // namespace
@@ -54,6 +68,10 @@ static int run_main(int argc, char** argv) {
   sim::mmleval::DatasetFiles files;
   for (int i = 1; i < argc; ++i) {
     const std::string a = argv[i];
+    if (a == "--help" || a == "-h") {
+      std::fputs(kUsage, stdout);
+      return 0;
+    }
     auto next = [&](long lo, long hi) -> long {
       if (i + 1 >= argc) { std::exit(usage(("missing value for " + a).c_str())); }
       char* end = nullptr;
