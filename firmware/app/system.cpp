@@ -54,8 +54,10 @@ Status LocalizationSystem::build(const SystemSpec& spec, const GlobalMap& map, c
   const bool want_mml = std::strcmp(name, "mcl") != 0;
   const bool want_mcl = std::strcmp(name, "mcl") == 0 || std::strcmp(name, "handoff") == 0;
   if (want_mml) {
-    const mml::MmlLocalizerConfig base =
-        spec.mml != nullptr ? *spec.mml : mml::mml_preset(spec.mml_preset, spec.seed);
+    const bool tracked = std::strcmp(name, "mml-track") == 0;
+    const mml::MmlLocalizerConfig base = spec.mml != nullptr ? *spec.mml
+                                         : tracked ? mml::mml_track_preset(spec.mml_preset, spec.seed)
+                                                   : mml::mml_preset(spec.mml_preset, spec.seed);
     // pRANSAM's contact field must cover this map (it is sized from the map, not the preset).
     const mml::MmlLocalizerConfig mc = mml::fit_contact_field_to_map(base, map);
     Result<mml::MmlLocalizer*> r = emplace<mml::MmlLocalizer>(arena, "MmlLocalizer");

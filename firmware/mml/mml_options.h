@@ -43,9 +43,12 @@ struct MmlOptions {
   // the rating test also needs this many members.
   std::uint32_t min_cluster_hypotheses = 5;
   // Extension: the members may be pooled over consecutive steps in which the best cluster was alone
-  // above δ_r and consistent (d², σ_med) — see interpretation.cpp. Off: one step must hold them all
-  // (the dissertation's rule; mml-eval --no-pool, mml-sim --opt pool=0).
-  bool pool_cluster_support = true;
+  // above δ_r and consistent (d², σ_med) — see interpretation.cpp. Off: one step must hold them all.
+  // Off for MML alone, on in mml-track (mml_track_preset): there the tracker confirms the fix on the
+  // same scan and guards it from then on, while MML alone publishes its soft-rule continuation
+  // (Eq. 5.22) unchecked — with pooling it localized earlier on intel's unknown-area run and then
+  // stayed `localized` 1.1 m behind as the robot drove into the erased box (bench mml, trial 1).
+  bool pool_cluster_support = false;
   float xi_r2 = 8.0f;           // d²(r_h, R_h) < ξ_r² (χ² quantile, 3 dof)
   float xi_med = 10.0f;         // σ_med < ξ_med
   std::uint32_t tau_m = 10;     // window of d² values for the median test (Eq. 5.15–5.16)

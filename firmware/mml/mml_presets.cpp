@@ -17,6 +17,12 @@ MmlLocalizerConfig mml_preset(int preset, std::uint64_t seed) {
   return c;
 }
 
+MmlLocalizerConfig mml_track_preset(int preset, std::uint64_t seed) {
+  MmlLocalizerConfig c = mml_preset(preset, seed);
+  c.mml.pool_cluster_support = true;
+  return c;
+}
+
 MmlLocalizerConfig fit_contact_field_to_map(MmlLocalizerConfig config, const GlobalMap& map) {
   const float res = std::max(0.05f, map.geometry.resolution);
   auto& f = config.matcher.field;

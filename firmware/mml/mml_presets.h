@@ -21,6 +21,10 @@ constexpr int kDefaultMmlPreset = 3;
 // Configuration C`preset` (1..4; other values give C3) with `seed` for RBSM and pRANSAM.
 MmlLocalizerConfig mml_preset(int preset, std::uint64_t seed);
 
+// The MML part of mml-track: C`preset` with the pooled cluster support (MmlOptions::
+// pool_cluster_support), which the tracker's confirmation of every fix makes safe to use.
+MmlLocalizerConfig mml_track_preset(int preset, std::uint64_t seed);
+
 // pRANSAM's contact field must cover the whole global map: its cell follows the map's resolution
 // (never finer than 5 cm) and its capacity the map's extent plus a margin (fr-clinic: 440 × 241 m).
 MmlLocalizerConfig fit_contact_field_to_map(MmlLocalizerConfig config, const GlobalMap& map);

@@ -79,7 +79,7 @@ TEST(LocalizeData, Fr101KidnapRunKeepsOdometryContinuous) {
   LoadedDataset ds;
   std::string err;
   ASSERT_TRUE(load_dataset("fr101", &ds, &err)) << err;
-  auto loc = OwnedLocalizer::make_track(ds.map, ds.image, mml_config(3, 1), fw::track::TrackOptions(), 1, &err);
+  auto loc = OwnedLocalizer::make_track(ds.map, ds.image, mml_track_config(3, 1), fw::track::TrackOptions(), 1, &err);
   ASSERT_TRUE(loc) << err;
   TrialOptions opt;
   opt.max_steps = 0;

@@ -177,7 +177,7 @@ bool run_localize_evaluation(const LocalizePlan& plan, BenchJson* json, std::str
   for (const auto& n : plan.datasets) jobs.push_back({n, nullptr});
   for (const auto& f : plan.custom) jobs.push_back({f.name, &f});
 
-  fw::mml::MmlLocalizerConfig mml_cfg = mml_config(plan.mml_config, plan.seed);
+  fw::mml::MmlLocalizerConfig mml_cfg = mml_track_config(plan.mml_config, plan.seed);
   mml_cfg.mml.pool_cluster_support = plan.pool_cluster_support;
   for (const Job& job : jobs) {
     const auto t0 = std::chrono::steady_clock::now();

@@ -10,7 +10,6 @@
 #include <vector>
 
 #include "sim/common/bench_json.h"
-#include "firmware/mml/mml_options.h"
 #include "sim/eval/mml_eval/mml_eval.h"
 
 namespace sim::mmleval {
@@ -21,7 +20,7 @@ struct LocalizePlan {
   std::uint64_t seed = 1;
   int threads = 2;
   int mml_config = 3;
-  bool pool_cluster_support = fw::mml::MmlOptions().pool_cluster_support;  // --no-pool / --pool (extension)
+  bool pool_cluster_support = true;  // --no-pool: mml-track's MML without the pooled support (mml_track_preset)
   TrialOptions step_rule;            // min_move_m / min_turn_rad (the suite's step rule)
   // Whole-log runs: kidnapped starts drawn over the first `whole_start_fraction` of the log's path,
   // each run continues to the END of the log (whole_max_steps = 0) or to that many steps.

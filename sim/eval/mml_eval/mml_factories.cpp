@@ -49,7 +49,7 @@ bool apply_local_map_options(const std::map<std::string, std::string>& o, const 
   if (!parse_int(o, "pool", 0, 1, &pool, who, err)) return false;
   cfg->mml.correct_local_map = correct != 0;
   cfg->mml.reduce_observations = reduce != 0;
-  cfg->mml.pool_cluster_support = pool != 0;  // MmlOptions::pool_cluster_support (extension, on)
+  cfg->mml.pool_cluster_support = pool != 0;  // MmlOptions::pool_cluster_support (on in mml-track)
   return true;
 }
 
@@ -130,7 +130,7 @@ std::unique_ptr<fw::Localizer> make_track_localizer(const LocalizerContext& ctx,
   if (ctx.global_map == nullptr) { *err = "localizer mml-track: needs a global map"; return nullptr; }
   long config = 3;
   if (!parse_int(ctx.options, "config", 1, 4, &config, "mml-track", err)) return nullptr;
-  auto cfg = mml_config(static_cast<int>(config), ctx.seed);
+  auto cfg = mml_track_config(static_cast<int>(config), ctx.seed);
   if (!apply_local_map_options(ctx.options, "mml-track", &cfg, err)) return nullptr;
   fw::track::TrackOptions to;
   const auto a = ctx.options.find("alert");

@@ -11,6 +11,9 @@
 namespace sim::mmleval {
 
 fw::mml::MmlLocalizerConfig mml_config(int config, std::uint64_t seed) { return fw::mml::mml_preset(config, seed); }
+fw::mml::MmlLocalizerConfig mml_track_config(int config, std::uint64_t seed) {
+  return fw::mml::mml_track_preset(config, seed);
+}
 
 bool OwnedLocalizer::start_pool(int threads, std::string* err) {
   if (threads <= 1) return true;

@@ -34,6 +34,8 @@ namespace sim::mmleval {
 //   C3: precomputed table, fixed local map (last 8 fragments of 2 m), Bollinger, 30k iterations
 //   C4: as C3 with 60k iterations
 fw::mml::MmlLocalizerConfig mml_config(int config, std::uint64_t seed);
+// The MML part of mml-track (fw::mml::mml_track_preset: pooled cluster support on).
+fw::mml::MmlLocalizerConfig mml_track_config(int config, std::uint64_t seed);
 // MCL presets: firmware/mcl/mcl_presets.h (shared with the firmware).
 using fw::mcl::mcl_baseline_options;
 using fw::mcl::mcl_tracking_options;
