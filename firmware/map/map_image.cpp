@@ -268,7 +268,7 @@ Status verify_map_image(const std::uint8_t* bytes, std::size_t size, const char*
 }
 
 Status load_map_image(const std::uint8_t* bytes, std::size_t size, StartupArena& arena, GlobalMap* out,
-                      const char* name) {
+                      const char* name, const MapLoadOptions& options) {
   if (out == nullptr) return Status::error(Errc::kInvalidArgument, "%s: no output map", name);
   FW_RETURN_IF_ERROR(verify_except_padding(bytes, size, name));
   const std::size_t count = map_section_count(bytes, size);
@@ -409,13 +409,28 @@ Status load_map_image(const std::uint8_t* bytes, std::size_t size, StartupArena&
 
   // Copy into the start-up arena (the image buffer may be unmapped afterwards). Everything is released
   // again (rewind) if the distance field turns out wrong: nothing stays allocated for a bad image.
+  // The distance field is kept truncated and tiled (distance_field.h); the dense float array the
+  // check recomputes is scratch above everything kept, released before returning.
+  DistanceFieldLayout layout;
+  FW_RETURN_IF_ERROR(plan_distance_field(dist_bytes, geometry.width, geometry.height, geometry.resolution,
+                                         options.distance_truncation_m, &layout));
+  OccupancyTilesLayout occ_layout;
+  FW_RETURN_IF_ERROR(plan_occupancy_tiles(occ_bytes, geometry.width, geometry.height, &occ_layout));
   const std::size_t arena_mark = arena.mark();
-  Result<std::uint8_t*> occ_mem = arena.allocate_array<std::uint8_t>(static_cast<std::size_t>(cells), "map occupancy");
-  if (!occ_mem) return occ_mem.status();
-  Result<float*> dist_mem = arena.allocate_array<float>(static_cast<std::size_t>(cells), "map distance field");
-  if (!dist_mem) {
+  Result<std::uint32_t*> occ_slots = arena.allocate_array<std::uint32_t>(occ_layout.slot_count(), "map occupancy tiles");
+  Result<std::uint8_t*> occ_mem = occ_slots ? arena.allocate_array<std::uint8_t>(occ_layout.cell_count(), "map occupancy tiles")
+                                            : Result<std::uint8_t*>(occ_slots.status());
+  if (!occ_mem) {
     arena.rewind(arena_mark);
-    return dist_mem.status();
+    return occ_mem.status();
+  }
+  Result<std::uint32_t*> slot_mem = arena.allocate_array<std::uint32_t>(layout.slot_count(), "map distance tiles");
+  Result<std::uint16_t*> tile_mem =
+      slot_mem ? arena.allocate_array<std::uint16_t>(layout.cell_count(), "map distance tiles")
+               : Result<std::uint16_t*>(slot_mem.status());
+  if (!tile_mem) {
+    arena.rewind(arena_mark);
+    return tile_mem.status();
   }
   Result<Point2f*> pts_mem = arena.allocate_array<Point2f>(num_points, "map occupied points");
   if (!pts_mem) {
@@ -423,40 +438,62 @@ Status load_map_image(const std::uint8_t* bytes, std::size_t size, StartupArena&
     return pts_mem.status();
   }
   Point2f* points = *pts_mem;
+  const std::size_t scratch_mark = arena.mark();
+  Result<float*> dist_mem = arena.allocate_array<float>(static_cast<std::size_t>(cells), "map distance check");
+  if (!dist_mem) {
+    arena.rewind(arena_mark);
+    return dist_mem.status();
+  }
   const Status field = recompute_distance_field(geometry, occ_bytes, dist_bytes, arena, *dist_mem, name);
+  arena.rewind(scratch_mark);
   if (!field) {
     arena.rewind(arena_mark);
     return field;
   }
-  std::memcpy(*occ_mem, occ_bytes, static_cast<std::size_t>(cells));
+  const DistanceField distance = fill_distance_field(layout, dist_bytes, *slot_mem, *tile_mem);
+  const OccupancyTiles occupancy = fill_occupancy_tiles(occ_layout, occ_bytes, *occ_slots, *occ_mem);
   for (std::uint32_t i = 0; i < num_points; ++i) {
     points[i] = Point2f(rd_f32(pts_bytes + 8u * i), rd_f32(pts_bytes + 8u * i + 4));
   }
 
   MemoryReport& report = MemoryReport::instance();
-  FW_RETURN_IF_ERROR(report.add({"map", "occupancy", static_cast<std::size_t>(cells), static_cast<std::size_t>(cells),
-                                 nullptr}));
-  FW_RETURN_IF_ERROR(report.add({"map", "distance field", static_cast<std::size_t>(cells) * sizeof(float),
-                                 static_cast<std::size_t>(cells), nullptr}));
+  FW_RETURN_IF_ERROR(report.add({"map", "occupancy (tiles)", occ_layout.bytes(), occ_layout.stored_tiles, nullptr}));
+  FW_RETURN_IF_ERROR(report.add({"map", "distance field (tiles)", layout.bytes(), layout.stored_tiles, nullptr}));
   FW_RETURN_IF_ERROR(report.add({"map", "occupied points", num_points * sizeof(Point2f), num_points, nullptr}));
 
   out->geometry = geometry;
-  out->occupancy = *occ_mem;
-  out->distance_m = *dist_mem;
+  out->occupancy = occupancy;
+  out->distance = distance;
   out->points = points;
   out->num_points = num_points;
   out->max_distance_m = max_distance;
   return Status::ok();
 }
 
-std::size_t map_image_arena_bytes(const std::uint8_t* bytes, std::size_t size) {
+std::size_t map_image_arena_bytes(const std::uint8_t* bytes, std::size_t size, const MapLoadOptions& options) {
   std::size_t len = 0;
   const std::uint8_t* g = find_section(bytes, size, MapSectionType::kGeometry, &len);
   if (g == nullptr || len != kMapGeometryBytes) return 0;
   const std::uint64_t w = rd_u32(g + 12), h = rd_u32(g + 16), points = rd_u32(g + 20);
   const std::uint64_t cells = w * h, longer = w > h ? w : h;
-  // occupancy + distance field + points + scratch (int v, float z/f/d) + alignment of each array.
-  const std::uint64_t bytes_needed = cells * (1 + sizeof(float)) + points * sizeof(Point2f) + (longer + 1) * 16 + 8 * 16;
+  // The distance tiles as load_map_image plans them (an absent or short distance section: 0).
+  std::size_t dlen = 0;
+  const std::uint8_t* d = find_section(bytes, size, MapSectionType::kDistanceField, &dlen);
+  if (d == nullptr || dlen != cells * 4) return 0;
+  DistanceFieldLayout layout;
+  if (!plan_distance_field(d, static_cast<std::uint32_t>(w), static_cast<std::uint32_t>(h), rd_f32(g),
+                           options.distance_truncation_m, &layout)) {
+    return 0;
+  }
+  // Peak: occupancy tiles + distance tiles + points + the check's dense float field and its scratch (int
+  // v, float z/f/d) + alignment of each array.
+  std::size_t olen = 0;
+  const std::uint8_t* o = find_section(bytes, size, MapSectionType::kOccupancy, &olen);
+  if (o == nullptr || olen != cells) return 0;
+  OccupancyTilesLayout occ_layout;
+  if (!plan_occupancy_tiles(o, static_cast<std::uint32_t>(w), static_cast<std::uint32_t>(h), &occ_layout)) return 0;
+  const std::uint64_t bytes_needed = occ_layout.bytes() + cells * sizeof(float) + layout.bytes() +
+                                     points * sizeof(Point2f) + (longer + 1) * 16 + 8 * 16;
   return bytes_needed > static_cast<std::uint64_t>(static_cast<std::size_t>(-1)) ? 0
                                                                                  : static_cast<std::size_t>(bytes_needed);
 }

@@ -59,6 +59,12 @@ using SectionType = MapSectionType;
 
 const char* map_section_name(MapSectionType type);
 
+struct MapLoadOptions {
+  // The distance field is kept as min(d, truncation) in tiles (distance_field.h): memory grows with
+  // the area within the truncation of a wall, not with the bounding box.
+  float distance_truncation_m = kDefaultDistanceTruncationM;
+};
+
 struct MapSectionInfo {
   MapSectionType type = MapSectionType::kGeometry;
   std::uint32_t version = 0;
@@ -75,16 +81,20 @@ Status verify_map_image(const std::uint8_t* bytes, std::size_t size, const char*
 // representable grid extent, finite floats, occupancy codes, at least one occupied cell, exactly one
 // point at the centre of each occupied cell in row-major order, reserved fields zero, and the distance
 // field equal to the exact EDT of the occupied cells, recomputed here), then copies the arrays into
-// `arena` and fills `out`. Nothing stays allocated unless the whole image is valid. The recomputation
-// needs map_image_arena_bytes() of arena at its peak (scratch released before returning) and costs
+// `arena` and fills `out` (the distance field truncated at options.distance_truncation_m and tiled:
+// distance_field.h). Nothing stays allocated unless the whole image is valid. The recomputation
+// needs map_image_arena_bytes() of arena at its peak (a dense float field of scratch, released before
+// returning: load the map before the other modules allocate, so the peak is not added to theirs) and costs
 // about as much as the writer's EDT (see sim/map/README.md for figures). Registers the copied bytes
 // with MemoryReport under module "map".
 Status load_map_image(const std::uint8_t* bytes, std::size_t size, StartupArena& arena, GlobalMap* out,
-                      const char* name = "map image");
+                      const char* name = "map image", const MapLoadOptions& options = MapLoadOptions{});
 
-// Arena bytes load_map_image needs at its peak for this image (the three arrays, the distance check's
-// scratch and alignment padding); 0 when the structure or the geometry section is malformed.
-std::size_t map_image_arena_bytes(const std::uint8_t* bytes, std::size_t size);
+// Arena bytes load_map_image needs at its peak for this image (the kept arrays, the distance check's
+// dense field and scratch, alignment padding); 0 when the structure, the geometry or the distance
+// section is malformed.
+std::size_t map_image_arena_bytes(const std::uint8_t* bytes, std::size_t size,
+                                  const MapLoadOptions& options = MapLoadOptions{});
 
 // Payload of the first section of `type`, or nullptr (absent, or header/table malformed). Checks only
 // the structure (bounds), not the CRCs: call it on an image load_map_image/verify_map_image accepted.

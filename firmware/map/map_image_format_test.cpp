@@ -102,7 +102,11 @@ TEST(MapImageFormatTest, LoadsHandMadeImage) {
   EXPECT_EQ(m.distance_at(1.25f, -0.75f, -1.0f), 0.0f);
   EXPECT_EQ(m.distance_at(1.75f, -0.75f, -1.0f), 0.5f);
   EXPECT_EQ(m.max_distance_m, 1.0f);  // cells (3,0) and (0,2): 2 cells from the nearest wall
-  EXPECT_EQ(arena.used(), 12u + 12u * 4u + 2u * 8u);  // occupancy, distances, points
+  // Occupancy and distance field as one 16×16 tile each (an index entry + 256 codes; an index entry +
+  // 256 uint16: the map has known cells and is within the truncation of a wall everywhere), points.
+  EXPECT_EQ(m.occupancy.stored_tiles, 1u);
+  EXPECT_EQ(m.distance.stored_tiles, 1u);
+  EXPECT_EQ(arena.used(), (4u + 256u) + (4u + 256u * 2u) + 2u * 8u);
 }
 
 TEST(MapImageFormatTest, RejectsWrongDistanceDuplicatesReservedFieldsAndFarOrigins) {

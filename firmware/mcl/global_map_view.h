@@ -16,7 +16,7 @@ inline MapView map_view_from_global(const GlobalMap& g) {
   v.width = g.geometry.width;
   v.height = g.geometry.height;
   v.occupancy = g.occupancy;
-  v.distance_m = g.distance_m;
+  v.distance = g.distance;
   return v;
 }
 

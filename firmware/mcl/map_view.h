@@ -6,6 +6,9 @@
 #include <cmath>
 #include <cstdint>
 
+#include "firmware/map/distance_field.h"
+#include "firmware/map/occupancy_tiles.h"
+
 namespace fw {
 namespace mcl {
 
@@ -13,10 +16,10 @@ struct MapView {
   float resolution = 0.05f;
   float origin_x = 0.0f, origin_y = 0.0f;  // world coordinates of cell (0,0)'s lower-left corner
   std::uint32_t width = 0, height = 0;
-  const std::uint8_t* occupancy = nullptr;  // 0 free, 100 occupied, 255 unknown
-  const float* distance_m = nullptr;        // metres to the nearest occupied cell
+  OccupancyTiles occupancy;                 // 0 free, 100 occupied, 255 unknown
+  DistanceField distance;                   // metres to the nearest occupied cell (truncated)
 
-  bool valid() const { return width > 0 && height > 0 && occupancy && distance_m && resolution > 0.0f; }
+  bool valid() const { return width > 0 && height > 0 && occupancy.valid() && distance.valid() && resolution > 0.0f; }
   bool cell_of(float x, float y, int* cx, int* cy) const {
     const float fx = (x - origin_x) / resolution, fy = (y - origin_y) / resolution;
     if (!(fx >= 0.0f && fy >= 0.0f)) return false;  // also rejects NaN
@@ -28,12 +31,12 @@ struct MapView {
   float distance_at(float x, float y, float outside) const {
     int cx, cy;
     if (!cell_of(x, y, &cx, &cy)) return outside;
-    return distance_m[static_cast<std::uint32_t>(cy) * width + static_cast<std::uint32_t>(cx)];
+    return distance.at(cx, cy);
   }
   std::uint8_t occupancy_at(float x, float y) const {
     int cx, cy;
     if (!cell_of(x, y, &cx, &cy)) return 255;
-    return occupancy[static_cast<std::uint32_t>(cy) * width + static_cast<std::uint32_t>(cx)];
+    return occupancy.at(cx, cy);
   }
   // Expected range along a ray by sphere tracing through the distance image (App. A: ray casting
   // accelerated with the distance image): each step advances by the free distance around the point.

@@ -93,7 +93,7 @@ Status Mcl::sample_free(RandomStream* rng, Particle* p) {
   // Rejection sampling over the grid: a free cell (occupancy 0), uniform within it.
   for (int tries = 0; tries < 100000; ++tries) {
     const std::uint32_t cx = rng->uniform_index(map_.width), cy = rng->uniform_index(map_.height);
-    if (map_.occupancy[cy * map_.width + cx] != 0) continue;
+    if (map_.occupancy.at(static_cast<std::int32_t>(cx), static_cast<std::int32_t>(cy)) != 0) continue;
     p->x = map_.origin_x + (static_cast<float>(cx) + rng->uniform01f()) * map_.resolution;
     p->y = map_.origin_y + (static_cast<float>(cy) + rng->uniform01f()) * map_.resolution;
     p->theta = rng->uniform(-kPi, kPi);

@@ -5,6 +5,7 @@
 #include <cstdint>
 #include <vector>
 
+#include "firmware/map/distance_field.h"
 #include "firmware/map/edt.h"
 #include "firmware/mcl/map_view.h"
 #include "hal/msg/laser_scan.h"
@@ -17,14 +18,25 @@ struct GridWorld {
   float res = 0.05f;
   std::uint32_t w = 0, h = 0;
   std::vector<std::uint8_t> occ;
-  std::vector<float> dist;
+  std::vector<float> dist;  // exact metres (finish())
+  // The truncated, tiled field the localizers read (finish(); distance_field.h).
+  DistanceFieldLayout dist_layout;
+  std::vector<std::uint32_t> dist_slots;
+  std::vector<std::uint16_t> dist_cells;
+  OccupancyTilesLayout occ_layout;
+  std::vector<std::uint32_t> occ_slots;
+  std::vector<std::uint8_t> occ_cells;
+  OccupancyTiles occupancy_tiles() const { return occupancy_tiles_view(occ_layout, occ_slots.data(), occ_cells.data()); }
+  DistanceField distance_field() const {
+    return distance_field_view(dist_layout, dist_slots.data(), dist_cells.data());
+  }
   MapView view() const {
     MapView v;
     v.resolution = res;
     v.width = w;
     v.height = h;
-    v.occupancy = occ.data();
-    v.distance_m = dist.data();
+    v.occupancy = occupancy_tiles();
+    v.distance = distance_field();
     return v;
   }
   void wall(float x0, float y0, float x1, float y1) {
@@ -49,6 +61,14 @@ struct GridWorld {
     squared_edt<2>(f.data(), dims, s);
     dist.resize(w * h);
     for (std::size_t i = 0; i < f.size(); ++i) dist[i] = std::sqrt(f[i]) * res;
+    (void)plan_distance_field(dist.data(), w, h, res, kDefaultDistanceTruncationM, &dist_layout);
+    dist_slots.assign(dist_layout.slot_count(), 0);
+    dist_cells.assign(dist_layout.cell_count(), 0);
+    fill_distance_field(dist_layout, dist.data(), dist_slots.data(), dist_cells.data());
+    (void)plan_occupancy_tiles(occ.data(), w, h, &occ_layout);
+    occ_slots.assign(occ_layout.slot_count(), 0);
+    occ_cells.assign(occ_layout.cell_count(), 0);
+    fill_occupancy_tiles(occ_layout, occ.data(), occ_slots.data(), occ_cells.data());
   }
 };
 

@@ -28,8 +28,8 @@ struct OwnedGlobalMap {
     map.geometry.resolution = g.res;
     map.geometry.width = g.w;
     map.geometry.height = g.h;
-    map.occupancy = g.occ.data();
-    map.distance_m = g.dist.data();
+    map.occupancy = g.occupancy_tiles();
+    map.distance = g.distance_field();
     map.points = points.data();
     map.num_points = static_cast<std::uint32_t>(points.size());
   }

@@ -5,6 +5,20 @@
 #include "firmware/base/memory_report.h"
 
 namespace fw::pransam {
+namespace {
+
+// Contact byte of a distance dm (metres): Eq. 4.31 / 4.33, 255 exclusive to hard contact.
+inline std::uint8_t contact_byte(float dm, float eh, float es) {
+  if (dm < eh) return 255;  // Eq. 4.31
+  if (dm < es) {
+    float f = std::floor(255.0f * (es - dm) / (es - eh));  // Eq. 4.33
+    if (f > 254.0f) f = 254.0f;
+    return static_cast<std::uint8_t>(f);
+  }
+  return 0;
+}
+
+}  // namespace
 
 template <int D>
 Status ContactField<D>::init(const ContactFieldOptions& options, StartupArena& arena) {
@@ -21,9 +35,16 @@ Status ContactField<D>::init(const ContactFieldOptions& options, StartupArena& a
   Result<std::uint8_t*> c = arena.allocate_array<std::uint8_t>(options.max_cells, "pransam contact field");
   if (!c) return c.status();
   cells_ = *c;
-  Result<float*> d = arena.allocate_array<float>(options.max_cells, "pransam distance field");
-  if (!d) return d.status();
-  dist2_ = *d;
+  dist2_ = nullptr;
+  if (options.keep_distance) {
+    Result<float*> d = arena.allocate_array<float>(options.max_cells, "pransam distance field");
+    if (!d) return d.status();
+    dist2_ = *d;
+  } else {
+    scratch_ = EdtScratch{};
+    return MemoryReport::instance().add({D == 2 ? "pransam2d" : "pransam3d", "contact field", arena_bytes(options),
+                                         options.max_cells, nullptr});
+  }
   const std::size_t n = options.max_axis;
   Result<int*> v = arena.allocate_array<int>(n, "pransam edt v");
   Result<float*> z = arena.allocate_array<float>(n + 1, "pransam edt z");
@@ -35,7 +56,49 @@ Status ContactField<D>::init(const ContactFieldOptions& options, StartupArena& a
   if (!dd) return dd.status();
   scratch_ = EdtScratch{*v, *z, *f, *dd, n};
   return MemoryReport::instance().add({D == 2 ? "pransam2d" : "pransam3d", "contact+distance field",
-                                       options.max_cells * 5 + n * 16, options.max_cells, nullptr});
+                                       arena_bytes(options), options.max_cells, nullptr});
+}
+
+template <int D>
+std::size_t ContactField<D>::arena_bytes(const ContactFieldOptions& options) {
+  if (!options.keep_distance) return options.max_cells;
+  return options.max_cells * 5 + static_cast<std::size_t>(options.max_axis) * 16 + 4;
+}
+
+template <int D>
+void ContactField<D>::stamp(const Point<D>* points, std::size_t n) {
+  const float res = options_.resolution, eh = options_.eps_hard, es = options_.eps_soft;
+  // Cells whose centre offset from a point's cell reaches ε_s get 0 anyway: radius ⌈ε_s/res⌉.
+  const int r = static_cast<int>(std::ceil(es / res));
+  for (std::size_t i = 0; i < total_; ++i) cells_[i] = 0;
+  for (std::size_t i = 0; i < n; ++i) {
+    std::int64_t c[D];
+    for (int a = 0; a < D; ++a) c[a] = static_cast<std::int64_t>((points[i](a) - origin_(a)) * inv_res_);
+    // Odometer over the (2r+1)^D offsets; cells off the field are skipped (the margin keeps the
+    // disc inside, but the test is cheap).
+    int off[D];
+    for (int a = 0; a < D; ++a) off[a] = -r;
+    for (;;) {
+      std::size_t idx = 0;
+      std::int64_t d2 = 0;
+      bool inside = true;
+      for (int a = 0; a < D; ++a) {
+        const std::int64_t g = c[a] + off[a];
+        if (g < 0 || g >= static_cast<std::int64_t>(dims_[a])) { inside = false; break; }
+        idx = idx * dims_[a] + static_cast<std::size_t>(g);
+        d2 += static_cast<std::int64_t>(off[a]) * off[a];
+      }
+      if (inside) {
+        // The EDT path's expression for the same integer d², so the same byte.
+        const std::uint8_t v = contact_byte(std::sqrt(static_cast<float>(d2)) * res, eh, es);
+        if (v > cells_[idx]) cells_[idx] = v;
+      }
+      int a = D - 1;
+      while (a >= 0 && off[a] == r) off[a--] = -r;
+      if (a < 0) break;
+      ++off[a];
+    }
+  }
 }
 
 template <int D>
@@ -75,6 +138,10 @@ Status ContactField<D>::build(const Point<D>* points, std::size_t n, const char*
     dims_f_[a] = static_cast<float>(dims[a]);
   }
   total_ = total;
+  if (dist2_ == nullptr) {
+    stamp(points, n);
+    return Status::ok();
+  }
   for (std::size_t i = 0; i < total; ++i) dist2_[i] = kEdtInf;
   for (std::size_t i = 0; i < n; ++i) {
     std::size_t idx = 0;
@@ -87,18 +154,7 @@ Status ContactField<D>::build(const Point<D>* points, std::size_t n, const char*
   squared_edt<D>(dist2_, dims, scratch_);
   const float eh = options_.eps_hard, es = options_.eps_soft;
   for (std::size_t i = 0; i < total; ++i) {
-    const float dm = std::sqrt(dist2_[i]) * res;
-    std::uint8_t c;
-    if (dm < eh) {
-      c = 255;  // Eq. 4.31
-    } else if (dm < es) {
-      float f = std::floor(255.0f * (es - dm) / (es - eh));  // Eq. 4.33
-      if (f > 254.0f) f = 254.0f;
-      c = static_cast<std::uint8_t>(f);
-    } else {
-      c = 0;
-    }
-    cells_[i] = c;
+    cells_[i] = contact_byte(std::sqrt(dist2_[i]) * res, eh, es);
   }
   return Status::ok();
 }

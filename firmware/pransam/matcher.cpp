@@ -479,6 +479,11 @@ Status Matcher<D>::match(const Point<D>* scene, std::size_t n, const MatchParams
   *out = MatchResult<D>{};
   if (!initialized_) return Status::error(Errc::kNotInitialized, "pransam match: matcher not initialised");
   if (model_ == nullptr) return Status::error(Errc::kNotInitialized, "pransam match: no model set (set_model)");
+  if ((params.refine_iterations > 0 || params.scene_origin_is_sensor) && !field_.has_distance()) {
+    return Status::error(Errc::kInvalidArgument,
+                         "pransam match: refinement / free-space test need the distance field "
+                         "(ContactFieldOptions.keep_distance = false)");
+  }
   if (scene == nullptr || n < 3) {
     return Status::error(Errc::kInvalidArgument, "pransam scene: %zu points (need >= 3)",
                          scene == nullptr ? std::size_t(0) : n);

@@ -779,7 +779,7 @@ bool run_simulation(const SimConfig& cfg_in, SimResult* out, std::string* err) {
     MapImageWriter writer;
     if (!writer.set_grid(grid, err)) return false;
     image = writer.bytes();
-    fw::Status s = arena.init_mapped(image.size() + (1u << 20), false, "map");
+    fw::Status s = arena.init_mapped(fw::map_image_arena_bytes(image.data(), image.size()) + (1u << 20), false, "map");
     if (s.is_ok()) s = fw::load_map_image(image.data(), image.size(), arena, &global_map, "simulated map");
     if (!s.is_ok()) {
       *err = std::string("map: ") + s.message();

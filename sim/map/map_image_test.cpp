@@ -111,7 +111,8 @@ TEST(MapImageTest, LoadsWhatTheWriterWrote) {
   EXPECT_EQ(m.geometry.origin_y, 1.0f);
   std::size_t occ = 0;
   for (std::size_t i = 0; i < g.cells.size(); ++i) {
-    EXPECT_EQ(m.occupancy[i], g.cells[i]);
+    EXPECT_EQ(m.cell(static_cast<std::int32_t>(i % m.geometry.width), static_cast<std::int32_t>(i / m.geometry.width)),
+              g.cells[i]);
     occ += g.cells[i] == fw::kCellOccupied;
   }
   EXPECT_EQ(m.num_points, occ);
@@ -125,7 +126,7 @@ TEST(MapImageTest, LoadsWhatTheWriterWrote) {
           if (g.cells[g.geometry.index(xx, yy)] == fw::kCellOccupied)
             best = std::min(best, (x - xx) * (x - xx) + (y - yy) * (y - yy));
       const float expect = std::sqrt(static_cast<float>(best)) * 0.1f;
-      ASSERT_EQ(m.distance_m[g.geometry.index(x, y)], expect) << x << "," << y;
+      ASSERT_EQ(m.distance.at(x, y), expect) << x << "," << y;
       maxd = std::max(maxd, expect);
     }
   }
@@ -141,8 +142,11 @@ TEST(MapImageTest, LoadsWhatTheWriterWrote) {
   EXPECT_EQ(m.distance_at(-1.95f, 1.05f, -1.0f), 0.0f);
   EXPECT_EQ(m.distance_at(100.0f, 0.0f, -1.0f), -1.0f);
   // Registered with the memory report.
+  // Occupancy, the distance tiles (a 40 × 30 map: 3 × 2 tiles, all within the truncation of a wall),
+  // points.
+  EXPECT_EQ(m.distance.stored_tiles, 6u);
   EXPECT_EQ(fw::MemoryReport::instance().module_bytes("map"),
-            g.cells.size() * (1 + sizeof(float)) + m.num_points * sizeof(fw::Point2f));
+            m.occupancy.bytes() + 6u * 4u + 6u * 256u * 2u + m.num_points * sizeof(fw::Point2f));
   fw::MemoryReport::instance().clear();
 }
 
@@ -487,7 +491,9 @@ TEST(MapImageTest, ArenaBytesCoverThePeakAndScratchIsReleased) {
   ASSERT_TRUE(st.is_ok()) << st.message();
   EXPECT_LE(arena.peak_used(), need);
   EXPECT_GT(arena.peak_used(), arena.used());  // the distance check's scratch came and went
-  EXPECT_EQ(arena.used(), 1200u + 1200u * 4u + m.num_points * sizeof(fw::Point2f));
+  // Kept: occupancy, distance tile index (3 × 2) and tiles, points; the dense float check is scratch.
+  EXPECT_EQ(arena.used(), m.occupancy.bytes() + m.distance.bytes() + m.num_points * sizeof(fw::Point2f));
+  EXPECT_EQ(m.distance.bytes(), 6u * 4u + m.distance.stored_tiles * 512u);
   EXPECT_EQ(fw::map_image_arena_bytes(bytes.data(), 10), 0u);
   fw::MemoryReport::instance().clear();
 }

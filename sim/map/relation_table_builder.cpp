@@ -22,7 +22,8 @@ bool add_relation_table(MapImageWriter* writer, const RelationTableBuild& build,
   // The table indexes the occupied points in the order the firmware loader produces them.
   fw::StartupArena map_arena;
   fw::GlobalMap map;
-  fw::Status s = map_arena.init_mapped(image.size() + (std::size_t(4) << 20), false, "table map");
+  fw::Status s = map_arena.init_mapped(fw::map_image_arena_bytes(image.data(), image.size()) + (std::size_t(4) << 20),
+                                       false, "table map");
   if (s.is_ok()) s = fw::load_map_image(image.data(), image.size(), map_arena, &map, name.c_str());
   if (!s.is_ok()) {
     *error = s.message();
@@ -33,7 +34,7 @@ bool add_relation_table(MapImageWriter* writer, const RelationTableBuild& build,
   fw::pransam::MatcherOptions mo = cfg.matcher;
   mo.num_workers = 1;
   mo.allocate_model_table = true;
-  const std::size_t arena_bytes = 2 * fw::pransam::kNumSlots * 12 + mo.field.max_cells * 5 +
+  const std::size_t arena_bytes = 2 * fw::pransam::kNumSlots * 12 + fw::pransam::ContactField<2>::arena_bytes(mo.field) +
                                   static_cast<std::size_t>(map.num_points) * 8 + mo.collect_capacity * 64 +
                                   (std::size_t(16) << 20);
   fw::StartupArena arena;
