@@ -69,9 +69,12 @@ Status plan(Source src, std::uint32_t w, std::uint32_t h, float res, float trunc
 }
 
 template <typename Source>
-DistanceField fill(const DistanceFieldLayout& l, Source src, std::uint32_t* slots, std::uint16_t* cells) {
+DistanceField fill(const DistanceFieldLayout& l, Source src, std::uint32_t* slots, std::uint16_t* cells,
+                   float* table) {
   const double inv_res = 1.0 / static_cast<double>(l.resolution);
   const std::uint32_t sat = l.saturation_d2;
+  // The writer's and loader's expression for an integer d² (map_image.cpp), once per value.
+  for (std::uint32_t q = 0; q <= sat; ++q) table[q] = std::sqrt(static_cast<float>(q)) * l.resolution;
   std::uint32_t next = 0;
   for (std::uint32_t ty = 0; ty < l.tiles_y; ++ty) {
     for (std::uint32_t tx = 0; tx < l.tiles_x; ++tx) {
@@ -95,16 +98,17 @@ DistanceField fill(const DistanceFieldLayout& l, Source src, std::uint32_t* slot
       }
     }
   }
-  return distance_field_view(l, slots, cells);
+  return distance_field_view(l, slots, cells, table);
 }
 
 }  // namespace
 
 DistanceField distance_field_view(const DistanceFieldLayout& l, const std::uint32_t* slots,
-                                  const std::uint16_t* cells) {
+                                  const std::uint16_t* cells, const float* table) {
   DistanceField f;
   f.tile_slot = slots;
   f.d2 = cells;
+  f.metres_of_d2 = table;
   f.tiles_x = l.tiles_x;
   f.tiles_y = l.tiles_y;
   f.stored_tiles = l.stored_tiles;
@@ -132,12 +136,12 @@ Status plan_distance_field(const float* metres, std::uint32_t width, std::uint32
 }
 
 DistanceField fill_distance_field(const DistanceFieldLayout& layout, const std::uint8_t* metres_le,
-                                  std::uint32_t* slots, std::uint16_t* cells) {
-  return fill(layout, LeSource{metres_le}, slots, cells);
+                                  std::uint32_t* slots, std::uint16_t* cells, float* table) {
+  return fill(layout, LeSource{metres_le}, slots, cells, table);
 }
 DistanceField fill_distance_field(const DistanceFieldLayout& layout, const float* metres, std::uint32_t* slots,
-                                  std::uint16_t* cells) {
-  return fill(layout, FloatSource{metres}, slots, cells);
+                                  std::uint16_t* cells, float* table) {
+  return fill(layout, FloatSource{metres}, slots, cells, table);
 }
 
 }  // namespace fw

@@ -33,6 +33,7 @@ struct Built {
   DistanceFieldLayout layout;
   std::vector<std::uint32_t> slots;
   std::vector<std::uint16_t> cells;
+  std::vector<float> table;
   DistanceField field;
 };
 
@@ -42,7 +43,8 @@ Built build(const std::vector<float>& metres, std::uint32_t w, std::uint32_t h, 
   EXPECT_TRUE(st.is_ok()) << st.message();
   b.slots.assign(b.layout.slot_count(), 0);
   b.cells.assign(b.layout.cell_count(), 0);
-  b.field = fill_distance_field(b.layout, metres.data(), b.slots.data(), b.cells.data());
+  b.table.assign(b.layout.table_count(), 0.0f);
+  b.field = fill_distance_field(b.layout, metres.data(), b.slots.data(), b.cells.data(), b.table.data());
   return b;
 }
 
@@ -81,6 +83,17 @@ TEST(DistanceFieldTest, LookupsEqualTheExactFieldBelowTheTruncation) {
   }
   EXPECT_GT(below, 0);
   EXPECT_GT(beyond, 0);
+  // corners() (one tile look-up inside a tile, four across a tile edge) equals at() everywhere.
+  for (std::int32_t y = 0; y + 1 < static_cast<std::int32_t>(h); ++y) {
+    for (std::int32_t x = 0; x + 1 < static_cast<std::int32_t>(w); ++x) {
+      float c[4];
+      b.field.corners(x, y, c);
+      ASSERT_EQ(c[0], b.field.at(x, y)) << x << "," << y;
+      ASSERT_EQ(c[1], b.field.at(x + 1, y)) << x << "," << y;
+      ASSERT_EQ(c[2], b.field.at(x, y + 1)) << x << "," << y;
+      ASSERT_EQ(c[3], b.field.at(x + 1, y + 1)) << x << "," << y;
+    }
+  }
   // The same map read from little-endian image bytes gives the same field.
   std::vector<std::uint8_t> le(exact.size() * 4);
   for (std::size_t i = 0; i < exact.size(); ++i) {
@@ -93,7 +106,8 @@ TEST(DistanceFieldTest, LookupsEqualTheExactFieldBelowTheTruncation) {
   EXPECT_EQ(l2.stored_tiles, b.layout.stored_tiles);
   std::vector<std::uint32_t> slots(l2.slot_count());
   std::vector<std::uint16_t> cells(l2.cell_count());
-  const DistanceField f2 = fill_distance_field(l2, le.data(), slots.data(), cells.data());
+  std::vector<float> table(l2.table_count());
+  const DistanceField f2 = fill_distance_field(l2, le.data(), slots.data(), cells.data(), table.data());
   EXPECT_EQ(slots, b.slots);
   EXPECT_EQ(cells, b.cells);
   EXPECT_EQ(f2.at(36, 20), b.field.at(36, 20));
@@ -111,7 +125,7 @@ TEST(DistanceFieldTest, TilesFarFromEveryWallAreNotStored) {
   EXPECT_EQ(b.layout.tiles_x, 4u);
   EXPECT_EQ(b.layout.tiles_y, 3u);
   EXPECT_EQ(b.layout.stored_tiles, 1u);
-  EXPECT_EQ(b.layout.bytes(), 12u * 4u + 256u * 2u);  // vs 64·48·4 = 12288 bytes of floats
+  EXPECT_EQ(b.layout.bytes(), 12u * 4u + 256u * 2u + 26u * 4u);  // vs 64·48·4 = 12288 bytes of floats
   EXPECT_EQ(b.slots[0], 0u);
   for (std::size_t i = 1; i < b.slots.size(); ++i) EXPECT_EQ(b.slots[i], DistanceField::kNoTile);
   EXPECT_EQ(b.field.at(2, 2), 0.0f);
@@ -119,6 +133,9 @@ TEST(DistanceFieldTest, TilesFarFromEveryWallAreNotStored) {
   EXPECT_EQ(b.field.at(4, 3), std::sqrt(5.0f) * res);
   EXPECT_EQ(b.field.at(63, 47), b.field.truncation_m);  // a tile that is not stored
   EXPECT_EQ(b.field.at(20, 2), b.field.truncation_m);
+  float c[4];
+  b.field.corners(40, 30, c);  // inside a tile that is not stored
+  for (float v : c) EXPECT_EQ(v, b.field.truncation_m);
 }
 
 TEST(DistanceFieldTest, BilinearSamplesMatchTheFloatFieldWhereAllCornersAreBelowTheTruncation) {

@@ -20,8 +20,9 @@ bool sample_distance(const GlobalMap& m, T x, T y, T* d, T* gx, T* gy) {
   }
   const std::int32_t ix = static_cast<std::int32_t>(fx), iy = static_cast<std::int32_t>(fy);
   const T ax = fx - static_cast<T>(ix), ay = fy - static_cast<T>(iy);
-  const T d00 = m.distance.at(ix, iy), d10 = m.distance.at(ix + 1, iy);
-  const T d01 = m.distance.at(ix, iy + 1), d11 = m.distance.at(ix + 1, iy + 1);
+  float c[4];
+  m.distance.corners(ix, iy, c);
+  const T d00 = c[0], d10 = c[1], d01 = c[2], d11 = c[3];
   *d = (1 - ax) * (1 - ay) * d00 + ax * (1 - ay) * d10 + (1 - ax) * ay * d01 + ax * ay * d11;
   *gx = ((1 - ay) * (d10 - d00) + ay * (d11 - d01)) / res;
   *gy = ((1 - ax) * (d01 - d00) + ax * (d11 - d10)) / res;

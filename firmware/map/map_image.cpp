@@ -428,9 +428,11 @@ Status load_map_image(const std::uint8_t* bytes, std::size_t size, StartupArena&
   Result<std::uint16_t*> tile_mem =
       slot_mem ? arena.allocate_array<std::uint16_t>(layout.cell_count(), "map distance tiles")
                : Result<std::uint16_t*>(slot_mem.status());
-  if (!tile_mem) {
+  Result<float*> table_mem = tile_mem ? arena.allocate_array<float>(layout.table_count(), "map distance tiles")
+                                      : Result<float*>(tile_mem.status());
+  if (!table_mem) {
     arena.rewind(arena_mark);
-    return tile_mem.status();
+    return table_mem.status();
   }
   Result<Point2f*> pts_mem = arena.allocate_array<Point2f>(num_points, "map occupied points");
   if (!pts_mem) {
@@ -450,7 +452,7 @@ Status load_map_image(const std::uint8_t* bytes, std::size_t size, StartupArena&
     arena.rewind(arena_mark);
     return field;
   }
-  const DistanceField distance = fill_distance_field(layout, dist_bytes, *slot_mem, *tile_mem);
+  const DistanceField distance = fill_distance_field(layout, dist_bytes, *slot_mem, *tile_mem, *table_mem);
   const OccupancyTiles occupancy = fill_occupancy_tiles(occ_layout, occ_bytes, *occ_slots, *occ_mem);
   for (std::uint32_t i = 0; i < num_points; ++i) {
     points[i] = Point2f(rd_f32(pts_bytes + 8u * i), rd_f32(pts_bytes + 8u * i + 4));

@@ -103,10 +103,12 @@ TEST(MapImageFormatTest, LoadsHandMadeImage) {
   EXPECT_EQ(m.distance_at(1.75f, -0.75f, -1.0f), 0.5f);
   EXPECT_EQ(m.max_distance_m, 1.0f);  // cells (3,0) and (0,2): 2 cells from the nearest wall
   // Occupancy and distance field as one 16×16 tile each (an index entry + 256 codes; an index entry +
-  // 256 uint16: the map has known cells and is within the truncation of a wall everywhere), points.
+  // 256 uint16: the map has known cells and is within the truncation of a wall everywhere, + the
+  // metres of d² = 0..289: 8.5 m is 17 cells of 0.5 m), points.
   EXPECT_EQ(m.occupancy.stored_tiles, 1u);
   EXPECT_EQ(m.distance.stored_tiles, 1u);
-  EXPECT_EQ(arena.used(), (4u + 256u) + (4u + 256u * 2u) + 2u * 8u);
+  EXPECT_EQ(m.distance.saturation_d2, 289u);
+  EXPECT_EQ(arena.used(), (4u + 256u) + (4u + 256u * 2u + 290u * 4u) + 2u * 8u);
 }
 
 TEST(MapImageFormatTest, RejectsWrongDistanceDuplicatesReservedFieldsAndFarOrigins) {

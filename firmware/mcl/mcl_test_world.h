@@ -23,12 +23,13 @@ struct GridWorld {
   DistanceFieldLayout dist_layout;
   std::vector<std::uint32_t> dist_slots;
   std::vector<std::uint16_t> dist_cells;
+  std::vector<float> dist_table;
   OccupancyTilesLayout occ_layout;
   std::vector<std::uint32_t> occ_slots;
   std::vector<std::uint8_t> occ_cells;
   OccupancyTiles occupancy_tiles() const { return occupancy_tiles_view(occ_layout, occ_slots.data(), occ_cells.data()); }
   DistanceField distance_field() const {
-    return distance_field_view(dist_layout, dist_slots.data(), dist_cells.data());
+    return distance_field_view(dist_layout, dist_slots.data(), dist_cells.data(), dist_table.data());
   }
   MapView view() const {
     MapView v;
@@ -64,7 +65,8 @@ struct GridWorld {
     (void)plan_distance_field(dist.data(), w, h, res, kDefaultDistanceTruncationM, &dist_layout);
     dist_slots.assign(dist_layout.slot_count(), 0);
     dist_cells.assign(dist_layout.cell_count(), 0);
-    fill_distance_field(dist_layout, dist.data(), dist_slots.data(), dist_cells.data());
+    dist_table.assign(dist_layout.table_count(), 0.0f);
+    fill_distance_field(dist_layout, dist.data(), dist_slots.data(), dist_cells.data(), dist_table.data());
     (void)plan_occupancy_tiles(occ.data(), w, h, &occ_layout);
     occ_slots.assign(occ_layout.slot_count(), 0);
     occ_cells.assign(occ_layout.cell_count(), 0);
