@@ -161,6 +161,7 @@ Status ContactField<D>::build(const Point<D>* points, std::size_t n, const char*
 
 template <int D>
 float ContactField<D>::distance(const Point<D>& p) const {
+  if (dist2_ == nullptr) return INFINITY;  // keep_distance = false: no field (the matcher refuses first)
   std::size_t idx = 0;
   for (int a = 0; a < D; ++a) {
     const float f = (p(a) - origin_(a)) * inv_res_;
@@ -172,6 +173,7 @@ float ContactField<D>::distance(const Point<D>& p) const {
 
 template <int D>
 bool ContactField<D>::distance_gradient(const Point<D>& p, float* d, Point<D>* grad) const {
+  if (dist2_ == nullptr) return false;
   std::size_t base[D];
   float frac[D];
   for (int a = 0; a < D; ++a) {

@@ -54,10 +54,10 @@ class ContactField {
   }
   // Whether distance()/distance_gradient() may be called (options.keep_distance).
   bool has_distance() const { return dist2_ != nullptr; }
-  // Distance (metres) to the nearest point of B at p's cell; +inf outside. Needs has_distance().
+  // Distance (metres) to the nearest point of B at p's cell; +inf outside or without has_distance().
   float distance(const Point<D>& p) const;
   // Multilinear interpolation of the distance between cell centres and its gradient (for the
-  // optional local refinement); false outside the field.
+  // optional local refinement); false outside the field or without has_distance().
   bool distance_gradient(const Point<D>& p, float* d, Point<D>* grad) const;
 
   const ContactFieldOptions& options() const { return options_; }

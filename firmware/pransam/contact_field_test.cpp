@@ -5,6 +5,7 @@
 
 #include <gtest/gtest.h>
 
+#include <cmath>
 #include <string>
 #include <vector>
 
@@ -41,6 +42,10 @@ void expect_same_bytes(float res, float eh, float es, int n_points, float extent
   EXPECT_EQ(ContactField<D>::arena_bytes(o), o.max_cells);
   EXPECT_TRUE(with.has_distance());
   EXPECT_FALSE(without.has_distance());
+  EXPECT_TRUE(std::isinf(without.distance(pts[0])));
+  float d = 0.0f;
+  Point<D> g;
+  EXPECT_FALSE(without.distance_gradient(pts[0], &d, &g));
   ASSERT_TRUE(with.build(pts.data(), pts.size(), "with").is_ok());
   ASSERT_TRUE(without.build(pts.data(), pts.size(), "without").is_ok());
   ASSERT_EQ(with.cells(), without.cells());
