@@ -36,7 +36,8 @@ template <typename Source>
 Status plan(Source src, std::uint32_t w, std::uint32_t h, float res, float truncation_m, DistanceFieldLayout* out) {
   if (w == 0 || h == 0 || !(res > 0.0f) || !(truncation_m > 0.0f)) {
     return Status::error(Errc::kInvalidArgument,
-                         "distance field: need a non-empty grid, resolution > 0 and truncation > 0 (got %ux%u, %g m, %g m)",
+                         "distance field: need a non-empty grid, resolution > 0 and truncation > 0 "
+                         "(got %ux%u, %g m, %g m)",
                          w, h, static_cast<double>(res), static_cast<double>(truncation_m));
   }
   DistanceFieldLayout l;

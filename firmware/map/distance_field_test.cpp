@@ -160,7 +160,8 @@ TEST(DistanceFieldTest, BilinearSamplesMatchTheFloatFieldWhereAllCornersAreBelow
       gy = std::fmin(std::fmax(gy, 0.0f), h - 1.0f);
       const int x0 = static_cast<int>(gx), y0 = static_cast<int>(gy);
       const int x1 = x0 + 1 < static_cast<int>(w) ? x0 + 1 : x0, y1 = y0 + 1 < static_cast<int>(h) ? y0 + 1 : y0;
-      const float d00 = exact[y0 * w + x0], d10 = exact[y0 * w + x1], d01 = exact[y1 * w + x0], d11 = exact[y1 * w + x1];
+      const float d00 = exact[y0 * w + x0], d10 = exact[y0 * w + x1];
+      const float d01 = exact[y1 * w + x0], d11 = exact[y1 * w + x1];
       const float fx = gx - x0, fy = gy - y0;
       const float a = d00 + fx * (d10 - d00), bb = d01 + fx * (d11 - d01);
       const float want = a + fy * (bb - a);

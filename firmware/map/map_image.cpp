@@ -417,9 +417,11 @@ Status load_map_image(const std::uint8_t* bytes, std::size_t size, StartupArena&
   OccupancyTilesLayout occ_layout;
   FW_RETURN_IF_ERROR(plan_occupancy_tiles(occ_bytes, geometry.width, geometry.height, &occ_layout));
   const std::size_t arena_mark = arena.mark();
-  Result<std::uint32_t*> occ_slots = arena.allocate_array<std::uint32_t>(occ_layout.slot_count(), "map occupancy tiles");
-  Result<std::uint8_t*> occ_mem = occ_slots ? arena.allocate_array<std::uint8_t>(occ_layout.cell_count(), "map occupancy tiles")
-                                            : Result<std::uint8_t*>(occ_slots.status());
+  Result<std::uint32_t*> occ_slots =
+      arena.allocate_array<std::uint32_t>(occ_layout.slot_count(), "map occupancy tiles");
+  Result<std::uint8_t*> occ_mem =
+      occ_slots ? arena.allocate_array<std::uint8_t>(occ_layout.cell_count(), "map occupancy tiles")
+                : Result<std::uint8_t*>(occ_slots.status());
   if (!occ_mem) {
     arena.rewind(arena_mark);
     return occ_mem.status();
@@ -487,8 +489,8 @@ std::size_t map_image_arena_bytes(const std::uint8_t* bytes, std::size_t size, c
                            options.distance_truncation_m, &layout)) {
     return 0;
   }
-  // Peak: occupancy tiles + distance tiles + points + the check's dense float field and its scratch (int
-  // v, float z/f/d) + alignment of each array.
+  // Peak: occupancy tiles + distance tiles + points + the check's dense float field and its scratch
+  // (int v, float z/f/d) + alignment of each array.
   std::size_t olen = 0;
   const std::uint8_t* o = find_section(bytes, size, MapSectionType::kOccupancy, &olen);
   if (o == nullptr || olen != cells) return 0;

@@ -27,7 +27,9 @@ struct GridWorld {
   OccupancyTilesLayout occ_layout;
   std::vector<std::uint32_t> occ_slots;
   std::vector<std::uint8_t> occ_cells;
-  OccupancyTiles occupancy_tiles() const { return occupancy_tiles_view(occ_layout, occ_slots.data(), occ_cells.data()); }
+  OccupancyTiles occupancy_tiles() const {
+    return occupancy_tiles_view(occ_layout, occ_slots.data(), occ_cells.data());
+  }
   DistanceField distance_field() const {
     return distance_field_view(dist_layout, dist_slots.data(), dist_cells.data(), dist_table.data());
   }

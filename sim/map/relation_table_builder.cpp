@@ -34,7 +34,8 @@ bool add_relation_table(MapImageWriter* writer, const RelationTableBuild& build,
   fw::pransam::MatcherOptions mo = cfg.matcher;
   mo.num_workers = 1;
   mo.allocate_model_table = true;
-  const std::size_t arena_bytes = 2 * fw::pransam::kNumSlots * 12 + fw::pransam::ContactField<2>::arena_bytes(mo.field) +
+  const std::size_t arena_bytes = 2 * fw::pransam::kNumSlots * 12 +
+                                  fw::pransam::ContactField<2>::arena_bytes(mo.field) +
                                   static_cast<std::size_t>(map.num_points) * 8 + mo.collect_capacity * 64 +
                                   (std::size_t(16) << 20);
   fw::StartupArena arena;

@@ -61,7 +61,8 @@ bool load_real_case(const std::string& dataset, const CaseOptions& options, Real
   if (!ensure_global_map(dataset, -1.0, map_cache_dir(), &ros, error)) return false;
   if (!read_file_bytes(global_map_image_path(dataset), &out->image, error)) return false;
   out->map_arena = std::make_unique<fw::StartupArena>();
-  fw::Status s = out->map_arena->init_mapped(fw::map_image_arena_bytes(out->image.data(), out->image.size()) + (std::size_t(4) << 20), false, "eval map");
+  const std::size_t map_bytes = fw::map_image_arena_bytes(out->image.data(), out->image.size());
+  fw::Status s = out->map_arena->init_mapped(map_bytes + (std::size_t(4) << 20), false, "eval map");
   if (s.is_ok()) s = fw::load_map_image(out->image.data(), out->image.size(), *out->map_arena, &out->map,
                                         global_map_image_path(dataset).c_str());
   if (!s.is_ok()) {
@@ -110,7 +111,8 @@ fw::pransam::MatcherOptions options_for(const fw::GlobalMap& map, int T, bool al
   return o;
 }
 std::size_t arena_bytes(const fw::pransam::MatcherOptions& o) {
-  return (o.allocate_model_table ? 2 : 1) * fw::pransam::kNumSlots * 12 + fw::pransam::ContactField<2>::arena_bytes(o.field) +
+  return (o.allocate_model_table ? 2 : 1) * fw::pransam::kNumSlots * 12 +
+         fw::pransam::ContactField<2>::arena_bytes(o.field) +
          static_cast<std::size_t>(o.max_model_points) * 8 + o.num_workers * (std::size_t(1) << 20) +
          o.collect_capacity * 64 + (std::size_t(8) << 20);
 }
@@ -150,7 +152,8 @@ bool build_table_section(RealCase* c, const TableBuild& build, double* seconds, 
   // The points of the rebuilt image must be the ones the table indexes.
   fw::StartupArena check_arena;
   fw::GlobalMap check;
-  s = check_arena.init_mapped(fw::map_image_arena_bytes(image.data(), image.size()) + (std::size_t(4) << 20), false, "table check");
+  s = check_arena.init_mapped(fw::map_image_arena_bytes(image.data(), image.size()) + (std::size_t(4) << 20), false,
+                              "table check");
   if (s.is_ok()) s = fw::load_map_image(image.data(), image.size(), check_arena, &check, "image with table");
   if (!s.is_ok()) {
     *error = s.message();
