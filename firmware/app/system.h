@@ -40,6 +40,9 @@ struct SystemSpec {
   const mcl::MclOptions* mcl = nullptr;
   const mml::HandoffOptions* handoff = nullptr;
   const OdometryLocalizerOptions* odom = nullptr;
+  // mml-track: when MML consumes scans and returns results (track/global_context.h); null = the
+  // reference schedule (every scan, result on the same scan: deterministic, what the tools measure).
+  const track::GlobalScheduleOptions* global_schedule = nullptr;
 };
 
 class LocalizationSystem {
@@ -66,6 +69,11 @@ class LocalizationSystem {
   mml::HandoffLocalizer* handoff() { return handoff_; }
   const mml::HandoffLocalizer* handoff() const { return handoff_; }
   OdometryLocalizer* odom() { return odom_; }
+  // mml-track only, start-up: runs the global search on its own thread as the execution-context
+  // table declares (`global`, execution_contexts.h); needs a schedule with result_delay_scans ≥ 1.
+  // `clock` times the global steps. Other localizers: nothing to start (ok).
+  Status start_global_context(bool realtime, const hal::Clock* clock);
+  void stop_global_context();
   // True when MML reads the map image's relation table in place (keep the image mapped).
   bool table_in_use() const;
   // Bytes of the localizer objects (they live in the arena; counted in arena.used()).
