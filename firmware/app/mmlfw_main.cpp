@@ -205,7 +205,10 @@ int main(int argc, char** argv) {
   sys.seed = c.seed;
   const fw::track::GlobalScheduleOptions live = fw::track::live_global_schedule();
   const bool global_thread = c.global_threaded && !std::strcmp(c.localizer, "mml-track") && !memory_report;
-  if (global_thread) sys.global_schedule = &live;
+  if (global_thread) {
+    sys.global_schedule = &live;
+    sys.anytime_global = true;
+  }
   st = g_system.build(sys, map, table, table_len, g_arena, &g_pool);
   if (!st) return fail("localizer", st);
   if (global_thread) {

@@ -67,7 +67,8 @@ Status LocalizationSystem::build(const SystemSpec& spec, const GlobalMap& map, c
     const mml::MmlLocalizerConfig base =
         spec.mml != nullptr ? *spec.mml : mml::mml_preset(spec.mml_preset, spec.seed);
     // pRANSAM's contact field must cover this map (it is sized from the map, not the preset).
-    const mml::MmlLocalizerConfig mc = mml::fit_contact_field_to_map(base, map);
+    mml::MmlLocalizerConfig mc = mml::fit_contact_field_to_map(base, map);
+    if (spec.anytime_global) mc.rbsm.grid.recenter_step_cells = kAnytimeRecenterCells;
     Result<mml::MmlLocalizer*> r = emplace<mml::MmlLocalizer>(arena, "MmlLocalizer");
     if (!r) return r.status();
     mml_ = *r;

@@ -43,7 +43,12 @@ struct SystemSpec {
   // mml-track: when MML consumes scans and returns results (track/global_context.h); null = the
   // reference schedule (every scan, result on the same scan: deterministic, what the tools measure).
   const track::GlobalScheduleOptions* global_schedule = nullptr;
+  // Anytime global search (issue 14): RBSM's end-point window re-centres by at most
+  // kAnytimeRecenterCells per step instead of in one 11–22 ms step. Deterministic. (pRANSAM's
+  // deadline mode, the time-dependent half, is switched on by start_global_context.)
+  bool anytime_global = false;
 };
+inline constexpr std::uint32_t kAnytimeRecenterCells = 16;
 
 class LocalizationSystem {
  public:

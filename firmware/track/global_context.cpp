@@ -43,6 +43,8 @@ Status GlobalContext::start_thread(const ExecutionContext& context, bool realtim
   FW_RETURN_IF_ERROR(schedule_.validate(true));
   clock_ = clock;
   stopping_ = false;
+  // Anytime global search: pRANSAM's iterations are cut so the step fits the context's window.
+  if (clock != nullptr) mml_->set_deadline_mode(clock, context.deadline_ns);
   const int rc = pthread_create(&thread_, nullptr, &GlobalContext::thread_main, this);
   if (rc != 0) return Status::error(Errc::kIoError, "global context: pthread_create failed (%d)", rc);
   threaded_ = true;

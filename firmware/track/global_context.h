@@ -57,7 +57,8 @@ class GlobalContext {
 
   Status init(mml::MmlLocalizer* mml, const GlobalScheduleOptions& schedule);
   // Start-up only: creates the global thread (pinned, SCHED_FIFO when realtime). `clock` times the
-  // global steps (perf_step()); may be null when not threaded.
+  // global steps (perf_step()) and puts MML in deadline mode (pRANSAM's iterations set by the time
+  // left in the context's deadline, Sec. 4.4.3); null = neither.
   Status start_thread(const ExecutionContext& context, bool realtime, const hal::Clock* clock);
   void stop_thread();
   bool threaded() const { return threaded_; }
