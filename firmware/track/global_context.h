@@ -73,6 +73,11 @@ class GlobalContext {
   Status step(const hal::LaserScan& scan, const hal::Odometry& odom, hal::PoseEstimate* out);
 
   const GlobalScheduleOptions& schedule() const { return schedule_; }
+  // A job handed to the global thread and not finished yet.
+  bool job_in_flight() const {
+    const Slot s = slot_.load(std::memory_order_acquire);
+    return s == Slot::kQueued || s == Slot::kRunning;
+  }
   std::uint64_t jobs() const { return jobs_; }
   std::uint64_t overruns() const { return overruns_; }
   std::uint64_t skipped_offers() const { return skipped_offers_; }

@@ -29,6 +29,7 @@
 
 #include "sim/eval/mml_eval/localize_eval.h"
 #include "sim/eval/mml_eval/mml_eval_run.h"
+#include "sim/eval/mml_eval/mml_systems.h"
 #include "sim/common/cli_main.h"
 
 namespace {
