@@ -29,6 +29,11 @@ int run_one(const std::string& name, const std::string& out_path, size_t scans) 
   o.deadline_ms = 1000.0 / 75.0;
   o.global_context = "thread";
   if (const char* v = std::getenv("MMLFW_REALTIME_GLOBAL")) o.global_context = v;
+  // Experiments (not used by scripts/bench.sh): schedule and re-centre overrides, rate (0 = lockstep).
+  if (const char* v = std::getenv("MMLFW_REALTIME_EVERY")) o.schedule_every = static_cast<unsigned>(std::atoi(v));
+  if (const char* v = std::getenv("MMLFW_REALTIME_DELAY")) o.schedule_delay = std::atoi(v);
+  if (const char* v = std::getenv("MMLFW_REALTIME_ANYTIME")) o.anytime_recentre = std::atoi(v);
+  if (const char* v = std::getenv("MMLFW_REALTIME_RATE")) o.rate_hz = std::atof(v);
   mmlfw_hil::ReplayResult r;
   std::string err;
   if (!mmlfw_hil::run_replay(o, &r, &err)) {
@@ -43,6 +48,9 @@ int run_one(const std::string& name, const std::string& out_path, size_t scans) 
   f << "\"" << key << "_75hz_scans_fed\": " << r.scans_fed << ",\n";
   f << "\"" << key << "_75hz_deadline_misses\": " << r.deadline_misses << ",\n";
   f << "\"" << key << "_75hz_dropped\": " << r.scans_dropped << ",\n";
+  f << "\"" << key << "_75hz_dropped_ring_overflow\": " << r.ring_overflows << ",\n";
+  f << "\"" << key << "_75hz_dropped_unpaired\": " << r.scans_unpaired << ",\n";
+  f << "\"" << key << "_75hz_dropped_out_of_order\": " << r.scans_out_of_order << ",\n";
   f << "\"" << key << "_track_step_ms_max\": " << r.step_max_ms << ",\n";
   f << "\"" << key << "_track_step_ms_p99\": " << r.step_p99_ms << ",\n";
   f << "\"" << key << "_global_step_ms_p50\": " << r.global_step_p50_ms << ",\n";
@@ -58,6 +66,8 @@ int run_one(const std::string& name, const std::string& out_path, size_t scans) 
   f << "\"" << key << "_first_fix_success_deadline_mode\": "
     << ((r.first_localized_scan >= 0 && r.wrong_localized == 0) ? "true" : "false") << ",\n";
   f << "\"" << key << "_static_memory_mib\": " << r.static_memory_mib << ",\n";
+  double load[3] = {0, 0, 0};
+  if (getloadavg(load, 3) == 3) f << "\"" << key << "_loadavg_1min_after\": " << load[0] << ",\n";
   std::printf("%s: %zu scans at 75 Hz, %zu deadline misses, track step max %.2f ms p99 %.2f ms; global (%s) %zu jobs p50 "
               "%.2f p99 %.2f max %.2f ms (window %.1f ms), %zu overruns; first fix at scan %ld, localized %zu, wrong %zu\n",
               name.c_str(), r.scans_processed, r.deadline_misses, r.step_max_ms, r.step_p99_ms, r.global_context.c_str(),

@@ -62,6 +62,18 @@ bool run_replay(const ReplayOptions& o, ReplayResult* r, std::string* error) {
   sim::CarmenReadOptions ro;
   ro.max_scans = o.first_scan + o.num_scans;
   if (!sim::read_carmen_log(sim::data_path(ds->raw_log), ro, &log, error)) return false;
+  if (log.odom.empty()) {
+    // A log without ODOM records (mit-killian's reconstructed log): FLASER carries the odometry pose
+    // of every scan; feed it as the odometry stream (one sample per scan, at the scan's time).
+    r->odometry_from_scans = true;
+    for (const sim::CarmenScan& sc : log.scans) {
+      sim::CarmenOdom od;
+      od.line = sc.line;
+      od.pose = sc.odom;
+      od.ipc_timestamp = sc.ipc_timestamp;
+      log.odom.push_back(od);
+    }
+  }
   if (log.scans.size() <= o.first_scan) {
     *error = "log has no scans after " + std::to_string(o.first_scan);
     return false;
@@ -131,11 +143,18 @@ bool run_replay(const ReplayOptions& o, ReplayResult* r, std::string* error) {
   spec.localizer = o.localizer.c_str();
   spec.mml_preset = o.mml_preset;
   spec.seed = o.seed;
-  const fw::track::GlobalScheduleOptions live = fw::track::live_global_schedule();
+  fw::track::GlobalScheduleOptions live = fw::track::live_global_schedule();
   if (gmode != "inline-ref") {
     spec.global_schedule = &live;
     spec.anytime_global = true;
   }
+  if (o.schedule_every > 0 || o.schedule_delay >= 0) {
+    if (gmode == "inline-ref") live = fw::track::GlobalScheduleOptions();
+    if (o.schedule_every > 0) live.every_n_scans = o.schedule_every;
+    if (o.schedule_delay >= 0) live.result_delay_scans = static_cast<std::uint32_t>(o.schedule_delay);
+    spec.global_schedule = &live;
+  }
+  if (o.anytime_recentre >= 0) spec.anytime_global = o.anytime_recentre != 0;
   st = sys.build(spec, map, table, table_len, arena, &pool);
   if (!st) { *error = std::string("localizer: ") + st.message(); pool.stop(); return false; }
   static hal_linux::LinuxClock perf_clock;
@@ -264,7 +283,10 @@ bool run_replay(const ReplayOptions& o, ReplayResult* r, std::string* error) {
       }
       std::int64_t jitter_ns = 0;
       if (o.scan_time_jitter_ms > 0) jitter_ns = static_cast<std::int64_t>((2.0 * lose_draw(lose_rng) - 1.0) * o.scan_time_jitter_ms * 1e6);
-      hal::LaserScan s = sim::to_laser_scan(log.scans[o.first_scan + k], warp(tk) + loop_offset_ns + jitter_ns);
+      // Scan k at t0 + k·period exactly (= warp(tk) for distinct log times; logs with two scans at
+      // one ipc time, as intel has, would otherwise feed the second at the same time: out of order).
+      const std::uint64_t scan_ns = t0 + static_cast<std::uint64_t>(static_cast<double>(k) * period * 1e9);
+      hal::LaserScan s = sim::to_laser_scan(log.scans[o.first_scan + k], scan_ns + loop_offset_ns + jitter_ns);
       if (o.mutate_scan) o.mutate_scan(o.first_scan + k, &s);
       if (lockstep) stepped.set_ns(warp(k + 1 < scan_t.size() ? scan_t[k + 1] : tk));
       const bool lost_random = (o.lose_prob > 0 && lose_draw(lose_rng) < o.lose_prob) ||
@@ -365,6 +387,9 @@ bool run_replay(const ReplayOptions& o, ReplayResult* r, std::string* error) {
   r->scans_dropped = loop.health().dropped_scans;
   r->health_dropped = loop.health().dropped_scans;
   r->pending_at_end = laser.pending() + (loop.scan_pending() ? 1 : 0);
+  r->scans_unpaired = loop.counters().scans_unpaired;
+  r->scans_out_of_order = loop.counters().scans_out_of_order;
+  r->scans_malformed = loop.counters().scans_malformed;
   r->achieved_rate_hz = wall > 0 ? static_cast<double>(r->scans_processed) / wall : 0;
   return true;
 }

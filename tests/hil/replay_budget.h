@@ -56,6 +56,10 @@ struct ReplayOptions {
   //   "inline-ref"  inline, every scan, result on the same scan (the reference schedule of the tools)
   std::string global_context = "auto";
   bool pin_sensor_thread = true;  // rate mode: pin this (the sensor) thread as the table says
+  // Overrides of the schedule for experiments (0 / -1 = as global_context says).
+  unsigned schedule_every = 0;
+  int schedule_delay = -1;
+  int anytime_recentre = -1;      // 0 / 1: RBSM window re-centre at once / spread (SystemSpec.anytime_global)
   // Fault campaign: called with each scan (log index) before it is fed; may corrupt it (NaN, inf,
   // zero readings, ...). The reference for scoring stays the log's.
   std::function<void(size_t log_index, hal::LaserScan* scan)> mutate_scan;
@@ -97,6 +101,8 @@ struct ReplayResult {
   size_t global_jobs = 0, global_overruns = 0, global_skipped_offers = 0;
   double global_period_ms = 0;    // the global context's window (its deadline)
   size_t global_deadline_stops = 0;  // pRANSAM runs cut by the deadline (anytime mode)
+  size_t scans_unpaired = 0, scans_out_of_order = 0, scans_malformed = 0;  // loop counters (dropped scans)
+  bool odometry_from_scans = false;  // the log has no ODOM records: the scans' odometry triple was used
 };
 
 bool run_replay(const ReplayOptions& options, ReplayResult* out, std::string* error);
