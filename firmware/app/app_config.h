@@ -14,8 +14,10 @@
 //   realtime         true | false  SCHED_FIFO + mlockall for every thread of the execution-context
 //                    table (firmware/runtime/execution_contexts.h); refused → start-up fails [false]
 //   global_context   thread | inline  mml-track: MML on its own pinned thread at lower priority,
-//                    fed every 2nd scan, result taken 2 scans later (thread), or inside the sensor
+//                    fed every scan it is idle for, result taken 1 scan later (thread), or inside the sensor
 //                    step on every scan (inline: the deterministic reference schedule)  [thread]
+//   global_period_scans 1..8 thread: MML gets every n-th scan, its result is taken n scans later
+//                    (deadline n scan periods) [the table's, firmware/runtime/execution_contexts.h]
 //   arena_mib        1..4096 start-up arena (map + localizer storage) [256]
 //   step_deadline_ms 0.1..1000 Localizer::step longer than this is a deadline miss [13.333 = 75 Hz]
 //   health_period_ms 10..10000 heartbeat period when no scans arrive [200]
@@ -49,6 +51,7 @@ struct AppConfig {
   int num_cores = 0;         // 0 = default (worker i → core i)
   bool realtime = false;
   bool global_threaded = true;
+  std::uint32_t global_period_scans = 0;  // 0 = the execution-context table's
   std::uint32_t arena_mib = 256;
   double step_deadline_ms = 1000.0 / 75.0;
   std::uint32_t health_period_ms = 200;

@@ -203,7 +203,8 @@ int main(int argc, char** argv) {
   sys.localizer = c.localizer;
   sys.mml_preset = c.mml_preset;
   sys.seed = c.seed;
-  const fw::track::GlobalScheduleOptions live = fw::track::live_global_schedule();
+  const fw::track::GlobalScheduleOptions live = fw::track::live_global_schedule(c.global_period_scans);
+  const fw::ExecutionContext global_ctx = fw::track::global_context_for(c.global_period_scans);
   const bool global_thread = c.global_threaded && !std::strcmp(c.localizer, "mml-track") && !memory_report;
   if (global_thread) {
     sys.global_schedule = &live;
@@ -212,7 +213,7 @@ int main(int argc, char** argv) {
   st = g_system.build(sys, map, table, table_len, g_arena, &g_pool);
   if (!st) return fail("localizer", st);
   if (global_thread) {
-    st = g_system.start_global_context(c.realtime, hal.clock);
+    st = g_system.start_global_context(c.realtime, hal.clock, global_ctx);
     if (!st) return fail("global context", st);
   } else if (g_system.tracked() != nullptr) {
     g_system.tracked()->global_context().set_clock(hal.clock);
@@ -330,7 +331,7 @@ int main(int argc, char** argv) {
     if (const fw::track::TrackedLocalizer* t = g_system.tracked()) {
       const fw::track::GlobalContext& gc = t->global_context();
       row(global_thread ? "global" : "sensor", "global.step", gc.step_stats(),
-          global_thread ? fw::kGlobalContext.deadline_ns * 1e-6 : 0);
+          global_thread ? global_ctx.deadline_ns * 1e-6 : 0);
       std::fprintf(stderr, "  global: jobs %llu, overruns %llu, skipped offers %llu (every %u scans, result after %u)\n",
                    static_cast<unsigned long long>(gc.jobs()), static_cast<unsigned long long>(gc.overruns()),
                    static_cast<unsigned long long>(gc.skipped_offers()), gc.schedule().every_n_scans,

@@ -29,9 +29,10 @@ LocalizationSystem::~LocalizationSystem() {
   if (odom_) odom_->~OdometryLocalizer();
 }
 
-Status LocalizationSystem::start_global_context(bool realtime, const hal::Clock* clock) {
+Status LocalizationSystem::start_global_context(bool realtime, const hal::Clock* clock,
+                                                const ExecutionContext& context) {
   if (tracked_ == nullptr) return Status::ok();
-  return tracked_->global_context().start_thread(kGlobalContext, realtime, clock);
+  return tracked_->global_context().start_thread(context, realtime, clock);
 }
 
 void LocalizationSystem::stop_global_context() {

@@ -77,7 +77,8 @@ class LocalizationSystem {
   // mml-track only, start-up: runs the global search on its own thread as the execution-context
   // table declares (`global`, execution_contexts.h); needs a schedule with result_delay_scans ≥ 1.
   // `clock` times the global steps. Other localizers: nothing to start (ok).
-  Status start_global_context(bool realtime, const hal::Clock* clock);
+  Status start_global_context(bool realtime, const hal::Clock* clock,
+                              const ExecutionContext& context = kGlobalContext);
   void stop_global_context();
   // True when MML reads the map image's relation table in place (keep the image mapped).
   bool table_in_use() const;

@@ -11,10 +11,12 @@
 //          context hands it the scan + odometry of every `period_scans`-th scan through a one-slot
 //          mailbox and takes its result (a fix hypothesis, moved to the current scan by odometry)
 //          `period_scans` scans later; the global step's deadline is that window. It never blocks
-//          the sensor context (the mailbox copy is the only shared section).
+//          the sensor context (the mailbox copy is the only shared section); a step still running
+//          when the next scan is due makes the sensor context skip that offer (counted).
 //  workers pRANSAM / RBSM worker pool threads (firmware/base/worker_pool.h), run by the global
 //          context only; same core as it, lower priority than the sensor context.
-// On a 2-core machine the sensor context has core 0 to itself and the global search core 1.
+// On a 2-core machine: sensor context on core 0 (shared only with the second worker, at lower
+// priority), the global context and the first worker on core 1.
 #pragma once
 
 #include <cstdint>
@@ -32,7 +34,12 @@ struct ExecutionContext {
 inline constexpr std::uint64_t kSensorPeriodNs = 13'333'333;  // 75 Hz SICK LMS
 
 inline constexpr ExecutionContext kSensorContext{"sensor", 0, 80, 1, kSensorPeriodNs};
-inline constexpr ExecutionContext kGlobalContext{"global", 1, 40, 2, 2 * kSensorPeriodNs};
+// Global: every scan, result one scan later (deadline one scan period). Measured (issue 14, mml-eval
+// --localize intel+fr079, 13 fix trials each): every 2nd scan with the result 2 scans later halves
+// the MML steps per metre and doubled the distance to the first fix (intel 3.4 → 7.5 m, first-fix
+// success 0.77 → 0.54); on a slower CPU where the MML step p99 exceeds one scan period, set
+// period_scans = 2 (config global_period_scans) and accept that cost.
+inline constexpr ExecutionContext kGlobalContext{"global", 1, 40, 1, kSensorPeriodNs};
 inline constexpr ExecutionContext kWorkerContext{"workers", 1, 30, 0, 0};
 
 inline constexpr ExecutionContext kExecutionContexts[] = {kSensorContext, kGlobalContext, kWorkerContext};

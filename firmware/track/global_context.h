@@ -40,12 +40,22 @@ struct GlobalScheduleOptions {
   Status validate(bool threaded) const;
 };
 
-// The shipped live schedule: the `global` entry of the execution-context table.
-inline GlobalScheduleOptions live_global_schedule() {
+// The shipped live schedule: the `global` entry of the execution-context table (period_scans 0), or
+// every n-th scan with the result n scans later.
+inline GlobalScheduleOptions live_global_schedule(std::uint32_t period_scans = 0) {
   GlobalScheduleOptions s;
-  s.every_n_scans = kGlobalContext.period_scans;
-  s.result_delay_scans = kGlobalContext.period_scans;
+  s.every_n_scans = period_scans > 0 ? period_scans : kGlobalContext.period_scans;
+  s.result_delay_scans = s.every_n_scans;
   return s;
+}
+// The `global` context for that schedule: deadline = period_scans scan periods.
+inline ExecutionContext global_context_for(std::uint32_t period_scans) {
+  ExecutionContext c = kGlobalContext;
+  if (period_scans > 0) {
+    c.period_scans = period_scans;
+    c.deadline_ns = period_scans * kSensorPeriodNs;
+  }
+  return c;
 }
 
 class GlobalContext {

@@ -53,10 +53,11 @@ TEST(GlobalContextTest, ScheduleValidation) {
   EXPECT_FALSE(s.validate(false).is_ok());
   EXPECT_TRUE(live_global_schedule().validate(true).is_ok());
   EXPECT_EQ(live_global_schedule().every_n_scans, kGlobalContext.period_scans);
+  EXPECT_EQ(live_global_schedule(3).result_delay_scans, 3u);
 }
 
 // Live schedule executed inline: still localizes on the synthetic room, never wrong; MML consumed
-// every 2nd scan while it searched.
+// every period_scans-th scan while it searched.
 TEST(GlobalContextTest, LiveScheduleInlineLocalizes) {
   Rig rig;
   ASSERT_TRUE(rig.init(testing::room_map().map, live_global_schedule()).is_ok());
@@ -72,7 +73,8 @@ TEST(GlobalContextTest, LiveScheduleInlineLocalizes) {
   EXPECT_EQ(wrong, 0);
   const GlobalContext& gc = rig.loc->global_context();
   EXPECT_GT(gc.jobs(), 0u);
-  EXPECT_LE(gc.jobs(), static_cast<std::uint64_t>(first) / 2 + 2) << "MML ran on more scans than every 2nd";
+  EXPECT_LE(gc.jobs(), static_cast<std::uint64_t>(first) / kGlobalContext.period_scans + 2)
+      << "MML ran on more scans than the schedule gives it";
   EXPECT_EQ(gc.overruns(), 0u);
 }
 

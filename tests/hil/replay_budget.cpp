@@ -163,7 +163,7 @@ bool run_replay(const ReplayOptions& o, ReplayResult* r, std::string* error) {
     r->global_period_ms = static_cast<double>(sys.tracked()->global_context().schedule().every_n_scans) * 1000.0 /
                           (o.rate_hz > 0 ? o.rate_hz : 75.0);
     if (gmode == "thread") {
-      st = sys.start_global_context(false, &perf_clock);
+      st = sys.start_global_context(false, &perf_clock, fw::track::global_context_for(live.every_n_scans));
       if (!st) { *error = std::string("global context: ") + st.message(); pool.stop(); return false; }
     } else {
       sys.tracked()->global_context().set_clock(&perf_clock);

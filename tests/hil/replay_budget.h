@@ -50,7 +50,7 @@ struct ReplayOptions {
   bool trace = false;             // one line per processed scan on stdout (interpreter state, error)
   // mml-track's global search (firmware/track/global_context.h, execution_contexts.h):
   //   "auto"        thread in rate mode (as mmlfw runs), inline-ref in lockstep
-  //   "thread"      MML on the pinned `global` thread, live schedule (every 2nd scan, result 2 later)
+  //   "thread"      MML on the pinned `global` thread, live schedule (execution_contexts.h)
   //   "inline-live" the live schedule executed inline (deterministic: what "thread" computes when
   //                 every global step meets its window)
   //   "inline-ref"  inline, every scan, result on the same scan (the reference schedule of the tools)
