@@ -1,5 +1,7 @@
 #include "tests/hil/replay_budget.h"
 
+#include <pthread.h>
+#include <sched.h>
 #include <time.h>
 #include <unistd.h>
 
@@ -117,14 +119,30 @@ bool run_replay(const ReplayOptions& o, ReplayResult* r, std::string* error) {
     *error = "global_context '" + gmode + "': expected auto, thread, inline-live or inline-ref";
     return false;
   }
-  if (!lockstep_run && o.pin_sensor_thread) {
+  const bool rt = o.realtime && !lockstep_run;
+  int old_policy = SCHED_OTHER;
+  sched_param old_param{};
+  pthread_getschedparam(pthread_self(), &old_policy, &old_param);
+  struct RestoreSched {  // the process goes on (tests): this thread back to its old policy
+    bool on;
+    int policy;
+    sched_param param;
+    ~RestoreSched() {
+      if (on) pthread_setschedparam(pthread_self(), policy, &param);
+    }
+  } restore{rt, old_policy, old_param};
+  if (!lockstep_run && (o.pin_sensor_thread || rt)) {
     char warning[160];
-    st = fw::apply_execution_context_here(fw::kSensorContext, false, warning);
+    st = fw::apply_execution_context_here(fw::kSensorContext, rt, warning);
     if (!st) { *error = st.message(); return false; }
   }
+  r->realtime = rt;
   static fw::WorkerPool pool;
   fw::WorkerPoolOptions po;
   po.num_workers = o.workers;
+  po.realtime = rt;
+  po.require_realtime = rt;
+  po.priority = fw::kWorkerContext.priority;
   if (gmode == "thread") {  // as mmlfw: the workers beside the global context (execution_contexts.h)
     const long online = sysconf(_SC_NPROCESSORS_ONLN) > 0 ? sysconf(_SC_NPROCESSORS_ONLN) : 1;
     for (int i = 0; i < o.workers && i < fw::WorkerPoolOptions::kMaxWorkers; ++i)
@@ -163,7 +181,7 @@ bool run_replay(const ReplayOptions& o, ReplayResult* r, std::string* error) {
     r->global_period_ms = static_cast<double>(sys.tracked()->global_context().schedule().every_n_scans) * 1000.0 /
                           (o.rate_hz > 0 ? o.rate_hz : 75.0);
     if (gmode == "thread") {
-      st = sys.start_global_context(false, &perf_clock, fw::track::global_context_for(live.every_n_scans));
+      st = sys.start_global_context(rt, &perf_clock, fw::track::global_context_for(live.every_n_scans));
       if (!st) { *error = std::string("global context: ") + st.message(); pool.stop(); return false; }
     } else {
       sys.tracked()->global_context().set_clock(&perf_clock);

@@ -56,6 +56,10 @@ struct ReplayOptions {
   //   "inline-ref"  inline, every scan, result on the same scan (the reference schedule of the tools)
   std::string global_context = "auto";
   bool pin_sensor_thread = true;  // rate mode: pin this (the sensor) thread as the table says
+  // Rate mode: SCHED_FIFO at the table's priorities for the sensor (this thread, restored after),
+  // global and worker threads, as mmlfw with realtime = true (memory is not locked here). An
+  // error when the OS refuses it.
+  bool realtime = false;
   // Overrides of the schedule for experiments (0 / -1 = as global_context says).
   unsigned schedule_every = 0;
   int schedule_delay = -1;
@@ -102,7 +106,8 @@ struct ReplayResult {
   double global_period_ms = 0;    // the global context's window (its deadline)
   size_t global_deadline_stops = 0;  // pRANSAM runs cut by the deadline (anytime mode)
   size_t scans_unpaired = 0, scans_out_of_order = 0, scans_malformed = 0;  // loop counters (dropped scans)
-  bool odometry_from_scans = false;  // the log has no ODOM records: the scans' odometry triple was used
+  bool odometry_from_scans = false;
+  bool realtime = false;             // ran with SCHED_FIFO  // the log has no ODOM records: the scans' odometry triple was used
 };
 
 bool run_replay(const ReplayOptions& options, ReplayResult* out, std::string* error);
