@@ -80,7 +80,9 @@ void trace_step(hal::Hal& hal) {
                  e.protection_xy_m, e.protection_theta_rad, e.unsupported_steps);
     return;
   }
-  if (mml == nullptr) {
+  // MML's state belongs to the global thread when it runs there: not read from here.
+  const bool mml_threaded = g_system.tracked() != nullptr && g_system.tracked()->global_context().threaded();
+  if (mml == nullptr || mml_threaded) {
     hal.log->log(hal::LogLevel::kDebug, "step scan %u t %llu odom %.4f %.4f %.4f status %s pose %.3f %.3f %.3f", e.scan_id,
                  static_cast<unsigned long long>(e.timestamp_ns), od.x, od.y, od.theta, hal::status_name(e.status), e.x, e.y,
                  e.theta);

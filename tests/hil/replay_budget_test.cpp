@@ -35,12 +35,21 @@ TEST(ReplayBudget, Aces75HzWithinBudget) {
   o.rate_hz = budget.count("scan_rate_hz") ? budget["scan_rate_hz"] : 75.0;
   o.deadline_ms = 1000.0 / o.rate_hz;
   apply_localizer_env(&o);
+  // As mmlfw with realtime = true (SCHED_FIFO at the execution-context table's priorities) where the
+  // OS permits it; otherwise as realtime = false (then the limits hold only on a quiet machine).
+  o.realtime = std::getenv("MMLFW_REPLAY_NO_FIFO") == nullptr;
   mmlfw_hil::ReplayResult r;
-  ASSERT_TRUE(mmlfw_hil::run_replay(o, &r, &err)) << err;
-  std::printf("replay aces (%s) %zu scans at %.0f Hz: processed %zu (%.1f Hz), dropped %zu, localized %zu, "
+  if (!mmlfw_hil::run_replay(o, &r, &err) && o.realtime) {
+    std::printf("SCHED_FIFO refused (%s): replay without it\n", err.c_str());
+    o.realtime = false;
+    err.clear();
+    ASSERT_TRUE(mmlfw_hil::run_replay(o, &r, &err)) << err;
+  }
+  ASSERT_TRUE(err.empty()) << err;
+  std::printf("replay aces (%s, %s) %zu scans at %.0f Hz: processed %zu (%.1f Hz), dropped %zu, localized %zu, "
               "step p50 %.2f ms p99 %.2f ms max %.2f ms, cycle p99 %.2f ms, deadline misses %zu, "
               "static memory %.1f MiB, map %zux%zu @ %.2f m, pin warnings %d\n",
-              r.localizer.c_str(), r.scans_fed, o.rate_hz, r.scans_processed, r.achieved_rate_hz, r.scans_dropped, r.localized,
+              r.localizer.c_str(), r.realtime ? "SCHED_FIFO" : "no SCHED_FIFO", r.scans_fed, o.rate_hz, r.scans_processed, r.achieved_rate_hz, r.scans_dropped, r.localized,
               r.step_p50_ms, r.step_p99_ms, r.step_max_ms, r.cycle_p99_ms, r.deadline_misses, r.static_memory_mib,
               r.map_width, r.map_height, r.map_resolution, r.pin_warnings);
   for (const auto& [m, mib] : r.module_mib) std::printf("  memory %-12s %8.2f MiB\n", m.c_str(), mib);
