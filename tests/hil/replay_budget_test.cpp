@@ -92,7 +92,8 @@ TEST(ReplayBudget, BudgetCheckFailsWhenBroken) {
   mmlfw_hil::ReplayResult r;
   ASSERT_TRUE(mmlfw_hil::run_replay(o, &r, &err)) << err;
   ASSERT_GT(r.scans_processed, 0u);
-  EXPECT_EQ(r.deadline_misses, r.scans_processed) << "a 1 us deadline must be missed by every step";
+  // (A step with nothing to do — no global work, no scan points — can take < 1 us.)
+  EXPECT_GT(r.deadline_misses, r.scans_processed / 2) << "a 1 us deadline must be missed by most steps";
   auto names = [](const std::vector<std::string>& v, const std::string& key) {
     for (const std::string& s : v)
       if (s.rfind(key + ":", 0) == 0) return true;
