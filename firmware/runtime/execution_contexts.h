@@ -35,10 +35,11 @@ inline constexpr std::uint64_t kSensorPeriodNs = 13'333'333;  // 75 Hz SICK LMS
 
 inline constexpr ExecutionContext kSensorContext{"sensor", 0, 80, 1, kSensorPeriodNs};
 // Global: every scan, result one scan later (deadline one scan period). Measured (issue 14, mml-eval
-// --localize intel+fr079, 13 fix trials each): every 2nd scan with the result 2 scans later halves
-// the MML steps per metre and doubled the distance to the first fix (intel 3.4 → 7.5 m, first-fix
-// success 0.77 → 0.54); on a slower CPU where the MML step p99 exceeds one scan period, set
-// period_scans = 2 (config global_period_scans) and accept that cost.
+// --localize intel+fr079, 13 fix trials each): the one-scan delay costs 0.2-0.7 m to the first fix;
+// every 2nd scan with the result 2 scans later halved the MML steps per metre and doubled the
+// distance to the first fix (intel 3.4 → 7.5 m, first-fix success 0.77 → 0.54). On a slower CPU
+// where the MML step p99 exceeds one scan period, set period_scans = 2 (config
+// global_period_scans) and accept that cost. README "Real time".
 inline constexpr ExecutionContext kGlobalContext{"global", 1, 40, 1, kSensorPeriodNs};
 inline constexpr ExecutionContext kWorkerContext{"workers", 1, 30, 0, 0};
 
