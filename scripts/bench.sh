@@ -47,7 +47,14 @@ for n in "${names[@]}"; do
     echo "bench.sh: unknown benchmark '$n' (available: ${available[*]:-none})" >&2; exit 2
   fi
   echo "=== bench $n ==="
-  "$exe" "build/bench/$n.json"
+  if [ "$n" = "realtime" ]; then
+    # Issue 14: the budget check must fail when broken (a tiny deadline, each limit out of reach).
+    build/release/tests/hil/replay_budget_test --gtest_filter='*BudgetCheckFailsWhenBroken*' \
+      > build/bench/realtime_broken.log 2>&1 || true
+    "$exe" "build/bench/$n.json" build/bench/realtime_broken.log
+  else
+    "$exe" "build/bench/$n.json"
+  fi
   if [ "$n" = "pransam" ]; then
     if [ -x build/release/bench/bench_pransam_pcl ]; then
       build/release/bench/bench_pransam_pcl "build/bench/$n.json"

@@ -64,7 +64,7 @@ bool parse_baud(const char* v, unsigned long* out) {
 constexpr const char* kKeys[] = {"laser",     "odometry",  "output",  "can_fd",           "localizer",
                                  "mml_preset", "map",       "workers", "cores",            "realtime",
                                  "arena_mib", "step_deadline_ms", "health_period_ms", "laser_timeout_ms", "seed",
-                                 "log_level"};
+                                 "log_level", "global_context", "global_period_scans"};
 constexpr int kNumKeys = static_cast<int>(sizeof(kKeys) / sizeof(kKeys[0]));
 
 // The config path as shown in messages: at most kShownPath characters, the end kept (the file
@@ -213,6 +213,13 @@ Status parse_app_config(const char* path, const char* text, std::size_t len, App
       }
     } else if (!std::strcmp(key, "realtime")) {
       if (!parse_bool(v, &out->realtime)) return CFG_ERR("'%s' is not true or false", v);
+    } else if (!std::strcmp(key, "global_period_scans")) {
+      if (!parse_int(v, 1, 8, &x)) return CFG_ERR("'%s' is not an integer in 1..8", v);
+      out->global_period_scans = static_cast<std::uint32_t>(x);
+    } else if (!std::strcmp(key, "global_context")) {
+      if (!std::strcmp(v, "thread")) out->global_threaded = true;
+      else if (!std::strcmp(v, "inline")) out->global_threaded = false;
+      else return CFG_ERR("'%s' is not thread or inline", v);
     } else if (!std::strcmp(key, "arena_mib")) {
       if (!parse_int(v, 1, 4096, &x)) return CFG_ERR("'%s' is not an integer in 1..4096", v);
       out->arena_mib = static_cast<std::uint32_t>(x);

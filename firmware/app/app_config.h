@@ -11,7 +11,13 @@
 //   map              path of the compiled map image (mml-mapc / mml-mapbuild)   (required for mml)
 //   workers          1..16 worker threads, created once  [2]
 //   cores            comma list of CPU ids for worker i  [0,1,...]; pinned to (core mod online CPUs)
-//   realtime         true | false  SCHED_FIFO workers + mlockall   [false]
+//   realtime         true | false  SCHED_FIFO + mlockall for every thread of the execution-context
+//                    table (firmware/runtime/execution_contexts.h); refused → start-up fails [false]
+//   global_context   thread | inline  mml-track: MML on its own pinned thread at lower priority,
+//                    fed every scan it is idle for, result taken 1 scan later (thread), or inside the sensor
+//                    step on every scan (inline: the deterministic reference schedule)  [thread]
+//   global_period_scans 1..8 thread: MML gets every n-th scan, its result is taken n scans later
+//                    (deadline n scan periods) [the table's, firmware/runtime/execution_contexts.h]
 //   arena_mib        1..4096 start-up arena (map + localizer storage) [256]
 //   step_deadline_ms 0.1..1000 Localizer::step longer than this is a deadline miss [13.333 = 75 Hz]
 //   health_period_ms 10..10000 heartbeat period when no scans arrive [200]
@@ -44,6 +50,8 @@ struct AppConfig {
   int cores[kMaxCores] = {0};
   int num_cores = 0;         // 0 = default (worker i → core i)
   bool realtime = false;
+  bool global_threaded = true;
+  std::uint32_t global_period_scans = 0;  // 0 = the execution-context table's
   std::uint32_t arena_mib = 256;
   double step_deadline_ms = 1000.0 / 75.0;
   std::uint32_t health_period_ms = 200;

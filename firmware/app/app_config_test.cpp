@@ -153,6 +153,17 @@ TEST(AppConfig, LaserTimeoutKey) {
   EXPECT_NE(std::strstr(s.message(), "line 3: key 'laser_timeout_ms'"), nullptr) << s.message();
 }
 
+// global_context (issue 14): thread by default, inline selectable, anything else named.
+TEST(AppConfig, GlobalContextKey) {
+  AppConfig c;
+  ASSERT_TRUE(parse("laser = socketcan:vcan0\nlocalizer = odom\n", &c).is_ok());
+  EXPECT_TRUE(c.global_threaded);
+  ASSERT_TRUE(parse("laser = socketcan:vcan0\nlocalizer = odom\nglobal_context = inline\n", &c).is_ok());
+  EXPECT_FALSE(c.global_threaded);
+  Status s = parse("laser = socketcan:vcan0\nlocalizer = odom\nglobal_context = fast\n", &c);
+  EXPECT_NE(std::strstr(s.message(), "line 3: key 'global_context'"), nullptr) << s.message();
+}
+
 TEST(AppConfig, FifoIsRefusedWithoutBlocking) {
   char dir[] = "/tmp/mmlfw-config-fifo.XXXXXX";
   ASSERT_NE(mkdtemp(dir), nullptr);

@@ -2,7 +2,14 @@
 // configuration → HAL board (backends from the config) → start-up arena → map image → worker
 // threads (pinned, created once) → localizer → LocalizationLoop; then the arena is sealed and the
 // loop runs until SIGINT/SIGTERM (or --max-scans / --duration). Steady state allocates nothing.
-//   mmlfw --config FILE [--memory-report] [--max-scans N] [--duration S]
+//   mmlfw --config FILE [--memory-report] [--timing-report] [--max-scans N] [--duration S]
+// Threads (firmware/runtime/execution_contexts.h, created here once and pinned): the main thread is
+// the `sensor` context (scan in → tracking → pose out, deadline one scan period); mml-track's MML
+// step runs on the `global` context thread (config global_context = thread, the default) and the
+// worker pool beside it. realtime = true: SCHED_FIFO at the table's priorities + mlockall; if the
+// OS refuses either, start-up fails with the reason (a real-time promise that cannot be kept is
+// an error, not a warning).
+// --timing-report: on exit, a per-stage timing table (perf counters: count, mean, p50, p99, max).
 // --memory-report: performs the full start-up, prints the static memory budget by module and exits;
 // the exit status is non-zero (with the reason on stderr) when this machine cannot run the config:
 // the board (bus, device) cannot be opened, the footprint exceeds the memory the machine or its
@@ -10,6 +17,7 @@
 // On exit a one-line summary "mmlfw summary: {...}" goes to stderr.
 #include <signal.h>
 #include <sys/mman.h>
+#include <unistd.h>
 
 #include <cstdio>
 #include <cstdlib>
@@ -24,7 +32,9 @@
 #include "firmware/map/global_map.h"
 #include "firmware/map/map_image.h"
 #include "firmware/map/map_image_file.h"
+#include "firmware/runtime/execution_contexts.h"
 #include "firmware/runtime/localization_loop.h"
+#include "firmware/runtime/rt_thread.h"
 #include "hal_linux/board.h"
 
 namespace {
@@ -41,7 +51,7 @@ volatile sig_atomic_t g_stop = 0;
 void on_signal(int) { g_stop = 1; }
 
 int usage(const char* msg) {
-  std::fprintf(stderr, "mmlfw: %s\nusage: mmlfw --config FILE [--memory-report] [--max-scans N] [--duration S]\n", msg);
+  std::fprintf(stderr, "mmlfw: %s\nusage: mmlfw --config FILE [--memory-report] [--timing-report] [--max-scans N] [--duration S]\n", msg);
   return 2;
 }
 
@@ -70,7 +80,9 @@ void trace_step(hal::Hal& hal) {
                  e.protection_xy_m, e.protection_theta_rad, e.unsupported_steps);
     return;
   }
-  if (mml == nullptr) {
+  // MML's state belongs to the global thread when it runs there: not read from here.
+  const bool mml_threaded = g_system.tracked() != nullptr && g_system.tracked()->global_context().threaded();
+  if (mml == nullptr || mml_threaded) {
     hal.log->log(hal::LogLevel::kDebug, "step scan %u t %llu odom %.4f %.4f %.4f status %s pose %.3f %.3f %.3f", e.scan_id,
                  static_cast<unsigned long long>(e.timestamp_ns), od.x, od.y, od.theta, hal::status_name(e.status), e.x, e.y,
                  e.theta);
@@ -89,6 +101,7 @@ void trace_step(hal::Hal& hal) {
 int main(int argc, char** argv) {
   const char* config_path = nullptr;
   bool memory_report = false;
+  bool timing_report = false;
   long max_scans = 0;
   double duration_s = 0;
   for (int i = 1; i < argc; ++i) {
@@ -96,6 +109,8 @@ int main(int argc, char** argv) {
       config_path = argv[++i];
     } else if (!std::strcmp(argv[i], "--memory-report")) {
       memory_report = true;
+    } else if (!std::strcmp(argv[i], "--timing-report")) {
+      timing_report = true;
     } else if (!std::strcmp(argv[i], "--max-scans") && i + 1 < argc) {
       max_scans = std::strtol(argv[++i], nullptr, 10);
       if (max_scans <= 0) return usage("--max-scans needs a positive integer");
@@ -133,7 +148,18 @@ int main(int argc, char** argv) {
   bool lock_refused = false;
   if (c.realtime && mlockall(MCL_CURRENT | MCL_FUTURE) != 0) {
     lock_refused = true;
-    hal.log->log(hal::LogLevel::kWarning, "mmlfw: mlockall refused; continuing without locked memory");
+    if (!memory_report) {
+      std::fprintf(stderr, "mmlfw: realtime = true but mlockall was refused (ulimit -l / CAP_IPC_LOCK); set "
+                           "realtime = false to run without locked memory\n");
+      return 1;
+    }
+  }
+  // This thread is the sensor context.
+  {
+    char warning[160];
+    st = fw::apply_execution_context_here(fw::kSensorContext, c.realtime && !memory_report, warning);
+    if (!st) return fail("sensor context", st);
+    if (warning[0]) hal.log->log(hal::LogLevel::kWarning, "mmlfw: %s", warning);
   }
   st = g_arena.init_mapped(static_cast<std::size_t>(c.arena_mib) << 20, c.realtime, "arena");
   if (!st) return fail("arena", st);
@@ -156,7 +182,15 @@ int main(int argc, char** argv) {
   fw::WorkerPoolOptions po;
   po.num_workers = c.workers;
   for (int i = 0; i < c.num_cores && i < fw::WorkerPoolOptions::kMaxWorkers; ++i) po.cores[i] = c.cores[i];
-  po.realtime = c.realtime;
+  if (c.num_cores == 0) {
+    // The table's worker core first (beside the global context), then the next ones round.
+    const long online = sysconf(_SC_NPROCESSORS_ONLN) > 0 ? sysconf(_SC_NPROCESSORS_ONLN) : 1;
+    for (int i = 0; i < c.workers && i < fw::WorkerPoolOptions::kMaxWorkers; ++i)
+      po.cores[i] = static_cast<int>((fw::kWorkerContext.core + i) % online);
+  }
+  po.realtime = c.realtime && !memory_report;
+  po.require_realtime = po.realtime;
+  po.priority = fw::kWorkerContext.priority;
   st = g_pool.start(po);
   if (!st) return fail("workers", st);
   if (g_pool.warning_count() > 0) {
@@ -171,8 +205,21 @@ int main(int argc, char** argv) {
   sys.localizer = c.localizer;
   sys.mml_preset = c.mml_preset;
   sys.seed = c.seed;
+  const fw::track::GlobalScheduleOptions live = fw::track::live_global_schedule(c.global_period_scans);
+  const fw::ExecutionContext global_ctx = fw::track::global_context_for(c.global_period_scans);
+  const bool global_thread = c.global_threaded && !std::strcmp(c.localizer, "mml-track") && !memory_report;
+  if (global_thread) {
+    sys.global_schedule = &live;
+    sys.anytime_global = true;
+  }
   st = g_system.build(sys, map, table, table_len, g_arena, &g_pool);
   if (!st) return fail("localizer", st);
+  if (global_thread) {
+    st = g_system.start_global_context(c.realtime, hal.clock, global_ctx);
+    if (!st) return fail("global context", st);
+  } else if (g_system.tracked() != nullptr) {
+    g_system.tracked()->global_context().set_clock(hal.clock);
+  }
   fw::Localizer* localizer = &g_system.localizer();
   // The map now lives in the arena. The image is a start-up copy (map_image_file.h: the file on
   // disk may be truncated or replaced while the firmware runs); a relation table section in use is
@@ -218,6 +265,7 @@ int main(int argc, char** argv) {
                 "(image copy) %.3f MiB = %.3f MiB (%.3f MiB with the arena trimmed to its peak use)\n",
                 g_arena.capacity() / 1048576.0, g_arena.used() / 1048576.0, statics / 1048576.0,
                 table_copy / 1048576.0, footprint / 1048576.0, (arena_need + statics + table_copy) / 1048576.0);
+    g_system.stop_global_context();
     g_pool.stop();
     // Pre-flight verdict: a configuration this machine cannot run is an error, with the reason.
     int reasons = 0;
@@ -269,6 +317,32 @@ int main(int argc, char** argv) {
     if (duration_s > 0 && static_cast<double>(now - t_start) * 1e-9 >= duration_s) g_stop = 1;
   }
 
+  g_system.stop_global_context();  // before the pool it drives
+  if (timing_report) {
+    std::fprintf(stderr, "mmlfw timing report (ms; context: sensor = main thread, global = MML thread%s)\n",
+                 global_thread ? "" : " (inline: inside loop.step)");
+    std::fprintf(stderr, "  %-8s %-14s %10s %9s %9s %9s %9s %9s\n", "context", "stage", "count", "mean", "p50", "p99",
+                 "max", "deadline");
+    auto row = [](const char* ctx, const char* stage, const fw::PerfStats& p, double deadline_ms) {
+      std::fprintf(stderr, "  %-8s %-14s %10llu %9.3f %9.3f %9.3f %9.3f %9.3f\n", ctx, stage,
+                   static_cast<unsigned long long>(p.count), p.mean_ms, p.p50_ms, p.p99_ms, p.max_ms, deadline_ms);
+    };
+    const double sensor_ms = c.step_deadline_ms;
+    row("sensor", g_loop.perf_poll().name(), g_loop.perf_poll().stats(), 0);
+    row("sensor", g_loop.perf_pair().name(), g_loop.perf_pair().stats(), 0);
+    row("sensor", g_loop.perf_step().name(), g_loop.perf_step().stats(), sensor_ms);
+    row("sensor", g_loop.perf_publish().name(), g_loop.perf_publish().stats(), 0);
+    row("sensor", g_loop.perf_total().name(), g_loop.perf_total().stats(), 0);
+    if (const fw::track::TrackedLocalizer* t = g_system.tracked()) {
+      const fw::track::GlobalContext& gc = t->global_context();
+      row(global_thread ? "global" : "sensor", "global.step", gc.step_stats(),
+          global_thread ? global_ctx.deadline_ns * 1e-6 : 0);
+      std::fprintf(stderr, "  global: jobs %llu, overruns %llu, skipped offers %llu (every %u scans, result after %u)\n",
+                   static_cast<unsigned long long>(gc.jobs()), static_cast<unsigned long long>(gc.overruns()),
+                   static_cast<unsigned long long>(gc.skipped_offers()), gc.schedule().every_n_scans,
+                   gc.schedule().result_delay_scans);
+    }
+  }
   const fw::PerfStats step = g_loop.perf_step().stats();
   const fw::PerfStats total = g_loop.perf_total().stats();
   const hal::Health& h = g_loop.health();

@@ -20,12 +20,23 @@ Result<T*> LocalizationSystem::emplace(StartupArena& arena, const char* what) {
 }
 
 LocalizationSystem::~LocalizationSystem() {
+  stop_global_context();
   // The arena owns the bytes; run the destructors (host tools build and drop systems).
   if (tracked_) tracked_->~TrackedLocalizer();
   if (handoff_) handoff_->~HandoffLocalizer();
   if (mcl_) mcl_->~MclLocalizer();
   if (mml_) mml_->~MmlLocalizer();
   if (odom_) odom_->~OdometryLocalizer();
+}
+
+Status LocalizationSystem::start_global_context(bool realtime, const hal::Clock* clock,
+                                                const ExecutionContext& context) {
+  if (tracked_ == nullptr) return Status::ok();
+  return tracked_->global_context().start_thread(context, realtime, clock);
+}
+
+void LocalizationSystem::stop_global_context() {
+  if (tracked_ != nullptr) tracked_->global_context().stop_thread();
 }
 
 bool LocalizationSystem::table_in_use() const { return mml_ != nullptr && mml_->using_precomputed_table(); }
@@ -59,7 +70,8 @@ Status LocalizationSystem::build(const SystemSpec& spec, const GlobalMap& map, c
                                          : tracked ? mml::mml_track_preset(spec.mml_preset, spec.seed)
                                                    : mml::mml_preset(spec.mml_preset, spec.seed);
     // pRANSAM's contact field must cover this map (it is sized from the map, not the preset).
-    const mml::MmlLocalizerConfig mc = mml::fit_contact_field_to_map(base, map);
+    mml::MmlLocalizerConfig mc = mml::fit_contact_field_to_map(base, map);
+    if (spec.anytime_global) mc.rbsm.grid.recenter_step_cells = kAnytimeRecenterCells;
     Result<mml::MmlLocalizer*> r = emplace<mml::MmlLocalizer>(arena, "MmlLocalizer");
     if (!r) return r.status();
     mml_ = *r;
@@ -93,7 +105,9 @@ Status LocalizationSystem::build(const SystemSpec& spec, const GlobalMap& map, c
     Result<track::TrackedLocalizer*> r = emplace<track::TrackedLocalizer>(arena, "TrackedLocalizer");
     if (!r) return r.status();
     tracked_ = *r;
-    const Status s = tracked_->init(spec.track != nullptr ? *spec.track : track::TrackOptions(), map, mml_);
+    const Status s = tracked_->init(spec.track != nullptr ? *spec.track : track::TrackOptions(), map, mml_,
+                                    spec.global_schedule != nullptr ? *spec.global_schedule
+                                                                    : track::GlobalScheduleOptions());
     if (!s) return Status::error(s.code(), "localizer mml-track: %s", s.message());
     localizer_ = tracked_;
   }

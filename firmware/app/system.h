@@ -40,7 +40,15 @@ struct SystemSpec {
   const mcl::MclOptions* mcl = nullptr;
   const mml::HandoffOptions* handoff = nullptr;
   const OdometryLocalizerOptions* odom = nullptr;
+  // mml-track: when MML consumes scans and returns results (track/global_context.h); null = the
+  // reference schedule (every scan, result on the same scan: deterministic, what the tools measure).
+  const track::GlobalScheduleOptions* global_schedule = nullptr;
+  // Anytime global search (issue 14): RBSM's end-point window re-centres by at most
+  // kAnytimeRecenterCells per step instead of in one 11–22 ms step. Deterministic. (pRANSAM's
+  // deadline mode, the time-dependent half, is switched on by start_global_context.)
+  bool anytime_global = false;
 };
+inline constexpr std::uint32_t kAnytimeRecenterCells = 16;
 
 class LocalizationSystem {
  public:
@@ -66,6 +74,12 @@ class LocalizationSystem {
   mml::HandoffLocalizer* handoff() { return handoff_; }
   const mml::HandoffLocalizer* handoff() const { return handoff_; }
   OdometryLocalizer* odom() { return odom_; }
+  // mml-track only, start-up: runs the global search on its own thread as the execution-context
+  // table declares (`global`, execution_contexts.h); needs a schedule with result_delay_scans ≥ 1.
+  // `clock` times the global steps. Other localizers: nothing to start (ok).
+  Status start_global_context(bool realtime, const hal::Clock* clock,
+                              const ExecutionContext& context = kGlobalContext);
+  void stop_global_context();
   // True when MML reads the map image's relation table in place (keep the image mapped).
   bool table_in_use() const;
   // Bytes of the localizer objects (they live in the arena; counted in arena.used()).

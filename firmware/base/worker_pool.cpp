@@ -86,6 +86,16 @@ Status WorkerPool::start(const WorkerPoolOptions& options) {
       pthread_attr_setschedparam(&attr, &sp);
     }
     int rc = pthread_create(&threads_[i], &attr, &WorkerPool::thread_main, &args_[i]);
+    if (rc == EPERM && options.realtime && options.require_realtime) {
+      pthread_attr_destroy(&attr);
+      num_workers_ = i;
+      started_ = num_workers_ > 0;
+      stop();
+      return Status::error(Errc::kIoError,
+                           "worker pool: realtime = true but SCHED_FIFO priority %d was refused for worker %d (needs "
+                           "CAP_SYS_NICE or RLIMIT_RTPRIO; set realtime = false to run without)",
+                           options.priority, i);
+    }
     if (rc == EPERM && options.realtime) {
       warn("worker %d: SCHED_FIFO not permitted (EPERM); running with the default scheduler", i);
       pthread_attr_setinheritsched(&attr, PTHREAD_INHERIT_SCHED);

@@ -23,7 +23,8 @@ struct WorkerPoolOptions {
   // Core for worker i; -1 = cores[i] := i. On machines with fewer online CPUs the worker is
   // pinned to (core mod online) with a warning (e.g. the single-CPU user-mode kernel).
   int cores[kMaxWorkers] = {-1, -1, -1, -1, -1, -1, -1, -1, -1, -1, -1, -1, -1, -1, -1, -1};
-  bool realtime = false;   // request SCHED_FIFO (warn and continue when not permitted)
+  bool realtime = false;   // request SCHED_FIFO (warn and continue when not permitted ...
+  bool require_realtime = false;  // ... unless this is set: then start() fails with the reason)
   int priority = 50;       // SCHED_FIFO priority when realtime
   bool pin = true;         // pthread_setaffinity_np
   // Spin-then-block hand-over: a worker that finished polls for the next job this long before it

@@ -316,6 +316,7 @@ Status MmlLocalizer::step(const hal::LaserScan& scan, const hal::Odometry& odom,
   if (!std::isfinite(odom.x) || !std::isfinite(odom.y) || !std::isfinite(odom.theta)) {
     return Status::error(Errc::kInvalidArgument, "MmlLocalizer: non-finite odometry at scan %u", scan.scan_id);
   }
+  const std::uint64_t step_begin_ns = deadline_clock_ != nullptr ? deadline_clock_->now_ns() : 0;
   // (1) RBSM: scan → local map.
   Se2f local_pose;
   const Status fs = front_end_.step(scan, odom, &local_pose);
@@ -396,7 +397,12 @@ Status MmlLocalizer::step(const hal::LaserScan& scan, const hal::Odometry& odom,
   mp.seed = config_.mml.seed * 1000003ull + steps_;
   pransam::MatchResult<2> mr;
   matched_points_ = num_scene_;
+  if (deadline_clock_ != nullptr && deadline_budget_ns_ > 0) {
+    mp.clock = deadline_clock_;
+    mp.deadline_ns = step_begin_ns + static_cast<std::uint64_t>(static_cast<double>(deadline_budget_ns_) * deadline_share_);
+  }
   const Status ms = matcher_.match(scene_, num_scene_, mp, &mr);
+  if (ms.is_ok() && mr.stats.stop == pransam::StopReason::kDeadline) ++deadline_stops_;
   std::size_t nh = 0;
   if (ms.is_ok()) {
     Se2f best_h;

@@ -87,6 +87,16 @@ class MmlLocalizer final : public Localizer {
   // Local map reduction: observations accepted since reset / currently kept.
   std::uint32_t observations_accepted() const { return observations_accepted_; }
   std::size_t observations_kept() const { return red_count_; }
+  // Anytime mode (issue 14; pRANSAM deadline mode, Sec. 4.4.3): pRANSAM's iterations end
+  // pransam_share of `step_budget_ns` after the step began (the rest is left for the front end
+  // before and the interpretation after it). clock null = off (every step runs I_max: the
+  // reproducible default). Kept across reset().
+  void set_deadline_mode(const hal::Clock* clock, std::uint64_t step_budget_ns, float pransam_share = 0.6f) {
+    deadline_clock_ = clock;
+    deadline_budget_ns_ = step_budget_ns;
+    deadline_share_ = pransam_share;
+  }
+  std::uint64_t deadline_stops() const { return deadline_stops_; }  // pRANSAM runs cut by the deadline
 
  private:
   Status gather_local_map();
@@ -149,6 +159,10 @@ class MmlLocalizer final : public Localizer {
   std::uint32_t unique_rejections_ = 0;
   hal::PoseEstimate last_out_;
   PerfCounter perf_match_{"mml.pransam"};
+  const hal::Clock* deadline_clock_ = nullptr;
+  std::uint64_t deadline_budget_ns_ = 0;
+  float deadline_share_ = 0.6f;
+  std::uint64_t deadline_stops_ = 0;
 
   // Local map correction (Eq. 5.23–5.27).
   Point2f corr_pts_[kMaxCorrectionPoints];

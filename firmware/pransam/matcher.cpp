@@ -594,11 +594,27 @@ Status Matcher<D>::match(const Point<D>* scene, std::size_t n, const MatchParams
   std::size_t dropped = 0;
   bool reached = false;
   std::uint32_t rounds = 0;
+  const bool deadline_mode = params.clock != nullptr && params.deadline_ns != 0;
+  bool deadline_hit = false;
+  std::uint64_t last_round_ns = 0, last_round_total = 0;
   while (done < params.max_iterations && !reached) {
     const std::uint64_t remaining = params.max_iterations - done;
     const std::uint64_t round_total = remaining < static_cast<std::uint64_t>(batch) * static_cast<std::uint64_t>(T)
                                           ? remaining
                                           : static_cast<std::uint64_t>(batch) * static_cast<std::uint64_t>(T);
+    std::uint64_t round_start = 0;
+    if (deadline_mode) {
+      round_start = params.clock->now_ns();
+      if (rounds > 0) {
+        // Sec. 4.4.3: stop when the next round, at the last round's rate, would end past the deadline.
+        const std::uint64_t predicted =
+            last_round_total > 0 ? last_round_ns * round_total / last_round_total : last_round_ns;
+        if (round_start >= params.deadline_ns || params.deadline_ns - round_start < predicted) {
+          deadline_hit = true;
+          break;
+        }
+      }
+    }
     for (int w = 0; w < T; ++w) {
       std::size_t b, e;
       WorkerPool::partition(static_cast<std::size_t>(round_total), w, T, &b, &e);
@@ -624,6 +640,10 @@ Status Matcher<D>::match(const Point<D>* scene, std::size_t n, const MatchParams
     if (out->best_valid) round_bound_ = out->best.quality;
     done += round_total;
     ++rounds;
+    if (deadline_mode) {
+      last_round_ns = params.clock->now_ns() - round_start;
+      last_round_total = round_total;
+    }
     if (batch < options_.max_batch) batch = batch * 2 < options_.max_batch ? batch * 2 : options_.max_batch;
   }
   MatchStats& s = out->stats;
@@ -644,7 +664,7 @@ Status Matcher<D>::match(const Point<D>* scene, std::size_t n, const MatchParams
     dropped += workers_[w].dropped;
   }
   s.rounds = rounds;
-  s.stop = reached ? StopReason::kThreshold : StopReason::kMaxIterations;
+  s.stop = reached ? StopReason::kThreshold : deadline_hit ? StopReason::kDeadline : StopReason::kMaxIterations;
   out->hypotheses = merged_;
   out->num_hypotheses = merged_n;
   out->dropped = dropped;

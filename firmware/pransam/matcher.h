@@ -36,6 +36,7 @@
 #include "firmware/pransam/hypothesis.h"
 #include "firmware/pransam/point_index.h"
 #include "firmware/pransam/relation_table.h"
+#include "hal/clock.h"
 
 namespace fw::pransam {
 
@@ -52,7 +53,7 @@ struct MatcherOptions {
   std::uint32_t collect_capacity = 4096; // collect-all buffer (merged), per-worker buffers the same
 };
 
-enum class StopReason : std::uint8_t { kThreshold, kMaxIterations };
+enum class StopReason : std::uint8_t { kThreshold, kMaxIterations, kDeadline };
 
 struct MatchParams {
   std::uint64_t seed = 1;
@@ -65,6 +66,12 @@ struct MatchParams {
   float extent = 0.0f;                    // online table extent; 0 = min(diam A, diam B, max_extent)
   float max_extent = 12.0f;
   float min_height_ratio = 0.1f;          // collinear rejection
+  // Deadline mode (Sec. 4.4.3, soft real-time): the iteration count is set by the time left. With a
+  // clock and deadline_ns ≠ 0 (absolute, on that clock), a round is started only if the previous
+  // round's time per iteration predicts it ends before the deadline; the first round always runs.
+  // I_max stays the upper bound. Time-dependent, so not reproducible: off in the lockstep tools.
+  const hal::Clock* clock = nullptr;
+  std::uint64_t deadline_ns = 0;
   std::uint32_t first_batch = 256;        // round batch starts here and doubles up to max_batch
                                           // (fewer barriers: 2-thread runs on a busy machine suffer less)
   std::uint32_t min_extrapolation_points = 12;

@@ -322,6 +322,40 @@ TEST_F(Matcher2DTest, ResetEmptiesOnlineTablesKeepsPrecomputedOne) {
   ASSERT_TRUE(matcher_->set_model(world_->map.data(), world_->map.size(), "floor plan").is_ok());
 }
 
+// Deadline mode (Sec. 4.4.3, issue 14): with a clock that advances 1 ms per reading, the first
+// round takes "1 ms"; the second (twice the batch) is predicted at 2 ms, so a deadline 1 ms after
+// its start stops the match after one round; a distant deadline changes nothing.
+TEST_F(Matcher2DTest, DeadlineModeStopsWhenTheNextRoundWouldNotFit) {
+  struct StepClock final : hal::Clock {
+    mutable std::uint64_t t = 0;
+    std::uint64_t now_ns() const override { return t += 1000000; }
+  };
+  RandomStream rng(51, 0);
+  const std::vector<P2> x = sim::pransam_scenes::cast_scan(world_->segs, Se2f(6.0f, 5.0f, 0.4f), 10.0f, 0.01f, rng);
+  MatchParams p;
+  p.seed = 3;
+  p.max_iterations = 30000;
+  p.omega_thres = 0.6f;
+  p.collect_all = true;
+  MatchResult<2> full;
+  ASSERT_TRUE(matcher_->match(x.data(), x.size(), p, &full).is_ok());
+  EXPECT_EQ(full.stats.stop, StopReason::kMaxIterations);
+  StepClock clock;
+  p.clock = &clock;
+  p.deadline_ns = 4000000;  // round 1: 1..2 ms; round 2 would start at 3 ms and need 2 ms
+  MatchResult<2> cut;
+  ASSERT_TRUE(matcher_->match(x.data(), x.size(), p, &cut).is_ok());
+  EXPECT_EQ(cut.stats.stop, StopReason::kDeadline);
+  EXPECT_EQ(cut.stats.rounds, 1u);
+  EXPECT_LT(cut.stats.iterations, full.stats.iterations);
+  clock.t = 0;
+  p.deadline_ns = 1000000000000ull;
+  MatchResult<2> late;
+  ASSERT_TRUE(matcher_->match(x.data(), x.size(), p, &late).is_ok());
+  EXPECT_EQ(late.stats.stop, StopReason::kMaxIterations);
+  EXPECT_EQ(late.stats.iterations, full.stats.iterations);
+}
+
 TEST_F(Matcher2DTest, RefinementAndFreeSpaceGateKeepTheRightAnswer) {
   RandomStream rng(47, 0);
   const Se2f pose(20.0f, 13.0f, -0.8f);

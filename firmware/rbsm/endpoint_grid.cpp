@@ -134,6 +134,7 @@ void EndpointGrid::clear() {
   // gave a different local map (trial results depended on the trials before them).
   origin_cx_ = origin_cy_ = 0;
   centered_ = false;
+  recentring_ = false;
 }
 
 void EndpointGrid::center_on(float x, float y) {
@@ -159,11 +160,18 @@ bool EndpointGrid::follow(float x, float y) {
   const std::int32_t half = static_cast<std::int32_t>(side_ / 2);
   const std::int32_t limit = static_cast<std::int32_t>(options_.recenter_fraction * static_cast<float>(side_));
   const std::int32_t ox = gx - (origin_cx_ + half), oy = gy - (origin_cy_ + half);
-  if (ox > limit || ox < -limit || oy > limit || oy < -limit) {
-    move_window(gx - half, gy - half);
+  if (!recentring_ && !(ox > limit || ox < -limit || oy > limit || oy < -limit)) return false;
+  const std::int32_t tx = gx - half, ty = gy - half;
+  if (options_.recenter_step_cells == 0) {
+    move_window(tx, ty);
     return true;
   }
-  return false;
+  const std::int32_t m = static_cast<std::int32_t>(options_.recenter_step_cells);
+  auto toward = [m](std::int32_t from, std::int32_t to) { return to > from + m ? from + m : to < from - m ? from - m : to; };
+  const std::int32_t nx = toward(origin_cx_, tx), ny = toward(origin_cy_, ty);
+  move_window(nx, ny);
+  recentring_ = nx != tx || ny != ty;
+  return true;
 }
 
 void EndpointGrid::move_window(std::int32_t nox, std::int32_t noy) {

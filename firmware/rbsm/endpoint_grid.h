@@ -30,6 +30,11 @@ struct EndpointGridOptions {
   std::uint32_t subcell_log2 = 2;  // lookup sub-cells per cell side = 2^subcell_log2
   float xi_cells = 1.41421356f;    // ξ: bound of the nearest-neighbour distance (Eq. 2.9), ≤ 1.5
   float recenter_fraction = 0.25f; // re-centre when the robot is this fraction of the side off-centre
+  // Anytime re-centre (issue 14): 0 = the whole shift at once (a 256-cell shift of the 1024-cell
+  // window clears 2 × 256k cells: 11–22 ms in one step); n > 0 = at most n cells per axis per
+  // follow() until the window is centred again, so the cost is spread over the following steps
+  // (a robot moves < 1 cell per scan at 75 Hz, so the window catches up).
+  std::uint32_t recenter_step_cells = 0;
 
   Status validate() const;
 };
@@ -127,6 +132,7 @@ class EndpointGrid {
   std::uint32_t side_ = 0, cell_mask_ = 0, k_ = 1, sub_mask_ = 0, sub_shift_ = 0;
   std::int32_t origin_cx_ = 0, origin_cy_ = 0;
   bool centered_ = false;
+  bool recentring_ = false;  // an incremental re-centre is under way
   std::size_t occupied_count_ = 0;
   // Bounding box (global cells) of everything written since the last clear().
   std::int32_t dirty_x0_ = 0, dirty_y0_ = 0, dirty_x1_ = -1, dirty_y1_ = -1;

@@ -105,3 +105,43 @@ TEST(EndpointGridOptionsTest, RejectsBadValues) {
 }
 
 }  // namespace
+
+// Anytime re-centre (issue 14): moving the window a few cells per follow() ends in exactly the
+// grid (occupancy and likelihood) of the one-step re-centre when the robot stands still.
+TEST(EndpointGridRecentreTest, SpreadRecentreEqualsOneStep) {
+  auto build = [](std::uint32_t step_cells, std::vector<unsigned char>* block, fw::StartupArena* arena,
+                  fw::EndpointGrid* grid) {
+    fw::EndpointGridOptions o;
+    o.size_log2 = 6;  // 64 cells = 3.2 m, re-centred 16 cells off-centre
+    o.recenter_step_cells = step_cells;
+    block->assign(fw::EndpointGrid::required_bytes(o) + 256, 0);
+    ASSERT_TRUE(arena->init(block->data(), block->size(), "test").is_ok());
+    ASSERT_TRUE(grid->init(o, *arena).is_ok());
+    grid->center_on(0, 0);
+    for (int i = 0; i < 400; ++i) {  // points all over the window, some near its edges
+      const float a = 0.37f * static_cast<float>(i);
+      grid->insert(1.5f * std::cos(a) * (0.2f + 0.002f * i), 1.5f * std::sin(1.3f * a) * (0.2f + 0.002f * i));
+    }
+  };
+  std::vector<unsigned char> b1, b2;
+  fw::StartupArena a1, a2;
+  fw::EndpointGrid once, spread;
+  build(0, &b1, &a1, &once);
+  build(3, &b2, &a2, &spread);
+  EXPECT_TRUE(once.follow(1.0f, -0.9f));  // 20 / 18 cells off-centre
+  int moves = 0;
+  while (spread.follow(1.0f, -0.9f)) {
+    ++moves;
+    ASSERT_LT(moves, 100);
+  }
+  EXPECT_EQ(moves, 7) << "20 cells at 3 per step";
+  EXPECT_EQ(spread.origin_cx(), once.origin_cx());
+  EXPECT_EQ(spread.origin_cy(), once.origin_cy());
+  EXPECT_EQ(spread.occupied_count(), once.occupied_count());
+  for (float y = -3.5f; y < 3.5f; y += 0.0125f) {
+    for (float x = -3.5f; x < 3.5f; x += 0.0125f) {
+      ASSERT_EQ(spread.occupied(x, y), once.occupied(x, y)) << x << " " << y;
+      ASSERT_EQ(spread.likelihood(x, y), once.likelihood(x, y)) << x << " " << y;
+    }
+  }
+}

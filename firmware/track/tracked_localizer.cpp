@@ -7,9 +7,11 @@
 namespace fw {
 namespace track {
 
-Status TrackedLocalizer::init(const TrackOptions& options, const GlobalMap& map, mml::MmlLocalizer* global) {
+Status TrackedLocalizer::init(const TrackOptions& options, const GlobalMap& map, mml::MmlLocalizer* global,
+                              const GlobalScheduleOptions& schedule) {
   if (global == nullptr) return Status::error(Errc::kInvalidArgument, "TrackedLocalizer: null global localizer");
   FW_RETURN_IF_ERROR(tracker_.init(options, map));
+  FW_RETURN_IF_ERROR(global_.init(global, schedule));
   mml_ = global;
   reset();
   return Status::ok();
@@ -17,7 +19,7 @@ Status TrackedLocalizer::init(const TrackOptions& options, const GlobalMap& map,
 
 void TrackedLocalizer::reset() {
   tracker_.reset();
-  if (mml_ != nullptr) mml_->reset();
+  global_.restart();
   fixes_ = fix_rejections_ = tracks_lost_ = cross_check_switches_ = confirmations_ = 0;
   cross_check_left_ = 0;
   unconfirmed_ = false;
@@ -58,6 +60,7 @@ Status TrackedLocalizer::step(const hal::LaserScan& scan, const hal::Odometry& o
   if (!std::isfinite(odom.x) || !std::isfinite(odom.y) || !std::isfinite(odom.theta)) {
     return Status::error(Errc::kInvalidArgument, "TrackedLocalizer: non-finite odometry at scan %u", scan.scan_id);
   }
+  global_.tick();
   const Se2f wheel(odom.x, odom.y, odom.theta);
   const std::size_t n = scan_points(scan);
   if (tracker_.active()) {
@@ -70,7 +73,7 @@ Status TrackedLocalizer::step(const hal::LaserScan& scan, const hal::Odometry& o
       // The robot may have been carried anywhere (a kidnap into a twin corridor fits every local
       // test): the pose needs MML's word again, from a local map that starts after the fault.
       unconfirmed_ = true;
-      mml_->reset();
+      global_.reset();
       cross_check_left_ = tracker_.options().cross_check_steps;
     }
     if (!ts.lost) return cross_check(scan, odom, wheel, n, ts, out);
@@ -78,9 +81,9 @@ Status TrackedLocalizer::step(const hal::LaserScan& scan, const hal::Odometry& o
       // The track is given up: global localization from a fresh local map, starting with this scan.
       ++tracks_lost_;
       cross_check_left_ = 0;
-      mml_->reset();
+      global_.reset();
       hal::PoseEstimate g;
-      FW_RETURN_IF_ERROR(mml_->step(scan, odom, &g));
+      FW_RETURN_IF_ERROR(global_.step(scan, odom, &g));
       out->status = ts.verdict == ScanVerdict::kOutsideMap ? hal::LocalizationStatus::kOutsideMap
                                                            : hal::LocalizationStatus::kSearching;
       out->mode = hal::LocalizationMode::kGlobal;
@@ -88,7 +91,7 @@ Status TrackedLocalizer::step(const hal::LaserScan& scan, const hal::Odometry& o
     }
     return Status::ok();
   }
-  FW_RETURN_IF_ERROR(mml_->step(scan, odom, out));
+  FW_RETURN_IF_ERROR(global_.step(scan, odom, out));
   out->mode = hal::LocalizationMode::kGlobal;
   out->protection_xy_m = out->protection_theta_rad = 0.0f;
   if (out->status != hal::LocalizationStatus::kLocalized) return Status::ok();
@@ -125,13 +128,13 @@ Status TrackedLocalizer::cross_check(const hal::LaserScan& scan, const hal::Odom
   if (budget == 0) return Status::ok();
   if (unconfirmed_) out->status = hal::LocalizationStatus::kAmbiguous;  // until MML agrees
   if (ts.status != hal::LocalizationStatus::kLocalized || unconfirmed_) {
-    if (cross_check_left_ == 0) mml_->reset();  // a fresh local map from this scan on
+    if (cross_check_left_ == 0) global_.reset();  // a fresh local map from this scan on
     cross_check_left_ = budget;                 // runs on for `budget` scans after the last doubt
   }
   if (cross_check_left_ == 0) return Status::ok();
   --cross_check_left_;
   hal::PoseEstimate g;
-  FW_RETURN_IF_ERROR(mml_->step(scan, odom, &g));
+  FW_RETURN_IF_ERROR(global_.step(scan, odom, &g));
   if (g.status != hal::LocalizationStatus::kLocalized) return Status::ok();
   cross_check_left_ = 0;
   const float d = std::hypot(g.x - ts.pose.x, g.y - ts.pose.y);

@@ -22,6 +22,7 @@
 
 #include "firmware/mml/mml_localizer.h"
 #include "firmware/runtime/localizer.h"
+#include "firmware/track/global_context.h"
 #include "firmware/track/pose_tracker.h"
 
 namespace fw {
@@ -29,8 +30,11 @@ namespace track {
 
 class TrackedLocalizer final : public Localizer {
  public:
-  // `global` must be initialised and outlive this object.
-  Status init(const TrackOptions& options, const GlobalMap& map, mml::MmlLocalizer* global);
+  // `global` must be initialised and outlive this object. Every MML step and reset goes through
+  // the global context (global_context.h): by default inline on every scan (the reference
+  // schedule); mmlfw runs it threaded on the schedule of the execution-context table.
+  Status init(const TrackOptions& options, const GlobalMap& map, mml::MmlLocalizer* global,
+              const GlobalScheduleOptions& schedule = GlobalScheduleOptions());
   const char* name() const override { return "mml-track"; }
   void reset() override;
   Status step(const hal::LaserScan& scan, const hal::Odometry& odom, hal::PoseEstimate* out) override;
@@ -39,6 +43,8 @@ class TrackedLocalizer final : public Localizer {
   const PoseTracker& tracker() const { return tracker_; }
   mml::MmlLocalizer* global() { return mml_; }
   const mml::MmlLocalizer* global() const { return mml_; }
+  GlobalContext& global_context() { return global_; }
+  const GlobalContext& global_context() const { return global_; }
   // Since reset: fixes accepted, MML fixes the tracker did not confirm, tracks given up.
   std::uint32_t fixes() const { return fixes_; }
   std::uint32_t fix_rejections() const { return fix_rejections_; }
@@ -57,6 +63,7 @@ class TrackedLocalizer final : public Localizer {
   Status cross_check(const hal::LaserScan& scan, const hal::Odometry& odom, const Se2f& wheel, std::size_t n,
                      const TrackStep& ts, hal::PoseEstimate* out);
   mml::MmlLocalizer* mml_ = nullptr;
+  GlobalContext global_;
   PoseTracker tracker_;
   Point2f pts_[hal::LaserScan::kMaxBeams];
   std::uint32_t fixes_ = 0, fix_rejections_ = 0, tracks_lost_ = 0, cross_check_switches_ = 0;

@@ -16,6 +16,7 @@
 //            [--no-pool]   (MML best-cluster support not pooled over consistent steps: Eq. 5.17 per step)
 //   --help prints the usage.
 //   --steps 0 = whole-log runs continue to the end of the log (else at most that many steps).
+//   --global ref|live|live-deadline: mml-track's global search schedule (mml_systems.h; issue 14)
 // Any building by path (implies --localize; only this building unless --datasets is given):
 //   mml-eval --log LOG.clf[.gz] --map MAP.yaml --reference POSES.txt|CORRECTED.log[.gz]
 //            [--relations R] [--name NAME] [--synthetic-odometry]
@@ -28,6 +29,7 @@
 
 #include "sim/eval/mml_eval/localize_eval.h"
 #include "sim/eval/mml_eval/mml_eval_run.h"
+#include "sim/eval/mml_eval/mml_systems.h"
 #include "sim/common/cli_main.h"
 
 namespace {
@@ -46,7 +48,7 @@ const char kUsage[] =
     "       mml-eval --localize [--datasets intel,fr101] [--whole-runs 3] [--steps 0] [--fix-trials 10]\n"
     "                [--fix-steps 200] [--mcl-trials 3] [--mcl-datasets intel,fr079] [--kidnap-runs 2]\n"
     "                [--kidnap-datasets intel,fr079,aces] [--no-unknown] [--seed 1] [--threads 2] [--out DIR]\n"
-    "                [--no-pool]\n"
+    "                [--no-pool] [--global ref|live|live-deadline]\n"
     "       mml-eval --log LOG.clf[.gz] --map MAP.yaml --reference POSES.txt|CORRECTED.log[.gz]\n"
     "                [--relations R] [--name NAME] [--synthetic-odometry]   (any building by path)\n"
     "Datasets are read from ../shared/data (MMLFW_DATA_DIR). Definitions of every figure:\n"
@@ -92,6 +94,13 @@ static int run_main(int argc, char** argv) {
     else if (a == "--synthetic-odometry") files.synthetic_odometry = true;
     else if (a == "--pool") lp.pool_cluster_support = true;
     else if (a == "--no-pool") lp.pool_cluster_support = false;
+    else if (a == "--global") {
+      const std::string m = str();
+      if (m == "ref") sim::mmleval::set_eval_global_mode(sim::mmleval::EvalGlobalMode::kReference);
+      else if (m == "live") sim::mmleval::set_eval_global_mode(sim::mmleval::EvalGlobalMode::kLive);
+      else if (m == "live-deadline") sim::mmleval::set_eval_global_mode(sim::mmleval::EvalGlobalMode::kLiveDeadline);
+      else std::exit(usage(("bad value for --global: '" + m + "' (ref, live, live-deadline)").c_str()));
+    }
     else if (a == "--whole-runs") lp.whole_runs = next(0, 1000);
     else if (a == "--fix-trials") lp.fix_trials = next(0, 1000);
     else if (a == "--fix-steps") lp.fix_steps = next(1, 100000);

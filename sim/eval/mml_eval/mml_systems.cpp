@@ -1,5 +1,7 @@
 #include "sim/eval/mml_eval/mml_systems.h"
 
+#include <time.h>
+
 #include <algorithm>
 #include <cstdlib>
 
@@ -35,7 +37,20 @@ const std::uint8_t* table_section(const std::vector<std::uint8_t>& image, std::s
   if (image.empty()) return nullptr;
   return fw::find_section(image.data(), image.size(), fw::MapSectionType::kRelationTable2D, len);
 }
+EvalGlobalMode g_global_mode = EvalGlobalMode::kReference;
+
+class MonotonicClock final : public hal::Clock {
+ public:
+  std::uint64_t now_ns() const override {
+    timespec t{};
+    clock_gettime(CLOCK_MONOTONIC, &t);
+    return static_cast<std::uint64_t>(t.tv_sec) * 1000000000ull + static_cast<std::uint64_t>(t.tv_nsec);
+  }
+};
+MonotonicClock g_mono_clock;
 }  // namespace
+
+void set_eval_global_mode(EvalGlobalMode mode) { g_global_mode = mode; }
 
 std::unique_ptr<OwnedLocalizer> OwnedLocalizer::make(const fw::SystemSpec& spec, const fw::GlobalMap& map,
                                                      const std::vector<std::uint8_t>& image, int threads,
@@ -46,7 +61,17 @@ std::unique_ptr<OwnedLocalizer> OwnedLocalizer::make(const fw::SystemSpec& spec,
   if (s.is_ok()) {
     std::size_t len = 0;
     const std::uint8_t* sec = table_section(image, &len);
-    s = o->system_.build(spec, map, sec, len, o->arena_, o->pool_.get());
+    fw::SystemSpec sp = spec;
+    const fw::track::GlobalScheduleOptions live = fw::track::live_global_schedule();
+    const bool track = sp.localizer != nullptr && std::string(sp.localizer) == "mml-track";
+    if (track && g_global_mode != EvalGlobalMode::kReference) {
+      sp.global_schedule = &live;
+      sp.anytime_global = true;
+    }
+    s = o->system_.build(sp, map, sec, len, o->arena_, o->pool_.get());
+    if (s.is_ok() && track && g_global_mode == EvalGlobalMode::kLiveDeadline && o->system_.mml() != nullptr) {
+      o->system_.mml()->set_deadline_mode(&g_mono_clock, fw::kGlobalContext.deadline_ns);
+    }
   }
   if (!s.is_ok()) {
     *err = s.message();

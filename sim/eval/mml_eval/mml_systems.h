@@ -42,6 +42,15 @@ using fw::mcl::mcl_tracking_options;
 
 // A localizer together with everything it needs (arena, pool), built by the firmware's one
 // start-up builder (firmware/app/system.h) exactly as mmlfw builds it. reset()/step() forward.
+// mml-track's global search in the evaluation (issue 14; mml-eval --global):
+//   kReference      every scan, result on the same scan (default; the figures of record)
+//   kLive           mmlfw's live schedule (execution_contexts.h: every scan, result 1 scan
+//                   later, moved by odometry) + the RBSM window re-centre spread over steps; inline,
+//                   deterministic — what the threaded firmware computes when every global step is on time
+//   kLiveDeadline   kLive + pRANSAM deadline mode at the global context's deadline (time-dependent)
+enum class EvalGlobalMode { kReference, kLive, kLiveDeadline };
+void set_eval_global_mode(EvalGlobalMode mode);
+
 class OwnedLocalizer : public fw::Localizer {
  public:
   const char* name() const override { return system_.name(); }

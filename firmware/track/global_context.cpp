@@ -1,0 +1,199 @@
+#include "firmware/track/global_context.h"
+
+#include "firmware/base/se2.h"
+#include "firmware/runtime/rt_thread.h"
+
+namespace fw {
+namespace track {
+
+Status GlobalScheduleOptions::validate(bool threaded) const {
+  if (every_n_scans == 0 || every_n_scans > 1000) {
+    return Status::error(Errc::kInvalidArgument, "global schedule: every_n_scans %u outside [1, 1000]", every_n_scans);
+  }
+  if (result_delay_scans > every_n_scans) {
+    return Status::error(Errc::kInvalidArgument,
+                         "global schedule: result_delay_scans %u > every_n_scans %u (one job in flight at most)",
+                         result_delay_scans, every_n_scans);
+  }
+  if (threaded && result_delay_scans == 0) {
+    return Status::error(Errc::kInvalidArgument,
+                         "global schedule: a threaded global context needs result_delay_scans >= 1 (the sensor "
+                         "context never waits for it)");
+  }
+  return Status::ok();
+}
+
+Status GlobalContext::init(mml::MmlLocalizer* mml, const GlobalScheduleOptions& schedule) {
+  if (mml == nullptr) return Status::error(Errc::kInvalidArgument, "global context: null MML localizer");
+  if (threaded_) return Status::error(Errc::kInvalidArgument, "global context: init() while the thread runs");
+  FW_RETURN_IF_ERROR(schedule.validate(false));
+  mml_ = mml;
+  schedule_ = schedule;
+  index_ = 0;
+  generation_ = 0;
+  jobs_ = overruns_ = skipped_offers_ = 0;
+  reset_pending_ = false;
+  slot_.store(Slot::kIdle);
+  return Status::ok();
+}
+
+Status GlobalContext::start_thread(const ExecutionContext& context, bool realtime, const hal::Clock* clock) {
+  if (mml_ == nullptr) return Status::error(Errc::kNotInitialized, "global context: start_thread() before init()");
+  if (threaded_) return Status::error(Errc::kInvalidArgument, "global context: thread already started");
+  FW_RETURN_IF_ERROR(schedule_.validate(true));
+  clock_ = clock;
+  stopping_ = false;
+  // Anytime global search: pRANSAM's iterations are cut so the step fits the context's window.
+  if (clock != nullptr) mml_->set_deadline_mode(clock, context.deadline_ns);
+  const int rc = pthread_create(&thread_, nullptr, &GlobalContext::thread_main, this);
+  if (rc != 0) return Status::error(Errc::kIoError, "global context: pthread_create failed (%d)", rc);
+  threaded_ = true;
+  char warning[160];
+  const Status s = apply_execution_context(thread_, context, realtime, warning);
+  if (!s) {
+    stop_thread();
+    return s;
+  }
+  return Status::ok();
+}
+
+void GlobalContext::stop_thread() {
+  if (!threaded_) return;
+  pthread_mutex_lock(&mutex_);
+  stopping_ = true;
+  pthread_cond_broadcast(&cv_);
+  pthread_mutex_unlock(&mutex_);
+  pthread_join(thread_, nullptr);
+  threaded_ = false;
+  // A job queued but never run is dropped; a finished one stays for the next step() (inline now).
+  Slot s = slot_.load();
+  if (s == Slot::kQueued || s == Slot::kRunning) slot_.store(Slot::kIdle);
+}
+
+void* GlobalContext::thread_main(void* self) {
+  static_cast<GlobalContext*>(self)->thread_loop();
+  return nullptr;
+}
+
+void GlobalContext::thread_loop() {
+  for (;;) {
+    pthread_mutex_lock(&mutex_);
+    while (!stopping_ && slot_.load(std::memory_order_acquire) != Slot::kQueued) pthread_cond_wait(&cv_, &mutex_);
+    const bool stop = stopping_;
+    pthread_mutex_unlock(&mutex_);
+    if (stop) return;
+    slot_.store(Slot::kRunning, std::memory_order_release);
+    run_job();
+  }
+}
+
+void GlobalContext::run_job() {
+  if (job_reset_) mml_->reset();
+  const std::uint64_t t0 = clock_ != nullptr ? clock_->now_ns() : 0;
+  job_status_ = mml_->step(job_scan_, job_odom_, &job_out_);
+  if (clock_ != nullptr) {
+    const std::uint64_t dt = clock_->now_ns() - t0;
+    pthread_mutex_lock(&stats_mutex_);
+    perf_step_.add_ns(dt);
+    pthread_mutex_unlock(&stats_mutex_);
+  }
+  slot_.store(Slot::kDone, std::memory_order_release);
+}
+
+PerfStats GlobalContext::step_stats() const {
+  pthread_mutex_lock(&stats_mutex_);
+  const PerfStats s = perf_step_.stats();
+  pthread_mutex_unlock(&stats_mutex_);
+  return s;
+}
+
+void GlobalContext::tick() {
+  ++index_;
+  if (!threaded_) return;
+  const Slot s = slot_.load(std::memory_order_acquire);
+  // The job's window closes at index job_index_ + delay: still not done then is an overrun.
+  if ((s == Slot::kQueued || s == Slot::kRunning) && index_ - 1 == job_index_ + schedule_.result_delay_scans) {
+    ++overruns_;
+  }
+}
+
+void GlobalContext::reset() {
+  ++generation_;
+  if (!threaded_) {
+    mml_->reset();  // at once: the tracker as it always was
+    reset_pending_ = false;
+  } else {
+    reset_pending_ = true;  // MML belongs to the global thread: it resets before its next job
+  }
+}
+
+void GlobalContext::restart() {
+  if (mml_ == nullptr) return;
+  reset();
+  index_ = 0;
+}
+
+void GlobalContext::take_result(const hal::LaserScan& scan, const hal::Odometry& odom, hal::PoseEstimate* out) {
+  *out = job_out_;
+  const std::uint64_t cur = index_ - 1;
+  if (cur != job_index_) {
+    // MML's estimate is for the scan it consumed: move it to this scan by the wheel odometry.
+    const Se2f before(job_odom_.x, job_odom_.y, job_odom_.theta);
+    const Se2f now(odom.x, odom.y, odom.theta);
+    const Se2f p = Se2f(job_out_.x, job_out_.y, job_out_.theta).compose(before.between(now));
+    out->x = p.x;
+    out->y = p.y;
+    out->theta = p.theta;
+  }
+  out->timestamp_ns = scan.timestamp_ns;
+  out->scan_id = scan.scan_id;
+  slot_.store(Slot::kIdle, std::memory_order_release);
+}
+
+Status GlobalContext::step(const hal::LaserScan& scan, const hal::Odometry& odom, hal::PoseEstimate* out) {
+  if (mml_ == nullptr) return Status::error(Errc::kNotInitialized, "global context: step() before init()");
+  *out = hal::PoseEstimate();
+  out->timestamp_ns = scan.timestamp_ns;
+  out->scan_id = scan.scan_id;
+  out->status = hal::LocalizationStatus::kSearching;
+  const std::uint64_t cur = index_ > 0 ? index_ - 1 : 0;
+  Status result_status;
+  // 1. A finished result whose window has come.
+  if (slot_.load(std::memory_order_acquire) == Slot::kDone) {
+    if (job_generation_ != generation_) {
+      slot_.store(Slot::kIdle, std::memory_order_release);  // asked before a reset: stale
+    } else if (cur >= job_index_ + schedule_.result_delay_scans) {
+      result_status = job_status_;
+      take_result(scan, odom, out);
+    }
+  }
+  // 2. This scan for MML, when the schedule says so and the mailbox is free.
+  if (cur % schedule_.every_n_scans != 0) return result_status;
+  if (slot_.load(std::memory_order_acquire) != Slot::kIdle) {
+    ++skipped_offers_;
+    return result_status;
+  }
+  job_scan_ = scan;
+  job_odom_ = odom;
+  job_index_ = cur;
+  job_generation_ = generation_;
+  job_reset_ = reset_pending_;
+  reset_pending_ = false;
+  ++jobs_;
+  if (threaded_) {
+    pthread_mutex_lock(&mutex_);
+    slot_.store(Slot::kQueued, std::memory_order_release);
+    pthread_cond_signal(&cv_);
+    pthread_mutex_unlock(&mutex_);
+    return result_status;
+  }
+  run_job();
+  if (schedule_.result_delay_scans == 0) {
+    result_status = job_status_;
+    take_result(scan, odom, out);
+  }
+  return result_status;
+}
+
+}  // namespace track
+}  // namespace fw

@@ -1,0 +1,132 @@
+// GlobalContext: how the tracker (sensor context) reaches the global search (MML) — issue 14.
+// The tracker calls step() on each scan it wants a global step for; the context decides by the
+// schedule, not by timing, which scans MML consumes and when their results come back:
+//   - scan index i counts the tracker's steps since reset (tick() on every step);
+//   - MML consumes the scan offered at index i when i % every_n_scans == 0 (and no job is in
+//     flight: with result_delay_scans ≤ every_n_scans, one on time never is);
+//   - its result is handed back at the first step() at index ≥ i + result_delay_scans, its pose
+//     moved from scan i to the current scan by the wheel odometry between them (Se2 ⊕, Eq. 5.1);
+//     at other scans step() reports `searching` without a pose.
+// Two executions of the same schedule:
+//   inline   MML runs synchronously inside step() (lockstep tools: sim, mml-eval, bench). With
+//            every_n_scans = 1 and result_delay_scans = 0 this is the tracker as it always was.
+//   threaded MML runs on its own pinned thread (execution_contexts.h, `global`); step() only
+//            copies the scan into a one-slot mailbox and takes a finished result. Same function of
+//            the inputs as inline as long as every global step finishes within its window
+//            (result_delay_scans scan periods); a late step is counted (overruns()), its result is
+//            taken at the first step() after it finished, and the offers it overlapped are
+//            skipped (skipped_offers()) — from then on the run differs from the inline one.
+// reset() forgets MML's state (fresh local map) before the next job; results of jobs handed over
+// before a reset are dropped. Nothing is allocated after init()/start_thread().
+#pragma once
+
+#include <pthread.h>
+
+#include <atomic>
+#include <cstdint>
+
+#include "firmware/base/perf_counter.h"
+#include "firmware/base/status.h"
+#include "firmware/mml/mml_localizer.h"
+#include "firmware/runtime/execution_contexts.h"
+#include "hal/clock.h"
+
+namespace fw {
+namespace track {
+
+struct GlobalScheduleOptions {
+  std::uint32_t every_n_scans = 1;
+  std::uint32_t result_delay_scans = 0;  // ≤ every_n_scans; ≥ 1 when threaded
+  Status validate(bool threaded) const;
+};
+
+// The shipped live schedule: the `global` entry of the execution-context table (period_scans 0), or
+// every n-th scan with the result n scans later.
+inline GlobalScheduleOptions live_global_schedule(std::uint32_t period_scans = 0) {
+  GlobalScheduleOptions s;
+  s.every_n_scans = period_scans > 0 ? period_scans : kGlobalContext.period_scans;
+  s.result_delay_scans = s.every_n_scans;
+  return s;
+}
+// The `global` context for that schedule: deadline = period_scans scan periods.
+inline ExecutionContext global_context_for(std::uint32_t period_scans) {
+  ExecutionContext c = kGlobalContext;
+  if (period_scans > 0) {
+    c.period_scans = period_scans;
+    c.deadline_ns = period_scans * kSensorPeriodNs;
+  }
+  return c;
+}
+
+class GlobalContext {
+ public:
+  GlobalContext() = default;
+  GlobalContext(const GlobalContext&) = delete;
+  GlobalContext& operator=(const GlobalContext&) = delete;
+  ~GlobalContext() { stop_thread(); }
+
+  Status init(mml::MmlLocalizer* mml, const GlobalScheduleOptions& schedule);
+  // Start-up only: creates the global thread (pinned, SCHED_FIFO when realtime). `clock` times the
+  // global steps (perf_step()) and puts MML in deadline mode (pRANSAM's iterations set by the time
+  // left in the context's deadline, Sec. 4.4.3); null = neither.
+  Status start_thread(const ExecutionContext& context, bool realtime, const hal::Clock* clock);
+  void stop_thread();
+  bool threaded() const { return threaded_; }
+  // Inline: the clock that times global steps (perf_step()); null = not timed.
+  void set_clock(const hal::Clock* clock) { clock_ = clock; }
+
+  // Once per tracker step, before any step()/reset() of that scan.
+  void tick();
+  void reset();   // MML forgets everything before its next job
+  void restart(); // reset() and the scan index back to 0 (TrackedLocalizer::reset)
+  // See the header comment. `out` is always written.
+  Status step(const hal::LaserScan& scan, const hal::Odometry& odom, hal::PoseEstimate* out);
+
+  const GlobalScheduleOptions& schedule() const { return schedule_; }
+  // A job handed to the global thread and not finished yet.
+  bool job_in_flight() const {
+    const Slot s = slot_.load(std::memory_order_acquire);
+    return s == Slot::kQueued || s == Slot::kRunning;
+  }
+  std::uint64_t jobs() const { return jobs_; }
+  std::uint64_t overruns() const { return overruns_; }
+  std::uint64_t skipped_offers() const { return skipped_offers_; }
+  const PerfCounter& perf_step() const { return perf_step_; }
+  // Thread-safe copy of the global step's stats (threaded: written by the global thread).
+  PerfStats step_stats() const;
+
+ private:
+  static void* thread_main(void* self);
+  void thread_loop();
+  void run_job();  // on whichever thread executes MML
+  void take_result(const hal::LaserScan& scan, const hal::Odometry& odom, hal::PoseEstimate* out);
+
+  mml::MmlLocalizer* mml_ = nullptr;
+  GlobalScheduleOptions schedule_;
+  const hal::Clock* clock_ = nullptr;
+  std::uint64_t index_ = 0;         // tracker steps since restart (index of the current scan + 1)
+  std::uint64_t generation_ = 0;    // bumped by reset(); jobs carry the generation they were taken in
+  std::uint64_t jobs_ = 0, overruns_ = 0, skipped_offers_ = 0;
+
+  // Mailbox (one slot each way). States: idle → queued (sensor) → running (global) → done → idle.
+  enum class Slot : std::uint8_t { kIdle, kQueued, kRunning, kDone };
+  hal::LaserScan job_scan_;
+  hal::Odometry job_odom_;
+  std::uint64_t job_index_ = 0, job_generation_ = 0;
+  bool job_reset_ = false;   // MML resets before this job
+  bool reset_pending_ = false;
+  Status job_status_;
+  hal::PoseEstimate job_out_;
+  std::atomic<Slot> slot_{Slot::kIdle};
+
+  bool threaded_ = false;
+  bool stopping_ = false;
+  pthread_t thread_{};
+  pthread_mutex_t mutex_ = PTHREAD_MUTEX_INITIALIZER;
+  pthread_cond_t cv_ = PTHREAD_COND_INITIALIZER;
+  mutable pthread_mutex_t stats_mutex_ = PTHREAD_MUTEX_INITIALIZER;
+  PerfCounter perf_step_{"global.step"};
+};
+
+}  // namespace track
+}  // namespace fw

@@ -1,0 +1,130 @@
+// GlobalContext (issue 14): the schedule is a function of the scan index, not of timing; the
+// threaded execution computes exactly what the inline one does when every global step is on time.
+#include "firmware/track/global_context.h"
+
+#include <gtest/gtest.h>
+#include <time.h>
+
+#include <cmath>
+#include <cstring>
+#include <memory>
+
+#include "firmware/track/track_test_util.h"
+#include "firmware/track/tracked_localizer.h"
+
+namespace fw {
+namespace track {
+namespace {
+
+mml::MmlLocalizerConfig test_config() {
+  mml::MmlLocalizerConfig c = mml::default_mml_config();
+  c.mml.matching_iterations = 20000;
+  c.mml.table_triples = 400000;
+  c.mml.min_local_map_points = 100;
+  return c;
+}
+
+struct Rig {
+  StartupArena arena;
+  std::unique_ptr<mml::MmlLocalizer> mml = std::make_unique<mml::MmlLocalizer>();
+  std::unique_ptr<TrackedLocalizer> loc = std::make_unique<TrackedLocalizer>();
+  Status init(const GlobalMap& map, const GlobalScheduleOptions& schedule) {
+    FW_RETURN_IF_ERROR(arena.init_mapped(192u << 20, false, "global-context-test"));
+    FW_RETURN_IF_ERROR(mml->init(test_config(), map, nullptr, 0, arena, nullptr));
+    return loc->init(TrackOptions(), map, mml.get(), schedule);
+  }
+};
+
+std::vector<Se2f> tour() {
+  return mml::testing::waypoint_path({{1.5f, 1.5f}, {1.5f, 6.5f}, {4.5f, 6.5f}, {4.5f, 2.0f}, {10.5f, 3.5f},
+                                      {10.5f, 6.5f}, {8.0f, 6.5f}},
+                                     0.1f);
+}
+
+TEST(GlobalContextTest, ScheduleValidation) {
+  GlobalScheduleOptions s;
+  EXPECT_TRUE(s.validate(false).is_ok());
+  EXPECT_FALSE(s.validate(true).is_ok()) << "threaded with no delay would make the sensor context wait";
+  s.every_n_scans = 2;
+  s.result_delay_scans = 3;
+  EXPECT_FALSE(s.validate(false).is_ok()) << "two jobs in flight";
+  s.every_n_scans = 0;
+  s.result_delay_scans = 0;
+  EXPECT_FALSE(s.validate(false).is_ok());
+  EXPECT_TRUE(live_global_schedule().validate(true).is_ok());
+  EXPECT_EQ(live_global_schedule().every_n_scans, kGlobalContext.period_scans);
+  EXPECT_EQ(live_global_schedule(3).result_delay_scans, 3u);
+}
+
+// Live schedule executed inline: still localizes on the synthetic room, never wrong; MML consumed
+// every period_scans-th scan while it searched.
+TEST(GlobalContextTest, LiveScheduleInlineLocalizes) {
+  Rig rig;
+  ASSERT_TRUE(rig.init(testing::room_map().map, live_global_schedule()).is_ok());
+  const auto path = tour();
+  const auto rec = mml::testing::drive(rig.loc.get(), testing::room(), path, 1);
+  int first = -1, wrong = 0;
+  for (std::size_t i = 0; i < rec.size(); ++i) {
+    if (rec[i].est.status != hal::LocalizationStatus::kLocalized) continue;
+    if (first < 0) first = static_cast<int>(i);
+    wrong += std::hypot(rec[i].est.x - rec[i].truth.x, rec[i].est.y - rec[i].truth.y) > 0.5f;
+  }
+  ASSERT_GE(first, 0) << "never localized";
+  EXPECT_EQ(wrong, 0);
+  const GlobalContext& gc = rig.loc->global_context();
+  EXPECT_GT(gc.jobs(), 0u);
+  EXPECT_LE(gc.jobs(), static_cast<std::uint64_t>(first) / kGlobalContext.period_scans + 2)
+      << "MML ran on more scans than the schedule gives it";
+  EXPECT_EQ(gc.overruns(), 0u);
+}
+
+// The same schedule on the global thread gives bit-identical poses when every job finishes within
+// its window (the hook waits for it, as a fast enough global context would).
+TEST(GlobalContextTest, ThreadedEqualsInlineWhenOnTime) {
+  const auto path = tour();
+  Rig a;
+  ASSERT_TRUE(a.init(testing::room_map().map, live_global_schedule()).is_ok());
+  const auto ra = mml::testing::drive(a.loc.get(), testing::room(), path, 1);
+  Rig b;
+  ASSERT_TRUE(b.init(testing::room_map().map, live_global_schedule()).is_ok());
+  ASSERT_TRUE(b.loc->global_context().start_thread(kGlobalContext, false, nullptr).is_ok());
+  ASSERT_TRUE(b.loc->global_context().threaded());
+  const auto rb = mml::testing::drive(b.loc.get(), testing::room(), path, 1, [&](mml::testing::StepRecord*) {
+    while (b.loc->global_context().job_in_flight()) {
+      timespec ts{0, 100000};
+      nanosleep(&ts, nullptr);
+    }
+  });
+  b.loc->global_context().stop_thread();
+  ASSERT_EQ(ra.size(), rb.size());
+  int localized = 0;
+  for (std::size_t i = 0; i < ra.size(); ++i) {
+    EXPECT_EQ(ra[i].est.status, rb[i].est.status) << i;
+    EXPECT_EQ(0, std::memcmp(&ra[i].est.x, &rb[i].est.x, sizeof(float))) << i;
+    EXPECT_EQ(0, std::memcmp(&ra[i].est.y, &rb[i].est.y, sizeof(float))) << i;
+    EXPECT_EQ(0, std::memcmp(&ra[i].est.theta, &rb[i].est.theta, sizeof(float))) << i;
+    localized += ra[i].est.status == hal::LocalizationStatus::kLocalized;
+  }
+  EXPECT_GT(localized, 0);
+  EXPECT_EQ(a.loc->global_context().jobs(), b.loc->global_context().jobs());
+  EXPECT_EQ(b.loc->global_context().overruns(), 0u);
+}
+
+// A global step that does not finish within its window is counted, and the sensor step never
+// waits for it: the result is taken at the first step after it finished.
+TEST(GlobalContextTest, LateGlobalStepIsCountedNotWaitedFor) {
+  const auto path = tour();
+  Rig b;
+  ASSERT_TRUE(b.init(testing::room_map().map, live_global_schedule()).is_ok());
+  ASSERT_TRUE(b.loc->global_context().start_thread(kGlobalContext, false, nullptr).is_ok());
+  // Steps back to back with no wait: MML (~ms per step) cannot keep up with a sensor step of µs.
+  std::vector<Se2f> short_path(path.begin(), path.begin() + 40);
+  const auto rb = mml::testing::drive(b.loc.get(), testing::room(), short_path, 1);
+  b.loc->global_context().stop_thread();
+  EXPECT_GT(b.loc->global_context().overruns() + b.loc->global_context().skipped_offers(), 0u);
+  for (const auto& r : rb) EXPECT_NE(r.est.status, hal::LocalizationStatus::kFault) << r.error;
+}
+
+}  // namespace
+}  // namespace track
+}  // namespace fw
