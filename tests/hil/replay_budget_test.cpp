@@ -164,7 +164,7 @@ TEST(ReplayBudget, LockstepAcesLocalizesNeverWrong) {
   // mean error. The robot stands still until scan 130; when it starts turning, the odometry sample
   // attached to a scan is out of step with the laser and the scan fix is 6° from the prediction in
   // heading (a large fault: tracked_localizer.h then waits for MML, which does not isolate the pose
-  // again before scan 250). Earlier versions, before the confirmation after a large fault, stayed
-  // localized on 231-234 scans. mml alone (MMLFW_REPLAY_LOCALIZER=mml), seed 1: 194 scans, 0.126 m.
+  // again before scan 250). The 231-234 scans noted here before were measured at d57ed19, before the
+  // confirmation after a large fault and the later tracker guards. mml alone (MMLFW_REPLAY_LOCALIZER=mml), seed 1: 194 scans, 0.126 m.
   EXPECT_GE(r.localized, 100u);
 }
