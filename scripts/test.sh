@@ -67,7 +67,7 @@ asan() {
 tsan() {
   echo "=== TSan build (threaded tests only) ==="
   cmake --preset tsan >/dev/null
-  cmake --build --preset tsan -j "$JOBS" --target fw_base_test fw_pransam_test fw_mml_reset_test replay_budget_test
+  cmake --build --preset tsan -j "$JOBS" --target fw_base_test fw_pransam_test fw_mml_reset_test replay_budget_test fw_track_test
   echo "=== TSan tests (label tsan) ==="
   ctest --preset tsan -j 1 --timeout 1200 -L '^tsan$'
 }
