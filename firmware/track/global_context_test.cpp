@@ -16,21 +16,13 @@ namespace fw {
 namespace track {
 namespace {
 
-mml::MmlLocalizerConfig test_config() {
-  mml::MmlLocalizerConfig c = mml::default_mml_config();
-  c.mml.matching_iterations = 20000;
-  c.mml.table_triples = 400000;
-  c.mml.min_local_map_points = 100;
-  return c;
-}
-
 struct Rig {
   StartupArena arena;
   std::unique_ptr<mml::MmlLocalizer> mml = std::make_unique<mml::MmlLocalizer>();
   std::unique_ptr<TrackedLocalizer> loc = std::make_unique<TrackedLocalizer>();
   Status init(const GlobalMap& map, const GlobalScheduleOptions& schedule) {
     FW_RETURN_IF_ERROR(arena.init_mapped(192u << 20, false, "global-context-test"));
-    FW_RETURN_IF_ERROR(mml->init(test_config(), map, nullptr, 0, arena, nullptr));
+    FW_RETURN_IF_ERROR(mml->init(testing::small_mml_config(), map, nullptr, 0, arena, nullptr));
     return loc->init(TrackOptions(), map, mml.get(), schedule);
   }
 };

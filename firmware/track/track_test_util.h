@@ -4,6 +4,7 @@
 #include <vector>
 
 #include "firmware/mcl/mcl_test_world.h"
+#include "firmware/mml/mml_localizer.h"
 #include "firmware/mml/mml_test_util.h"
 #include "firmware/scan/scan_points.h"
 #include "firmware/track/pose_tracker.h"
@@ -14,6 +15,15 @@ namespace testing {
 
 using mcl::testing::GridWorld;
 using mml::testing::OwnedGlobalMap;
+
+// MML sized for the small synthetic worlds of the tracking tests (fast start-up, small table).
+inline mml::MmlLocalizerConfig small_mml_config() {
+  mml::MmlLocalizerConfig c = mml::default_mml_config();
+  c.mml.matching_iterations = 20000;
+  c.mml.table_triples = 400000;
+  c.mml.min_local_map_points = 100;
+  return c;
+}
 
 // The 12 × 8 m room with a unique layout and its global map.
 inline const GridWorld& room() {
