@@ -115,8 +115,6 @@ void MmlLocalizer::reset() {
   num_scene_ = 0;
   matched_points_ = 0;
   num_scan_pts_ = 0;
-  have_odom_ = false;
-  prev_odom_ = Se2f();
   have_h_ = false;
   last_h_ = Se2f();
   steps_ = 0;
@@ -431,8 +429,6 @@ Status MmlLocalizer::step(const hal::LaserScan& scan, const hal::Odometry& odom,
   const Se2f wheel(odom.x, odom.y, odom.theta);
   in.have_odom_delta = have_wheel_;
   in.odom_delta = have_wheel_ ? prev_wheel_.between(wheel) : Se2f();
-  prev_odom_ = local_pose;
-  have_odom_ = true;
   FW_RETURN_IF_ERROR(interp_.interpret(in, &last_));
   if (reduce) {
     // Eq. 5.29 on f(t) = |C(t)|: a crossing accepts observation t−1; t becomes the undecided t−1.

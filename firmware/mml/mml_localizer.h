@@ -140,8 +140,6 @@ class MmlLocalizer final : public Localizer {
   Point2f scan_pts_[hal::LaserScan::kMaxBeams];
   std::size_t num_scan_pts_ = 0;
 
-  bool have_odom_ = false;
-  Se2f prev_odom_;
   bool have_h_ = false;
   Se2f last_h_;  // map ← local of the best hypothesis
   std::uint64_t steps_ = 0;

@@ -1,5 +1,7 @@
-// TaskRunner: a fixed table of periodic tasks (PX4 work-queue style). The Linux backend runs them
-// on a loop with real time; the sim backend runs them in lockstep with the stepped clock.
+// TaskRunner: a fixed table of periodic tasks (PX4 work-queue style), run in lockstep with the
+// stepped clock by the sim backend (hal_sim::SimTaskRunner). There is no Linux backend: mmlfw's
+// threads are the execution contexts of firmware/runtime/execution_contexts.h (sensor, global,
+// workers), created once at start-up and pinned.
 #pragma once
 
 #include <cstdint>
