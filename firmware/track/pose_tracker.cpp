@@ -118,6 +118,15 @@ bool outside_bound(const Eigen::Vector3f& e, const ProtectionLevel& pl) {
 }
 }  // namespace
 
+// At most kAliasMaxPoints end-points, evenly subsampled into alias_points_ (beam order kept).
+std::size_t PoseTracker::subsample_alias_points(const Point2f* points, std::size_t n) {
+  if (n == 0) return 0;
+  const std::size_t stride = (n + kAliasMaxPoints - 1) / kAliasMaxPoints;
+  std::size_t m = 0;
+  for (std::size_t i = 0; i < n && m < kAliasMaxPoints; i += stride) alias_points_[m++] = points[i];
+  return m;
+}
+
 // Gauss-Newton from the prediction; while recovering from a fault with a prediction too uncertain for
 // its capture range, also from the best pose of a correlative search over the prediction's window
 // (correlative_search.h), kept only when it explains the scan clearly better.
@@ -202,7 +211,16 @@ TrackStep PoseTracker::step(const Point2f* points, std::size_t n, const Se2f& od
       // into a twin corridor showed as 0.27 m and 6° at the first scan (the target fits the map next
       // to the prediction); odometry that turned 10–20° wrong (mit-killian) cannot be told from it by
       // this scan alone, so it waits for MML as well (availability, never integrity).
-      out.large_fault = std::hypot(e(0), e(1)) > o.alert_limit_m || std::fabs(e(2)) > o.alert_limit_rad;
+      const float exy = std::hypot(e(0), e(1));
+      out.large_fault = exy > o.alert_limit_m || std::fabs(e(2)) > o.alert_limit_rad;
+      if (out.large_fault && o.heading_fault_local_recovery && exy <= pred_pl.xy_m &&
+          exy <= o.alert_limit_m) {
+        // Heading only (track_options.h): the scan must prefer its fix to the prediction significantly.
+        const std::size_t m = subsample_alias_points(points, n);
+        out.heading_fault = rival_significantly_better(map_, alias_points_, m, pred, a.pose, o.alias_clip_m,
+                                                       a.independent, o.alias_z);
+        out.large_fault = !out.heading_fault;
+      }
       // A significant innovation is a fault only when the scan fix lies outside what the prediction
       // promises (its protection level): within it, the published bound already covers the
       // disagreement, and the scan is fused (measurement models of real scans are never exact).
@@ -222,9 +240,7 @@ TrackStep PoseTracker::step(const Point2f* points, std::size_t n, const Se2f& od
     uo.rotation_step_rad = o.alias_rotation_step_rad;
     uo.max_rotation_rad = o.alias_max_rotation_rad;
     uo.min_separation_rad = o.alias_min_separation_rad;
-    const std::size_t stride = (n + kAliasMaxPoints - 1) / kAliasMaxPoints;
-    std::size_t m = 0;
-    for (std::size_t i = 0; i < n && m < kAliasMaxPoints; i += stride) alias_points_[m++] = points[i];
+    const std::size_t m = subsample_alias_points(points, n);
     const mml::UniquenessResult u = mml::check_pose_uniqueness(map_, alias_points_, m, a.pose, uo);
     out.alias_cost = u.cost;
     out.alias_rival_cost = u.rival_cost;

@@ -57,6 +57,8 @@ struct TrackStep {
   // beyond them, the odometry disagreeing over the window): the robot may have been carried
   // anywhere, so local evidence alone can no longer make the pose `localized` (tracked_localizer.h).
   bool large_fault = false;
+  // A fault in heading only, recovered by the track (TrackOptions::heading_fault_local_recovery).
+  bool heading_fault = false;
   std::uint32_t unsupported_steps = 0, faulty_steps = 0, outside_steps = 0;
   float innovation_chi2 = 0.0f;
   float odometry_chi2 = 0.0f;   // odometry consistency over the window (0 = not tested)
@@ -82,6 +84,7 @@ class PoseTracker {
 
  private:
   void predict_to(const Se2f& odom);
+  std::size_t subsample_alias_points(const Point2f* points, std::size_t n);
   ScanAlignment align_from_prediction(const Point2f* points, std::size_t n, const Se2f& pred, TrackStep* out);
   static constexpr std::size_t kSearchScratch = 2 * 1081;
   Point2f search_scratch_[kSearchScratch];

@@ -111,6 +111,15 @@ struct TrackOptions {
   // A better rival contradicts only when a paired test of the per-point costs says so at this z
   // (3.09: one-sided 1e-3), the end-points counted once per correlation cell.
   float alias_z = 3.09f;
+  // A heading-only fault is recovered by the track itself: the scan fix lies inside the prediction's
+  // horizontal protection level (the position is where the track promised it) and turned beyond the
+  // heading alert limit, and the paired test (alias_z) says the scan fits significantly better at the
+  // fix than at the predicted pose. Wheels that over-report a turn (mit-killian: 23° of odometry where
+  // the robot turned 5°) do that, a carried robot does not: carrying moves the position, and a place
+  // that looks the same turned would fail the test against the prediction. The fault still widens the
+  // covariance and needs `recovery_steps` consistent scans; MML still cross-checks in the background.
+  // false = every heading fault beyond the alert limit waits for MML's confirmation.
+  bool heading_fault_local_recovery = true;
   // Global cross-check (tracked_localizer.h): when the track stops being `localized` while still
   // tracked (an alias, a fault being recovered, scans that say nothing), MML searches in the
   // background from a fresh local map for at most this many scans; if it isolates a pose outside the
