@@ -308,6 +308,9 @@ float MmlLocalizer::unknown_contact(const Se2f& h) const {
   return used > 0 ? static_cast<float>(sum / used) : 1.0f;
 }
 
+// One MML step (Fig. 5.5) as named stages: (1) RBSM front end, (2) the observation memory of
+// Eq. 5.37, (3) the local map handed to pRANSAM, (4) pRANSAM collect-all against the global map,
+// (5) interpretation (Eq. 5.8–5.29, unknown regions), (6) the published pose, (7) publication.
 Status MmlLocalizer::step(const hal::LaserScan& scan, const hal::Odometry& odom, hal::PoseEstimate* out) {
   if (!initialized_) return Status::error(Errc::kNotInitialized, "MmlLocalizer: step() before init()");
   if (out == nullptr) return Status::error(Errc::kInvalidArgument, "MmlLocalizer: null output");
@@ -315,10 +318,10 @@ Status MmlLocalizer::step(const hal::LaserScan& scan, const hal::Odometry& odom,
     return Status::error(Errc::kInvalidArgument, "MmlLocalizer: non-finite odometry at scan %u", scan.scan_id);
   }
   const std::uint64_t step_begin_ns = deadline_clock_ != nullptr ? deadline_clock_->now_ns() : 0;
-  // (1) RBSM: scan → local map.
-  Se2f local_pose;
-  const Status fs = front_end_.step(scan, odom, &local_pose);
-  if (!fs.is_ok()) {
+  Se2f rbsm_pose, local_pose;
+  bool used = false;
+  FW_RETURN_IF_ERROR(front_end_stage(scan, odom, &rbsm_pose, &local_pose, &used));
+  if (!used) {
     // A scan RBSM cannot use (e.g. no valid returns in an open space) is bad luck, not a fault:
     // count it and repeat the last estimate; the next good scan continues the local map.
     ++front_end_failures_;
@@ -327,9 +330,41 @@ Status MmlLocalizer::step(const hal::LaserScan& scan, const hal::Odometry& odom,
     out->scan_id = scan.scan_id;
     return Status::ok();
   }
+  remember_observation(scan, local_pose);
+  *out = hal::PoseEstimate();
+  out->timestamp_ns = scan.timestamp_ns;
+  out->scan_id = scan.scan_id;
+  out->mode = hal::LocalizationMode::kGlobal;
+  bool enough = false;
+  FW_RETURN_IF_ERROR(local_map_stage(rbsm_pose, &enough));
+  if (!enough) {
+    out->status = hal::LocalizationStatus::kSearching;
+    last_out_ = *out;
+    return Status::ok();
+  }
+  float omega_thres = 0.0f;
+  const std::size_t nh = global_match_stage(local_pose, step_begin_ns, &omega_thres);
+  const Se2f wheel(odom.x, odom.y, odom.theta);
+  // x_r of Eq. 5.8 from the wheel odometry (thesis); the RBSM pose can slip in corridors.
+  const Se2f odom_delta = have_wheel_ ? prev_wheel_.between(wheel) : Se2f();
+  FW_RETURN_IF_ERROR(interpretation_stage(nh, omega_thres, odom_delta));
+  published_pose_stage(odom_delta);
+  prev_wheel_ = wheel;
+  have_wheel_ = true;
+  if (config_.mml.correct_local_map) correct_local_map(local_pose);
+  publish(out);
+  return Status::ok();
+}
+
+// (1) RBSM: scan → local map. `local_pose` is the RBSM pose with the local map's correction;
+// `used` = false when RBSM could not use the scan.
+Status MmlLocalizer::front_end_stage(const hal::LaserScan& scan, const hal::Odometry& odom, Se2f* rbsm_pose,
+                                     Se2f* local_pose, bool* used) {
+  *used = front_end_.step(scan, odom, local_pose).is_ok();
+  if (!*used) return Status::ok();
   ++steps_;
   matched_points_ = 0;
-  const Se2f rbsm_pose = local_pose;
+  *rbsm_pose = *local_pose;
   if (config_.mml.correct_local_map && local_map_.num_fragments() > 0) {
     // A new fragment inherits its predecessor's correction (as a local-map transform): RBSM's
     // drift is continuous, so the new fragment starts where the corrected map continues.
@@ -342,33 +377,32 @@ Status MmlLocalizer::step(const hal::LaserScan& scan, const hal::Odometry& odom,
     }
     have_newest_ = true;
     newest_id_ = v.id;
-    local_pose = corrected_pose(rbsm_pose);
+    *local_pose = corrected_pose(*rbsm_pose);
   }
+  return Status::ok();
+}
 
-  // Remember a subsample of this observation (local frame) for Eq. 5.37.
-  {
-    ScanPointsResult sr;
-    ScanPointsOptions so = config_.front_end.scan;
-    num_scan_pts_ = 0;
-    if (scan_to_points(scan, so, scan_pts_, hal::LaserScan::kMaxBeams, &sr).is_ok() && sr.count > 0) {
-      num_scan_pts_ = sr.count;
-      Observation ob;
-      const std::size_t stride = (sr.count + kUnknownPointsPerObservation - 1) / kUnknownPointsPerObservation;
-      for (std::size_t i = 0; i < sr.count && ob.n < kUnknownPointsPerObservation; i += stride) {
-        ob.pts[ob.n++] = local_pose.transform_point(scan_pts_[i]);
-      }
-      if (observations_.size() >= config_.mml.tau_up) { Observation d; observations_.pop(&d); }
-      observations_.push_overwrite(ob);
-    }
+// (2) A subsample of this observation (local frame) for Eq. 5.37, and the scan's end-points for
+// the published-pose refinement.
+void MmlLocalizer::remember_observation(const hal::LaserScan& scan, const Se2f& local_pose) {
+  ScanPointsResult sr;
+  ScanPointsOptions so = config_.front_end.scan;
+  num_scan_pts_ = 0;
+  if (!scan_to_points(scan, so, scan_pts_, hal::LaserScan::kMaxBeams, &sr).is_ok() || sr.count == 0) return;
+  num_scan_pts_ = sr.count;
+  Observation ob;
+  const std::size_t stride = (sr.count + kUnknownPointsPerObservation - 1) / kUnknownPointsPerObservation;
+  for (std::size_t i = 0; i < sr.count && ob.n < kUnknownPointsPerObservation; i += stride) {
+    ob.pts[ob.n++] = local_pose.transform_point(scan_pts_[i]);
   }
+  if (observations_.size() >= config_.mml.tau_up) { Observation d; observations_.pop(&d); }
+  observations_.push_overwrite(ob);
+}
 
-  *out = hal::PoseEstimate();
-  out->timestamp_ns = scan.timestamp_ns;
-  out->scan_id = scan.scan_id;
-  out->mode = hal::LocalizationMode::kGlobal;
-
-  const bool reduce = config_.mml.reduce_observations;
-  if (reduce) {
+// (3) The scene pRANSAM matches: the whole local map, or the information-rich observations
+// (Sec. 5.4). `enough` = the local map is large enough to match (Fig. 5.5, t = 0).
+Status MmlLocalizer::local_map_stage(const Se2f& rbsm_pose, bool* enough) {
+  if (config_.mml.reduce_observations) {
     capture_observation(rbsm_pose);
     if (local_map_.total_points() < config_.mml.min_local_map_points) {
       // Before matching starts (t = 0 of Fig. 5.5) every observation is kept: the first one is
@@ -381,18 +415,21 @@ Status MmlLocalizer::step(const hal::LaserScan& scan, const hal::Odometry& odom,
   } else {
     FW_RETURN_IF_ERROR(gather_local_map());
   }
-  if (local_map_.total_points() < config_.mml.min_local_map_points || num_scene_ < 3) {
-    out->status = hal::LocalizationStatus::kSearching;
-    last_out_ = *out;
-    return Status::ok();
-  }
+  *enough = local_map_.total_points() >= config_.mml.min_local_map_points && num_scene_ >= 3;
+  return Status::ok();
+}
 
-  // (2) pRANSAM collect-all against the global map at the adaptive threshold.
+// (4) pRANSAM collect-all against the global map at the adaptive threshold (Sec. 5.3.3); the
+// hypotheses as robot poses in hyps_. Returns their number. A failed match (e.g. all triples of a
+// degenerate local map rejected) is "no hypotheses".
+std::size_t MmlLocalizer::global_match_stage(const Se2f& local_pose, std::uint64_t step_begin_ns,
+                                             float* omega_thres) {
   pransam::MatchParams mp = config_.match;
   mp.collect_all = true;
   mp.max_iterations = config_.mml.matching_iterations;
   mp.omega_thres = interp_.omega_thres();
-  mp.seed = config_.mml.seed * 1000003ull + steps_;
+  *omega_thres = mp.omega_thres;
+  mp.seed = config_.mml.seed * 1000003ull + steps_;  // a fresh, reproducible stream per step
   pransam::MatchResult<2> mr;
   matched_points_ = num_scene_;
   if (deadline_clock_ != nullptr && deadline_budget_ns_ > 0) {
@@ -400,37 +437,37 @@ Status MmlLocalizer::step(const hal::LaserScan& scan, const hal::Odometry& odom,
     mp.deadline_ns = step_begin_ns + static_cast<std::uint64_t>(static_cast<double>(deadline_budget_ns_) * deadline_share_);
   }
   const Status ms = matcher_.match(scene_, num_scene_, mp, &mr);
-  if (ms.is_ok() && mr.stats.stop == pransam::StopReason::kDeadline) ++deadline_stops_;
+  if (!ms.is_ok()) return 0;
+  if (mr.stats.stop == pransam::StopReason::kDeadline) ++deadline_stops_;
   std::size_t nh = 0;
-  if (ms.is_ok()) {
-    Se2f best_h;
-    float best_q = -1.0f;
-    for (std::size_t i = 0; i < mr.num_hypotheses && nh < config_.mml.max_hypotheses; ++i) {
-      const Se2f h = pransam::to_se2(mr.hypotheses[i]);
-      const Se2f robot = h.compose(local_pose);
-      Hypothesis& o = hyps_[nh++];
-      o.x = robot.x;
-      o.y = robot.y;
-      o.theta = robot.theta;
-      o.quality = mr.hypotheses[i].quality;
-      o.roll = 0.0f;  // flipped 2-D frames are already rejected inside pRANSAM (Eq. 5.3)
-      o.pitch = 0.0f;
-      if (o.quality > best_q) { best_q = o.quality; best_h = h; }
-    }
-    if (best_q >= 0.0f) { last_h_ = best_h; have_h_ = true; }
+  Se2f best_h;
+  float best_q = -1.0f;
+  for (std::size_t i = 0; i < mr.num_hypotheses && nh < config_.mml.max_hypotheses; ++i) {
+    const Se2f h = pransam::to_se2(mr.hypotheses[i]);
+    const Se2f robot = h.compose(local_pose);
+    Hypothesis& o = hyps_[nh++];
+    o.x = robot.x;
+    o.y = robot.y;
+    o.theta = robot.theta;
+    o.quality = mr.hypotheses[i].quality;
+    o.roll = 0.0f;  // flipped 2-D frames are already rejected inside pRANSAM (Eq. 5.3)
+    o.pitch = 0.0f;
+    if (o.quality > best_q) { best_q = o.quality; best_h = h; }
   }
-  // A failed match (e.g. all triples of a degenerate local map rejected) is "no hypotheses".
+  if (best_q >= 0.0f) { last_h_ = best_h; have_h_ = true; }
+  return nh;
+}
 
-  // (3) Interpretation.
+// (5) Interpretation of the hypotheses (Eq. 5.8–5.17), the observation-selection rule (Eq. 5.29)
+// and the unknown-region test (Eq. 5.37, plus steps without any match).
+Status MmlLocalizer::interpretation_stage(std::size_t nh, float omega_thres, const Se2f& odom_delta) {
   InterpretInput in;
   in.hypotheses = hyps_;
   in.count = nh;
-  // x_r of Eq. 5.8 from the wheel odometry (thesis); the RBSM pose can slip in corridors.
-  const Se2f wheel(odom.x, odom.y, odom.theta);
   in.have_odom_delta = have_wheel_;
-  in.odom_delta = have_wheel_ ? prev_wheel_.between(wheel) : Se2f();
+  in.odom_delta = odom_delta;
   FW_RETURN_IF_ERROR(interp_.interpret(in, &last_));
-  if (reduce) {
+  if (config_.mml.reduce_observations) {
     // Eq. 5.29 on f(t) = |C(t)|: a crossing accepts observation t−1; t becomes the undecided t−1.
     // Extension: nothing is accepted while localized (the pose was known before observation t−1
     // arrived, so it cannot be information-rich about which pose it is); f(t) keeps feeding the rule.
@@ -449,7 +486,7 @@ Status MmlLocalizer::step(const hal::LaserScan& scan, const hal::Odometry& odom,
     interp_.report_unknown(unknown_contact(last_h_), static_cast<std::uint32_t>(observations_.size()), &last_);
   }
   const MmlOptions& mo = config_.mml;
-  if (last_.hypotheses_valid == 0 && in.count == 0 && mp.omega_thres <= mo.omega_thres_min + 1e-6f &&
+  if (last_.hypotheses_valid == 0 && nh == 0 && omega_thres <= mo.omega_thres_min + 1e-6f &&
       local_map_.total_points() >= 2u * mo.min_local_map_points) {
     ++no_match_steps_;
   } else {
@@ -459,65 +496,69 @@ Status MmlLocalizer::step(const hal::LaserScan& scan, const hal::Odometry& odom,
       last_.status != hal::LocalizationStatus::kLocalized) {
     last_.status = hal::LocalizationStatus::kOutsideMap;
   }
+  return Status::ok();
+}
 
-  // Published pose (pose_refiner.h). Once a `localized` cluster pose is confirmed by refining the
-  // newest scan against the global map, that pose is tracked with the wheel odometry and refined
-  // every step; it replaces x_prev of Eq. 5.8, so a cluster that drifts away from it (a slipping
-  // local map in a corridor) fails Eq. 5.14 instead of dragging the estimate along.
-  if (mo.refine_pose && num_scan_pts_ > 0) {
-    const std::size_t stride = (num_scan_pts_ + mo.refine_points - 1) / mo.refine_points;
-    std::size_t m = 0;
-    for (std::size_t i = 0; i < num_scan_pts_; i += stride) refine_pts_[m++] = scan_pts_[i];
-    const RefineOptions ro;
-    const bool loc = last_.status == hal::LocalizationStatus::kLocalized;
-    if (tracked_valid_ && mo.track_when_localized) {
-      const Se2f pred = tracked_pose_.compose(in.odom_delta);
-      last_refine_ = refine_pose(map_, refine_pts_, m, pred, ro);
-      tracked_pose_ = last_refine_.pose;  // = pred when rejected
-      tracked_bad_steps_ = last_refine_.accepted ? 0 : tracked_bad_steps_ + 1;
-      tracked_unlocalized_steps_ = loc ? 0 : tracked_unlocalized_steps_ + 1;
-      if (tracked_bad_steps_ >= 5 || tracked_unlocalized_steps_ >= 30 ||
-          last_.status == hal::LocalizationStatus::kOutsideMap) {
-        tracked_valid_ = false;
-        // The scans stopped fitting the map around the tracked pose: not sure any more.
-        interp_.drop_soft();
-        if (last_.status == hal::LocalizationStatus::kLocalized) last_.status = hal::LocalizationStatus::kAmbiguous;
-      }
-    }
-    if (!tracked_valid_ && last_.status == hal::LocalizationStatus::kLocalized) {
-      last_refine_ = refine_pose(map_, refine_pts_, m, last_.pose, ro);
-      bool unique = true;
-      if (last_refine_.accepted && mo.unique_check) {
-        UniquenessOptions uo;
-        uo.clip_m = ro.clip_m;
-        uo.max_shift_m = mo.unique_max_shift_m;
-        uo.shift_step_m = mo.unique_shift_step_m;
-        uo.margin = mo.unique_margin;
-        last_unique_ = check_pose_uniqueness(map_, refine_pts_, m, last_refine_.pose, uo);
-        unique = last_unique_.unique;
-        if (!unique) ++unique_rejections_;
-      }
-      if (last_refine_.accepted && unique) {
-        tracked_valid_ = true;
-        tracked_pose_ = last_refine_.pose;
-        tracked_bad_steps_ = tracked_unlocalized_steps_ = 0;
-      } else {
-        // The newest scan does not fit the map at the cluster pose, or fits a rival pose along the
-        // corridor as well: not sure after all (and no soft rule on the strength of this step).
-        last_.status = hal::LocalizationStatus::kAmbiguous;
-        interp_.drop_soft();
-      }
-    }
-    if (tracked_valid_) {
-      interp_.set_previous_pose(tracked_pose_);
-      last_.pose = tracked_pose_;
-      last_.have_pose = true;
+// (6) Published pose (pose_refiner.h). Once a `localized` cluster pose is confirmed by refining the
+// newest scan against the global map, that pose is tracked with the wheel odometry and refined
+// every step; it replaces x_prev of Eq. 5.8, so a cluster that drifts away from it (a slipping
+// local map in a corridor) fails Eq. 5.14 instead of dragging the estimate along.
+void MmlLocalizer::published_pose_stage(const Se2f& odom_delta) {
+  const MmlOptions& mo = config_.mml;
+  if (!mo.refine_pose || num_scan_pts_ == 0) return;
+  const std::size_t stride = (num_scan_pts_ + mo.refine_points - 1) / mo.refine_points;
+  std::size_t m = 0;
+  for (std::size_t i = 0; i < num_scan_pts_; i += stride) refine_pts_[m++] = scan_pts_[i];
+  const RefineOptions ro;
+  const bool loc = last_.status == hal::LocalizationStatus::kLocalized;
+  if (tracked_valid_ && mo.track_when_localized) {
+    const Se2f pred = tracked_pose_.compose(odom_delta);
+    last_refine_ = refine_pose(map_, refine_pts_, m, pred, ro);
+    tracked_pose_ = last_refine_.pose;  // = pred when rejected
+    tracked_bad_steps_ = last_refine_.accepted ? 0 : tracked_bad_steps_ + 1;
+    tracked_unlocalized_steps_ = loc ? 0 : tracked_unlocalized_steps_ + 1;
+    if (tracked_bad_steps_ >= mo.tracked_max_rejected_steps ||
+        tracked_unlocalized_steps_ >= mo.tracked_max_unlocalized_steps ||
+        last_.status == hal::LocalizationStatus::kOutsideMap) {
+      tracked_valid_ = false;
+      // The scans stopped fitting the map around the tracked pose: not sure any more.
+      interp_.drop_soft();
+      if (last_.status == hal::LocalizationStatus::kLocalized) last_.status = hal::LocalizationStatus::kAmbiguous;
     }
   }
-  prev_wheel_ = wheel;
-  have_wheel_ = true;
-  if (mo.correct_local_map) correct_local_map(local_pose);
+  if (!tracked_valid_ && last_.status == hal::LocalizationStatus::kLocalized) {
+    last_refine_ = refine_pose(map_, refine_pts_, m, last_.pose, ro);
+    bool unique = true;
+    if (last_refine_.accepted && mo.unique_check) {
+      UniquenessOptions uo;
+      uo.clip_m = ro.clip_m;
+      uo.max_shift_m = mo.unique_max_shift_m;
+      uo.shift_step_m = mo.unique_shift_step_m;
+      uo.margin = mo.unique_margin;
+      last_unique_ = check_pose_uniqueness(map_, refine_pts_, m, last_refine_.pose, uo);
+      unique = last_unique_.unique;
+      if (!unique) ++unique_rejections_;
+    }
+    if (last_refine_.accepted && unique) {
+      tracked_valid_ = true;
+      tracked_pose_ = last_refine_.pose;
+      tracked_bad_steps_ = tracked_unlocalized_steps_ = 0;
+    } else {
+      // The newest scan does not fit the map at the cluster pose, or fits a rival pose along the
+      // corridor as well: not sure after all (and no soft rule on the strength of this step).
+      last_.status = hal::LocalizationStatus::kAmbiguous;
+      interp_.drop_soft();
+    }
+  }
+  if (tracked_valid_) {
+    interp_.set_previous_pose(tracked_pose_);
+    last_.pose = tracked_pose_;
+    last_.have_pose = true;
+  }
+}
 
+// (7) The estimate of this step, remembered for a step the front end cannot use.
+void MmlLocalizer::publish(hal::PoseEstimate* out) {
   localized_before_prev_ = localized_prev_;
   localized_prev_ = last_.status == hal::LocalizationStatus::kLocalized;
   out->status = last_.status;
@@ -532,7 +573,6 @@ Status MmlLocalizer::step(const hal::LaserScan& scan, const hal::Odometry& odom,
   out->cluster_count = static_cast<std::uint16_t>(last_.cluster_count > 65535 ? 65535 : last_.cluster_count);
   out->rating = last_.best_rating;
   last_out_ = *out;
-  return Status::ok();
 }
 
 }  // namespace mml

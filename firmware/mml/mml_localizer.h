@@ -99,6 +99,15 @@ class MmlLocalizer final : public Localizer {
   std::uint64_t deadline_stops() const { return deadline_stops_; }  // pRANSAM runs cut by the deadline
 
  private:
+  // The stages of step() (mml_localizer.cpp), in order.
+  Status front_end_stage(const hal::LaserScan& scan, const hal::Odometry& odom, Se2f* rbsm_pose, Se2f* local_pose,
+                         bool* used);
+  void remember_observation(const hal::LaserScan& scan, const Se2f& local_pose);
+  Status local_map_stage(const Se2f& rbsm_pose, bool* enough);
+  std::size_t global_match_stage(const Se2f& local_pose, std::uint64_t step_begin_ns, float* omega_thres);
+  Status interpretation_stage(std::size_t nh, float omega_thres, const Se2f& odom_delta);
+  void published_pose_stage(const Se2f& odom_delta);
+  void publish(hal::PoseEstimate* out);
   Status gather_local_map();
   Status gather_reduced_map();
   // Reduction storage: a ring of accepted observations, each in its fragment's frame.

@@ -54,6 +54,8 @@ Status MmlOptions::validate() const {
   FW_RETURN_IF_ERROR(check_positive("hyp_sigma_trans_floor_m", hyp_sigma_trans_floor_m));
   FW_RETURN_IF_ERROR(check_positive("hyp_sigma_rot_floor_rad", hyp_sigma_rot_floor_rad));
   FW_RETURN_IF_ERROR(check_range("refine_points", refine_points, 3, 1081));
+  FW_RETURN_IF_ERROR(check_range("tracked_max_rejected_steps", tracked_max_rejected_steps, 1, 100000));
+  FW_RETURN_IF_ERROR(check_range("tracked_max_unlocalized_steps", tracked_max_unlocalized_steps, 1, 100000));
   if (!(unique_shift_step_m > 0.0f) || !(unique_max_shift_m >= unique_shift_step_m) || unique_max_shift_m > 20.0f) {
     return Status::error(Errc::kInvalidArgument, "MmlOptions: need 0 < unique_shift_step_m (%g) <= unique_max_shift_m (%g) <= 20",
                          static_cast<double>(unique_shift_step_m), static_cast<double>(unique_max_shift_m));

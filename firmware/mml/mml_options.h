@@ -75,6 +75,10 @@ struct MmlOptions {
   bool refine_pose = true;
   bool track_when_localized = true;
   std::uint32_t refine_points = 180;   // scan points used
+  // The tracked pose is dropped (and the soft rule with it) after this many consecutive scans the
+  // refinement rejects, or this many consecutive steps the interpretation is not `localized`.
+  std::uint32_t tracked_max_rejected_steps = 5;
+  std::uint32_t tracked_max_unlocalized_steps = 30;
   // Extension (pose_uniqueness.h): entering `localized` also needs the refined pose to be the best
   // fit of the newest scan among rivals seeded along its principal axes (corridor aliases).
   bool unique_check = true;
