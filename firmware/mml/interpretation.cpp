@@ -60,7 +60,7 @@ float Interpreter::circular_mean(const float* angles, std::size_t n) {
 void Interpreter::filter(const InterpretInput& in, InterpretResult* out) {
   num_hyps_ = 0;
   for (std::size_t i = 0; i < in.count; ++i) {
-    const Hypothesis& h = in.hypotheses[i];
+    const PoseHypothesis& h = in.hypotheses[i];
     if (!std::isfinite(h.x) || !std::isfinite(h.y) || !std::isfinite(h.theta) || !std::isfinite(h.quality)) continue;
     if (std::fabs(wrap_angle(h.roll)) >= options_.filter_max_roll_rad) continue;
     if (std::fabs(wrap_angle(h.pitch)) >= options_.filter_max_pitch_rad) continue;
@@ -162,7 +162,7 @@ bool Interpreter::split(const Cluster& c, bool by_rotation, Cluster* a, Cluster*
   while (lo < hi) {
     if (labels_[lo] == 0) { ++lo; continue; }
     --hi;
-    const Hypothesis th = hyps_[lo]; hyps_[lo] = hyps_[hi]; hyps_[hi] = th;
+    const PoseHypothesis th = hyps_[lo]; hyps_[lo] = hyps_[hi]; hyps_[hi] = th;
     const std::uint8_t tl = labels_[lo]; labels_[lo] = labels_[hi]; labels_[hi] = tl;
   }
   if (lo == c.begin || lo == c.end) return false;

@@ -19,10 +19,10 @@ namespace fw {
 namespace mml {
 
 // One pose hypothesis from pRANSAM, reduced to the plane and expressed as the robot pose in the map
-// (H ⊕ robot pose in the local map), so clusters and Eq. 5.8–5.14 live in robot-pose space.
+// (H ⊕ robot pose in the local map; pransam::Hypothesis is the transform H it comes from), so clusters and Eq. 5.8–5.14 live in robot-pose space.
 // roll/pitch are the rotations of the matched triangle frames about x and y (0 for a proper 2-D
 // match, π for a flipped one, Eq. 5.3).
-struct Hypothesis {
+struct PoseHypothesis {
   float x = 0.0f, y = 0.0f, theta = 0.0f;  // robot pose in the map
   float quality = 0.0f;                    // Ω ∈ [0, 1] (Eq. 4.7)
   float roll = 0.0f, pitch = 0.0f;
@@ -39,7 +39,7 @@ struct Cluster {
 };
 
 struct InterpretInput {
-  const Hypothesis* hypotheses = nullptr;
+  const PoseHypothesis* hypotheses = nullptr;
   std::size_t count = 0;
   Se2f odom_delta;       // robot motion since the previous interpretation (odometry, robot frame)
   bool have_odom_delta = false;  // false on the first step after reset
@@ -81,7 +81,7 @@ class Interpreter {
   float omega_thres() const { return omega_thres_; }
   const Cluster* clusters() const { return clusters_; }
   std::size_t cluster_count() const { return num_clusters_; }
-  const Hypothesis* hypotheses() const { return hyps_; }
+  const PoseHypothesis* hypotheses() const { return hyps_; }
   bool localized_before() const { return soft_active_; }
   const MmlOptions& options() const { return options_; }
 
@@ -100,7 +100,7 @@ class Interpreter {
   MmlOptions options_;
   bool initialized_ = false;
 
-  Hypothesis hyps_[kMaxHypotheses];
+  PoseHypothesis hyps_[kMaxHypotheses];
   std::uint8_t labels_[kMaxHypotheses];
   std::size_t num_hyps_ = 0;
   Cluster clusters_[kMaxClusters];

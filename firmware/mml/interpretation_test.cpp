@@ -11,10 +11,10 @@ namespace fw {
 namespace mml {
 namespace {
 
-std::vector<Hypothesis> blob(float x, float y, float t, int n, float spread, float q, RandomStream* rng) {
-  std::vector<Hypothesis> v;
+std::vector<PoseHypothesis> blob(float x, float y, float t, int n, float spread, float q, RandomStream* rng) {
+  std::vector<PoseHypothesis> v;
   for (int i = 0; i < n; ++i) {
-    Hypothesis h;
+    PoseHypothesis h;
     h.x = x + spread * static_cast<float>(rng->gaussian());
     h.y = y + spread * static_cast<float>(rng->gaussian());
     h.theta = t + 0.5f * spread * static_cast<float>(rng->gaussian());
@@ -24,7 +24,7 @@ std::vector<Hypothesis> blob(float x, float y, float t, int n, float spread, flo
   return v;
 }
 
-InterpretResult run(Interpreter* it, const std::vector<Hypothesis>& h, Se2f delta, bool have_delta) {
+InterpretResult run(Interpreter* it, const std::vector<PoseHypothesis>& h, Se2f delta, bool have_delta) {
   InterpretInput in;
   in.hypotheses = h.data();
   in.count = h.size();
@@ -62,7 +62,7 @@ TEST(MmlOptionsTest, MalformedRejectedNamingField) {
 TEST(InterpreterTest, FilterDropsFlippedAndWeak) {
   static Interpreter it;
   ASSERT_TRUE(it.init(MmlOptions()).is_ok());
-  std::vector<Hypothesis> h(4);
+  std::vector<PoseHypothesis> h(4);
   h[0].quality = 0.9f;
   h[1].quality = 0.9f; h[1].roll = 3.14159f;  // flipped frame (Eq. 5.3)
   h[2].quality = 0.5f;                        // below Ω_thres0 = 0.7

@@ -80,7 +80,7 @@ Status MmlLocalizer::init(const MmlLocalizerConfig& config, const GlobalMap& map
   Result<Point2f*> sp = arena.allocate_array<Point2f>(scene_capacity_, "mml local map points");
   if (!sp) return sp.status();
   scene_ = *sp;
-  Result<Hypothesis*> hp = arena.allocate_array<Hypothesis>(kMaxHypotheses, "mml hypotheses");
+  Result<PoseHypothesis*> hp = arena.allocate_array<PoseHypothesis>(kMaxHypotheses, "mml hypotheses");
   if (!hp) return hp.status();
   hyps_ = *hp;
   rule_ = ReductionRule(config.mml);
@@ -246,7 +246,7 @@ void MmlLocalizer::correct_local_map(const Se2f& mml_pose) {
   for (std::size_t i = 1; i < interp_.cluster_count(); ++i)
     if (cl[i].rating > cl[best].rating) best = i;
   if (cl[best].end <= cl[best].begin) return;
-  const Hypothesis* hy = interp_.hypotheses();
+  const PoseHypothesis* hy = interp_.hypotheses();
   std::uint32_t bh = cl[best].begin;
   for (std::uint32_t i = cl[best].begin; i < cl[best].end; ++i)
     if (hy[i].quality > hy[bh].quality) bh = i;
@@ -445,7 +445,7 @@ std::size_t MmlLocalizer::global_match_stage(const Se2f& local_pose, std::uint64
   for (std::size_t i = 0; i < mr.num_hypotheses && nh < config_.mml.max_hypotheses; ++i) {
     const Se2f h = pransam::to_se2(mr.hypotheses[i]);
     const Se2f robot = h.compose(local_pose);
-    Hypothesis& o = hyps_[nh++];
+    PoseHypothesis& o = hyps_[nh++];
     o.x = robot.x;
     o.y = robot.y;
     o.theta = robot.theta;

@@ -138,7 +138,7 @@ class MmlLocalizer final : public Localizer {
   std::size_t num_scene_ = 0;
   std::size_t matched_points_ = 0;
   std::size_t scene_capacity_ = 0;
-  Hypothesis* hyps_ = nullptr;  // arena, kMaxHypotheses
+  PoseHypothesis* hyps_ = nullptr;  // arena, kMaxHypotheses
 
   // Eq. 5.37: the last τ_up observations (subsampled scan points in the local frame).
   struct Observation {
