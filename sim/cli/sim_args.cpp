@@ -50,8 +50,8 @@ bool parse_u64(const std::string& flag, const std::string& v, unsigned long long
 }  // namespace
 
 std::string sim_usage() {
-  return R"(usage: mml-sim (--world NAME | --dataset NAME | --log FILE.clf[.gz] [--reference POSES.txt] [--map MAP.yaml])
-               [options]
+  return R"(usage: mml-sim (--world NAME | --dataset NAME | --log FILE.clf[.gz] [--reference POSES.txt]
+                [--map MAP.yaml|MAP.mmap] [--start N]) [options]
 
 Feeds a synthetic world or a CARMEN log through the hal/sim backend into the firmware's localization
 loop and writes DIR/steps.csv, DIR/summary.json, DIR/run.svg, DIR/run.png and DIR/map.yaml/.pgm.
@@ -61,8 +61,11 @@ source:
   --dataset NAME          a dataset of ../shared/data (intel, fr079, aces, mit-killian, fr-clinic): its raw
                           log, reference poses and global map (built once, cached in build/maps)
   --log FILE              CARMEN log (plain or gzip) to replay
-  --reference FILE        *.corrected-poses.txt: ground truth for the log's scans
-  --map FILE.yaml         ROS map_server map for the log (the localizer's global map)
+  --reference FILE        ground truth for the log's scans: "flaser_index ipc logger x y theta" rows
+                          (*.corrected-poses.txt, or written by 'mml-carmen reference RAW CORRECTED OUT')
+  --map FILE              the localizer's global map for the log: a ROS map_server YAML, or a compiled
+                          map image (.mmap from mml-mapc / mml-mapbuild; its relation table is used)
+  --start N               replay the log from its scan N (0-based; default 0)
   --max-log-mib N         refuse a log larger than N MiB, plain or inflated (default 512; stops gzip bombs)
 run:
   --localizer NAME        localizer (default mml-track, the firmware's; --list shows all)
@@ -71,7 +74,8 @@ run:
   --steps N               stop after N scans (default: the whole route / log)
   --paced                 pace at the data's real time (default: lockstep, as fast as possible)
   --speed F               pacing speed factor with --paced (default 1)
-  --threads N             worker threads offered to the localizer (default 1)
+  --threads N             worker threads offered to the localizer (default 2, as mml-eval; results
+                          depend on the seed only, not on N)
   --deadline-ms MS        count localizer steps longer than MS as deadline misses (default off)
   --out DIR               output directory (default build/run)
   --timing wall|none      measure step times with the wall clock (default) or not (byte-identical CSV)
@@ -83,13 +87,15 @@ synthetic world:
   --max-range M           laser maximum range in m (8 or 80 for an LMS 200; default 8)
   --range-noise SIGMA     laser range noise in m (default 0.005)
   --dropout P             probability of a max-range dropout per beam (default 0.01)
-  --odom-noise T,R        odometry noise per scan step: T m, R deg (default 0.04,4)
+  --odom-noise T,R        odometry noise per scan step: T m, R deg (default 0.04,4); with a log: extra
+                          noise on the log's odometry (default none)
   --scan-period S         seconds between scans (default 0.4)
   --route-length M        metres to drive (default: per world)
   --start-node N          route-graph node to start at (default: drawn from the seed)
   --enter-unknown         the route may enter the unknown area
   --via-unknown           drive into the unknown area first (the localizer should say outside-map there)
-  --kidnap-at N           at scan N carry the robot to another place (odometry does not see it)
+  --kidnap-at N           at scan N carry the robot to another place (odometry does not see it); with a
+                          log: the replay jumps to a scan >= 5 m away (drawn from the seed)
   --map-unknown           keep the unknown area in the map (default: erased)
   --resolution M          map resolution in m (default: per world; large-office 0.06)
 other:
@@ -109,6 +115,9 @@ std::string sim_list() {
 bool parse_sim_args(const std::vector<std::string>& args, SimConfig* cfg, SimArgsAction* action, std::string* err) {
   *action = SimArgsAction::kRun;
   cfg->out_dir = "build/run";
+  cfg->threads = 2;  // as mml-eval (SimConfig's own default stays 1 for the library's tests)
+  std::vector<std::string> world_only;  // options of synthetic worlds that were given
+  bool start_given = false, odom_noise_given = false;
   for (size_t i = 0; i < args.size(); ++i) {
     const std::string& a = args[i];
     auto value = [&](std::string* v) {
@@ -136,6 +145,10 @@ bool parse_sim_args(const std::vector<std::string>& args, SimConfig* cfg, SimArg
       if (!value(&cfg->reference_path)) return false;
     } else if (a == "--map") {
       if (!value(&cfg->map_yaml)) return false;
+    } else if (a == "--start") {
+      if (!value(&v) || !parse_u64(a, v, 100000000ull, &n, err)) return false;
+      cfg->log_start = static_cast<size_t>(n);
+      start_given = true;
     } else if (a == "--max-log-mib") {
       if (!value(&v) || !parse_u64(a, v, 1ull << 20, &n, err)) return false;
       if (n == 0) {
@@ -186,9 +199,11 @@ bool parse_sim_args(const std::vector<std::string>& args, SimConfig* cfg, SimArg
     } else if (a == "--no-pictures") {
       cfg->pictures = false;
     } else if (a == "--people") {
+      world_only.push_back(a);
       if (!value(&v) || !parse_u64(a, v, 200, &n, err)) return false;
       cfg->synthetic.people = static_cast<int>(n);
     } else if (a == "--beams") {
+      world_only.push_back(a);
       if (!value(&v) || !parse_u64(a, v, hal::LaserScan::kMaxBeams, &n, err)) return false;
       if (n < 2) {
         *err = "--beams: need at least 2";
@@ -196,10 +211,13 @@ bool parse_sim_args(const std::vector<std::string>& args, SimConfig* cfg, SimArg
       }
       cfg->synthetic.laser.beams = static_cast<int>(n);
     } else if (a == "--max-range") {
+      world_only.push_back(a);
       if (!value(&v) || !parse_double(a, v, 0.5, 200, &cfg->synthetic.laser.max_range, err)) return false;
     } else if (a == "--range-noise") {
+      world_only.push_back(a);
       if (!value(&v) || !parse_double(a, v, 0, 1, &cfg->synthetic.laser.sigma_range, err)) return false;
     } else if (a == "--dropout") {
+      world_only.push_back(a);
       if (!value(&v) || !parse_double(a, v, 0, 1, &cfg->synthetic.laser.dropout_rate, err)) return false;
     } else if (a == "--odom-noise") {
       if (!value(&v)) return false;
@@ -212,14 +230,21 @@ bool parse_sim_args(const std::vector<std::string>& args, SimConfig* cfg, SimArg
           !parse_double(a, v.substr(comma + 1), 0, 180, &cfg->synthetic.odometry.sigma_rot_deg, err)) {
         return false;
       }
+      cfg->log_odom_sigma_m = cfg->synthetic.odometry.sigma_trans;
+      cfg->log_odom_sigma_deg = cfg->synthetic.odometry.sigma_rot_deg;
+      odom_noise_given = true;
     } else if (a == "--scan-period") {
+      world_only.push_back(a);
       if (!value(&v) || !parse_double(a, v, 0.01, 10, &cfg->synthetic.scan_period_s, err)) return false;
     } else if (a == "--route-length") {
+      world_only.push_back(a);
       if (!value(&v) || !parse_double(a, v, 1, 100000, &cfg->synthetic.route.length_m, err)) return false;
     } else if (a == "--start-node") {
+      world_only.push_back(a);
       if (!value(&v) || !parse_u64(a, v, 1000000, &n, err)) return false;
       cfg->synthetic.route.start_node = static_cast<int>(n);
     } else if (a == "--via-unknown") {
+      world_only.push_back(a);
       cfg->synthetic.route.via_unknown = true;
     } else if (a == "--kidnap-at") {
       if (!value(&v) || !parse_u64(a, v, 100000000ull, &n, err)) return false;
@@ -228,11 +253,15 @@ bool parse_sim_args(const std::vector<std::string>& args, SimConfig* cfg, SimArg
         return false;
       }
       cfg->synthetic.kidnap_at_scan = static_cast<size_t>(n);
+      cfg->log_kidnap_at = static_cast<size_t>(n);
     } else if (a == "--enter-unknown") {
+      world_only.push_back(a);
       cfg->synthetic.route.avoid_unknown = false;
     } else if (a == "--map-unknown") {
+      world_only.push_back(a);
       cfg->raster.erase_unknown_areas = false;
     } else if (a == "--resolution") {
+      world_only.push_back(a);
       if (!value(&v) || !parse_double(a, v, 0.01, 1, &d, err)) return false;
       cfg->raster.resolution = d;
     } else {
@@ -257,6 +286,22 @@ bool parse_sim_args(const std::vector<std::string>& args, SimConfig* cfg, SimArg
   if (!cfg->map_yaml.empty() && cfg->log_path.empty() && cfg->dataset.empty()) {
     *err = "--map is for --log replays (worlds bring their own map)";
     return false;
+  }
+  const bool log_source = cfg->world.empty();
+  if (log_source) {
+    if (!world_only.empty()) {
+      *err = world_only.front() + " is an option of synthetic worlds (--world); a log (--log, --dataset) brings " +
+             "its own laser, route and map";
+      return false;
+    }
+    cfg->log_odom_noise = odom_noise_given;
+    cfg->synthetic.kidnap_at_scan = 0;
+  } else {
+    if (start_given) {
+      *err = "--start is for --log / --dataset replays (a world's route: --start-node)";
+      return false;
+    }
+    cfg->log_kidnap_at = 0;
   }
   return true;
 }

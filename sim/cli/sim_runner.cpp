@@ -9,6 +9,7 @@
 #include <cstdarg>
 #include <cmath>
 #include <cstdio>
+#include <cstring>
 #include <filesystem>
 #include <fstream>
 #include <memory>
@@ -28,6 +29,8 @@
 #include "sim/map/map_image_writer.h"
 #include "sim/viz/picture.h"
 #include "sim/world/builtin_worlds.h"
+#include "sim/world/odometry_model.h"
+#include "firmware/base/rng.h"
 
 namespace sim {
 
@@ -58,7 +61,9 @@ struct FrameInfo {
 };
 
 // A CARMEN log prepared as frames: odometry records in file order before each scan, plus the
-// scan's own odometry triple (FLASER/RLASER/ROBOTLASER1) at the scan time.
+// scan's own odometry triple (FLASER/RLASER/ROBOTLASER1) at the scan time. --start skips the first
+// scans; --kidnap-at jumps to another part of the log (the odometry continues with that part's
+// increments, so it sees nothing); --odom-noise perturbs every odometry increment.
 bool load_log_frames(const SimConfig& cfg, std::vector<Frame>* frames, std::size_t* restamped, std::string* err) {
   CarmenLog log;
   // The whole log is read even with --steps: the reference is chained from corrected poses that
@@ -68,6 +73,12 @@ bool load_log_frames(const SimConfig& cfg, std::vector<Frame>* frames, std::size
   if (!read_carmen_log(cfg.log_path, ro, &log, err)) return false;
   if (log.scans.empty()) {
     *err = "log '" + cfg.log_path + "' contains no laser scans";
+    return false;
+  }
+  const size_t n = log.scans.size();
+  if (cfg.log_start >= n) {
+    *err = "--start " + std::to_string(cfg.log_start) + ": the log '" + cfg.log_path + "' has only " +
+           std::to_string(n) + " scans (0.." + std::to_string(n - 1) + ")";
     return false;
   }
   std::vector<fw::Se2d> truth;
@@ -80,24 +91,101 @@ bool load_log_frames(const SimConfig& cfg, std::vector<Frame>* frames, std::size
       return false;
     }
   }
-  const double t0 = log.scans.front().ipc_timestamp;
-  double last_ts = t0;
-  size_t next_odom = 0;
+  // Source scan of every replayed step.
+  std::vector<size_t> order;
+  size_t jump_step = 0;  // step of the kidnapped frame (0 = no kidnapping)
+  if (cfg.log_kidnap_at > 0) {
+    const size_t last_before = cfg.log_start + cfg.log_kidnap_at - 1;  // last scan before the carry
+    if (last_before + 1 >= n) {
+      *err = "--kidnap-at " + std::to_string(cfg.log_kidnap_at) + ": after the end of the log (" +
+             std::to_string(n - cfg.log_start) + " scans from --start " + std::to_string(cfg.log_start) + ")";
+      return false;
+    }
+    auto where = [&](size_t i) { return i < truth.size() ? truth[i] : log.scans[i].pose; };
+    const fw::Se2d here = where(last_before);
+    // Candidates: ≥ kLogKidnapMinJumpM away, with 50 scans (or a quarter of the log) to run on.
+    const size_t tail = std::min<size_t>(50, n / 4);
+    std::vector<size_t> cand;
+    for (size_t j = 1; j + tail < n; ++j) {
+      const fw::Se2d p = where(j);
+      if (std::hypot(p.x - here.x, p.y - here.y) >= kLogKidnapMinJumpM) cand.push_back(j);
+    }
+    if (cand.empty()) {
+      *err = "--kidnap-at " + std::to_string(cfg.log_kidnap_at) + ": no scan of the log lies " +
+             std::to_string(kLogKidnapMinJumpM).substr(0, 3) + " m or more from the pose at scan " +
+             std::to_string(last_before);
+      return false;
+    }
+    fw::RandomStream rng(cfg.seed, 5);  // stream 5: the kidnapping, as in synthetic worlds
+    const size_t to = cand[rng.uniform_index(static_cast<std::uint32_t>(cand.size()))];
+    for (size_t i = cfg.log_start; i <= last_before; ++i) order.push_back(i);
+    jump_step = order.size();
+    for (size_t i = to; i < n; ++i) order.push_back(i);
+    if (cfg.progress) {
+      const fw::Se2d p = where(to);
+      std::fprintf(stderr, "mml-sim: kidnapping at step %zu: the replay jumps from scan %zu to scan %zu (%.1f m away%s)\n",
+                   jump_step, last_before, to, std::hypot(p.x - here.x, p.y - here.y),
+                   truth.empty() ? ", by the log's own poses" : "");
+    }
+  } else {
+    for (size_t i = cfg.log_start; i < n; ++i) order.push_back(i);
+  }
+  if (cfg.steps > 0 && order.size() > cfg.steps) order.resize(cfg.steps);
+
+  const double t0 = log.scans[order.front()].ipc_timestamp;
+  double last_ts = t0, shift = 0;
+  auto first_odom_after = [&](size_t line) {
+    return static_cast<size_t>(std::upper_bound(log.odom.begin(), log.odom.end(), line,
+                                                [](size_t l, const CarmenOdom& o) { return l < o.line; }) -
+                               log.odom.begin());
+  };
+  size_t next_odom = order.front() > 0 ? first_odom_after(log.scans[order.front() - 1].line) : 0;
   double travelled = 0;
   fw::Se2d prev;
-  const size_t n_scans = cfg.steps > 0 ? std::min(cfg.steps, log.scans.size()) : log.scans.size();
-  for (size_t i = 0; i < n_scans; ++i) {
+  // Odometry of the replay = A ⊕ (the log's odometry); A changes at the kidnapping only.
+  fw::Se2d A, last_src_odom, last_out_odom;
+  bool have_odom = false;
+  auto emit = [&](const fw::Se2d& src, std::uint64_t t_ns, double v, double w) {
+    const fw::Se2d o = A.compose(src);
+    hal::Odometry h;
+    h.timestamp_ns = t_ns;
+    h.x = static_cast<float>(o.x);
+    h.y = static_cast<float>(o.y);
+    h.theta = static_cast<float>(o.theta);
+    h.v = static_cast<float>(v);
+    h.omega = static_cast<float>(w);
+    last_src_odom = src;
+    last_out_odom = o;
+    have_odom = true;
+    return h;
+  };
+  for (size_t k = 0; k < order.size(); ++k) {
+    const size_t i = order[k];
     const CarmenScan& s = log.scans[i];
+    const bool scan_has_odom = s.type.rfind("RAWLASER", 0) != 0;
     Frame f;
-    f.index = static_cast<std::uint32_t>(i);
-    f.t = s.ipc_timestamp - t0;
+    f.index = static_cast<std::uint32_t>(k);
+    if (k > 0 && k == jump_step) {
+      // Carried away: time goes on by the log's own scan interval; the odometry chains on from the
+      // last replayed sample with the increments of the new part.
+      f.kidnapped = true;
+      const double dt = s.ipc_timestamp - log.scans[i - 1].ipc_timestamp;
+      shift = last_ts + std::max(dt, 1e-3) - s.ipc_timestamp;
+      next_odom = first_odom_after(log.scans[i - 1].line);
+      fw::Se2d q = log.scans[i - 1].odom;
+      if (!scan_has_odom) {
+        q = last_src_odom;
+        if (next_odom > 0) q = log.odom[next_odom - 1].pose;
+      }
+      if (have_odom) A = last_out_odom.compose(q.inverse());
+    }
     // Some logs step back in time (intel: 631 scans whose ipc and logger stamps are earlier than the
     // previous scan's). The scan line carries its own odometry, so file order is the truth: such a
     // scan is re-stamped 1 ms after its predecessor (counted), keeping scan and odometry together.
-    double ts_scan = s.ipc_timestamp;
-    if (i > 0 && ts_scan <= last_ts) {
+    double ts_scan = s.ipc_timestamp + shift;
+    if (k > 0 && ts_scan <= last_ts) {
       ts_scan = last_ts + 1e-3;
-      ++*restamped;
+      if (k != jump_step) ++*restamped;
     }
     last_ts = ts_scan;
     f.t = ts_scan - t0;
@@ -106,27 +194,13 @@ bool load_log_frames(const SimConfig& cfg, std::vector<Frame>* frames, std::size
     // with exactly that; separate ODOM records are used only for scans without it (RAWLASER). Mixing
     // both would feed the loop out-of-order samples: in intel, ODOM records are stamped up to 0.4 s
     // after the FLASER lines that follow them.
-    const bool scan_has_odom = s.type.rfind("RAWLASER", 0) != 0;
     while (next_odom < log.odom.size() && log.odom[next_odom].line < s.line) {
       const CarmenOdom& o = log.odom[next_odom++];
       if (scan_has_odom) continue;
-      hal::Odometry h;
-      h.timestamp_ns = o.ipc_timestamp >= t0 - 1.0 ? to_ns(o.ipc_timestamp) : 0;
-      h.x = static_cast<float>(o.pose.x);
-      h.y = static_cast<float>(o.pose.y);
-      h.theta = static_cast<float>(o.pose.theta);
-      h.v = static_cast<float>(o.tv);
-      h.omega = static_cast<float>(o.rv);
-      f.odometry.push_back(h);
+      const double ts = o.ipc_timestamp + shift;
+      f.odometry.push_back(emit(o.pose, ts >= t0 - 1.0 ? to_ns(ts) : 0, o.tv, o.rv));
     }
-    if (scan_has_odom) {
-      hal::Odometry h;
-      h.timestamp_ns = to_ns(ts_scan);
-      h.x = static_cast<float>(s.odom.x);
-      h.y = static_cast<float>(s.odom.y);
-      h.theta = static_cast<float>(s.odom.theta);
-      f.odometry.push_back(h);
-    }
+    if (scan_has_odom) f.odometry.push_back(emit(s.odom, to_ns(ts_scan), 0, 0));
     f.scan = to_laser_scan(s, to_ns(ts_scan));
     f.scan.scan_id = f.index;
     if (i < truth.size()) {
@@ -134,12 +208,47 @@ bool load_log_frames(const SimConfig& cfg, std::vector<Frame>* frames, std::size
       f.truth = truth[i];
     }
     const fw::Se2d here = f.has_truth ? f.truth : s.odom;
-    if (i > 0) travelled += std::hypot(here.x - prev.x, here.y - prev.y);
+    if (k > 0 && k != jump_step) travelled += std::hypot(here.x - prev.x, here.y - prev.y);
     prev = here;
     f.travelled_m = travelled;
     frames->push_back(std::move(f));
   }
+  if (cfg.log_odom_noise) {
+    // The log's odometry is taken as the true motion and perturbed as in synthetic worlds
+    // (sim/world/odometry_model.h: σ per scan step, split over the samples of a step).
+    OdometryNoiseOptions no;
+    no.sigma_trans = cfg.log_odom_sigma_m;
+    no.sigma_rot_deg = cfg.log_odom_sigma_deg;
+    bool started = false;
+    for (Frame& f : *frames) {
+      if (!started && !f.odometry.empty()) {
+        no.odom_origin = fw::Se2d(f.odometry.front().x, f.odometry.front().y, f.odometry.front().theta);
+      }
+      if (!f.odometry.empty()) break;
+    }
+    OdometrySimulator sim_odom(no, cfg.seed);
+    for (Frame& f : *frames) {
+      const double frac = f.odometry.empty() ? 1.0 : 1.0 / static_cast<double>(f.odometry.size());
+      for (hal::Odometry& h : f.odometry) {
+        const fw::Se2d src(h.x, h.y, h.theta);
+        h = started ? sim_odom.next(src, h.timestamp_ns, frac) : sim_odom.start(src, h.timestamp_ns);
+        started = true;
+      }
+    }
+  }
   return true;
+}
+
+// A compiled map image starts with the magic "MMLFWMAP" (firmware/map/map_image.h).
+bool is_map_image_file(const std::string& path) {
+  std::error_code ec;
+  if (!std::filesystem::is_regular_file(path, ec)) return false;  // errors: left to the YAML reader
+  std::FILE* f = std::fopen(path.c_str(), "rb");
+  if (f == nullptr) return false;
+  char magic[8] = {};
+  const bool ok = std::fread(magic, 1, sizeof(magic), f) == sizeof(magic) && std::memcmp(magic, "MMLFWMAP", 8) == 0;
+  std::fclose(f);
+  return ok;
 }
 
 double percentile(std::vector<double> v, double p) {
@@ -734,6 +843,8 @@ bool run_simulation(const SimConfig& cfg_in, SimResult* out, std::string* err) {
     return false;
   }
   // ---- source and map ----
+  std::vector<std::uint8_t> image;  // the compiled map image the firmware loads
+  bool image_from_file = false;
   World world;
   SyntheticRun synthetic;
   std::vector<Frame> log_frames;
@@ -763,8 +874,14 @@ bool run_simulation(const SimConfig& cfg_in, SimResult* out, std::string* err) {
     if (!load_log_frames(cfg, &log_frames, &sum.scans_restamped, err)) return false;
     total = log_frames.size();
     if (!cfg.map_yaml.empty()) {
-      RosMap rm;
-      if (!read_ros_map(cfg.map_yaml, &rm, err) || !ros_map_to_grid(rm, &grid, err)) return false;
+      if (is_map_image_file(cfg.map_yaml)) {
+        // A compiled map image (mml-mapc / mml-mapbuild): used as it is, relation table included.
+        if (!read_file_bytes(cfg.map_yaml, &image, err)) return false;
+        image_from_file = true;
+      } else {
+        RosMap rm;
+        if (!read_ros_map(cfg.map_yaml, &rm, err) || !ros_map_to_grid(rm, &grid, err)) return false;
+      }
       have_grid = true;
     }
     sum.source = cfg.dataset.empty() ? "log:" + std::filesystem::path(cfg.log_path).filename().string()
@@ -772,18 +889,31 @@ bool run_simulation(const SimConfig& cfg_in, SimResult* out, std::string* err) {
   }
 
   // ---- compiled map image, loaded by the firmware's own loader into a start-up arena ----
-  std::vector<std::uint8_t> image;
   fw::StartupArena arena;
   fw::GlobalMap global_map;
   if (have_grid) {
-    MapImageWriter writer;
-    if (!writer.set_grid(grid, err)) return false;
-    image = writer.bytes();
+    if (!image_from_file) {
+      MapImageWriter writer;
+      if (!writer.set_grid(grid, err)) return false;
+      image = writer.bytes();
+    }
+    const std::string what = image_from_file ? cfg.map_yaml : std::string("simulated map");
     fw::Status s = arena.init_mapped(fw::map_image_arena_bytes(image.data(), image.size()) + (1u << 20), false, "map");
-    if (s.is_ok()) s = fw::load_map_image(image.data(), image.size(), arena, &global_map, "simulated map");
+    if (s.is_ok()) s = fw::load_map_image(image.data(), image.size(), arena, &global_map, what.c_str());
     if (!s.is_ok()) {
-      *err = std::string("map: ") + s.message();
+      *err = (image_from_file ? cfg.map_yaml + ": " : std::string("map: ")) + s.message();
       return false;
+    }
+    if (image_from_file) {
+      // The host grid (pictures, map.yaml, the MCL baseline) from the image's own occupancy.
+      grid.geometry = global_map.geometry;
+      grid.cells.assign(grid.geometry.cell_count(), fw::kCellUnknown);
+      for (std::uint32_t cy = 0; cy < grid.geometry.height; ++cy) {
+        for (std::uint32_t cx = 0; cx < grid.geometry.width; ++cx) {
+          grid.cells[grid.geometry.index(cx, cy)] =
+              global_map.cell(static_cast<std::int32_t>(cx), static_cast<std::int32_t>(cy));
+        }
+      }
     }
   }
 

@@ -21,13 +21,26 @@
 
 namespace sim {
 
+// --kidnap-at with a log: the replay jumps to a scan at least this far from the robot's pose.
+constexpr double kLogKidnapMinJumpM = 5.0;
+
 struct SimConfig {
   std::string world;           // built-in world name, or
   const World* custom_world = nullptr;  // a world built in code (tests: a unique room, a symmetric corridor), or
   std::string dataset;         // a dataset of ../shared/data (log, reference and cached global map), or
   std::string log_path;        // CARMEN log (plain or .gz)
   std::string reference_path;  // *.corrected-poses.txt for a log (ground truth)
-  std::string map_yaml;        // ROS map for a log replay (optional)
+  std::string map_yaml;        // map for a log replay (optional): ROS map_server YAML, or a compiled map
+                               // image (.mmap, "MMLFWMAP" magic; its relation table is used)
+  std::size_t log_start = 0;   // --start: first scan of the log to replay (0-based)
+  // --odom-noise with a log: extra Gaussian noise on every odometry increment (per scan step,
+  // σ_t m on x and y, σ_r deg on θ; seeded by --seed); off when log_odom_noise is false.
+  bool log_odom_noise = false;
+  double log_odom_sigma_m = 0, log_odom_sigma_deg = 0;
+  // --kidnap-at with a log: at this replayed scan (1-based count from --start) the replay jumps to
+  // another part of the log (chosen by the seed, ≥ kLogKidnapMinJumpM away); the odometry continues
+  // with the new part's increments and sees nothing. 0 = off.
+  std::size_t log_kidnap_at = 0;
   std::uint64_t max_log_bytes = kDefaultMaxLogBytes;  // --max-log-mib: cap on the log, plain or inflated
   // Empty: "mml-track" when it is registered (the product, firmware/app/system.h), else "odom".
   std::string localizer;
@@ -39,7 +52,7 @@ struct SimConfig {
   bool wall_timing = true;     // false: step times are not measured (CSV byte-identical across runs)
   bool progress = true;        // \r-updated progress line on stderr
   bool pictures = true;
-  int threads = 1;
+  int threads = 1;             // the mml-sim CLI defaults to 2, as mml-eval (sim_args.cpp)
   double deadline_ms = 0;      // Localizer::step longer than this counts a deadline miss (0 = off)
   std::string out_dir;         // empty: no files
   SyntheticRunOptions synthetic;

@@ -67,21 +67,6 @@ void check_reference_file(LoadedDataset* ds, const std::string& relations_path) 
 
 }  // namespace
 
-std::vector<fw::Se2d> synthesize_odometry(const std::vector<fw::Se2d>& reference, std::uint64_t seed) {
-  std::vector<fw::Se2d> out;
-  if (reference.empty()) return out;
-  fw::RandomStream rng(seed, 4242);
-  out.push_back(reference[0]);
-  for (std::size_t i = 1; i < reference.size(); ++i) {
-    const fw::Se2d d = reference[i - 1].between(reference[i]);
-    const double ds = std::hypot(d.x, d.y), dth = std::fabs(fw::wrap_angle(d.theta));
-    const double st = 0.05 * ds + 0.01 * dth, sr = 0.05 * dth + 0.01 * ds;
-    const double nx = st * rng.gaussian(), ny = st * rng.gaussian(), nt = sr * rng.gaussian();
-    out.push_back(out.back().compose(fw::Se2d(d.x + nx, d.y + ny, fw::wrap_angle(d.theta + nt))));
-  }
-  return out;
-}
-
 std::size_t check_reference_against_relations(LoadedDataset* ds, const std::vector<Relation>& relations,
                                               double max_dt_s, double tol_m, double tol_rad) {
   const std::size_t n = ds->log.scans.size();
@@ -139,8 +124,13 @@ void set_reference(LoadedDataset* ds, const std::vector<CorrectedPose>& cp) {
 
 bool load_dataset(const std::string& name, LoadedDataset* ds, std::string* err) {
   const Dataset* d = find_dataset(name);
-  if (d == nullptr || (d->raw_log.empty() && d->corrected_log.empty()))
-    return fail(err, "mml-eval: unknown dataset or no log: '" + name + "'");
+  if (d == nullptr || (d->raw_log.empty() && d->corrected_log.empty())) {
+    std::string known;
+    for (const Dataset& k : datasets()) {
+      if (!k.raw_log.empty() || !k.corrected_log.empty()) known += (known.empty() ? "" : ", ") + k.name;
+    }
+    return fail(err, "unknown dataset or no log: '" + name + "' (known: " + known + ")");
+  }
   ds->name = name;
   ds->key = name;
   std::replace(ds->key.begin(), ds->key.end(), '-', '_');

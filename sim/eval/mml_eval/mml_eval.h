@@ -16,6 +16,7 @@
 #include "firmware/map/global_map.h"
 #include "firmware/runtime/localizer.h"
 #include "hal/msg/pose_estimate.h"
+#include "sim/io/synthetic_odometry.h"
 #include "sim/io/carmen_log.h"
 #include "sim/eval/mml_eval/reference_map_check.h"
 #include "sim/io/relations.h"
@@ -78,11 +79,9 @@ struct DatasetFiles {
 };
 bool load_dataset_files(const DatasetFiles& files, LoadedDataset* out, std::string* err);
 
-// Wheel odometry synthesised from reference increments (for logs without raw odometry): per scan
-// pair Δ = ref[i-1] ⊖ ref[i], Δs = |Δ_xy|, Δθ = wrap(Δ_θ); odometry increment = Δ + n with
-// n_x, n_y ~ N(0, σ_t²), n_θ ~ N(0, σ_r²), σ_t = 0.05·Δs + 0.01·|Δθ| (m), σ_r = 0.05·|Δθ| + 0.01·Δs
-// (rad) — AMCL's noise form with α = 0.05 / 0.01 — from fw::RandomStream(seed, 4242). Starts at ref[0].
-std::vector<fw::Se2d> synthesize_odometry(const std::vector<fw::Se2d>& reference, std::uint64_t seed);
+// Wheel odometry synthesised from reference increments (for logs without raw odometry): the model of
+// sim/io/synthetic_odometry.h (also behind `mml-carmen synth-odom`).
+using sim::synthesize_odometry;
 
 // Reference-quality rule (README "Reference quality"): every benchmark relation with
 // |t2 − t1| ≤ max_dt_s whose two scans are in the log is evaluated on the reference; if it

@@ -1,6 +1,6 @@
 // mml-eval: MML vs MCL vs hand-off on the real logs (issue 6 §5). Full runs with flags; the
 // 20-minute benchmark is bench_mml (scripts/bench.sh mml).
-//   mml-eval [--datasets intel,aces] [--trials 10] [--mcl-trials N] [--steps 150] [--mit-steps 300]
+//   mml-eval [--datasets intel,aces] [--trials 10] [--mcl-trials N] [--steps 200] [--mit-steps 300]
 //            [--seed 1] [--threads 2] [--config 3] [--all-configs] [--mcl-particles 30000]
 //            [--mcl-particles-mit 120000] [--no-handoff] [--no-mcl] [--no-unknown] [--out build/eval/mml]
 //            [--correct] [--reduce] [--no-unique] [--compare-local-map-options]
@@ -31,6 +31,7 @@
 #include "sim/eval/mml_eval/mml_eval_run.h"
 #include "sim/eval/mml_eval/mml_systems.h"
 #include "sim/common/cli_main.h"
+#include "sim/io/datasets.h"
 
 namespace {
 std::vector<std::string> split(const std::string& s) {
@@ -41,7 +42,7 @@ std::vector<std::string> split(const std::string& s) {
   return out;
 }
 const char kUsage[] =
-    "usage: mml-eval [--datasets intel,aces] [--trials 10] [--mcl-trials N] [--steps 150] [--mit-steps 300]\n"
+    "usage: mml-eval [--datasets intel,aces] [--trials 10] [--mcl-trials N] [--steps 200] [--mit-steps 300]\n"
     "                [--seed 1] [--threads 2] [--config 3] [--all-configs] [--mcl-particles 30000]\n"
     "                [--mcl-particles-mit 120000] [--no-handoff] [--no-mcl] [--no-unknown] [--out build/eval/mml]\n"
     "                [--correct] [--reduce] [--no-unique] [--compare-local-map-options]\n"
@@ -51,22 +52,55 @@ const char kUsage[] =
     "                [--no-pool] [--global ref|live|live-deadline]\n"
     "       mml-eval --log LOG.clf[.gz] --map MAP.yaml --reference POSES.txt|CORRECTED.log[.gz]\n"
     "                [--relations R] [--name NAME] [--synthetic-odometry]   (any building by path)\n"
-    "Datasets are read from ../shared/data (MMLFW_DATA_DIR). Definitions of every figure:\n"
-    "sim/eval/mml_eval/README.md.\n";
+    "Datasets (--datasets, --mcl-datasets, --kidnap-datasets): intel, fr079, aces, mit-killian, fr-clinic,\n"
+    "fr101, fr-campus, read from ../shared/data (MMLFW_DATA_DIR). --steps: localizer steps per kidnapped\n"
+    "trial (default 200, as scripts/bench.sh mml); with --localize / --log the cap of a whole-log run\n"
+    "(default 0 = to the end of the log). --threads: worker threads (default 2, as mml-sim).\n"
+    "Your own building: --log RAW.clf --map MAP.yaml --reference REF (REF: 'mml-carmen reference' rows or\n"
+    "a CARMEN log with one pose per scan of RAW). Definitions of every figure: sim/eval/mml_eval/README.md.\n";
 int usage(const char* msg) {
   std::fprintf(stderr, "mml-eval: %s\n%s", msg, kUsage);
   return 2;
+}
+// Errors of the evaluation library may already carry the tool's name: print it once.
+void print_error(const std::string& err) {
+  std::fprintf(stderr, "%s%s\n", err.rfind("mml-eval:", 0) == 0 ? "" : "mml-eval: ", err.c_str());
+}
+std::string known_dataset_names() {
+  std::string names;
+  for (const sim::Dataset& d : sim::datasets()) {
+    if (d.raw_log.empty() && d.corrected_log.empty()) continue;
+    names += (names.empty() ? "" : ", ") + d.name;
+  }
+  return names;
+}
+// Every dataset name given on the command line, checked before anything runs (a bad name used to
+// fail only when its turn came, after the figures of the datasets before it had been printed).
+bool check_dataset_names(const std::string& option, const std::vector<std::string>& names, const std::string& custom) {
+  for (const std::string& n : names) {
+    if (!custom.empty() && n == custom) continue;
+    const sim::Dataset* d = sim::find_dataset(n);
+    if (d == nullptr || (d->raw_log.empty() && d->corrected_log.empty())) {
+      std::fprintf(stderr,
+                   "mml-eval: %s: unknown dataset '%s' (known: %s; your own building: --log LOG --map MAP.yaml "
+                   "--reference REF, see --help)\n",
+                   option.c_str(), n.c_str(), known_dataset_names().c_str());
+      return false;
+    }
+  }
+  return true;
 }
 }  // namespace
 
 static int run_main(int argc, char** argv) {
   sim::mmleval::EvalPlan plan;
   plan.out_dir = "build/eval/mml";
+  plan.trial.max_steps = 200;  // as scripts/bench.sh mml and the README (≤ 200 steps per trial)
   plan.trial_mit = plan.trial;
   plan.trial_mit.max_steps = 300;
   sim::mmleval::LocalizePlan lp;
   lp.out_dir = "build/eval/localize";
-  bool localize = false, datasets_given = false;
+  bool localize = false, datasets_given = false, mcl_datasets_given = false, kidnap_datasets_given = false;
   sim::mmleval::DatasetFiles files;
   for (int i = 1; i < argc; ++i) {
     const std::string a = argv[i];
@@ -104,10 +138,14 @@ static int run_main(int argc, char** argv) {
     else if (a == "--whole-runs") lp.whole_runs = next(0, 1000);
     else if (a == "--fix-trials") lp.fix_trials = next(0, 1000);
     else if (a == "--fix-steps") lp.fix_steps = next(1, 100000);
-    else if (a == "--mcl-datasets") lp.mcl_datasets = split(str());
+    else if (a == "--mcl-datasets") { lp.mcl_datasets = split(str()); mcl_datasets_given = true; }
     else if (a == "--kidnap-runs") lp.kidnap_runs = next(0, 1000);
-    else if (a == "--kidnap-datasets") lp.kidnap_datasets = split(str());
-    else if (a == "--datasets" && i + 1 < argc) { plan.datasets = split(argv[++i]); datasets_given = true; }
+    else if (a == "--kidnap-datasets") { lp.kidnap_datasets = split(str()); kidnap_datasets_given = true; }
+    else if (a == "--datasets") {
+      plan.datasets = split(str());
+      if (plan.datasets.empty()) return usage("--datasets: empty list");
+      datasets_given = true;
+    }
     else if (a == "--trials") plan.trials = next(1, 1000);
     else if (a == "--mcl-trials") lp.mcl_trials = plan.mcl_trials = next(0, 1000);
     else if (a == "--steps") lp.whole_max_steps = plan.trial.max_steps = next(0, 100000);
@@ -125,8 +163,13 @@ static int run_main(int argc, char** argv) {
     else if (a == "--reduce") plan.mml_reduce = true;
     else if (a == "--no-unique") plan.mml_unique = false;
     else if (a == "--compare-local-map-options") plan.compare_local_map_options = true;
-    else if (a == "--out" && i + 1 < argc) lp.out_dir = plan.out_dir = argv[++i];
+    else if (a == "--out") lp.out_dir = plan.out_dir = str();
     else return usage(("unknown argument '" + a + "'").c_str());
+  }
+  if ((datasets_given && !check_dataset_names("--datasets", plan.datasets, "")) ||
+      (mcl_datasets_given && !check_dataset_names("--mcl-datasets", lp.mcl_datasets, "")) ||
+      (kidnap_datasets_given && !check_dataset_names("--kidnap-datasets", lp.kidnap_datasets, files.name))) {
+    return 2;
   }
   sim::BenchJson json;
   std::string err;
@@ -143,7 +186,7 @@ static int run_main(int argc, char** argv) {
       lp.datasets = plan.datasets;
     }
     if (!sim::mmleval::run_localize_evaluation(lp, &json, &err)) {
-      std::fprintf(stderr, "%s%s\n", err.rfind("mml-eval:", 0) == 0 ? "" : "mml-eval: ", err.c_str());
+      print_error(err);
       return 1;
     }
     json.write(lp.out_dir + "/localize.json");
@@ -151,7 +194,7 @@ static int run_main(int argc, char** argv) {
     return 0;
   }
   if (!sim::mmleval::run_evaluation(plan, &json, &err)) {
-    std::fprintf(stderr, "mml-eval: %s\n", err.c_str());
+    print_error(err);
     return 1;
   }
   json.write(plan.out_dir + "/mml_eval.json");
