@@ -1,10 +1,17 @@
 // mml-mapbuild: global occupancy maps of the real datasets from their SLAM-corrected logs.
-//   mml-mapbuild --dataset intel|fr079|aces|mit-killian|fr-clinic|all [--resolution R] [--out DIR]
+//   mml-mapbuild --dataset intel|fr079|aces|mit-killian|fr-clinic|fr101|fr-campus|all [--resolution R] [--out DIR]
 // writes DIR/<dataset>.yaml + .pgm (ROS map_server), .png (picture), .mmap (compiled firmware map
 // image), .build.txt (parameters). Default DIR: build/maps; default R: 0.05 m (0.10 m mit-killian, fr-clinic).
-//   mml-mapbuild --log FILE.clf[.gz] --name NAME [--resolution R] [--max-range M] [--out DIR]
-// builds from any CARMEN log whose scan poses are known (e.g. a corrected log).
+//   mml-mapbuild --log FILE.clf[.gz] --name NAME [--resolution R] [--max-range M] [--laser-max-range M] [--out DIR]
+// builds from any CARMEN log whose scan poses are known (e.g. a corrected log). --max-range: readings
+// used up to M m (default 25 m, as the built-in indoor maps); --laser-max-range: the laser's own
+// maximum (readings at or beyond it are "no return", not drawn; default: the log's PARAM
+// robot_front_laser_max / robot_rear_laser_max, else its largest reading). How many beams that
+// leaves out is printed, with a warning when it is more than 5 %.
+#include <algorithm>
+#include <cerrno>
 #include <chrono>
+#include <cmath>
 #include <cstdio>
 #include <cstdlib>
 #include <cstring>
@@ -19,11 +26,40 @@
 
 namespace {
 
-int usage() {
-  std::fprintf(stderr,
-               "usage: mml-mapbuild --dataset intel|fr079|aces|mit-killian|fr-clinic|all [--resolution R] [--out DIR]\n"
-               "       mml-mapbuild --log FILE --name NAME [--resolution R] [--max-range M] [--out DIR]\n");
+const char kUsage[] =
+    "usage: mml-mapbuild --dataset intel|fr079|aces|mit-killian|fr-clinic|fr101|fr-campus|all [--resolution R] [--out DIR]\n"
+    "       mml-mapbuild --log FILE --name NAME [--resolution R] [--max-range M] [--laser-max-range M] [--out DIR]\n"
+    "Writes DIR/NAME.yaml + .pgm (ROS map_server), .png, .mmap (the firmware's map image, for mmlfw and\n"
+    "mml-sim --map; add pRANSAM's relation table with 'mml-mapc --relation-table DIR/NAME.yaml OUT.mmap').\n"
+    "  --dataset NAME        a built-in dataset of ../shared/data (MMLFW_DATA_DIR), or all\n"
+    "  --log FILE            a CARMEN log whose scan poses are correct (a corrected log: GMapping's,\n"
+    "                        mml-slam's, ...); needs --name\n"
+    "  --name NAME           file name of the map built from --log\n"
+    "  --resolution R        cell size in m (default 0.05; built-in: 0.10 for mit-killian, fr-clinic, fr-campus)\n"
+    "  --max-range M         --log: readings used up to M m, longer ones only clear free space (default 25,\n"
+    "                        as the built-in indoor maps; 40 for mit-killian and fr-campus)\n"
+    "  --laser-max-range M   --log: the laser's maximum range; readings at or beyond it are 'no return' and\n"
+    "                        not drawn (default: the log's PARAM robot_front_laser_max / robot_rear_laser_max,\n"
+    "                        else its largest reading)\n"
+    "  --out DIR             output directory (default build/maps)\n"
+    "  --help                this text\n";
+
+int usage_error(const std::string& msg) {
+  std::fprintf(stderr, "mml-mapbuild: %s\n%s", msg.c_str(), kUsage);
   return 2;
+}
+
+// A number > 0 (finite), or a message naming the option and the value.
+bool parse_positive(const std::string& opt, const char* v, double* out, std::string* err) {
+  char* end = nullptr;
+  errno = 0;
+  const double d = std::strtod(v, &end);
+  if (*v == '\0' || *end != '\0' || errno != 0 || !std::isfinite(d) || !(d > 0.0)) {
+    *err = opt + ": '" + v + "' is not a number > 0";
+    return false;
+  }
+  *out = d;
+  return true;
 }
 
 bool write_all(const std::string& dir, const std::string& name, const sim::RosMap& map, std::string* err) {
@@ -47,30 +83,47 @@ void print_stats(const std::string& name, const sim::RosMap& m, const sim::Occup
 
 static int run_main(int argc, char** argv) {
   std::string dataset, log_path, name, out = sim::map_cache_dir();
-  double resolution = 0.0, max_range = 0.0;
+  double resolution = 0.0, max_range = 0.0, laser_max = 0.0;
+  std::string err;
   for (int i = 1; i < argc; ++i) {
     const std::string a = argv[i];
-    auto next = [&]() -> const char* { return i + 1 < argc ? argv[++i] : nullptr; };
-    const char* v = nullptr;
-    if (a == "--dataset" && (v = next())) {
-      dataset = v;
-    } else if (a == "--resolution" && (v = next())) {
-      resolution = std::atof(v);
-      if (!(resolution > 0.0)) {
-        std::fprintf(stderr, "mml-mapbuild: --resolution must be > 0 (got '%s')\n", v);
-        return 2;
-      }
-    } else if (a == "--out" && (v = next())) {
-      out = v;
-    } else if (a == "--log" && (v = next())) {
-      log_path = v;
-    } else if (a == "--name" && (v = next())) {
-      name = v;
-    } else if (a == "--max-range" && (v = next())) {
-      max_range = std::atof(v);
-    } else {
-      return usage();
+    if (a == "--help" || a == "-h") {
+      std::fputs(kUsage, stdout);
+      return 0;
     }
+    const bool takes_value = a == "--dataset" || a == "--resolution" || a == "--out" || a == "--log" ||
+                             a == "--name" || a == "--max-range" || a == "--laser-max-range";
+    if (!takes_value) return usage_error("unknown argument '" + a + "'");
+    if (i + 1 >= argc) return usage_error(a + " needs a value");
+    const char* v = argv[++i];
+    if (a == "--dataset") {
+      dataset = v;
+    } else if (a == "--resolution") {
+      if (!parse_positive(a, v, &resolution, &err)) return usage_error(err);
+    } else if (a == "--out") {
+      out = v;
+    } else if (a == "--log") {
+      log_path = v;
+    } else if (a == "--name") {
+      name = v;
+      if (name.empty() || name.find('/') != std::string::npos) {
+        return usage_error("--name: '" + name + "' is not a file name (no '/'; the directory is --out)");
+      }
+    } else if (a == "--max-range") {
+      if (!parse_positive(a, v, &max_range, &err)) return usage_error(err);
+    } else if (a == "--laser-max-range") {
+      if (!parse_positive(a, v, &laser_max, &err)) return usage_error(err);
+    }
+  }
+  if (!dataset.empty() && !log_path.empty()) return usage_error("--dataset and --log exclude each other");
+  if (dataset.empty() && log_path.empty()) return usage_error("nothing to build: give --dataset NAME or --log FILE --name NAME");
+  if (!log_path.empty() && name.empty()) {
+    return usage_error("--log needs --name NAME (the map's file name: DIR/NAME.yaml, .pgm, .png, .mmap)");
+  }
+  if (!dataset.empty() && !name.empty()) return usage_error("--name is for --log (a dataset's map is named after it)");
+  if (!dataset.empty() && (max_range > 0.0 || laser_max > 0.0)) {
+    return usage_error(std::string(max_range > 0.0 ? "--max-range" : "--laser-max-range") +
+                       " is for --log (the built-in maps use their own: 25 m, 40 m for mit-killian and fr-campus)");
   }
   std::error_code ec;
   std::filesystem::create_directories(out, ec);
@@ -78,22 +131,76 @@ static int run_main(int argc, char** argv) {
     std::fprintf(stderr, "mml-mapbuild: %s: %s\n", out.c_str(), ec.message().c_str());
     return 1;
   }
-  std::string err;
   if (!log_path.empty()) {
-    if (name.empty()) return usage();
     const auto t0 = std::chrono::steady_clock::now();
     sim::CarmenLog log;
     if (!sim::read_carmen_log(log_path, sim::CarmenReadOptions{}, &log, &err)) {
       std::fprintf(stderr, "mml-mapbuild: %s\n", err.c_str());
       return 1;
     }
+    if (log.scans.empty()) {
+      std::fprintf(stderr, "mml-mapbuild: %s: no laser scans in the log\n", log_path.c_str());
+      return 1;
+    }
+    // The laser's maximum: readings at or beyond it are "no return" (occupancy_builder.h) and are
+    // not drawn. Say where it comes from and how many beams it leaves out.
+    std::string max_src = "--laser-max-range";
+    if (laser_max <= 0.0) {
+      max_src = "the largest reading of the log (no PARAM robot_front_laser_max / robot_rear_laser_max)";
+      for (const auto& kv : log.params) {
+        if (kv.first == "robot_front_laser_max" || kv.first == "robot_rear_laser_max") max_src = "PARAM " + kv.first;
+      }
+    }
+    std::size_t beams = 0, at_max = 0, beyond = 0;
+    float max_seen = 0.0f;
+    for (sim::CarmenScan& s : log.scans) {
+      if (laser_max > 0.0) s.max_range = static_cast<float>(laser_max);
+      for (float r : s.ranges) {
+        ++beams;
+        if (std::isfinite(r)) max_seen = std::max(max_seen, r);
+        if (s.max_range > 0.0f && r >= s.max_range - 0.01f) ++(r > s.max_range + 0.01f ? beyond : at_max);
+      }
+    }
+    // Beyond the maximum but below the largest reading: real measurements (the largest reading
+    // itself is often the laser's no-echo code, 81.91 m for a SICK LMS).
+    std::size_t beyond_below_largest = 0;
+    for (const sim::CarmenScan& s : log.scans) {
+      for (float r : s.ranges) {
+        if (s.max_range > 0.0f && r > s.max_range + 0.01f && r < max_seen - 0.01f) ++beyond_below_largest;
+      }
+    }
+    const double lmax = log.scans.front().max_range;
+    const double pct = 100.0 / static_cast<double>(std::max<std::size_t>(beams, 1));
+    std::printf("%s: laser maximum range %.2f m (from %s): of %zu beams, %zu (%.1f %%) read the maximum (no echo) and "
+                "%zu (%.1f %%) beyond it; both are 'no return' and not drawn; largest reading %.2f m\n",
+                name.c_str(), lmax, max_src.c_str(), beams, at_max, pct * static_cast<double>(at_max), beyond,
+                pct * static_cast<double>(beyond), static_cast<double>(max_seen));
+    if (beyond > 0 && beyond_below_largest * 100 <= beyond) {
+      std::printf("%s: %zu of the %zu beams beyond it read %.2f m, the laser's no-echo value: next to nothing is lost\n",
+                  name.c_str(), beyond - beyond_below_largest, beyond, static_cast<double>(max_seen));
+    } else if (beyond > 0) {
+      std::fprintf(stderr,
+                   "mml-mapbuild: warning: %s: %zu of %zu beams (%.1f %%) read beyond the laser maximum range %.2f m "
+                   "(%s), up to %.2f m, and are left out of the map; if the laser measures that far, give "
+                   "--laser-max-range %.2f\n",
+                   log_path.c_str(), beyond, beams, pct * static_cast<double>(beyond), lmax, max_src.c_str(),
+                   static_cast<double>(max_seen), std::ceil((static_cast<double>(max_seen) + 0.02) * 100.0) / 100.0);
+    } else if (pct * static_cast<double>(at_max) > 5.0) {
+      std::fprintf(stderr,
+                   "mml-mapbuild: warning: %s: %zu of %zu beams (%.1f %%) read the laser maximum range %.2f m (%s) and "
+                   "are left out of the map as 'no echo'; if that is not the laser's no-echo value, give "
+                   "--laser-max-range M\n",
+                   log_path.c_str(), at_max, beams, pct * static_cast<double>(at_max), lmax, max_src.c_str());
+    }
     std::vector<sim::PosedScan> scans;
     for (const sim::CarmenScan& s : log.scans) {
       scans.push_back({s.pose, s.angle_min, s.angle_increment, s.max_range, s.ranges.data(), s.ranges.size()});
     }
-    sim::OccupancyBuildOptions o;
-    o.resolution = resolution > 0.0 ? resolution : 0.05;
+    // Default options of the built-in maps (sim/map/global_maps.cpp: 25 m indoors).
+    sim::OccupancyBuildOptions o = sim::global_map_options("", resolution > 0.0 ? resolution : 0.05);
     if (max_range > 0.0) o.max_usable_range = max_range;
+    std::printf("%s: resolution %.3g m, readings used up to %.1f m%s\n", name.c_str(), o.resolution, o.max_usable_range,
+                max_range > 0.0 ? " (--max-range)" : " (default, as the built-in indoor maps)");
     sim::OccupancyGrid grid;
     sim::OccupancyBuildStats stats;
     if (!sim::build_occupancy_grid(scans, o, &grid, &stats, &err)) {
@@ -106,9 +213,9 @@ static int run_main(int argc, char** argv) {
       return 1;
     }
     print_stats(name, map, stats, std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count());
+    std::printf("  wrote %s/%s.{yaml,pgm,png,mmap}\n", out.c_str(), name.c_str());
     return 0;
   }
-  if (dataset.empty()) return usage();
   std::vector<std::string> list;
   if (dataset == "all") {
     list = sim::global_map_datasets();
