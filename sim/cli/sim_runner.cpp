@@ -904,6 +904,15 @@ bool run_simulation(const SimConfig& cfg_in, SimResult* out, std::string* err) {
       *err = (image_from_file ? cfg.map_yaml + ": " : std::string("map: ")) + s.message();
       return false;
     }
+    if (image_from_file && cfg.progress) {
+      std::size_t table_len = 0;
+      const bool table = fw::find_section(image.data(), image.size(), fw::MapSectionType::kRelationTable2D,
+                                          &table_len) != nullptr;
+      std::fprintf(stderr, "mml-sim: map image %s: %ux%u cells at %.3g m; relation table: %s\n", cfg.map_yaml.c_str(),
+                   global_map.geometry.width, global_map.geometry.height,
+                   static_cast<double>(global_map.geometry.resolution),
+                   table ? "in the image (used as it is)" : "none (the localizer fills its own at start-up)");
+    }
     if (image_from_file) {
       // The host grid (pictures, map.yaml, the MCL baseline) from the image's own occupancy.
       grid.geometry = global_map.geometry;
