@@ -22,10 +22,18 @@
 
 namespace {
 
+const char kUsage[] =
+    "usage: mml-mapc [--relation-table [--seed N] [--preset 1..4]] MAP.yaml OUT.mmap\n"
+    "       mml-mapc --info IMAGE.mmap\n"
+    "Compiles a ROS map_server map (YAML + PGM, e.g. from mml-mapbuild) into the firmware's map image\n"
+    "(for mmlfw's `map = OUT.mmap` and mml-sim --map OUT.mmap), verified by the firmware's own loader.\n"
+    "  --relation-table   append pRANSAM's precomputed global relation table, so the robot (and mml-sim)\n"
+    "                     skips filling it at start-up; it must match mmlfw's `seed` and `mml_preset`\n"
+    "  --seed N           seed of the table (default 1)   --preset 1..4   MML configuration (default 3)\n"
+    "  --info IMAGE.mmap  validate an image and print its section table\n";
+
 int usage() {
-  std::fprintf(stderr,
-               "usage: mml-mapc [--relation-table [--seed N] [--preset 1..4]] MAP.yaml OUT.mmap\n"
-               "       mml-mapc --info IMAGE.mmap\n");
+  std::fputs(kUsage, stderr);
   return 2;
 }
 
@@ -76,6 +84,16 @@ bool parse_u64(const char* text, std::uint64_t lo, std::uint64_t hi, std::uint64
 
 static int run_main(int argc, char** argv) {
   std::string err;
+  for (int i = 1; i < argc; ++i) {
+    if (std::strcmp(argv[i], "--help") == 0 || std::strcmp(argv[i], "-h") == 0) {
+      std::fputs(kUsage, stdout);
+      return 0;
+    }
+  }
+  if (argc >= 2 && std::strcmp(argv[1], "--info") == 0 && argc != 3) {
+    std::fprintf(stderr, "mml-mapc: --info needs exactly one IMAGE.mmap\n");
+    return usage();
+  }
   if (argc == 3 && std::strcmp(argv[1], "--info") == 0) {
     std::vector<std::uint8_t> bytes;
     if (!sim::read_file_bytes(argv[2], &bytes, &err)) {
@@ -117,7 +135,10 @@ static int run_main(int argc, char** argv) {
       files.push_back(a);
     }
   }
-  if (files.size() != 2) return usage();
+  if (files.size() != 2) {
+    std::fprintf(stderr, "mml-mapc: need MAP.yaml and OUT.mmap (got %zu file arguments)\n", files.size());
+    return usage();
+  }
   sim::RosMap map;
   sim::MapImageWriter writer;
   if (!sim::read_ros_map(files[0], &map, &err) || !writer.set_map(map, &err)) {
