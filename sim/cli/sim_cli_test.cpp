@@ -99,6 +99,44 @@ TEST(SimArgs, ParsesAFullCommandLine) {
   EXPECT_EQ(action, SimArgsAction::kHelp);
 }
 
+// Issue 12 item 4: the log options and their errors (nothing silently ignored).
+TEST(SimArgs, LogReplayOptions) {
+  SimConfig cfg;
+  SimArgsAction action;
+  std::string err;
+  ASSERT_TRUE(parse_sim_args({"--log", "x.clf", "--map", "m.mmap", "--start", "120", "--kidnap-at", "30",
+                              "--odom-noise", "0.01,1"},
+                             &cfg, &action, &err))
+      << err;
+  EXPECT_EQ(cfg.log_start, 120u);
+  EXPECT_EQ(cfg.log_kidnap_at, 30u);
+  EXPECT_EQ(cfg.synthetic.kidnap_at_scan, 0u);  // not the synthetic world's kidnapping
+  EXPECT_TRUE(cfg.log_odom_noise);
+  EXPECT_DOUBLE_EQ(cfg.log_odom_sigma_m, 0.01);
+  EXPECT_DOUBLE_EQ(cfg.log_odom_sigma_deg, 1.0);
+  EXPECT_EQ(cfg.map_yaml, "m.mmap");
+  EXPECT_EQ(cfg.threads, 2);  // the CLI's default, as mml-eval's
+  SimConfig plain;
+  ASSERT_TRUE(parse_sim_args({"--log", "x.clf"}, &plain, &action, &err)) << err;
+  EXPECT_FALSE(plain.log_odom_noise);  // the world's default noise is not added to a log
+  EXPECT_EQ(plain.log_kidnap_at, 0u);
+  SimConfig world;
+  ASSERT_TRUE(parse_sim_args({"--world", "corridor", "--kidnap-at", "40"}, &world, &action, &err)) << err;
+  EXPECT_EQ(world.synthetic.kidnap_at_scan, 40u);
+  EXPECT_EQ(world.log_kidnap_at, 0u);
+  EXPECT_NE(parse_error({"--log", "x.clf", "--start", "abc"}).find("--start: 'abc'"), std::string::npos);
+  EXPECT_NE(parse_error({"--world", "corridor", "--start", "3"}).find("--start is for --log"), std::string::npos);
+  for (const char* opt : {"--people", "--beams", "--max-range", "--route-length", "--scan-period"}) {
+    EXPECT_NE(parse_error({"--log", "x.clf", opt, "3"}).find(std::string(opt) + " is an option of synthetic worlds"),
+              std::string::npos)
+        << opt;
+  }
+  EXPECT_NE(parse_error({"--log", "x.clf", "--resolution", "0.1"}).find("--resolution is an option of synthetic"),
+            std::string::npos);
+  EXPECT_NE(parse_error({"--dataset", "intel", "--via-unknown"}).find("--via-unknown is an option of synthetic"),
+            std::string::npos);
+}
+
 SimConfig small_run(const std::string& out, std::uint64_t seed) {
   SimConfig cfg;
   cfg.world = "small-office";
