@@ -155,6 +155,9 @@ elif [ "$mode" = path ]; then
     --whole-runs 1 --fix-trials 2 --kidnap-runs 0 --mcl-trials 0 --steps 400 --out "$t/ev"
   grep -q '"mybuilding_first_fix_success": 1' "$t/ev/localize.json" ||
     fail "eval: first-fix success not 1: $(grep first_fix "$t/ev/localize.json")"
+  expect "eval on the map image" 0 "wrote $t/ev2/" \
+    "$eval_" --log "$t/raw.clf" --map "$t/maps/mybuilding.mmap" --reference "$t/ref.txt" --name mybuilding \
+    --whole-runs 1 --fix-trials 1 --kidnap-runs 0 --mcl-trials 0 --steps 300 --out "$t/ev2"
   # A building with corrected poses only: odometry synthesised, then the same path.
   expect "synth-odom" 0 "292 scans with synthesised odometry (seed 1" \
     "$carmen" synth-odom "$d/fr101/freiburg-101-corrected.log.gz" "$t/fr101.clf"

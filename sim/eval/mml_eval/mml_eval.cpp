@@ -40,6 +40,15 @@ bool load_image(LoadedDataset* ds, std::string* err) {
   return true;
 }
 
+// A compiled map image starts with the magic "MMLFWMAP" (firmware/map/map_image.h).
+bool is_map_image_path(const std::string& path) {
+  std::error_code ec;
+  if (!std::filesystem::is_regular_file(path, ec)) return false;
+  std::ifstream in(path, std::ios::binary);
+  char magic[8] = {};
+  return in.read(magic, sizeof(magic)) && std::string(magic, sizeof(magic)) == "MMLFWMAP";
+}
+
 }  // namespace
 
 namespace {
@@ -277,6 +286,22 @@ bool load_dataset_files(const DatasetFiles& f, LoadedDataset* ds, std::string* e
     }
   } else {
     ds->ref_check_note = "reference not checked: no --relations given";
+  }
+  if (is_map_image_path(f.map_yaml)) {
+    // A compiled map image (mml-mapc, mml-mapbuild): used as it is, relation table included; the
+    // host grid (pictures, MCL) from its occupancy.
+    if (!read_file_bytes(f.map_yaml, &ds->image, &e)) return fail(err, "mml-eval: map " + e);
+    if (!load_image(ds, &e)) return fail(err, "mml-eval: " + f.map_yaml + ": " + e);
+    ds->grid.geometry = ds->map.geometry;
+    ds->grid.cells.assign(ds->grid.geometry.cell_count(), fw::kCellUnknown);
+    for (std::uint32_t cy = 0; cy < ds->grid.geometry.height; ++cy) {
+      for (std::uint32_t cx = 0; cx < ds->grid.geometry.width; ++cx) {
+        ds->grid.cells[ds->grid.geometry.index(cx, cy)] =
+            ds->map.cell(static_cast<std::int32_t>(cx), static_cast<std::int32_t>(cy));
+      }
+    }
+    ds->ros = grid_to_ros_map(ds->grid, ds->name + ".pgm");
+    return true;
   }
   if (!read_ros_map(f.map_yaml, &ds->ros, &e)) return fail(err, "mml-eval: map " + e);
   if (!ros_map_to_grid(ds->ros, &ds->grid, &e)) return fail(err, "mml-eval: " + f.map_yaml + ": " + e);

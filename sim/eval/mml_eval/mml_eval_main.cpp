@@ -18,7 +18,7 @@
 //   --steps 0 = whole-log runs continue to the end of the log (else at most that many steps).
 //   --global ref|live|live-deadline: mml-track's global search schedule (mml_systems.h; issue 14)
 // Any building by path (implies --localize; only this building unless --datasets is given):
-//   mml-eval --log LOG.clf[.gz] --map MAP.yaml --reference POSES.txt|CORRECTED.log[.gz]
+//   mml-eval --log LOG.clf[.gz] --map MAP.yaml|MAP.mmap --reference POSES.txt|CORRECTED.log[.gz]
 //            [--relations R] [--name NAME] [--synthetic-odometry]
 //   POSES.txt rows: "flaser_index ipc_timestamp logger_timestamp x y theta" (like
 //   intel.corrected-poses.txt); a CARMEN reference log must have one scan per scan of LOG.
@@ -50,14 +50,15 @@ const char kUsage[] =
     "                [--fix-steps 200] [--mcl-trials 3] [--mcl-datasets intel,fr079] [--kidnap-runs 2]\n"
     "                [--kidnap-datasets intel,fr079,aces] [--no-unknown] [--seed 1] [--threads 2] [--out DIR]\n"
     "                [--no-pool] [--global ref|live|live-deadline]\n"
-    "       mml-eval --log LOG.clf[.gz] --map MAP.yaml --reference POSES.txt|CORRECTED.log[.gz]\n"
+    "       mml-eval --log LOG.clf[.gz] --map MAP.yaml|MAP.mmap --reference POSES.txt|CORRECTED.log[.gz]\n"
     "                [--relations R] [--name NAME] [--synthetic-odometry]   (any building by path)\n"
     "Datasets (--datasets, --mcl-datasets, --kidnap-datasets): intel, fr079, aces, mit-killian, fr-clinic,\n"
     "fr101, fr-campus, read from ../shared/data (MMLFW_DATA_DIR). --steps: localizer steps per kidnapped\n"
     "trial (default 200, as scripts/bench.sh mml); with --localize / --log the cap of a whole-log run\n"
     "(default 0 = to the end of the log). --threads: worker threads (default 2, as mml-sim).\n"
-    "Your own building: --log RAW.clf --map MAP.yaml --reference REF (REF: 'mml-carmen reference' rows or\n"
-    "a CARMEN log with one pose per scan of RAW). Definitions of every figure: sim/eval/mml_eval/README.md.\n";
+    "Your own building: --log RAW.clf --map MAP.yaml or MAP.mmap (a compiled image: its relation table is\n"
+    "used) --reference REF (REF: 'mml-carmen reference' rows or a CARMEN log with one pose per scan of\n"
+    "RAW). Definitions of every figure: sim/eval/mml_eval/README.md.\n";
 int usage(const char* msg) {
   std::fprintf(stderr, "mml-eval: %s\n%s", msg, kUsage);
   return 2;
