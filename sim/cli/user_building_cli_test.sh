@@ -48,7 +48,7 @@ if [ "$mode" = errors ]; then
   grep -v PARAM "$t/tiny.clf" | sed 's/^FLASER 30 2.500/FLASER 30 9.000/' >"$t/other.clf"
 
   # mml-eval
-  expect "eval --help" 0 "--log LOG.clf[.gz] --map MAP.yaml --reference" "$eval_" --help
+  expect "eval --help" 0 "--log LOG.clf[.gz] --map MAP.yaml|MAP.mmap --reference" "$eval_" --help
   expect "eval --help: --steps default" 0 "--steps 200" "$eval_" --help
   expect "eval unknown dataset" 2 "--datasets: unknown dataset 'NAME' (known: intel, fr079, aces" \
     "$eval_" --datasets intel,NAME --out "$t/ev"
