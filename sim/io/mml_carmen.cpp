@@ -51,7 +51,7 @@ const char kUsage[] =
 const char kReferenceHelp[] =
     "usage: mml-carmen reference RAW CORRECTED OUT [--every-scan]\n"
     "Ground truth for the scans of a raw log (laser + odometry) from a corrected log of the same run\n"
-    "(e.g. GMapping's or mml-slam's output): every scan of CORRECTED is associated, in order, with the\n"
+    "(e.g. GMapping's output): every scan of CORRECTED is associated, in order, with the\n"
     "scan of RAW whose range readings are identical (to 1 mm). OUT gets one row per associated scan,\n"
     "  flaser_index ipc_timestamp logger_timestamp x y theta\n"
     "(flaser_index: 0-based scan index in RAW; timestamps from RAW; pose from CORRECTED), the format of\n"
