@@ -147,17 +147,17 @@ elif [ "$mode" = path ]; then
     --out "$t/run" --no-pictures
   grep -qF "relation table: in the image" "$t/err" || fail "sim: the image's relation table not used: $(cat "$t/err")"
   grep -qF "integrity failures 0" "$t/out" || fail "sim: integrity failures: $(cat "$t/out")"
-  expect "sim kidnapped in the log" 0 "kidnap at step 150" \
-    "$sim" --log "$t/raw.clf" --map "$t/maps/mybuilding.mmap" --reference "$t/ref.txt" --start 200 --steps 400 \
-    --kidnap-at 150 --odom-noise 0.005,0.5 --out "$t/run" --no-pictures
+  expect "sim kidnapped in the log" 0 "kidnap at step 100" \
+    "$sim" --log "$t/raw.clf" --map "$t/maps/mybuilding.mmap" --reference "$t/ref.txt" --start 200 --steps 250 \
+    --kidnap-at 100 --odom-noise 0.005,0.5 --out "$t/run" --no-pictures
   expect "eval --log --map --reference" 0 "wrote $t/ev/" \
     "$eval_" --log "$t/raw.clf" --map "$t/maps/mybuilding.yaml" --reference "$t/ref.txt" --name mybuilding \
-    --whole-runs 1 --fix-trials 2 --kidnap-runs 0 --mcl-trials 0 --steps 400 --out "$t/ev"
+    --whole-runs 1 --fix-trials 1 --kidnap-runs 0 --mcl-trials 0 --steps 300 --out "$t/ev"
   grep -q '"mybuilding_first_fix_success": 1' "$t/ev/localize.json" ||
     fail "eval: first-fix success not 1: $(grep first_fix "$t/ev/localize.json")"
   expect "eval on the map image" 0 "wrote $t/ev2/" \
     "$eval_" --log "$t/raw.clf" --map "$t/maps/mybuilding.mmap" --reference "$t/ref.txt" --name mybuilding \
-    --whole-runs 1 --fix-trials 1 --kidnap-runs 0 --mcl-trials 0 --steps 300 --out "$t/ev2"
+    --whole-runs 1 --fix-trials 0 --kidnap-runs 0 --mcl-trials 0 --steps 200 --out "$t/ev2"
   # A building with corrected poses only: odometry synthesised, then the same path.
   expect "synth-odom" 0 "292 scans with synthesised odometry (seed 1" \
     "$carmen" synth-odom "$d/fr101/freiburg-101-corrected.log.gz" "$t/fr101.clf"
