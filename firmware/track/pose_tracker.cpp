@@ -7,6 +7,7 @@
 #include "firmware/base/sym2_eigen.h"
 #include "firmware/map/distance_sample.h"
 #include "firmware/mml/pose_uniqueness.h"
+#include "firmware/track/fit_comparison.h"
 
 namespace fw {
 namespace track {
@@ -43,6 +44,7 @@ void PoseTracker::reset() {
   bias_xy_m_ = map_.geometry.resolution;
   bias_theta_rad_ = 0.0f;
   unsupported_ = faulty_ = outside_ = 0;
+  excess_xy_m_ = excess_theta_rad_ = 0.0f;
   consistent_since_fault_ = 0;
   had_fault_ = false;
   odometry_check_.clear();
@@ -84,35 +86,6 @@ void PoseTracker::predict_to(const Se2f& odom) {
 }
 
 namespace {
-// Paired test of the truncated per-point costs (pose_uniqueness.h) of the same end-points at the
-// pose and at the rival: the rival is better only when the mean difference exceeds z standard
-// errors, with the end-points counted as `independent` observations (the correlation cells of the
-// alignment) — a few cluttered beams or a map drawn a little off in a corridor do not move a track.
-bool rival_significantly_better(const GlobalMap& map, const Point2f* pts, std::size_t n, const Se2f& pose,
-                                const Se2f& rival, float clip_m, std::uint32_t independent, float z) {
-  if (n < 2 || independent < 2) return false;
-  const float c0 = std::cos(pose.theta), s0 = std::sin(pose.theta);
-  const float c1 = std::cos(rival.theta), s1 = std::sin(rival.theta);
-  const double clip2 = static_cast<double>(clip_m) * clip_m;
-  auto cost = [&](float x, float y) {
-    float d = 0.0f, gx = 0.0f, gy = 0.0f;
-    if (!sample_distance<float>(map, x, y, &d, &gx, &gy) || d > clip_m) return 1.0;
-    return static_cast<double>(d) * d / clip2;
-  };
-  double sum = 0.0, sq = 0.0;
-  for (std::size_t i = 0; i < n; ++i) {
-    const float px = pts[i].x(), py = pts[i].y();
-    const double diff = cost(pose.x + c0 * px - s0 * py, pose.y + s0 * px + c0 * py) -
-                        cost(rival.x + c1 * px - s1 * py, rival.y + s1 * px + c1 * py);
-    sum += diff;
-    sq += diff * diff;
-  }
-  const double mean = sum / static_cast<double>(n);
-  const double var = std::fmax(sq / static_cast<double>(n) - mean * mean, 0.0);
-  const double se = std::sqrt(var / static_cast<double>(independent));
-  return mean > static_cast<double>(z) * se;
-}
-
 bool outside_bound(const Eigen::Vector3f& e, const ProtectionLevel& pl) {
   return std::hypot(e(0), e(1)) > pl.xy_m || std::fabs(e(2)) > pl.theta_rad;
 }
@@ -158,6 +131,38 @@ ScanAlignment PoseTracker::align_from_prediction(const Point2f* points, std::siz
     return b;
   }
   return a;
+}
+
+// The scan's own confidence region (track_options.h, fit_comparison.h), bounded by the prediction's PL:
+// where it reaches farther than the covariance's protection level `pl`, the excess is kept and
+// added to the PL of this and of every following scan until the next scan that supports the pose
+// (so the bound never shrinks on scans that say nothing; the covariance itself is left alone —
+// widening it instead weakened the fusion and the innovation tests: aces availability 0.98 → 0.64).
+void PoseTracker::update_confidence_excess(const Point2f* points, std::size_t n, const ScanAlignment& a,
+                                           const ProtectionLevel& pred_pl, const ProtectionLevel& pl,
+                                           TrackStep* out) {
+  const TrackOptions& o = options_;
+  ConfidenceExtentOptions co;
+  co.clip_m = o.alias_clip_m;
+  co.z = o.alias_z;
+  co.max_xy_m = o.confidence_extent_xy ? o.alert_limit_m : 0.0f;
+  co.max_rad = o.confidence_extent_theta ? o.alert_limit_rad : 0.0f;
+  const std::size_t m = subsample_alias_points(points, n);
+  const ConfidenceExtent ce = confidence_extent(map_, alias_points_, m, a.pose, a.information(0, 0),
+                                                a.information(0, 1), a.information(1, 1), a.independent, co);
+  out->confidence_xy_m = ce.xy_m;
+  out->confidence_theta_rad = ce.theta_rad;
+  excess_xy_m_ = excess_theta_rad_ = 0.0f;
+  if (o.confidence_extent_xy) {
+    const float bound = std::fmin(ce.xy_m + std::hypot(pose_.x - a.pose.x, pose_.y - a.pose.y) + bias_xy_m_,
+                                  pred_pl.xy_m);
+    excess_xy_m_ = std::fmax(bound - pl.xy_m, 0.0f);
+  }
+  if (o.confidence_extent_theta) {
+    const float bound = std::fmin(ce.theta_rad + std::fabs(wrap_angle(pose_.theta - a.pose.theta)) + bias_theta_rad_,
+                                  pred_pl.theta_rad);
+    excess_theta_rad_ = std::fmax(bound - pl.theta_rad, 0.0f);
+  }
 }
 
 TrackStep PoseTracker::step(const Point2f* points, std::size_t n, const Se2f& odom, bool predict) {
@@ -330,6 +335,12 @@ TrackStep PoseTracker::step(const Point2f* points, std::size_t n, const Se2f& od
   out.pose = pose_;
   out.cov = cov_;
   out.pl = protection_level(cov_, k_, bias_xy_m_, bias_theta_rad_);
+  if ((o.confidence_extent_xy || o.confidence_extent_theta) &&
+      (v == ScanVerdict::kSupported || v == ScanVerdict::kAmbiguous)) {
+    update_confidence_excess(points, n, a, pred_pl, out.pl, &out);
+  }
+  out.pl.xy_m += excess_xy_m_;
+  out.pl.theta_rad += excess_theta_rad_;
   out.unsupported_steps = unsupported_;
   out.faulty_steps = faulty_;
   out.outside_steps = outside_;

@@ -59,6 +59,8 @@ struct TrackStep {
   bool large_fault = false;
   // A fault in heading only, recovered by the track (TrackOptions::heading_fault_local_recovery).
   bool heading_fault = false;
+  // Confidence extent of the scan fix (fit_comparison.h; 0 when not computed).
+  float confidence_xy_m = 0.0f, confidence_theta_rad = 0.0f;
   std::uint32_t unsupported_steps = 0, faulty_steps = 0, outside_steps = 0;
   float innovation_chi2 = 0.0f;
   float odometry_chi2 = 0.0f;   // odometry consistency over the window (0 = not tested)
@@ -81,10 +83,13 @@ class PoseTracker {
   TrackStep step(const Point2f* points, std::size_t n, const Se2f& odom, bool predict = true);
   const TrackStep& last() const { return last_; }
   const TrackOptions& options() const { return options_; }
+  const GlobalMap& map() const { return map_; }
 
  private:
   void predict_to(const Se2f& odom);
   std::size_t subsample_alias_points(const Point2f* points, std::size_t n);
+  void update_confidence_excess(const Point2f* points, std::size_t n, const ScanAlignment& a,
+                                const ProtectionLevel& pred_pl, const ProtectionLevel& pl, TrackStep* out);
   ScanAlignment align_from_prediction(const Point2f* points, std::size_t n, const Se2f& pred, TrackStep* out);
   static constexpr std::size_t kSearchScratch = 2 * 1081;
   Point2f search_scratch_[kSearchScratch];
@@ -95,6 +100,8 @@ class PoseTracker {
   OdometryConsistency odometry_check_;
   TrackOptions options_;
   GlobalMap map_;
+  // Protection level beyond the covariance's, from the last supporting scan's confidence extent.
+  float excess_xy_m_ = 0.0f, excess_theta_rad_ = 0.0f;
   ProtectionFactors k_;
   bool initialized_ = false;
   bool active_ = false;

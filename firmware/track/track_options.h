@@ -120,6 +120,16 @@ struct TrackOptions {
   // covariance and needs `recovery_steps` consistent scans; MML still cross-checks in the background.
   // false = every heading fault beyond the alert limit waits for MML's confirmation.
   bool heading_fault_local_recovery = true;
+  // Confidence extent (fit_comparison.h): the protection level of a scan-supported pose covers at least
+  // the farthest shift from the scan fix that the scan cannot reject (paired test at alias_z), plus
+  // the published pose's distance from the fix and the map bias — where the information matrix
+  // claims more than the data can tell apart (aces scan 5120: PL 0.13 m, error 0.25 m along a
+  // corridor that fits as well there). Never beyond the prediction's own protection level: the
+  // odometry still carries a featureless corridor. In heading the same test is weak (intel: turns
+  // of 3–5° not rejected at steps the heading PL covers; availability 0.95 → 0.61), so it is off by
+  // default there.
+  bool confidence_extent_xy = true;
+  bool confidence_extent_theta = false;
   // Global cross-check (tracked_localizer.h): when the track stops being `localized` while still
   // tracked (an alias, a fault being recovered, scans that say nothing), MML searches in the
   // background from a fresh local map for at most this many scans; if it isolates a pose outside the

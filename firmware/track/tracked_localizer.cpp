@@ -3,6 +3,7 @@
 #include <cmath>
 
 #include "firmware/scan/scan_points.h"
+#include "firmware/track/fit_comparison.h"
 
 namespace fw {
 namespace track {
@@ -20,7 +21,7 @@ Status TrackedLocalizer::init(const TrackOptions& options, const GlobalMap& map,
 void TrackedLocalizer::reset() {
   tracker_.reset();
   global_.restart();
-  fixes_ = fix_rejections_ = tracks_lost_ = cross_check_switches_ = confirmations_ = 0;
+  fixes_ = fix_rejections_ = tracks_lost_ = cross_check_switches_ = confirmations_ = cross_check_conflicts_ = 0;
   cross_check_left_ = 0;
   unconfirmed_ = false;
 }
@@ -147,7 +148,27 @@ Status TrackedLocalizer::cross_check(const hal::LaserScan& scan, const hal::Odom
     }
     return Status::ok();
   }
-  // MML isolates a pose the track does not contain: the track sat in a look-alike.
+  // MML isolates a pose the track does not contain. After a large fault (a possible kidnap) the
+  // track was waiting for exactly this: MML's fix replaces it. A track that saw no such fault is
+  // replaced only when the scan itself prefers MML's pose significantly (the paired test of the
+  // alias check): a corridor that looks the same turned 180° (aces scan 6281: MML isolated the
+  // track's mirror image, 4.7 m and 180° away, and the track was right) fits both, and then neither
+  // pose is `localized` until MML isolates the tracked pose from a fresh local map.
+  if (!unconfirmed_) {
+    const TrackOptions& o = tracker_.options();
+    const Se2f mml_pose(g.x, g.y, g.theta);
+    const bool scan_prefers_mml = rival_significantly_better(tracker_.map(), pts_, n, ts.pose, mml_pose, o.alias_clip_m,
+                                                             ts.alignment.independent, o.alias_z);
+    if (!scan_prefers_mml) {
+      ++cross_check_conflicts_;
+      unconfirmed_ = true;
+      out->status = hal::LocalizationStatus::kAmbiguous;
+      global_.reset();
+      cross_check_left_ = o.cross_check_steps;
+      return Status::ok();
+    }
+  }
+  // The track sat in a look-alike.
   ++cross_check_switches_;
   ++tracks_lost_;
   *out = hal::PoseEstimate();

@@ -50,6 +50,9 @@ class TrackedLocalizer final : public Localizer {
   std::uint32_t fix_rejections() const { return fix_rejections_; }
   std::uint32_t tracks_lost() const { return tracks_lost_; }
   std::uint32_t cross_check_switches() const { return cross_check_switches_; }  // tracks replaced by MML
+  // MML isolated a pose outside a track that had seen no large fault, and the scan did not prefer
+  // MML's pose significantly: neither is published `localized` until MML isolates the tracked pose.
+  std::uint32_t cross_check_conflicts() const { return cross_check_conflicts_; }
   bool cross_checking() const { return cross_check_left_ > 0; }
   // A large fault (TrackStep::large_fault) was seen and MML has not yet isolated the tracked pose.
   bool awaiting_confirmation() const { return unconfirmed_; }
@@ -68,7 +71,7 @@ class TrackedLocalizer final : public Localizer {
   Point2f pts_[hal::LaserScan::kMaxBeams];
   std::uint32_t fixes_ = 0, fix_rejections_ = 0, tracks_lost_ = 0, cross_check_switches_ = 0;
   std::uint32_t cross_check_left_ = 0;  // scans the background search still runs (0 = idle)
-  std::uint32_t confirmations_ = 0;
+  std::uint32_t confirmations_ = 0, cross_check_conflicts_ = 0;
   bool unconfirmed_ = false;
 };
 

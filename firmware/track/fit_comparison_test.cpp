@@ -1,0 +1,113 @@
+#include "firmware/track/fit_comparison.h"
+
+#include <gtest/gtest.h>
+
+#include <cmath>
+
+#include "firmware/track/scan_alignment.h"
+#include "firmware/track/track_test_util.h"
+
+namespace fw {
+namespace track {
+namespace {
+
+using testing::GridWorld;
+using testing::OwnedGlobalMap;
+
+// A plain corridor 2 m wide and 30 m long: with a 4 m laser its ends are never seen. `stub` adds a
+// 10 cm stub on one wall at x = 12 m (a door frame): a few end-points that constrain the axis.
+GridWorld plain_corridor(bool stub = false) {
+  GridWorld g;
+  g.w = 600; g.h = 80;
+  g.occ.assign(g.w * g.h, 0);
+  g.box(0.5f, 1.0f, 29.5f, 3.0f);
+  if (stub) g.wall(12.0f, 1.0f, 12.0f, 1.1f);
+  g.finish();
+  return g;
+}
+
+ConfidenceExtent extent_at(const GridWorld& world, const OwnedGlobalMap& map, const Se2f& pose, float maxr,
+                           std::uint32_t seed) {
+  RandomStream rng(seed, 0);
+  const auto pts = testing::scan_at(world, pose, &rng, 0.01f, maxr);
+  const ScanAlignment a = align_scan(map.map, pts.data(), pts.size(), pose, ScanAlignOptions());
+  return confidence_extent(map.map, pts.data(), pts.size(), a.pose, a.information(0, 0), a.information(0, 1),
+                           a.information(1, 1), a.independent, ConfidenceExtentOptions());
+}
+
+// In a corridor the scan cannot reject shifts along it: the extent reaches the 0.5 m cap, whatever
+// the information matrix claims; in a room with a unique layout the first 5 cm step is rejected.
+TEST(ConfidenceExtentTest, OpenAlongACorridorClosedInARoom) {
+  const GridWorld corridor = plain_corridor();
+  const OwnedGlobalMap corridor_map(corridor);
+  const ConfidenceExtent c = extent_at(corridor, corridor_map, Se2f(15.0f, 2.0f, 0.0f), 4.0f, 3);
+  EXPECT_GE(c.xy_m, 0.45f);
+  const ConfidenceExtent r = extent_at(testing::room(), testing::room_map(), Se2f(5.0f, 3.0f, 0.3f), 8.0f, 5);
+  EXPECT_LE(r.xy_m, 0.1f);
+  EXPECT_LE(r.theta_rad, 0.035f);  // 2°: in heading the test is weak (track_options.h)
+}
+
+// The paired test itself: a pose 0.3 m off in the room is significantly worse than the truth, and
+// the truth is not significantly worse than itself.
+TEST(ConfidenceExtentTest, PairedTestPrefersTheTruePose) {
+  RandomStream rng(7, 0);
+  const Se2f truth(5.0f, 3.0f, 0.3f);
+  const auto pts = testing::scan_at(testing::room(), truth, &rng);
+  const ScanAlignment a = align_scan(testing::room_map().map, pts.data(), pts.size(), truth, ScanAlignOptions());
+  const Se2f off(truth.x + 0.3f, truth.y, truth.theta);
+  EXPECT_TRUE(rival_significantly_better(testing::room_map().map, pts.data(), pts.size(), off, a.pose, 0.15f,
+                                         a.independent, 3.09f));
+  EXPECT_FALSE(rival_significantly_better(testing::room_map().map, pts.data(), pts.size(), a.pose, off, 0.15f,
+                                          a.independent, 3.09f));
+  EXPECT_FALSE(rival_significantly_better(testing::room_map().map, pts.data(), pts.size(), a.pose, a.pose, 0.15f,
+                                          a.independent, 3.09f));
+}
+
+// Tracking along the corridor with one 10 cm stub: the stub's few end-points give the information
+// matrix a strong axis along the corridor (PL 0.15–0.17 m from the covariance) although the scan
+// cannot reject a 0.5 m shift (the paired test); with the extent the PL covers what the scan leaves
+// open, up to the prediction's own PL (0.24 m here).
+TEST(ConfidenceExtentTest, ProtectionLevelInACorridorCoversTheExtent) {
+  float min_pl_off = 0.0f;
+  const GridWorld corridor = plain_corridor(true);
+  const OwnedGlobalMap map(corridor);
+  for (const bool on : {false, true}) {
+    PoseTracker t;
+    TrackOptions o;
+    o.confidence_extent_xy = on;
+    o.align.max_range_m = 4.0f;
+    ASSERT_TRUE(t.init(o, map.map).is_ok());
+    RandomStream rng(11, 0);
+    Se2f truth(10.0f, 2.0f, 0.0f), odom;
+    Eigen::Matrix3f cov = Eigen::Matrix3f::Zero();
+    cov(0, 0) = cov(1, 1) = 0.0025f;
+    cov(2, 2) = 0.0004f;
+    t.start(truth, cov, odom);
+    auto pts = testing::scan_at(corridor, truth, &rng, 0.01f, 4.0f);
+    t.step(pts.data(), pts.size(), odom, false);
+    float min_pl = 1e9f;
+    for (int i = 0; i < 20; ++i) {
+      odom = odom.compose(Se2f(0.2f, 0.0f, 0.0f));
+      truth = truth.compose(Se2f(0.2f, 0.0f, 0.0f));
+      pts = testing::scan_at(corridor, truth, &rng, 0.01f, 4.0f);
+      const TrackStep s = t.step(pts.data(), pts.size(), odom);
+      min_pl = std::fmin(min_pl, s.pl.xy_m);
+      if (on) {
+        EXPECT_GE(s.confidence_xy_m, 0.45f) << i;
+      } else {
+        EXPECT_EQ(s.confidence_xy_m, 0.0f) << i;
+      }
+    }
+    if (!on) {
+      min_pl_off = min_pl;
+      EXPECT_LT(min_pl, 0.2f) << "the scenario no longer has an over-confident covariance";
+    } else {
+      EXPECT_GT(min_pl, 0.2f) << "the PL must cover the open corridor (bounded by the prediction)";
+      EXPECT_GT(min_pl, min_pl_off + 0.05f);
+    }
+  }
+}
+
+}  // namespace
+}  // namespace track
+}  // namespace fw
