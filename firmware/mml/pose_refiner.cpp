@@ -4,6 +4,7 @@
 #include <cmath>
 
 #include "firmware/map/distance_sample.h"
+#include "firmware/scan/point_to_line.h"
 
 namespace fw {
 namespace mml {
@@ -16,9 +17,9 @@ RefineResult refine_pose(const GlobalMap& map, const Point2f* points, std::size_
   Se2f t = initial;
   std::size_t inl = 0;
   double sq = 0.0;
+  PointToLineSystem sys;  // the shared 2-D solver (firmware/scan/point_to_line.h)
   for (std::uint32_t it = 0; it <= o.iterations; ++it) {
-    Eigen::Matrix3d h = Eigen::Matrix3d::Zero();
-    Eigen::Vector3d b = Eigen::Vector3d::Zero();
+    sys.clear();
     const float c = std::cos(t.theta), s = std::sin(t.theta);
     inl = 0;
     sq = 0.0;
@@ -31,23 +32,15 @@ RefineResult refine_pose(const GlobalMap& map, const Point2f* points, std::size_
       if (!sample_distance<float>(map, qx, qy, &d, &gx, &gy) || d > clip) continue;
       ++inl;
       sq += static_cast<double>(d) * d;
-      const Eigen::Vector3d j(gx, gy, gx * (-s * px - c * py) + gy * (c * px - s * py));
-      h += wd * (j * j.transpose());
-      b += wd * static_cast<double>(d) * j;
+      sys.add(px, py, c, s, gx, gy, d, wd);  // on the distance field: residual d, normal ∇d
     }
     if (it == o.iterations || inl < 3) break;
-    // Prior N(initial, diag(σ_xy², σ_xy², σ_θ²)).
+    // Prior N(initial, diag(σ_xy², σ_xy², σ_θ²)) and a Levenberg damping of 1e-6 of the scale.
     const double pxy = 1.0 / (static_cast<double>(o.prior_sigma_xy_m) * o.prior_sigma_xy_m);
     const double pth = 1.0 / (static_cast<double>(o.prior_sigma_theta_rad) * o.prior_sigma_theta_rad);
-    h(0, 0) += pxy;
-    h(1, 1) += pxy;
-    h(2, 2) += pth;
-    b(0) += pxy * (t.x - initial.x);
-    b(1) += pxy * (t.y - initial.y);
-    b(2) += pth * wrap_angle(t.theta - initial.theta);
-    h.diagonal() += Eigen::Vector3d(1e-6, 1e-6, 1e-6) * (1.0 + h.trace());  // Levenberg damping
-    const Eigen::Vector3d dx = -h.ldlt().solve(b);
-    if (!dx.allFinite()) break;
+    const Eigen::Vector3d offset(t.x - initial.x, t.y - initial.y, wrap_angle(t.theta - initial.theta));
+    Eigen::Vector3d dx;
+    if (!sys.solve(&dx, pxy, pth, offset, 1e-6)) break;
     t = Se2f(t.x + static_cast<float>(dx(0)), t.y + static_cast<float>(dx(1)), wrap_angle(t.theta + static_cast<float>(dx(2))));
     if (dx.head<2>().norm() < 1e-4 && std::fabs(dx(2)) < 1e-4) {
       // Converged: one more pass computes the final statistics.

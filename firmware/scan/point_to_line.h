@@ -1,7 +1,9 @@
 // Point-to-line Gauss–Newton normal equations for a 2-D rigid alignment: the one solver shared by
 // RBSM's final refinement (scan → local end-point map, issue 15), the PL-ICP baseline (scan → last
-// key scan, Censi 2008) and the tracker's distance-field alignment (scan → global map,
-// firmware/track/scan_alignment.cpp). All three minimise Σ w_i r_i² with a residual that is, to
+// key scan, Censi 2008), the tracker's distance-field alignment (scan → global map,
+// firmware/track/scan_alignment.cpp) and MML's published-pose refinement (firmware/mml/pose_refiner.cpp).
+// Not here, on purpose: pRANSAM's refinement (D-dimensional, 2-D and 3-D frames) and the local-map
+// correction (gradient descent of Eq. 5.27 on the truncated cost, as the dissertation). All three minimise Σ w_i r_i² with a residual that is, to
 // first order, the distance of the transformed sensor point q_i = R(θ) p_i + t from a line through
 // c_i with unit normal n_i:  r_i = n_iᵀ(q_i − c_i)  (on a distance field: r = d(q), n = ∇d).
 // Its Jacobian with respect to (x, y, θ) is J_i = (n_x, n_y, n_ᵀ ∂q/∂θ), ∂q/∂θ = (−s p_x − c p_y,
@@ -42,11 +44,12 @@ struct PointToLineSystem {
     ++used;
   }
 
-  // Gauss–Newton step dx = −(H + D)⁻¹ (b + D·offset), D = diag(reg_xy, reg_xy, reg_th) and
-  // `offset` = current pose − prior (θ wrapped by the caller): with D = 0 a plain GN step.
+  // Gauss–Newton step dx = −(H + D + λI)⁻¹ (b + D·offset), D = diag(reg_xy, reg_xy, reg_th) and
+  // `offset` = current pose − prior (θ wrapped by the caller), λ = damping·(1 + trace(H + D)) (a
+  // Levenberg damping relative to the system's scale): with D = 0 and damping 0 a plain GN step.
   // False when the step is not finite (a degenerate system).
   bool solve(Eigen::Vector3d* dx, double reg_xy = 0.0, double reg_th = 0.0,
-             const Eigen::Vector3d& offset = Eigen::Vector3d::Zero()) const {
+             const Eigen::Vector3d& offset = Eigen::Vector3d::Zero(), double damping = 0.0) const {
     Eigen::Matrix3d a = h;
     Eigen::Vector3d g = b;
     a(0, 0) += reg_xy;
@@ -55,6 +58,7 @@ struct PointToLineSystem {
     g(0) += reg_xy * offset(0);
     g(1) += reg_xy * offset(1);
     g(2) += reg_th * offset(2);
+    if (damping > 0.0) a.diagonal() += Eigen::Vector3d(damping, damping, damping) * (1.0 + a.trace());
     *dx = -a.ldlt().solve(g);
     return dx->allFinite();
   }
