@@ -98,194 +98,239 @@ void trace_step(hal::Hal& hal) {
 }
 }  // namespace
 
-int main(int argc, char** argv) {
+namespace {
+
+// Command line.
+struct Args {
   const char* config_path = nullptr;
   bool memory_report = false;
   bool timing_report = false;
   long max_scans = 0;
   double duration_s = 0;
+};
+
+// What start-up learned and later steps need.
+struct Startup {
+  fw::Status board_status;
+  bool board_ok = false;
+  bool lock_refused = false;
+  fw::GlobalMap map{};
+  fw::MapImageFile image;
+  const std::uint8_t* table = nullptr;
+  std::size_t table_len = 0;
+  bool table_in_use = false;
+  bool global_thread = false;
+  fw::track::GlobalScheduleOptions live;
+  fw::ExecutionContext global_ctx;
+};
+Startup g_startup;  // static storage, as every big object (the map image handle, the map view)
+
+// 0 = parsed; otherwise the exit status (usage printed).
+int parse_args(int argc, char** argv, Args* a) {
   for (int i = 1; i < argc; ++i) {
     if (!std::strcmp(argv[i], "--config") && i + 1 < argc) {
-      config_path = argv[++i];
+      a->config_path = argv[++i];
     } else if (!std::strcmp(argv[i], "--memory-report")) {
-      memory_report = true;
+      a->memory_report = true;
     } else if (!std::strcmp(argv[i], "--timing-report")) {
-      timing_report = true;
+      a->timing_report = true;
     } else if (!std::strcmp(argv[i], "--max-scans") && i + 1 < argc) {
-      max_scans = std::strtol(argv[++i], nullptr, 10);
-      if (max_scans <= 0) return usage("--max-scans needs a positive integer");
+      a->max_scans = std::strtol(argv[++i], nullptr, 10);
+      if (a->max_scans <= 0) return usage("--max-scans needs a positive integer");
     } else if (!std::strcmp(argv[i], "--duration") && i + 1 < argc) {
-      duration_s = std::strtod(argv[++i], nullptr);
-      if (!(duration_s > 0)) return usage("--duration needs a positive number of seconds");
+      a->duration_s = std::strtod(argv[++i], nullptr);
+      if (!(a->duration_s > 0)) return usage("--duration needs a positive number of seconds");
     } else {
       return usage("unknown or incomplete argument");
     }
   }
-  if (!config_path) return usage("--config FILE is required");
-  fw::Status st = fw::load_app_config(config_path, &g_config);
-  if (!st) {
-    std::fprintf(stderr, "mmlfw: %s\n", st.message());
-    return 2;
-  }
-  const fw::AppConfig& c = g_config;
+  if (!a->config_path) return usage("--config FILE is required");
+  return 0;
+}
 
+// HAL board from the config's backends. The memory report is a pre-flight check: it still prints
+// the budget on a machine without the configured bus or device, but then exits non-zero with the
+// reason (the hardware cannot run it). 0 = go on.
+int open_board(const Args& a, Startup* su) {
+  const fw::AppConfig& c = g_config;
   hal_linux::BoardSpec spec;
   spec.laser = c.laser;
   spec.odometry = c.odometry[0] ? c.odometry : nullptr;
   spec.output = c.output[0] ? c.output : nullptr;
   spec.can_fd = c.can_fd;
   spec.log_level = static_cast<hal::LogLevel>(c.log_level);
-  st = g_board.create(spec);
-  // The memory report is a pre-flight check: it still prints the budget on a machine without the
-  // configured bus or device, but then exits non-zero with the reason (the hardware cannot run it).
-  const fw::Status board_status = st;
-  const bool board_ok = st.is_ok();
-  if (!board_ok && !memory_report) return fail("board", st);
-  if (!board_ok) std::fprintf(stderr, "mmlfw: board: %s (memory report only)\n", st.message());
-  hal::Hal& hal = g_board.hal();
-  if (board_ok) hal.log->log(hal::LogLevel::kInfo, "mmlfw: board %s", g_board.describe());
+  const fw::Status st = g_board.create(spec);
+  su->board_status = st;
+  su->board_ok = st.is_ok();
+  if (!su->board_ok && !a.memory_report) return fail("board", st);
+  if (!su->board_ok) std::fprintf(stderr, "mmlfw: board: %s (memory report only)\n", st.message());
+  if (su->board_ok) g_board.hal().log->log(hal::LogLevel::kInfo, "mmlfw: board %s", g_board.describe());
+  return 0;
+}
 
-  bool lock_refused = false;
+// Locked memory (realtime), this thread as the sensor context, the start-up arena. 0 = go on.
+int prepare_memory_and_sensor_context(const Args& a, Startup* su) {
+  const fw::AppConfig& c = g_config;
+  hal::Hal& hal = g_board.hal();
   if (c.realtime && mlockall(MCL_CURRENT | MCL_FUTURE) != 0) {
-    lock_refused = true;
-    if (!memory_report) {
+    su->lock_refused = true;
+    if (!a.memory_report) {
       std::fprintf(stderr, "mmlfw: realtime = true but mlockall was refused (ulimit -l / CAP_IPC_LOCK); set "
                            "realtime = false to run without locked memory\n");
       return 1;
     }
   }
-  // This thread is the sensor context.
-  {
-    char warning[160];
-    st = fw::apply_execution_context_here(fw::kSensorContext, c.realtime && !memory_report, warning);
-    if (!st) return fail("sensor context", st);
-    if (warning[0]) hal.log->log(hal::LogLevel::kWarning, "mmlfw: %s", warning);
-  }
+  char warning[160];
+  fw::Status st = fw::apply_execution_context_here(fw::kSensorContext, c.realtime && !a.memory_report, warning);
+  if (!st) return fail("sensor context", st);
+  if (warning[0]) hal.log->log(hal::LogLevel::kWarning, "mmlfw: %s", warning);
   st = g_arena.init_mapped(static_cast<std::size_t>(c.arena_mib) << 20, c.realtime, "arena");
   if (!st) return fail("arena", st);
+  return 0;
+}
 
-  fw::GlobalMap map{};
-  fw::MapImageFile image;
-  const std::uint8_t* table = nullptr;
-  std::size_t table_len = 0;
-  if (c.map[0]) {
-    st = image.open(c.map);
-    if (!st) return fail("map", st);
-    st = fw::load_map_image(image.data(), image.size(), g_arena, &map, c.map);
-    if (!st) return fail("map", st);
-    table = fw::find_section(image.data(), image.size(), fw::MapSectionType::kRelationTable2D, &table_len);
-    hal.log->log(hal::LogLevel::kInfo, "mmlfw: map '%s' %ux%u cells at %.3f m, %u points%s", c.map,
-                 map.geometry.width, map.geometry.height, static_cast<double>(map.geometry.resolution), map.num_points,
-                 table ? ", precomputed relation table" : "");
-  }
+// The map image into the arena, and its relation table section if it has one. 0 = go on.
+int load_map(Startup* su) {
+  const fw::AppConfig& c = g_config;
+  if (!c.map[0]) return 0;
+  fw::Status st = su->image.open(c.map);
+  if (!st) return fail("map", st);
+  st = fw::load_map_image(su->image.data(), su->image.size(), g_arena, &su->map, c.map);
+  if (!st) return fail("map", st);
+  su->table = fw::find_section(su->image.data(), su->image.size(), fw::MapSectionType::kRelationTable2D, &su->table_len);
+  g_board.hal().log->log(hal::LogLevel::kInfo, "mmlfw: map '%s' %ux%u cells at %.3f m, %u points%s", c.map,
+                         su->map.geometry.width, su->map.geometry.height,
+                         static_cast<double>(su->map.geometry.resolution), su->map.num_points,
+                         su->table ? ", precomputed relation table" : "");
+  return 0;
+}
 
+// Worker threads, created once and pinned (the table's worker core first, then round). 0 = go on.
+int start_workers(const Args& a) {
+  const fw::AppConfig& c = g_config;
   fw::WorkerPoolOptions po;
   po.num_workers = c.workers;
   for (int i = 0; i < c.num_cores && i < fw::WorkerPoolOptions::kMaxWorkers; ++i) po.cores[i] = c.cores[i];
   if (c.num_cores == 0) {
-    // The table's worker core first (beside the global context), then the next ones round.
     const long online = sysconf(_SC_NPROCESSORS_ONLN) > 0 ? sysconf(_SC_NPROCESSORS_ONLN) : 1;
     for (int i = 0; i < c.workers && i < fw::WorkerPoolOptions::kMaxWorkers; ++i)
       po.cores[i] = static_cast<int>((fw::kWorkerContext.core + i) % online);
   }
-  po.realtime = c.realtime && !memory_report;
+  po.realtime = c.realtime && !a.memory_report;
   po.require_realtime = po.realtime;
   po.priority = fw::kWorkerContext.priority;
-  st = g_pool.start(po);
+  const fw::Status st = g_pool.start(po);
   if (!st) return fail("workers", st);
   if (g_pool.warning_count() > 0) {
-    hal.log->log(hal::LogLevel::kWarning, "mmlfw: %d worker warning(s), last: %s", g_pool.warning_count(),
-                 g_pool.warning());
+    g_board.hal().log->log(hal::LogLevel::kWarning, "mmlfw: %d worker warning(s), last: %s", g_pool.warning_count(),
+                           g_pool.warning());
   }
+  return 0;
+}
 
-  // The one start-up builder (firmware/app/system.h), as mml-sim, mml-eval and the replays use it.
-  if (!table && c.map[0] && std::strcmp(c.localizer, "odom") && std::strcmp(c.localizer, "mcl") && c.mml_preset != 1)
+// The one start-up builder (firmware/app/system.h), as mml-sim, mml-eval and the replays use it;
+// the global context thread; the image kept only where the relation table is read in place. 0 = go on.
+int build_localizer(const Args& a, Startup* su) {
+  const fw::AppConfig& c = g_config;
+  hal::Hal& hal = g_board.hal();
+  if (!su->table && c.map[0] && std::strcmp(c.localizer, "odom") && std::strcmp(c.localizer, "mcl") && c.mml_preset != 1)
     hal.log->log(hal::LogLevel::kInfo, "mmlfw: map image has no relation table; filling it at start-up");
   fw::SystemSpec sys;
   sys.localizer = c.localizer;
   sys.mml_preset = c.mml_preset;
   sys.seed = c.seed;
-  const fw::track::GlobalScheduleOptions live = fw::track::live_global_schedule(c.global_period_scans);
-  const fw::ExecutionContext global_ctx = fw::track::global_context_for(c.global_period_scans);
-  const bool global_thread = c.global_threaded && !std::strcmp(c.localizer, "mml-track") && !memory_report;
-  if (global_thread) {
-    sys.global_schedule = &live;
+  su->live = fw::track::live_global_schedule(c.global_period_scans);
+  su->global_ctx = fw::track::global_context_for(c.global_period_scans);
+  su->global_thread = c.global_threaded && !std::strcmp(c.localizer, "mml-track") && !a.memory_report;
+  if (su->global_thread) {
+    sys.global_schedule = &su->live;
     sys.anytime_global = true;
   }
-  st = g_system.build(sys, map, table, table_len, g_arena, &g_pool);
+  fw::Status st = g_system.build(sys, su->map, su->table, su->table_len, g_arena, &g_pool);
   if (!st) return fail("localizer", st);
-  if (global_thread) {
-    st = g_system.start_global_context(c.realtime, hal.clock, global_ctx);
+  if (su->global_thread) {
+    st = g_system.start_global_context(c.realtime, hal.clock, su->global_ctx);
     if (!st) return fail("global context", st);
   } else if (g_system.tracked() != nullptr) {
     g_system.tracked()->global_context().set_clock(hal.clock);
   }
-  fw::Localizer* localizer = &g_system.localizer();
   // The map now lives in the arena. The image is a start-up copy (map_image_file.h: the file on
   // disk may be truncated or replaced while the firmware runs); a relation table section in use is
   // read in place from that copy, so only its pages are kept.
-  const bool table_in_use = table != nullptr && g_system.table_in_use();
-  if (table_in_use) {
-    st = image.retain(table, table_len);
+  su->table_in_use = su->table != nullptr && g_system.table_in_use();
+  if (su->table_in_use) {
+    st = su->image.retain(su->table, su->table_len);
     if (!st) return fail("map", st);
   } else {
-    image.close();
+    su->image.close();
   }
-
   fw::LocalizationLoopOptions lo;
   lo.step_deadline_ns = static_cast<std::uint64_t>(c.step_deadline_ms * 1e6);
   lo.laser_timeout_ns = static_cast<std::uint64_t>(c.laser_timeout_ms) * 1000000ull;
-  if (board_ok) {
-    st = g_loop.init(hal, *localizer, lo);
+  if (su->board_ok) {
+    st = g_loop.init(hal, g_system.localizer(), lo);
     if (!st) return fail("loop", st);
   }
+  return 0;
+}
 
+// The static memory budget; with --memory-report printed with the pre-flight verdict (the exit
+// status, ≥ 0), otherwise -1 (go on; a budget beyond the machine's limits is a warning).
+int memory_budget(const Args& a, const Startup& su) {
+  const fw::AppConfig& c = g_config;
   fw::MemoryReport& mr = fw::MemoryReport::instance();
   mr.add({"hal", "board (sockets, CAN node rings, SICK parser)", sizeof(g_board), 0, nullptr});
   mr.add({"runtime", "localization loop (odometry ring, pending scan, perf)", sizeof(g_loop), 0, nullptr});
   mr.add({"runtime", "worker pool", sizeof(g_pool), static_cast<std::size_t>(c.workers), nullptr});
-  if (table_in_use) mr.add({"map", "relation table (image copy)", table_len, 0, nullptr});
+  if (su.table_in_use) mr.add({"map", "relation table (image copy)", su.table_len, 0, nullptr});
   g_arena.seal();
   // The map/pransam/mml regions are carved from the arena (listed for the breakdown), so the
   // footprint is the arena plus the static objects plus the relation table kept from the image.
   // (The localizer objects are in the arena: system.h.)
   const std::size_t statics = sizeof(g_board) + sizeof(g_loop) + sizeof(g_pool) + sizeof(g_system);
-  const std::size_t table_copy = table_in_use ? image.mapped_bytes() : 0;
+  const std::size_t table_copy = su.table_in_use ? su.image.mapped_bytes() : 0;
   const std::uint64_t footprint = static_cast<std::uint64_t>(g_arena.capacity()) + statics + table_copy;
   const fw::Status memory_status =
       fw::check_memory_fits(footprint, fw::read_memory_limits(), "arena_mib + static objects + table");
   // The arena must hold its peak (the map loader's distance check is start-up scratch), not just
   // what stays allocated.
   const std::size_t arena_need = g_arena.peak_used() > g_arena.used() ? g_arena.peak_used() : g_arena.used();
-  if (memory_report) {
-    std::printf("mmlfw memory report (config '%s', localizer %s, arena used %zu of %zu bytes)\n", config_path,
-                localizer->name(), g_arena.used(), g_arena.capacity());
-    mr.print(stdout);
-    std::printf("footprint: arena reserved %.3f MiB (used %.3f MiB) + static objects %.3f MiB + relation table "
-                "(image copy) %.3f MiB = %.3f MiB (%.3f MiB with the arena trimmed to its peak use)\n",
-                g_arena.capacity() / 1048576.0, g_arena.used() / 1048576.0, statics / 1048576.0,
-                table_copy / 1048576.0, footprint / 1048576.0, (arena_need + statics + table_copy) / 1048576.0);
-    g_system.stop_global_context();
-    g_pool.stop();
-    // Pre-flight verdict: a configuration this machine cannot run is an error, with the reason.
-    int reasons = 0;
-    if (!board_ok) {
-      std::fprintf(stderr, "mmlfw: memory report: cannot run: board: %s\n", board_status.message());
-      ++reasons;
-    }
-    if (!memory_status) {
-      std::fprintf(stderr, "mmlfw: memory report: cannot run: memory: %s\n", memory_status.message());
-      ++reasons;
-    }
-    if (lock_refused) {
-      std::fprintf(stderr, "mmlfw: memory report: cannot run: realtime = true but mlockall was refused (ulimit -l / "
-                           "CAP_IPC_LOCK)\n");
-      ++reasons;
-    }
-    return reasons == 0 ? 0 : 1;
+  if (!a.memory_report) {
+    if (!memory_status) g_board.hal().log->log(hal::LogLevel::kWarning, "mmlfw: memory: %s", memory_status.message());
+    return -1;
   }
-  if (!memory_status) hal.log->log(hal::LogLevel::kWarning, "mmlfw: memory: %s", memory_status.message());
+  std::printf("mmlfw memory report (config '%s', localizer %s, arena used %zu of %zu bytes)\n", a.config_path,
+              g_system.localizer().name(), g_arena.used(), g_arena.capacity());
+  mr.print(stdout);
+  std::printf("footprint: arena reserved %.3f MiB (used %.3f MiB) + static objects %.3f MiB + relation table "
+              "(image copy) %.3f MiB = %.3f MiB (%.3f MiB with the arena trimmed to its peak use)\n",
+              g_arena.capacity() / 1048576.0, g_arena.used() / 1048576.0, statics / 1048576.0,
+              table_copy / 1048576.0, footprint / 1048576.0, (arena_need + statics + table_copy) / 1048576.0);
+  g_system.stop_global_context();
+  g_pool.stop();
+  // Pre-flight verdict: a configuration this machine cannot run is an error, with the reason.
+  int reasons = 0;
+  if (!su.board_ok) {
+    std::fprintf(stderr, "mmlfw: memory report: cannot run: board: %s\n", su.board_status.message());
+    ++reasons;
+  }
+  if (!memory_status) {
+    std::fprintf(stderr, "mmlfw: memory report: cannot run: memory: %s\n", memory_status.message());
+    ++reasons;
+  }
+  if (su.lock_refused) {
+    std::fprintf(stderr, "mmlfw: memory report: cannot run: realtime = true but mlockall was refused (ulimit -l / "
+                         "CAP_IPC_LOCK)\n");
+    ++reasons;
+  }
+  return reasons == 0 ? 0 : 1;
+}
 
+// The steady state: scans in, poses out, heartbeats, until a signal, --max-scans or --duration.
+// Returns the number of steps that failed.
+std::uint64_t run_loop(const Args& a) {
+  const fw::AppConfig& c = g_config;
+  hal::Hal& hal = g_board.hal();
   struct sigaction sa {};
   sa.sa_handler = on_signal;
   sigemptyset(&sa.sa_mask);
@@ -293,7 +338,7 @@ int main(int argc, char** argv) {
   sigaction(SIGTERM, &sa, nullptr);
   signal(SIGPIPE, SIG_IGN);
 
-  hal.log->log(hal::LogLevel::kInfo, "mmlfw: running (localizer %s, %d workers)", localizer->name(), c.workers);
+  hal.log->log(hal::LogLevel::kInfo, "mmlfw: running (localizer %s, %d workers)", g_system.localizer().name(), c.workers);
   const std::uint64_t t_start = hal.clock->now_ns();
   const std::uint64_t health_period = static_cast<std::uint64_t>(c.health_period_ms) * 1000000ull;
   std::uint64_t last_health = t_start;
@@ -301,48 +346,54 @@ int main(int argc, char** argv) {
   while (!g_stop) {
     g_board.wait_for_input(5);
     for (int k = 0; k < 16 && !g_stop; ++k) {
-      st = g_loop.spin_once();
+      const fw::Status st = g_loop.spin_once();
       if (!st) ++step_errors;
       if (!g_loop.stepped()) break;
       ++scans;
       last_health = hal.clock->now_ns();  // the loop published health with the pose
       if (c.log_level == static_cast<int>(hal::LogLevel::kDebug)) trace_step(hal);
-      if (max_scans > 0 && static_cast<long>(scans) >= max_scans) g_stop = 1;
+      if (a.max_scans > 0 && static_cast<long>(scans) >= a.max_scans) g_stop = 1;
     }
     const std::uint64_t now = hal.clock->now_ns();
     if (now - last_health >= health_period) {
       g_board.publish_heartbeat(g_loop.health());
       last_health = now;
     }
-    if (duration_s > 0 && static_cast<double>(now - t_start) * 1e-9 >= duration_s) g_stop = 1;
+    if (a.duration_s > 0 && static_cast<double>(now - t_start) * 1e-9 >= a.duration_s) g_stop = 1;
   }
+  return step_errors;
+}
 
-  g_system.stop_global_context();  // before the pool it drives
-  if (timing_report) {
-    std::fprintf(stderr, "mmlfw timing report (ms; context: sensor = main thread, global = MML thread%s)\n",
-                 global_thread ? "" : " (inline: inside loop.step)");
-    std::fprintf(stderr, "  %-8s %-14s %10s %9s %9s %9s %9s %9s\n", "context", "stage", "count", "mean", "p50", "p99",
-                 "max", "deadline");
-    auto row = [](const char* ctx, const char* stage, const fw::PerfStats& p, double deadline_ms) {
-      std::fprintf(stderr, "  %-8s %-14s %10llu %9.3f %9.3f %9.3f %9.3f %9.3f\n", ctx, stage,
-                   static_cast<unsigned long long>(p.count), p.mean_ms, p.p50_ms, p.p99_ms, p.max_ms, deadline_ms);
-    };
-    const double sensor_ms = c.step_deadline_ms;
-    row("sensor", g_loop.perf_poll().name(), g_loop.perf_poll().stats(), 0);
-    row("sensor", g_loop.perf_pair().name(), g_loop.perf_pair().stats(), 0);
-    row("sensor", g_loop.perf_step().name(), g_loop.perf_step().stats(), sensor_ms);
-    row("sensor", g_loop.perf_publish().name(), g_loop.perf_publish().stats(), 0);
-    row("sensor", g_loop.perf_total().name(), g_loop.perf_total().stats(), 0);
-    if (const fw::track::TrackedLocalizer* t = g_system.tracked()) {
-      const fw::track::GlobalContext& gc = t->global_context();
-      row(global_thread ? "global" : "sensor", "global.step", gc.step_stats(),
-          global_thread ? global_ctx.deadline_ns * 1e-6 : 0);
-      std::fprintf(stderr, "  global: jobs %llu, overruns %llu, skipped offers %llu (every %u scans, result after %u)\n",
-                   static_cast<unsigned long long>(gc.jobs()), static_cast<unsigned long long>(gc.overruns()),
-                   static_cast<unsigned long long>(gc.skipped_offers()), gc.schedule().every_n_scans,
-                   gc.schedule().result_delay_scans);
-    }
+// --timing-report: per-stage perf counters of both execution contexts.
+void print_timing_report(const Startup& su) {
+  const fw::AppConfig& c = g_config;
+  std::fprintf(stderr, "mmlfw timing report (ms; context: sensor = main thread, global = MML thread%s)\n",
+               su.global_thread ? "" : " (inline: inside loop.step)");
+  std::fprintf(stderr, "  %-8s %-14s %10s %9s %9s %9s %9s %9s\n", "context", "stage", "count", "mean", "p50", "p99",
+               "max", "deadline");
+  auto row = [](const char* ctx, const char* stage, const fw::PerfStats& p, double deadline_ms) {
+    std::fprintf(stderr, "  %-8s %-14s %10llu %9.3f %9.3f %9.3f %9.3f %9.3f\n", ctx, stage,
+                 static_cast<unsigned long long>(p.count), p.mean_ms, p.p50_ms, p.p99_ms, p.max_ms, deadline_ms);
+  };
+  const double sensor_ms = c.step_deadline_ms;
+  row("sensor", g_loop.perf_poll().name(), g_loop.perf_poll().stats(), 0);
+  row("sensor", g_loop.perf_pair().name(), g_loop.perf_pair().stats(), 0);
+  row("sensor", g_loop.perf_step().name(), g_loop.perf_step().stats(), sensor_ms);
+  row("sensor", g_loop.perf_publish().name(), g_loop.perf_publish().stats(), 0);
+  row("sensor", g_loop.perf_total().name(), g_loop.perf_total().stats(), 0);
+  if (const fw::track::TrackedLocalizer* t = g_system.tracked()) {
+    const fw::track::GlobalContext& gc = t->global_context();
+    row(su.global_thread ? "global" : "sensor", "global.step", gc.step_stats(),
+        su.global_thread ? su.global_ctx.deadline_ns * 1e-6 : 0);
+    std::fprintf(stderr, "  global: jobs %llu, overruns %llu, skipped offers %llu (every %u scans, result after %u)\n",
+                 static_cast<unsigned long long>(gc.jobs()), static_cast<unsigned long long>(gc.overruns()),
+                 static_cast<unsigned long long>(gc.skipped_offers()), gc.schedule().every_n_scans,
+                 gc.schedule().result_delay_scans);
   }
+}
+
+// The one-line exit summary on stderr.
+void print_summary(std::uint64_t step_errors) {
   const fw::PerfStats step = g_loop.perf_step().stats();
   const fw::PerfStats total = g_loop.perf_total().stats();
   const hal::Health& h = g_loop.health();
@@ -374,6 +425,29 @@ int main(int argc, char** argv) {
                node ? node->decoder_stats().invalid_scans : 0, g_board.sick() ? g_board.sick()->stats().bad_measurements : 0,
                g_board.serial_reconnects(), static_cast<unsigned long long>(g_loop.counters().laser_timeouts),
                h.fault_bits, hal::status_name(g_loop.last_estimate().status));
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  Args a;
+  if (const int rc = parse_args(argc, argv, &a)) return rc;
+  const fw::Status st = fw::load_app_config(a.config_path, &g_config);
+  if (!st) {
+    std::fprintf(stderr, "mmlfw: %s\n", st.message());
+    return 2;
+  }
+  Startup& su = g_startup;
+  if (const int rc = open_board(a, &su)) return rc;
+  if (const int rc = prepare_memory_and_sensor_context(a, &su)) return rc;
+  if (const int rc = load_map(&su)) return rc;
+  if (const int rc = start_workers(a)) return rc;
+  if (const int rc = build_localizer(a, &su)) return rc;
+  if (const int rc = memory_budget(a, su); rc >= 0) return rc;
+  const std::uint64_t step_errors = run_loop(a);
+  g_system.stop_global_context();  // before the pool it drives
+  if (a.timing_report) print_timing_report(su);
+  print_summary(step_errors);
   g_pool.stop();
   return 0;
 }
