@@ -53,148 +53,144 @@ std::optional<fw::LocalizationSystem> g_system;
 
 }  // namespace
 
-bool run_replay(const ReplayOptions& o, ReplayResult* r, std::string* error) {
-  *r = ReplayResult{};
-  const sim::Dataset* ds = sim::find_dataset(o.dataset);
-  if (!ds || ds->raw_log.empty()) {
-    *error = "dataset '" + o.dataset + "' unknown or without a raw log";
-    return false;
-  }
-  sim::CarmenLog log;
+namespace {
+
+// The log (with the scans' odometry as the odometry stream when it has no ODOM records) and the
+// reference pose at every scan (empty when the dataset has none).
+bool load_replay_inputs(const ReplayOptions& o, const sim::Dataset& ds, sim::CarmenLog* log,
+                        std::vector<fw::Se2d>* reference, ReplayResult* r, std::string* error) {
   sim::CarmenReadOptions ro;
   ro.max_scans = o.first_scan + o.num_scans;
-  if (!sim::read_carmen_log(sim::data_path(ds->raw_log), ro, &log, error)) return false;
-  if (log.odom.empty()) {
+  if (!sim::read_carmen_log(sim::data_path(ds.raw_log), ro, log, error)) return false;
+  if (log->odom.empty()) {
     // A log without ODOM records (mit-killian's reconstructed log): FLASER carries the odometry pose
     // of every scan; feed it as the odometry stream (one sample per scan, at the scan's time).
     r->odometry_from_scans = true;
-    for (const sim::CarmenScan& sc : log.scans) {
+    for (const sim::CarmenScan& sc : log->scans) {
       sim::CarmenOdom od;
       od.line = sc.line;
       od.pose = sc.odom;
       od.ipc_timestamp = sc.ipc_timestamp;
-      log.odom.push_back(od);
+      log->odom.push_back(od);
     }
   }
-  if (log.scans.size() <= o.first_scan) {
+  if (log->scans.size() <= o.first_scan) {
     *error = "log has no scans after " + std::to_string(o.first_scan);
     return false;
   }
-  std::vector<fw::Se2d> reference;
-  if (!ds->corrected_poses.empty()) {
+  if (!ds.corrected_poses.empty()) {
     sim::CarmenLog full;
     std::vector<sim::CorrectedPose> corrected;
-    if (sim::read_carmen_log(sim::data_path(ds->raw_log), sim::CarmenReadOptions{}, &full, error) &&
-        sim::read_corrected_poses(sim::data_path(ds->corrected_poses), &corrected, error)) {
-      reference = sim::reference_at_every_scan(full, corrected);
+    if (sim::read_carmen_log(sim::data_path(ds.raw_log), sim::CarmenReadOptions{}, &full, error) &&
+        sim::read_corrected_poses(sim::data_path(ds.corrected_poses), &corrected, error)) {
+      *reference = sim::reference_at_every_scan(full, corrected);
     }
     error->clear();
   }
-  const std::string dir = o.map_dir.empty() ? sim::map_cache_dir() : o.map_dir;
-  sim::RosMap ros;
-  if (!sim::ensure_global_map(o.dataset, 0, dir, &ros, error)) return false;
-  const std::string image_path = sim::global_map_image_path(o.dataset, dir);
+  return true;
+}
 
-  g_system.reset();  // before its arena is set up again
-  fw::MemoryReport::instance().clear();
-  fw::StartupArena& arena = g_arena;
-  fw::Status st = arena.init_mapped(256u << 20, false, "arena");
-  if (!st) { *error = st.message(); return false; }
+// The firmware side of the replay, in static storage as mmlfw keeps it.
+struct ReplayRig {
   fw::GlobalMap map{};
   fw::MapImageFile image;
-  st = image.open(image_path.c_str());
-  if (st) st = fw::load_map_image(image.data(), image.size(), arena, &map, image_path.c_str());
-  if (!st) { *error = st.message(); return false; }
+  const std::uint8_t* table = nullptr;
   std::size_t table_len = 0;
-  const std::uint8_t* table =
-      fw::find_section(image.data(), image.size(), fw::MapSectionType::kRelationTable2D, &table_len);
-  r->map_width = map.geometry.width;
-  r->map_height = map.geometry.height;
-  r->map_resolution = map.geometry.resolution;
+  std::string gmode;
+  bool lockstep = false;
+  bool rt = false;
+  fw::WorkerPool* pool = nullptr;
+  fw::LocalizationSystem* sys = nullptr;
+  fw::LocalizationLoop* loop = nullptr;
+  hal::Hal hal;
+  hal_linux::LinuxClock* clock = nullptr;
+  hal_sim::SteppedClock* stepped = nullptr;
+  hal_sim::SimLaserSource* laser = nullptr;
+  hal_sim::SimOdometrySource* odom = nullptr;
+  hal_sim::SimPoseSink* sink = nullptr;
+};
 
-  const bool lockstep_run = o.rate_hz <= 0;
-  std::string gmode = o.global_context;
-  if (gmode == "auto") gmode = lockstep_run ? "inline-ref" : "thread";
-  if (gmode != "thread" && gmode != "inline-live" && gmode != "inline-ref") {
-    *error = "global_context '" + gmode + "': expected auto, thread, inline-live or inline-ref";
-    return false;
-  }
-  const bool rt = o.realtime && !lockstep_run;
-  int old_policy = SCHED_OTHER;
-  sched_param old_param{};
-  pthread_getschedparam(pthread_self(), &old_policy, &old_param);
-  struct RestoreSched {  // the process goes on (tests): this thread back to its old policy
-    bool on;
-    int policy;
-    sched_param param;
-    ~RestoreSched() {
-      if (on) pthread_setschedparam(pthread_self(), policy, &param);
-    }
-  } restore{rt, old_policy, old_param};
-  if (!lockstep_run && (o.pin_sensor_thread || rt)) {
-    char warning[160];
-    st = fw::apply_execution_context_here(fw::kSensorContext, rt, warning);
-    if (!st) { *error = st.message(); return false; }
-  }
-  r->realtime = rt;
+// Arena, map image and relation table (as mmlfw loads them).
+bool load_replay_map(const std::string& image_path, ReplayRig* rig, ReplayResult* r, std::string* error) {
+  g_system.reset();  // before its arena is set up again
+  fw::MemoryReport::instance().clear();
+  fw::Status st = g_arena.init_mapped(256u << 20, false, "arena");
+  if (!st) { *error = st.message(); return false; }
+  st = rig->image.open(image_path.c_str());
+  if (st) st = fw::load_map_image(rig->image.data(), rig->image.size(), g_arena, &rig->map, image_path.c_str());
+  if (!st) { *error = st.message(); return false; }
+  rig->table = fw::find_section(rig->image.data(), rig->image.size(), fw::MapSectionType::kRelationTable2D,
+                                &rig->table_len);
+  r->map_width = rig->map.geometry.width;
+  r->map_height = rig->map.geometry.height;
+  r->map_resolution = rig->map.geometry.resolution;
+  return true;
+}
+
+// The worker pool (pinned beside the global context when MML runs on its thread, as in mmlfw).
+bool start_replay_pool(const ReplayOptions& o, ReplayRig* rig, ReplayResult* r, std::string* error) {
   static fw::WorkerPool pool;
+  rig->pool = &pool;
   fw::WorkerPoolOptions po;
   po.num_workers = o.workers;
-  po.realtime = rt;
-  po.require_realtime = rt;
+  po.realtime = rig->rt;
+  po.require_realtime = rig->rt;
   po.priority = fw::kWorkerContext.priority;
-  if (gmode == "thread") {  // as mmlfw: the workers beside the global context (execution_contexts.h)
+  if (rig->gmode == "thread") {  // as mmlfw: the workers beside the global context (execution_contexts.h)
     const long online = sysconf(_SC_NPROCESSORS_ONLN) > 0 ? sysconf(_SC_NPROCESSORS_ONLN) : 1;
     for (int i = 0; i < o.workers && i < fw::WorkerPoolOptions::kMaxWorkers; ++i)
       po.cores[i] = static_cast<int>((fw::kWorkerContext.core + i) % online);
   }
-  st = pool.start(po);
+  const fw::Status st = pool.start(po);
   if (!st) { *error = st.message(); return false; }
   r->pin_warnings = pool.warning_count();
+  return true;
+}
 
-  // The localizer exactly as mmlfw builds it (firmware/app/mmlfw_main.cpp): the one start-up
-  // builder with the config's localizer name, MML preset and seed; the relation table is the
-  // image's section or filled at start-up.
+// The localizer exactly as mmlfw builds it (firmware/app/mmlfw_main.cpp): the one start-up builder
+// with the config's localizer name, MML preset and seed; the relation table is the image's section
+// or filled at start-up. Then the HAL of simulated devices and the localization loop.
+bool build_replay_localizer(const ReplayOptions& o, ReplayRig* rig, ReplayResult* r, std::string* error) {
   g_system.emplace();
   fw::LocalizationSystem& sys = *g_system;
+  rig->sys = &sys;
   fw::SystemSpec spec;
   spec.localizer = o.localizer.c_str();
   spec.mml_preset = o.mml_preset;
   spec.seed = o.seed;
   fw::track::GlobalScheduleOptions live = fw::track::live_global_schedule();
-  if (gmode != "inline-ref") {
+  if (rig->gmode != "inline-ref") {
     spec.global_schedule = &live;
     spec.anytime_global = true;
   }
   if (o.schedule_every > 0 || o.schedule_delay >= 0) {
-    if (gmode == "inline-ref") live = fw::track::GlobalScheduleOptions();
+    if (rig->gmode == "inline-ref") live = fw::track::GlobalScheduleOptions();
     if (o.schedule_every > 0) live.every_n_scans = o.schedule_every;
     if (o.schedule_delay >= 0) live.result_delay_scans = static_cast<std::uint32_t>(o.schedule_delay);
     spec.global_schedule = &live;
   }
   if (o.anytime_recentre >= 0) spec.anytime_global = o.anytime_recentre != 0;
-  st = sys.build(spec, map, table, table_len, arena, &pool);
-  if (!st) { *error = std::string("localizer: ") + st.message(); pool.stop(); return false; }
+  fw::Status st = sys.build(spec, rig->map, rig->table, rig->table_len, g_arena, rig->pool);
+  if (!st) { *error = std::string("localizer: ") + st.message(); return false; }
   static hal_linux::LinuxClock perf_clock;
   if (sys.tracked() != nullptr) {
-    r->global_context = gmode;
+    r->global_context = rig->gmode;
     r->global_period_ms = static_cast<double>(sys.tracked()->global_context().schedule().every_n_scans) * 1000.0 /
                           (o.rate_hz > 0 ? o.rate_hz : 75.0);
-    if (gmode == "thread") {
-      st = sys.start_global_context(rt, &perf_clock, fw::track::global_context_for(live.every_n_scans));
-      if (!st) { *error = std::string("global context: ") + st.message(); pool.stop(); return false; }
+    if (rig->gmode == "thread") {
+      st = sys.start_global_context(rig->rt, &perf_clock, fw::track::global_context_for(live.every_n_scans));
+      if (!st) { *error = std::string("global context: ") + st.message(); return false; }
     } else {
       sys.tracked()->global_context().set_clock(&perf_clock);
     }
   }
-  fw::Localizer* loc = &sys.localizer();
   r->localizer = sys.name();
   // A table section in use is read in place from the image copy: keep only its pages (as mmlfw does).
-  if (table != nullptr && sys.table_in_use()) {
-    st = image.retain(table, table_len);
-    if (!st) { *error = st.message(); pool.stop(); return false; }
+  if (rig->table != nullptr && sys.table_in_use()) {
+    st = rig->image.retain(rig->table, rig->table_len);
+    if (!st) { *error = st.message(); return false; }
   } else {
-    image.close();
+    rig->image.close();
   }
 
   static hal_linux::LinuxClock clock;
@@ -202,21 +198,29 @@ bool run_replay(const ReplayOptions& o, ReplayResult* r, std::string* error) {
   static hal_sim::SimLaserSource laser;
   static hal_sim::SimOdometrySource odom;
   static hal_sim::SimPoseSink sink;
-  hal::Hal hal;
-  const bool lockstep = o.rate_hz <= 0;
-  hal.clock = lockstep ? static_cast<hal::Clock*>(&stepped) : static_cast<hal::Clock*>(&clock);
-  hal.laser = &laser;
-  hal.odometry = &odom;
-  hal.pose_sink = &sink;
+  rig->clock = &clock;
+  rig->stepped = &stepped;
+  rig->laser = &laser;
+  rig->odom = &odom;
+  rig->sink = &sink;
+  rig->hal.clock = rig->lockstep ? static_cast<hal::Clock*>(&stepped) : static_cast<hal::Clock*>(&clock);
+  rig->hal.laser = &laser;
+  rig->hal.odometry = &odom;
+  rig->hal.pose_sink = &sink;
   static fw::LocalizationLoop loop;
+  rig->loop = &loop;
   fw::LocalizationLoopOptions lo;
   lo.step_deadline_ns = static_cast<std::uint64_t>(o.deadline_ms * 1e6);
   lo.perf_clock = &clock;
-  st = loop.init(hal, *loc, lo);
-  if (!st) { *error = st.message(); pool.stop(); return false; }
-  arena.seal();
+  st = loop.init(rig->hal, sys.localizer(), lo);
+  if (!st) { *error = st.message(); return false; }
+  g_arena.seal();
+  return true;
+}
 
-  // Memory: arena used + the static objects of the firmware binary.
+// Memory: arena used (its peak: the map loader's distance check is start-up scratch, issue 14) +
+// the static objects of the firmware binary. The localizer objects are in the arena, as in mmlfw.
+void record_memory(const ReplayRig& rig, ReplayResult* r) {
   const double mib = 1.0 / (1024.0 * 1024.0);
   const auto& mr = fw::MemoryReport::instance();
   for (std::size_t i = 0; i < mr.region_count(); ++i) {
@@ -224,163 +228,197 @@ bool run_replay(const ReplayOptions& o, ReplayResult* r, std::string* error) {
     if (std::string(reg.module) == "arena") continue;
     r->module_mib[reg.module] += static_cast<double>(reg.bytes) * mib;
   }
-  // (The localizer objects are in the arena, as in mmlfw: counted in arena_used.)
-  const double statics = static_cast<double>(sizeof(fw::LocalizationSystem) + sizeof(loop) + sizeof(pool) +
-                                             sizeof(laser) + sizeof(odom) + sizeof(sink)) * mib;
+  const double statics = static_cast<double>(sizeof(fw::LocalizationSystem) + sizeof(*rig.loop) + sizeof(*rig.pool) +
+                                             sizeof(*rig.laser) + sizeof(*rig.odom) + sizeof(*rig.sink)) * mib;
   r->module_mib["statics"] = statics;
-  // The arena must hold its peak (the map loader's distance check is start-up scratch), not only
-  // what stays allocated (issue 14).
-  const std::size_t arena_need = arena.peak_used() > arena.used() ? arena.peak_used() : arena.used();
+  const std::size_t arena_need = g_arena.peak_used() > g_arena.used() ? g_arena.peak_used() : g_arena.used();
   r->module_mib["arena_used"] = static_cast<double>(arena_need) * mib;
   r->static_memory_mib = static_cast<double>(arena_need) * mib + statics;
+}
 
-  // Feed: scans at rate_hz of the wall clock; sensor time compressed the same way (per-scan
-  // motion unchanged), odometry records between scans interleaved by their log time.
-  const size_t last = std::min(log.scans.size(), o.first_scan + o.num_scans);
-  const double log_t0 = log.scans[o.first_scan].ipc_timestamp;
-  const double period = 1.0 / (o.rate_hz > 0 ? o.rate_hz : 75.0);
-  auto sensor_ns = [&](double ipc) {
-    // Piecewise-linear time warp: scan k of the log is at k * period.
-    return ipc;  // replaced below
-  };
-  (void)sensor_ns;
-  std::vector<double> scan_t;  // log times of the scans fed
-  for (size_t i = o.first_scan; i < last; ++i) scan_t.push_back(log.scans[i].ipc_timestamp);
-  // Scan times in the HAL clock domain (hal/msg/laser_scan.h): scan k is due at t0 + k * period.
-  const std::uint64_t t0 = mono_ns() + 10'000'000;
-  auto warp = [&](double ipc) -> std::uint64_t {
-    auto it = std::upper_bound(scan_t.begin(), scan_t.end(), ipc);
-    size_t k = static_cast<size_t>(it - scan_t.begin());
-    double t;
-    if (k == 0) t = 0;
-    else if (k >= scan_t.size()) t = (scan_t.size() - 1) * period;
-    else {
-      const double a = scan_t[k - 1], b = scan_t[k];
-      t = ((k - 1) + (b > a ? (ipc - a) / (b - a) : 0)) * period;
-    }
-    return t0 + static_cast<std::uint64_t>(t * 1e9);
-  };
-  size_t oi = 0;
-  while (oi < log.odom.size() && log.odom[oi].ipc_timestamp < log_t0 - 0.5) ++oi;
-  size_t k = 0;  // index into scan_t of the next scan to feed
-  size_t g = 0;  // scans fed over all loops (soak): scan g is due at t0 + g * period
-  const size_t oi_start = oi;
-  const bool soak = o.duration_s > 0 && !lockstep;
-  std::uint64_t next_sample_ns = t0 + static_cast<std::uint64_t>(o.sample_period_s * 1e9);
-  std::mt19937_64 lose_rng(o.lose_seed);
-  std::uniform_real_distribution<double> lose_draw(0.0, 1.0);
-  const double to_ms = 1e-6;
-  (void)to_ms;
-  const std::uint64_t end_ns =
-      soak ? t0 + static_cast<std::uint64_t>(o.duration_s * 1e9)
-           : t0 + (lockstep ? 600'000'000'000ull
-                            : static_cast<std::uint64_t>((last - o.first_scan) * period * 1e9) + 3'000'000'000ull);
-  // Soak: one pass of the log lasts n * period; pass L runs L * n * period later in sensor time.
-  std::uint64_t loop_offset_ns = 0;
-  while (true) {
-    const std::uint64_t now = mono_ns();
-    if (soak && k >= scan_t.size() && now < end_ns) {
-      k = 0;
-      oi = oi_start;
-      ++r->loops;
-      loop_offset_ns = static_cast<std::uint64_t>(static_cast<double>(r->loops * scan_t.size()) * period * 1e9);
-    }
-    // Push everything due.
-    while (k < scan_t.size() && (!soak || now < end_ns) &&
-           (lockstep ? (laser.pending() == 0 && !loop.scan_pending() &&
-                         loop.health().scans_processed + loop.health().dropped_scans + r->scans_dropped +
-                                 r->scans_lost >= k)
-                     : now >= t0 + static_cast<std::uint64_t>(static_cast<double>(g) * period * 1e9))) {
-      const double tk = scan_t[k];
-      while (oi < log.odom.size() && log.odom[oi].ipc_timestamp <= tk + 0.5 * (k + 1 < scan_t.size() ? scan_t[k + 1] - tk : 0)) {
-        const sim::CarmenOdom& c = log.odom[oi++];
-        hal::Odometry od;
-        od.timestamp_ns = warp(c.ipc_timestamp) + loop_offset_ns;
-        od.x = static_cast<float>(c.pose.x);
-        od.y = static_cast<float>(c.pose.y);
-        od.theta = static_cast<float>(c.pose.theta);
-        if (o.mutate_odometry) o.mutate_odometry(c.ipc_timestamp, &od);
-        odom.push(od);
-      }
-      std::int64_t jitter_ns = 0;
-      if (o.scan_time_jitter_ms > 0) jitter_ns = static_cast<std::int64_t>((2.0 * lose_draw(lose_rng) - 1.0) * o.scan_time_jitter_ms * 1e6);
-      // Scan k at t0 + k·period exactly (= warp(tk) for distinct log times; logs with two scans at
-      // one ipc time, as intel has, would otherwise feed the second at the same time: out of order).
-      const std::uint64_t scan_ns = t0 + static_cast<std::uint64_t>(static_cast<double>(k) * period * 1e9);
-      hal::LaserScan s = sim::to_laser_scan(log.scans[o.first_scan + k], scan_ns + loop_offset_ns + jitter_ns);
-      if (o.mutate_scan) o.mutate_scan(o.first_scan + k, &s);
-      if (lockstep) stepped.set_ns(warp(k + 1 < scan_t.size() ? scan_t[k + 1] : tk));
-      const bool lost_random = (o.lose_prob > 0 && lose_draw(lose_rng) < o.lose_prob) ||
-                               std::find(o.lose_list.begin(), o.lose_list.end(), o.first_scan + k) != o.lose_list.end();
-      if ((o.lose_every > 0 && k % o.lose_every == o.lose_every - 1) || lost_random) {
-        ++r->scans_lost;
-      } else if (!laser.push(s)) {
-        ++r->scans_dropped;
-        ++r->ring_overflows;
-      }
-      ++r->scans_fed;
-      ++k;
-      ++g;
-    }
-    if (o.on_sample && now >= next_sample_ns) {
-      next_sample_ns += static_cast<std::uint64_t>(o.sample_period_s * 1e9);
-      ReplaySample smp;
-      smp.elapsed_s = static_cast<double>(now - t0) * 1e-9;
-      smp.scans_fed = r->scans_fed;
-      smp.scans_processed = r->scans_processed;
-      smp.health_dropped = loop.health().dropped_scans;
-      smp.ring_overflows = r->ring_overflows;
-      smp.localized = r->localized;
-      smp.wrong_localized = r->wrong_localized;
-      smp.loops = r->loops;
-      o.on_sample(smp);
-    }
-    loop.spin_once();
-    // Lockstep: a scan waiting for odometry that will never come must see time pass (timeout).
-    if (lockstep && !loop.stepped() && loop.scan_pending()) stepped.advance_ns(50'000'000);
-    hal::PoseEstimate e;
-    while (sink.pop(&e)) {
-      ++r->scans_processed;
-      const fw::mml::MmlLocalizer* mml = sys.mml();
-      if (o.trace && mml != nullptr && e.scan_id < reference.size()) {
-        const fw::mml::InterpretResult& ir = mml->last();
-        const fw::Se2d& ref = reference[e.scan_id];
-        std::printf("trace %u %-10s %s err %6.3f pose %8.3f %8.3f %6.3f ref %8.3f %8.3f pl %.3f hyps %4u cl %3u r %.3f d2 %8.2f smed %6.2f c %d%d%d soft %d inl %.2f uq %d %.3f/%.3f\n",
-                    e.scan_id, hal::status_name(e.status), e.mode == hal::LocalizationMode::kTracking ? "trk" : "glb",
-                    std::hypot(e.x - ref.x, e.y - ref.y), e.x, e.y, e.theta, ref.x, ref.y, e.protection_xy_m,
-                    ir.hypotheses_valid, ir.cluster_count, ir.best_rating, ir.d2, ir.sigma_med, ir.c_rating,
-                    ir.c_mahalanobis, ir.c_median, ir.soft, mml->last_refine().inlier_ratio, mml->last_uniqueness().unique,
-                    mml->last_uniqueness().cost, mml->last_uniqueness().rival_cost);
-      }
-      // Availability: share of the poses after the first fix that are `localized` (as mml-sim).
-      if (r->first_localized_scan >= 0) {
-        ++r->after_first_fix;
-        if (e.status == hal::LocalizationStatus::kLocalized) ++r->localized_after_first_fix;
-      }
-      if (e.status == hal::LocalizationStatus::kLocalized) {
-        if (r->first_localized_scan < 0) r->first_localized_scan = static_cast<long>(e.scan_id);
-        r->last_localized_scan = static_cast<long>(e.scan_id);
-        ++r->localized;
-        const size_t idx = e.scan_id;  // to_laser_scan: scan_id = log index
-        if (idx < reference.size()) {
-          const double err = std::hypot(e.x - reference[idx].x, e.y - reference[idx].y);
-          r->mean_err_localized_m += err;
-          if (err > o.localized_bound_m) {
-            ++r->wrong_localized;
-            if (r->wrong_localized_scans.size() < 20) r->wrong_localized_scans.push_back(idx);
-          }
-        }
-      }
-    }
-    if ((!soak || mono_ns() >= end_ns) && k >= scan_t.size() && laser.pending() == 0 && !loop.scan_pending()) break;
-    if (soak && mono_ns() >= end_ns && laser.pending() == 0 && !loop.scan_pending()) break;
-    if (mono_ns() > end_ns + (soak ? 3'000'000'000ull : 0)) break;
-    if (!loop.stepped()) {
-      timespec ts{0, 200'000};  // 0.2 ms: idle until the next scan is due
-      nanosleep(&ts, nullptr);
+// One published pose: the trace line, availability and the error against the reference.
+void account_pose(const ReplayOptions& o, const fw::LocalizationSystem& sys, const std::vector<fw::Se2d>& reference,
+                  const hal::PoseEstimate& e, ReplayResult* r) {
+  ++r->scans_processed;
+  const fw::mml::MmlLocalizer* mml = sys.mml();
+  if (o.trace && mml != nullptr && e.scan_id < reference.size()) {
+    const fw::mml::InterpretResult& ir = mml->last();
+    const fw::Se2d& ref = reference[e.scan_id];
+    std::printf("trace %u %-10s %s err %6.3f pose %8.3f %8.3f %6.3f ref %8.3f %8.3f pl %.3f hyps %4u cl %3u r %.3f d2 %8.2f smed %6.2f c %d%d%d soft %d inl %.2f uq %d %.3f/%.3f\n",
+                e.scan_id, hal::status_name(e.status), e.mode == hal::LocalizationMode::kTracking ? "trk" : "glb",
+                std::hypot(e.x - ref.x, e.y - ref.y), e.x, e.y, e.theta, ref.x, ref.y, e.protection_xy_m,
+                ir.hypotheses_valid, ir.cluster_count, ir.best_rating, ir.d2, ir.sigma_med, ir.c_rating,
+                ir.c_mahalanobis, ir.c_median, ir.soft, mml->last_refine().inlier_ratio, mml->last_uniqueness().unique,
+                mml->last_uniqueness().cost, mml->last_uniqueness().rival_cost);
+  }
+  // Availability: share of the poses after the first fix that are `localized` (as mml-sim).
+  if (r->first_localized_scan >= 0) {
+    ++r->after_first_fix;
+    if (e.status == hal::LocalizationStatus::kLocalized) ++r->localized_after_first_fix;
+  }
+  if (e.status != hal::LocalizationStatus::kLocalized) return;
+  if (r->first_localized_scan < 0) r->first_localized_scan = static_cast<long>(e.scan_id);
+  r->last_localized_scan = static_cast<long>(e.scan_id);
+  ++r->localized;
+  const size_t idx = e.scan_id;  // to_laser_scan: scan_id = log index
+  if (idx < reference.size()) {
+    const double err = std::hypot(e.x - reference[idx].x, e.y - reference[idx].y);
+    r->mean_err_localized_m += err;
+    if (err > o.localized_bound_m) {
+      ++r->wrong_localized;
+      if (r->wrong_localized_scans.size() < 20) r->wrong_localized_scans.push_back(idx);
     }
   }
-  const double wall = static_cast<double>(mono_ns() - t0) * 1e-9;
+}
+
+// Feeds the log's scans (at rate_hz of the wall clock, or in lockstep) with the odometry records
+// between them interleaved by their log time, and runs the loop until every scan is processed (or
+// the soak's duration is over). Sensor time is compressed the same way (per-scan motion unchanged).
+class ReplayFeeder {
+ public:
+  ReplayFeeder(const ReplayOptions& o, const sim::CarmenLog& log, ReplayRig& rig, ReplayResult* r)
+      : o_(o), log_(log), rig_(rig), r_(r), lose_rng_(o.lose_seed) {
+    last_ = std::min(log.scans.size(), o.first_scan + o.num_scans);
+    period_ = 1.0 / (o.rate_hz > 0 ? o.rate_hz : 75.0);
+    for (size_t i = o.first_scan; i < last_; ++i) scan_t_.push_back(log.scans[i].ipc_timestamp);
+    // Scan times in the HAL clock domain (hal/msg/laser_scan.h): scan k is due at t0 + k * period.
+    t0_ = mono_ns() + 10'000'000;
+    const double log_t0 = log.scans[o.first_scan].ipc_timestamp;
+    while (oi_ < log.odom.size() && log.odom[oi_].ipc_timestamp < log_t0 - 0.5) ++oi_;
+    oi_start_ = oi_;
+    soak_ = o.duration_s > 0 && !rig.lockstep;
+    next_sample_ns_ = t0_ + static_cast<std::uint64_t>(o.sample_period_s * 1e9);
+    end_ns_ = soak_ ? t0_ + static_cast<std::uint64_t>(o.duration_s * 1e9)
+                    : t0_ + (rig.lockstep ? 600'000'000'000ull
+                                          : static_cast<std::uint64_t>((last_ - o.first_scan) * period_ * 1e9) +
+                                                3'000'000'000ull);
+  }
+  std::uint64_t t0() const { return t0_; }
+
+  void run(const std::vector<fw::Se2d>& reference) {
+    while (true) {
+      const std::uint64_t now = mono_ns();
+      if (soak_ && k_ >= scan_t_.size() && now < end_ns_) {
+        // Soak: one pass of the log lasts n * period; pass L runs L * n * period later in sensor time.
+        k_ = 0;
+        oi_ = oi_start_;
+        ++r_->loops;
+        loop_offset_ns_ = static_cast<std::uint64_t>(static_cast<double>(r_->loops * scan_t_.size()) * period_ * 1e9);
+      }
+      while (due(now)) feed_next();
+      if (o_.on_sample && now >= next_sample_ns_) sample(now);
+      rig_.loop->spin_once();
+      // Lockstep: a scan waiting for odometry that will never come must see time pass (timeout).
+      if (rig_.lockstep && !rig_.loop->stepped() && rig_.loop->scan_pending()) rig_.stepped->advance_ns(50'000'000);
+      hal::PoseEstimate e;
+      while (rig_.sink->pop(&e)) account_pose(o_, *rig_.sys, reference, e, r_);
+      const bool idle = rig_.laser->pending() == 0 && !rig_.loop->scan_pending();
+      if ((!soak_ || mono_ns() >= end_ns_) && k_ >= scan_t_.size() && idle) break;
+      if (soak_ && mono_ns() >= end_ns_ && idle) break;
+      if (mono_ns() > end_ns_ + (soak_ ? 3'000'000'000ull : 0)) break;
+      if (!rig_.loop->stepped()) {
+        timespec ts{0, 200'000};  // 0.2 ms: idle until the next scan is due
+        nanosleep(&ts, nullptr);
+      }
+    }
+  }
+
+ private:
+  // Piecewise-linear time warp of a log time: scan k of the log is at t0 + k * period.
+  std::uint64_t warp(double ipc) const {
+    auto it = std::upper_bound(scan_t_.begin(), scan_t_.end(), ipc);
+    const size_t k = static_cast<size_t>(it - scan_t_.begin());
+    double t;
+    if (k == 0) t = 0;
+    else if (k >= scan_t_.size()) t = (scan_t_.size() - 1) * period_;
+    else {
+      const double a = scan_t_[k - 1], b = scan_t_[k];
+      t = ((k - 1) + (b > a ? (ipc - a) / (b - a) : 0)) * period_;
+    }
+    return t0_ + static_cast<std::uint64_t>(t * 1e9);
+  }
+
+  // The next scan is due: in lockstep when the loop has taken every scan fed so far, at rate when
+  // its wall time has come.
+  bool due(std::uint64_t now) const {
+    if (k_ >= scan_t_.size() || (soak_ && now >= end_ns_)) return false;
+    if (rig_.lockstep) {
+      const hal::Health& h = rig_.loop->health();
+      return rig_.laser->pending() == 0 && !rig_.loop->scan_pending() &&
+             h.scans_processed + h.dropped_scans + r_->scans_dropped + r_->scans_lost >= k_;
+    }
+    return now >= t0_ + static_cast<std::uint64_t>(static_cast<double>(g_) * period_ * 1e9);
+  }
+
+  void feed_next() {
+    const double tk = scan_t_[k_];
+    while (oi_ < log_.odom.size() &&
+           log_.odom[oi_].ipc_timestamp <= tk + 0.5 * (k_ + 1 < scan_t_.size() ? scan_t_[k_ + 1] - tk : 0)) {
+      const sim::CarmenOdom& c = log_.odom[oi_++];
+      hal::Odometry od;
+      od.timestamp_ns = warp(c.ipc_timestamp) + loop_offset_ns_;
+      od.x = static_cast<float>(c.pose.x);
+      od.y = static_cast<float>(c.pose.y);
+      od.theta = static_cast<float>(c.pose.theta);
+      if (o_.mutate_odometry) o_.mutate_odometry(c.ipc_timestamp, &od);
+      rig_.odom->push(od);
+    }
+    std::int64_t jitter_ns = 0;
+    if (o_.scan_time_jitter_ms > 0)
+      jitter_ns = static_cast<std::int64_t>((2.0 * lose_draw_(lose_rng_) - 1.0) * o_.scan_time_jitter_ms * 1e6);
+    // Scan k at t0 + k·period exactly (= warp(tk) for distinct log times; logs with two scans at
+    // one ipc time, as intel has, would otherwise feed the second at the same time: out of order).
+    const std::uint64_t scan_ns = t0_ + static_cast<std::uint64_t>(static_cast<double>(k_) * period_ * 1e9);
+    hal::LaserScan s = sim::to_laser_scan(log_.scans[o_.first_scan + k_], scan_ns + loop_offset_ns_ + jitter_ns);
+    if (o_.mutate_scan) o_.mutate_scan(o_.first_scan + k_, &s);
+    if (rig_.lockstep) rig_.stepped->set_ns(warp(k_ + 1 < scan_t_.size() ? scan_t_[k_ + 1] : tk));
+    const bool lost_random =
+        (o_.lose_prob > 0 && lose_draw_(lose_rng_) < o_.lose_prob) ||
+        std::find(o_.lose_list.begin(), o_.lose_list.end(), o_.first_scan + k_) != o_.lose_list.end();
+    if ((o_.lose_every > 0 && k_ % o_.lose_every == o_.lose_every - 1) || lost_random) {
+      ++r_->scans_lost;
+    } else if (!rig_.laser->push(s)) {
+      ++r_->scans_dropped;
+      ++r_->ring_overflows;
+    }
+    ++r_->scans_fed;
+    ++k_;
+    ++g_;
+  }
+
+  void sample(std::uint64_t now) {
+    next_sample_ns_ += static_cast<std::uint64_t>(o_.sample_period_s * 1e9);
+    ReplaySample smp;
+    smp.elapsed_s = static_cast<double>(now - t0_) * 1e-9;
+    smp.scans_fed = r_->scans_fed;
+    smp.scans_processed = r_->scans_processed;
+    smp.health_dropped = rig_.loop->health().dropped_scans;
+    smp.ring_overflows = r_->ring_overflows;
+    smp.localized = r_->localized;
+    smp.wrong_localized = r_->wrong_localized;
+    smp.loops = r_->loops;
+    o_.on_sample(smp);
+  }
+
+  const ReplayOptions& o_;
+  const sim::CarmenLog& log_;
+  ReplayRig& rig_;
+  ReplayResult* r_;
+  std::vector<double> scan_t_;  // log times of the scans fed
+  size_t last_ = 0;
+  double period_ = 0;
+  std::uint64_t t0_ = 0, end_ns_ = 0, next_sample_ns_ = 0, loop_offset_ns_ = 0;
+  size_t oi_ = 0, oi_start_ = 0;
+  size_t k_ = 0;  // index into scan_t_ of the next scan to feed
+  size_t g_ = 0;  // scans fed over all loops (soak): scan g is due at t0 + g * period
+  bool soak_ = false;
+  std::mt19937_64 lose_rng_;
+  std::uniform_real_distribution<double> lose_draw_{0.0, 1.0};
+};
+
+// Timing, the global context's figures and the loop's counters after the run.
+void collect_results(ReplayRig& rig, double wall_s, ReplayResult* r) {
+  fw::LocalizationSystem& sys = *rig.sys;
   sys.stop_global_context();  // before the pool it drives
   if (sys.tracked() != nullptr) {
     const fw::track::GlobalContext& gc = sys.tracked()->global_context();
@@ -397,7 +435,8 @@ bool run_replay(const ReplayOptions& o, ReplayResult* r, std::string* error) {
   if (r->after_first_fix) {
     r->availability = static_cast<double>(r->localized_after_first_fix) / static_cast<double>(r->after_first_fix);
   }
-  pool.stop();
+  rig.pool->stop();
+  const fw::LocalizationLoop& loop = *rig.loop;
   const fw::PerfStats step = loop.perf_step().stats();
   r->step_p50_ms = step.p50_ms;
   r->step_p99_ms = step.p99_ms;
@@ -407,11 +446,64 @@ bool run_replay(const ReplayOptions& o, ReplayResult* r, std::string* error) {
   // HEALTH dropped_scans includes the ring overflows counted above (SimLaserSource::skipped_scans).
   r->scans_dropped = loop.health().dropped_scans;
   r->health_dropped = loop.health().dropped_scans;
-  r->pending_at_end = laser.pending() + (loop.scan_pending() ? 1 : 0);
+  r->pending_at_end = rig.laser->pending() + (loop.scan_pending() ? 1 : 0);
   r->scans_unpaired = loop.counters().scans_unpaired;
   r->scans_out_of_order = loop.counters().scans_out_of_order;
   r->scans_malformed = loop.counters().scans_malformed;
-  r->achieved_rate_hz = wall > 0 ? static_cast<double>(r->scans_processed) / wall : 0;
+  r->achieved_rate_hz = wall_s > 0 ? static_cast<double>(r->scans_processed) / wall_s : 0;
+}
+
+}  // namespace
+
+bool run_replay(const ReplayOptions& o, ReplayResult* r, std::string* error) {
+  *r = ReplayResult{};
+  const sim::Dataset* ds = sim::find_dataset(o.dataset);
+  if (!ds || ds->raw_log.empty()) {
+    *error = "dataset '" + o.dataset + "' unknown or without a raw log";
+    return false;
+  }
+  sim::CarmenLog log;
+  std::vector<fw::Se2d> reference;
+  if (!load_replay_inputs(o, *ds, &log, &reference, r, error)) return false;
+  const std::string dir = o.map_dir.empty() ? sim::map_cache_dir() : o.map_dir;
+  sim::RosMap ros;
+  if (!sim::ensure_global_map(o.dataset, 0, dir, &ros, error)) return false;
+  ReplayRig rig;
+  if (!load_replay_map(sim::global_map_image_path(o.dataset, dir), &rig, r, error)) return false;
+
+  rig.lockstep = o.rate_hz <= 0;
+  rig.gmode = o.global_context == "auto" ? (rig.lockstep ? "inline-ref" : "thread") : o.global_context;
+  if (rig.gmode != "thread" && rig.gmode != "inline-live" && rig.gmode != "inline-ref") {
+    *error = "global_context '" + rig.gmode + "': expected auto, thread, inline-live or inline-ref";
+    return false;
+  }
+  rig.rt = o.realtime && !rig.lockstep;
+  int old_policy = SCHED_OTHER;
+  sched_param old_param{};
+  pthread_getschedparam(pthread_self(), &old_policy, &old_param);
+  struct RestoreSched {  // the process goes on (tests): this thread back to its old policy
+    bool on;
+    int policy;
+    sched_param param;
+    ~RestoreSched() {
+      if (on) pthread_setschedparam(pthread_self(), policy, &param);
+    }
+  } restore{rig.rt, old_policy, old_param};
+  if (!rig.lockstep && (o.pin_sensor_thread || rig.rt)) {
+    char warning[160];
+    const fw::Status st = fw::apply_execution_context_here(fw::kSensorContext, rig.rt, warning);
+    if (!st) { *error = st.message(); return false; }
+  }
+  r->realtime = rig.rt;
+  if (!start_replay_pool(o, &rig, r, error)) return false;
+  if (!build_replay_localizer(o, &rig, r, error)) {
+    rig.pool->stop();
+    return false;
+  }
+  record_memory(rig, r);
+  ReplayFeeder feeder(o, log, rig, r);
+  feeder.run(reference);
+  collect_results(rig, static_cast<double>(mono_ns() - feeder.t0()) * 1e-9, r);
   return true;
 }
 
