@@ -156,237 +156,251 @@ void write_plots(const LocalizePlan& plan, const LoadedDataset& ds, const std::s
 
 }  // namespace
 
-bool run_localize_evaluation(const LocalizePlan& plan, BenchJson* json, std::string* err) {
-  const auto t_all = std::chrono::steady_clock::now();
-  std::filesystem::create_directories(plan.out_dir);
+namespace {
+
+// State of one evaluation shared by its steps.
+struct LocalizeRun {
+  const LocalizePlan& plan;
+  BenchJson* json;
+  std::chrono::steady_clock::time_point t_all;
   std::vector<SystemSummary> rows;
   std::ostringstream notes, refnotes;
   std::vector<double> track_ms_all;
   std::vector<TrialResult> kidnap_all;
   MetricBounds kidnap_bounds;
-  json->add_int("seed", static_cast<long long>(plan.seed));
-  json->add_int("whole_runs_per_dataset", static_cast<long long>(plan.whole_runs));
-  json->add_int("fix_trials_per_dataset", static_cast<long long>(plan.fix_trials));
-  json->add_int("fix_steps", static_cast<long long>(plan.fix_steps));
+  fw::mml::MmlLocalizerConfig mml_cfg;
+};
 
-  struct Job {
-    std::string name;
-    const DatasetFiles* files = nullptr;
+// Whole-log runs: kidnapped starts drawn over the first whole_start_fraction of the path, to the end.
+void run_whole_logs(LocalizeRun& run, const LoadedDataset& ds, OwnedLocalizer& loc, const MetricBounds& b,
+                    std::vector<TrialResult>* all) {
+  const LocalizePlan& plan = run.plan;
+  const std::size_t nwhole = count_for(plan.whole_runs_override, ds.name, plan.whole_runs);
+  const double total = ds.travelled.back();
+  std::size_t last = 0;
+  for (std::size_t i = 0; i < ds.travelled.size(); ++i)
+    if (ds.travelled[i] <= plan.whole_start_fraction * total) last = i;
+  fw::RandomStream rng(plan.seed, 501);
+  TrialOptions opt = plan.step_rule;
+  opt.max_steps = plan.whole_max_steps;
+  std::vector<TrialResult> whole;
+  for (std::size_t k = 0; k < nwhole; ++k) {
+    const std::size_t start = last > 0 ? rng.uniform_index(static_cast<std::uint32_t>(last)) : 0;
+    const auto tk = std::chrono::steady_clock::now();
+    TrialResult t = run_trial(loc, ds, start, opt);
+    t.whole_log = true;
+    if (plan.verbose) progress(ds, "whole-log", k, nwhole, t, b, since(tk));
+    describe_failures(ds, "whole-log", k, t, b, &run.notes, plan.verbose);
+    whole.push_back(t);
+    all->push_back(std::move(t));
+  }
+  write_plots(plan, ds, "mml-track_whole", whole, nullptr);
+}
+
+// First-fix trials from kidnapped starts, fix_steps long each.
+void run_fix_trials(LocalizeRun& run, const LoadedDataset& ds, OwnedLocalizer& loc, const MetricBounds& b,
+                    const std::vector<std::size_t>& starts, const TrialOptions& fopt, std::vector<TrialResult>* all) {
+  std::vector<TrialResult> fix;
+  for (std::size_t k = 0; k < starts.size(); ++k) {
+    const auto tk = std::chrono::steady_clock::now();
+    TrialResult t = run_trial(loc, ds, starts[k], fopt);
+    if (run.plan.verbose) progress(ds, "fix-trial", k, starts.size(), t, b, since(tk));
+    describe_failures(ds, "fix-trial", k, t, b, &run.notes, run.plan.verbose);
+    fix.push_back(t);
+    all->push_back(std::move(t));
+  }
+  write_plots(run.plan, ds, "mml-track_fix", fix, nullptr);
+}
+
+// The dataset's flat figures (D_first_fix_success, ...).
+void add_dataset_figures(BenchJson* json, const std::string& D, const SystemSummary& s) {
+  json->add(D + "_first_fix_success", s.first_fix_success);
+  json->add(D + "_m_to_fix_median", s.m_to_fix_median);
+  json->add(D + "_availability", s.availability);
+  json->add_int(D + "_integrity_failures", static_cast<long long>(s.integrity_failures));
+  json->add_int(D + "_localized_steps_checked", static_cast<long long>(s.localized_checked));
+  json->add(D + "_pl_exceed_rate", s.pl_exceed_rate);
+  // The same against the log reference alone, and what the reference checks excluded.
+  json->add_int(D + "_integrity_failures_vs_log_reference", static_cast<long long>(s.integrity_failures_raw));
+  json->add(D + "_pl_exceed_rate_vs_log_reference",
+            s.pl_steps_raw ? static_cast<double>(s.pl_exceed_raw) / s.pl_steps_raw : NAN);
+  json->add_int(D + "_excluded_map_steps", static_cast<long long>(s.excluded_map_steps));
+  json->add_int(D + "_excluded_ref_bound_steps", static_cast<long long>(s.excluded_bound_steps));
+  json->add(D + "_pl_exceed_xy_rate", s.pl_steps ? static_cast<double>(s.pl_exceed_xy) / s.pl_steps : NAN);
+  json->add(D + "_pl_exceed_theta_rate", s.pl_steps ? static_cast<double>(s.pl_exceed_theta) / s.pl_steps : NAN);
+  json->add(D + "_availability_steps", static_cast<double>(s.avail_steps));
+  json->add(D + "_track_err_m_median", s.track_err_median_m);
+  json->add(D + "_track_err_m_p95", s.track_err_p95_m);
+  json->add(D + "_step_ms_p50", s.step_ms_p50);
+  json->add(D + "_step_ms_p99", s.step_ms_p99);
+  json->add_int(D + "_trials", static_cast<long long>(s.trials));
+}
+
+// MCL baseline: metres to the first fix on the first fix-trial starts.
+bool run_mcl_baseline(LocalizeRun& run, const LoadedDataset& ds, const MetricBounds& b,
+                      const std::vector<std::size_t>& starts, const TrialOptions& fopt, std::string* err) {
+  const LocalizePlan& plan = run.plan;
+  std::string e;
+  auto mcl = OwnedLocalizer::make_mcl(ds.map, mcl_baseline_options(plan.mcl_particles, plan.seed), plan.threads, &e);
+  if (!mcl) return (*err = ds.name + ": mcl: " + e, false);
+  std::vector<TrialResult> mt;
+  const std::string label = "mcl-" + std::to_string(plan.mcl_particles / 1000) + "k";
+  for (std::size_t k = 0; k < std::min(plan.mcl_trials, starts.size()); ++k) {
+    const auto tk = std::chrono::steady_clock::now();
+    mt.push_back(run_trial(*mcl, ds, starts[k], fopt));
+    if (plan.verbose) progress(ds, label, k, std::min(plan.mcl_trials, starts.size()), mt.back(), b, since(tk));
+  }
+  SystemSummary ms = summarize(ds.name, label, mt, mcl->static_bytes() / (1024.0 * 1024.0), b);
+  run.rows.push_back(ms);
+  run.json->add(ds.key + "_mcl_m_to_fix_median", ms.m_to_fix_median);
+  run.json->add(ds.key + "_mcl_first_fix_success", ms.first_fix_success);
+  return true;
+}
+
+// Kidnaps: a fix, then carried to a random scan at least kidnap_min_dist_m away.
+void run_kidnaps(LocalizeRun& run, const LoadedDataset& ds, OwnedLocalizer& loc, const MetricBounds& b) {
+  const LocalizePlan& plan = run.plan;
+  TrialOptions kopt = plan.step_rule;
+  kopt.kidnap_after_fix_steps = plan.kidnap_after_fix;
+  kopt.kidnap_at_step = plan.kidnap_latest_step;
+  kopt.kidnap_steps_after = plan.kidnap_steps_after;
+  kopt.max_steps = 0;
+  TrialOptions sopt = kopt;
+  sopt.max_steps = plan.kidnap_latest_step + plan.kidnap_steps_after;
+  const std::vector<std::size_t> kstarts = draw_starts(ds, plan.kidnap_runs, plan.seed + 7, sopt);
+  fw::RandomStream krng(plan.seed, 733);
+  // Targets: a random scan at least kidnap_min_dist_m from the robot's true position, with room
+  // for kidnap_steps_after steps of log after it.
+  const double need = static_cast<double>(plan.kidnap_steps_after) * plan.step_rule.min_move_m * 0.5;
+  std::size_t last = 0;
+  for (std::size_t i = 0; i < ds.travelled.size(); ++i)
+    if (ds.travelled[i] <= ds.travelled.back() - need) last = i;
+  kopt.kidnap_target = [&](std::size_t from) -> std::size_t {
+    for (int attempt = 0; attempt < 200; ++attempt) {
+      const std::size_t j = krng.uniform_index(static_cast<std::uint32_t>(std::max<std::size_t>(last, 1)));
+      const fw::Se2d& a = ds.reference[from];
+      const fw::Se2d& c = ds.reference[j];
+      if (std::hypot(a.x - c.x, a.y - c.y) >= plan.kidnap_min_dist_m) return j;
+    }
+    return krng.uniform_index(static_cast<std::uint32_t>(std::max<std::size_t>(last, 1)));
   };
-  std::vector<Job> jobs;
-  for (const auto& n : plan.datasets) jobs.push_back({n, nullptr});
-  for (const auto& f : plan.custom) jobs.push_back({f.name, &f});
-
-  fw::mml::MmlLocalizerConfig mml_cfg = mml_track_config(plan.mml_config, plan.seed);
-  mml_cfg.mml.pool_cluster_support = plan.pool_cluster_support;
-  for (const Job& job : jobs) {
-    const auto t0 = std::chrono::steady_clock::now();
-    LoadedDataset ds;
-    if (job.files ? !load_dataset_files(*job.files, &ds, err) : !load_dataset(job.name, &ds, err)) return false;
-    if (plan.verbose) {
-      std::printf("dataset %s: %zu scans, %.0f m of path, map %ux%u @ %.2f m, reference: %s%s (loaded in %.1f s)\n  %s\n",
-                  ds.name.c_str(), ds.log.scans.size(), ds.travelled.back(), ds.map.geometry.width,
-                  ds.map.geometry.height, ds.map.geometry.resolution, ds.reference_note.c_str(),
-                  ds.synthetic_odometry ? " [synthetic odometry]" : "", since(t0), ds.ref_check_note.c_str());
-      std::fflush(stdout);
-    }
-    refnotes << "- " << ds.name << ": " << ds.ref_check_note << "\n";
-    json->add_int(ds.key + "_ref_excluded_scans", static_cast<long long>(ds.ref_excluded_scans));
-    const MetricBounds b = bounds_for(ds);
-    std::string e;
-    auto loc = OwnedLocalizer::make_track(ds.map, ds.image, mml_cfg, fw::track::TrackOptions(), plan.threads, &e);
-    if (!loc) return (*err = ds.name + ": mml-track: " + e, false);
-
-    std::vector<TrialResult> all;  // every mml-track trial on this dataset (whole + fix)
-    // Whole-log runs.
-    const std::size_t nwhole = count_for(plan.whole_runs_override, ds.name, plan.whole_runs);
-    {
-      const double total = ds.travelled.back();
-      std::size_t last = 0;
-      for (std::size_t i = 0; i < ds.travelled.size(); ++i)
-        if (ds.travelled[i] <= plan.whole_start_fraction * total) last = i;
-      fw::RandomStream rng(plan.seed, 501);
-      TrialOptions opt = plan.step_rule;
-      opt.max_steps = plan.whole_max_steps;
-      std::vector<TrialResult> whole;
-      for (std::size_t k = 0; k < nwhole; ++k) {
-        const std::size_t start = last > 0 ? rng.uniform_index(static_cast<std::uint32_t>(last)) : 0;
-        const auto tk = std::chrono::steady_clock::now();
-        TrialResult t = run_trial(*loc, ds, start, opt);
-        t.whole_log = true;
-        if (plan.verbose) progress(ds, "whole-log", k, nwhole, t, b, since(tk));
-        describe_failures(ds, "whole-log", k, t, b, &notes, plan.verbose);
-        whole.push_back(t);
-        all.push_back(std::move(t));
-      }
-      write_plots(plan, ds, "mml-track_whole", whole, nullptr);
-    }
-    // First-fix trials.
-    const std::size_t nfix = count_for(plan.fix_trials_override, ds.name, plan.fix_trials);
-    TrialOptions fopt = plan.step_rule;
-    fopt.max_steps = plan.fix_steps;
-    const std::vector<std::size_t> starts = draw_starts(ds, nfix, plan.seed, fopt);
-    {
-      std::vector<TrialResult> fix;
-      for (std::size_t k = 0; k < starts.size(); ++k) {
-        const auto tk = std::chrono::steady_clock::now();
-        TrialResult t = run_trial(*loc, ds, starts[k], fopt);
-        if (plan.verbose) progress(ds, "fix-trial", k, starts.size(), t, b, since(tk));
-        describe_failures(ds, "fix-trial", k, t, b, &notes, plan.verbose);
-        fix.push_back(t);
-        all.push_back(std::move(t));
-      }
-      write_plots(plan, ds, "mml-track_fix", fix, nullptr);
-    }
-    SystemSummary s = summarize(ds.name, "mml-track", all, loc->static_bytes() / (1024.0 * 1024.0), b);
-    rows.push_back(s);
-    for (const auto& t : all)
-      for (const auto& st : t.steps)
-        if (st.mode == hal::LocalizationMode::kTracking) track_ms_all.push_back(st.step_ms);
-    const std::string& D = ds.key;
-    json->add(D + "_first_fix_success", s.first_fix_success);
-    json->add(D + "_m_to_fix_median", s.m_to_fix_median);
-    json->add(D + "_availability", s.availability);
-    json->add_int(D + "_integrity_failures", static_cast<long long>(s.integrity_failures));
-    json->add_int(D + "_localized_steps_checked", static_cast<long long>(s.localized_checked));
-    json->add(D + "_pl_exceed_rate", s.pl_exceed_rate);
-    // The same against the log reference alone, and what the reference checks excluded.
-    json->add_int(D + "_integrity_failures_vs_log_reference", static_cast<long long>(s.integrity_failures_raw));
-    json->add(D + "_pl_exceed_rate_vs_log_reference",
-              s.pl_steps_raw ? static_cast<double>(s.pl_exceed_raw) / s.pl_steps_raw : NAN);
-    json->add_int(D + "_excluded_map_steps", static_cast<long long>(s.excluded_map_steps));
-    json->add_int(D + "_excluded_ref_bound_steps", static_cast<long long>(s.excluded_bound_steps));
-    json->add(D + "_pl_exceed_xy_rate", s.pl_steps ? static_cast<double>(s.pl_exceed_xy) / s.pl_steps : NAN);
-    json->add(D + "_pl_exceed_theta_rate", s.pl_steps ? static_cast<double>(s.pl_exceed_theta) / s.pl_steps : NAN);
-    json->add(D + "_availability_steps", static_cast<double>(s.avail_steps));
-    json->add(D + "_track_err_m_median", s.track_err_median_m);
-    json->add(D + "_track_err_m_p95", s.track_err_p95_m);
-    json->add(D + "_step_ms_p50", s.step_ms_p50);
-    json->add(D + "_step_ms_p99", s.step_ms_p99);
-    json->add_int(D + "_trials", static_cast<long long>(s.trials));
-
-    // MCL baseline: metres to the first fix on the first fix-trial starts.
-    if (std::find(plan.mcl_datasets.begin(), plan.mcl_datasets.end(), ds.name) != plan.mcl_datasets.end() &&
-        plan.mcl_trials > 0) {
-      auto mcl = OwnedLocalizer::make_mcl(ds.map, mcl_baseline_options(plan.mcl_particles, plan.seed), plan.threads, &e);
-      if (!mcl) return (*err = ds.name + ": mcl: " + e, false);
-      std::vector<TrialResult> mt;
-      const std::string label = "mcl-" + std::to_string(plan.mcl_particles / 1000) + "k";
-      for (std::size_t k = 0; k < std::min(plan.mcl_trials, starts.size()); ++k) {
-        const auto tk = std::chrono::steady_clock::now();
-        mt.push_back(run_trial(*mcl, ds, starts[k], fopt));
-        if (plan.verbose) progress(ds, label, k, std::min(plan.mcl_trials, starts.size()), mt.back(), b, since(tk));
-      }
-      SystemSummary ms = summarize(ds.name, label, mt, mcl->static_bytes() / (1024.0 * 1024.0), b);
-      rows.push_back(ms);
-      json->add(D + "_mcl_m_to_fix_median", ms.m_to_fix_median);
-      json->add(D + "_mcl_first_fix_success", ms.first_fix_success);
-    }
-    // Kidnaps.
-    if (std::find(plan.kidnap_datasets.begin(), plan.kidnap_datasets.end(), ds.name) != plan.kidnap_datasets.end() &&
-        plan.kidnap_runs > 0) {
-      TrialOptions kopt = plan.step_rule;
-      kopt.kidnap_after_fix_steps = plan.kidnap_after_fix;
-      kopt.kidnap_at_step = plan.kidnap_latest_step;
-      kopt.kidnap_steps_after = plan.kidnap_steps_after;
-      kopt.max_steps = 0;
-      TrialOptions sopt = kopt;
-      sopt.max_steps = plan.kidnap_latest_step + plan.kidnap_steps_after;
-      const std::vector<std::size_t> kstarts = draw_starts(ds, plan.kidnap_runs, plan.seed + 7, sopt);
-      fw::RandomStream krng(plan.seed, 733);
-      // Targets: a random scan at least kidnap_min_dist_m from the robot's true position, with room
-      // for kidnap_steps_after steps of log after it.
-      const double need = static_cast<double>(plan.kidnap_steps_after) * plan.step_rule.min_move_m * 0.5;
-      std::size_t last = 0;
-      for (std::size_t i = 0; i < ds.travelled.size(); ++i)
-        if (ds.travelled[i] <= ds.travelled.back() - need) last = i;
-      kopt.kidnap_target = [&](std::size_t from) -> std::size_t {
-        for (int attempt = 0; attempt < 200; ++attempt) {
-          const std::size_t j = krng.uniform_index(static_cast<std::uint32_t>(std::max<std::size_t>(last, 1)));
-          const fw::Se2d& a = ds.reference[from];
-          const fw::Se2d& c = ds.reference[j];
-          if (std::hypot(a.x - c.x, a.y - c.y) >= plan.kidnap_min_dist_m) return j;
-        }
-        return krng.uniform_index(static_cast<std::uint32_t>(std::max<std::size_t>(last, 1)));
-      };
-      std::vector<TrialResult> kt;
-      for (std::size_t k = 0; k < kstarts.size(); ++k) {
-        const auto tk = std::chrono::steady_clock::now();
-        kt.push_back(run_trial(*loc, ds, kstarts[k], kopt));
-        if (plan.verbose) progress(ds, "kidnap", k, kstarts.size(), kt.back(), kidnap_bounds, since(tk));
-        describe_failures(ds, "kidnap", k, kt.back(), b, &notes, plan.verbose);
-      }
-      SystemSummary ks = summarize(ds.name, "mml-track kidnap", kt, 0, b);
-      rows.push_back(ks);
-      json->add(D + "_kidnap_refix_success", ks.kidnap_refix_success);
-      json->add_int(D + "_kidnap_integrity_failures", static_cast<long long>(ks.kidnap_integrity_failures));
-      write_plots(plan, ds, "mml-track_kidnap", kt, nullptr);
-      kidnap_all.insert(kidnap_all.end(), kt.begin(), kt.end());
-    }
-    if (plan.verbose) {
-      std::printf("dataset %s done in %.1f s (total %.1f s)\n", ds.name.c_str(), since(t0), since(t_all));
-      std::fflush(stdout);
-    }
+  std::vector<TrialResult> kt;
+  for (std::size_t k = 0; k < kstarts.size(); ++k) {
+    const auto tk = std::chrono::steady_clock::now();
+    kt.push_back(run_trial(loc, ds, kstarts[k], kopt));
+    if (plan.verbose) progress(ds, "kidnap", k, kstarts.size(), kt.back(), run.kidnap_bounds, since(tk));
+    describe_failures(ds, "kidnap", k, kt.back(), b, &run.notes, plan.verbose);
   }
-  if (!kidnap_all.empty()) {
-    SystemSummary ks = summarize("all", "mml-track kidnap", kidnap_all, 0, kidnap_bounds);
-    json->add("kidnap_refix_success", ks.kidnap_refix_success);
-    json->add_int("kidnap_integrity_failures", static_cast<long long>(ks.kidnap_integrity_failures));
-    json->add_int("kidnap_runs", static_cast<long long>(ks.kidnaps));
-    json->add("kidnap_detected_rate", ks.kidnaps ? static_cast<double>(ks.kidnaps_detected) / ks.kidnaps : NAN);
-    json->add("kidnap_delay_steps_median", ks.kidnap_delay_median);
-    json->add("kidnap_refix_m_median", ks.kidnap_refix_m_median);
-  }
+  SystemSummary ks = summarize(ds.name, "mml-track kidnap", kt, 0, b);
+  run.rows.push_back(ks);
+  run.json->add(ds.key + "_kidnap_refix_success", ks.kidnap_refix_success);
+  run.json->add_int(ds.key + "_kidnap_integrity_failures", static_cast<long long>(ks.kidnap_integrity_failures));
+  write_plots(plan, ds, "mml-track_kidnap", kt, nullptr);
+  run.kidnap_all.insert(run.kidnap_all.end(), kt.begin(), kt.end());
+}
 
-  // Unknown area: as mml_eval_run.cpp (same region and starts), with mml-track.
-  if (plan.run_unknown) {
-    const auto t0 = std::chrono::steady_clock::now();
-    LoadedDataset ds;
-    double region[4];
-    std::vector<std::size_t> starts;
-    if (!prepare_unknown_area(plan.unknown_dataset, plan.seed, plan.unknown_trials, &ds, region, &starts, err))
-      return false;
-    std::string e;
-    auto loc = OwnedLocalizer::make_track(ds.map, ds.image, mml_cfg, fw::track::TrackOptions(), plan.threads, &e);
-    if (!loc) return (*err = "unknown area: mml-track: " + e, false);
-    TrialOptions uo = plan.step_rule;
-    uo.max_steps = plan.unknown_steps;
-    const MetricBounds b = bounds_for(ds);
-    std::vector<TrialResult> ut;
-    for (std::size_t k = 0; k < starts.size(); ++k) {
-      const auto tk = std::chrono::steady_clock::now();
-      ut.push_back(run_trial(*loc, ds, starts[k], uo, region));
-      if (plan.verbose) progress(ds, "unknown-area", k, starts.size(), ut.back(), b, since(tk));
-      describe_failures(ds, "unknown-area", k, ut.back(), b, &notes, plan.verbose);
-    }
-    SystemSummary us = summarize(ds.name + "-erased", "mml-track", ut, 0, b);
-    rows.push_back(us);
-    std::size_t in_region = 0, in_region_loc = 0, in_region_wrong = 0;
-    for (const auto& t : ut)
-      for (const auto& st : t.steps) {
-        if (!st.in_region) continue;
-        ++in_region;
-        if (st.status == hal::LocalizationStatus::kLocalized) {
-          ++in_region_loc;
-          in_region_wrong += std::isfinite(st.err_m) && (st.err_m > b.bound_m || st.err_rad > b.bound_rad);
-        }
+// One dataset (built-in or given by path): whole logs, fix trials, MCL, kidnaps.
+bool evaluate_dataset(LocalizeRun& run, const std::string& name, const DatasetFiles* files, std::string* err) {
+  const LocalizePlan& plan = run.plan;
+  BenchJson* json = run.json;
+  const auto t0 = std::chrono::steady_clock::now();
+  LoadedDataset ds;
+  if (files ? !load_dataset_files(*files, &ds, err) : !load_dataset(name, &ds, err)) return false;
+  if (plan.verbose) {
+    std::printf("dataset %s: %zu scans, %.0f m of path, map %ux%u @ %.2f m, reference: %s%s (loaded in %.1f s)\n  %s\n",
+                ds.name.c_str(), ds.log.scans.size(), ds.travelled.back(), ds.map.geometry.width,
+                ds.map.geometry.height, ds.map.geometry.resolution, ds.reference_note.c_str(),
+                ds.synthetic_odometry ? " [synthetic odometry]" : "", since(t0), ds.ref_check_note.c_str());
+    std::fflush(stdout);
+  }
+  run.refnotes << "- " << ds.name << ": " << ds.ref_check_note << "\n";
+  json->add_int(ds.key + "_ref_excluded_scans", static_cast<long long>(ds.ref_excluded_scans));
+  const MetricBounds b = bounds_for(ds);
+  std::string e;
+  auto loc = OwnedLocalizer::make_track(ds.map, ds.image, run.mml_cfg, fw::track::TrackOptions(), plan.threads, &e);
+  if (!loc) return (*err = ds.name + ": mml-track: " + e, false);
+
+  std::vector<TrialResult> all;  // every mml-track trial on this dataset (whole + fix)
+  run_whole_logs(run, ds, *loc, b, &all);
+  const std::size_t nfix = count_for(plan.fix_trials_override, ds.name, plan.fix_trials);
+  TrialOptions fopt = plan.step_rule;
+  fopt.max_steps = plan.fix_steps;
+  const std::vector<std::size_t> starts = draw_starts(ds, nfix, plan.seed, fopt);
+  run_fix_trials(run, ds, *loc, b, starts, fopt, &all);
+  SystemSummary s = summarize(ds.name, "mml-track", all, loc->static_bytes() / (1024.0 * 1024.0), b);
+  run.rows.push_back(s);
+  for (const auto& t : all)
+    for (const auto& st : t.steps)
+      if (st.mode == hal::LocalizationMode::kTracking) run.track_ms_all.push_back(st.step_ms);
+  add_dataset_figures(json, ds.key, s);
+
+  if (std::find(plan.mcl_datasets.begin(), plan.mcl_datasets.end(), ds.name) != plan.mcl_datasets.end() &&
+      plan.mcl_trials > 0) {
+    if (!run_mcl_baseline(run, ds, b, starts, fopt, err)) return false;
+  }
+  if (std::find(plan.kidnap_datasets.begin(), plan.kidnap_datasets.end(), ds.name) != plan.kidnap_datasets.end() &&
+      plan.kidnap_runs > 0) {
+    run_kidnaps(run, ds, *loc, b);
+  }
+  if (plan.verbose) {
+    std::printf("dataset %s done in %.1f s (total %.1f s)\n", ds.name.c_str(), since(t0), since(run.t_all));
+    std::fflush(stdout);
+  }
+  return true;
+}
+
+// Unknown area: as mml_eval_run.cpp (same region and starts), with mml-track.
+bool run_unknown_area(LocalizeRun& run, std::string* err) {
+  const LocalizePlan& plan = run.plan;
+  BenchJson* json = run.json;
+  const auto t0 = std::chrono::steady_clock::now();
+  LoadedDataset ds;
+  double region[4];
+  std::vector<std::size_t> starts;
+  if (!prepare_unknown_area(plan.unknown_dataset, plan.seed, plan.unknown_trials, &ds, region, &starts, err))
+    return false;
+  std::string e;
+  auto loc = OwnedLocalizer::make_track(ds.map, ds.image, run.mml_cfg, fw::track::TrackOptions(), plan.threads, &e);
+  if (!loc) return (*err = "unknown area: mml-track: " + e, false);
+  TrialOptions uo = plan.step_rule;
+  uo.max_steps = plan.unknown_steps;
+  const MetricBounds b = bounds_for(ds);
+  std::vector<TrialResult> ut;
+  for (std::size_t k = 0; k < starts.size(); ++k) {
+    const auto tk = std::chrono::steady_clock::now();
+    ut.push_back(run_trial(*loc, ds, starts[k], uo, region));
+    if (plan.verbose) progress(ds, "unknown-area", k, starts.size(), ut.back(), b, since(tk));
+    describe_failures(ds, "unknown-area", k, ut.back(), b, &run.notes, plan.verbose);
+  }
+  SystemSummary us = summarize(ds.name + "-erased", "mml-track", ut, 0, b);
+  run.rows.push_back(us);
+  std::size_t in_region = 0, in_region_loc = 0, in_region_wrong = 0;
+  for (const auto& t : ut)
+    for (const auto& st : t.steps) {
+      if (!st.in_region) continue;
+      ++in_region;
+      if (st.status == hal::LocalizationStatus::kLocalized) {
+        ++in_region_loc;
+        in_region_wrong += std::isfinite(st.err_m) && (st.err_m > b.bound_m || st.err_rad > b.bound_rad);
       }
-    json->add_int("unknown_area_integrity_failures", static_cast<long long>(us.integrity_failures));
-    json->add_int("unknown_area_in_region_steps", static_cast<long long>(in_region));
-    json->add("unknown_area_in_region_localized_fraction",
-              in_region ? static_cast<double>(in_region_loc) / in_region : NAN);
-    json->add("unknown_area_availability_outside_region", us.availability);
-    write_plots(plan, ds, "mml-track_unknown", ut, region);
-    if (plan.verbose)
-      std::printf("unknown area (%s, 8 x 8 m erased): %zu in-region steps, %zu localized there (%zu wrong); integrity "
-                  "failures %zu; done in %.1f s\n",
-                  ds.name.c_str(), in_region, in_region_loc, in_region_wrong, us.integrity_failures, since(t0));
-  }
-  json->add("track_step_ms_p50", percentile(track_ms_all, 50));
-  json->add("track_step_ms_p99", percentile(track_ms_all, 99));
-  json->add("localize_eval_seconds", since(t_all));
+    }
+  json->add_int("unknown_area_integrity_failures", static_cast<long long>(us.integrity_failures));
+  json->add_int("unknown_area_in_region_steps", static_cast<long long>(in_region));
+  json->add("unknown_area_in_region_localized_fraction",
+            in_region ? static_cast<double>(in_region_loc) / in_region : NAN);
+  json->add("unknown_area_availability_outside_region", us.availability);
+  write_plots(plan, ds, "mml-track_unknown", ut, region);
+  if (plan.verbose)
+    std::printf("unknown area (%s, 8 x 8 m erased): %zu in-region steps, %zu localized there (%zu wrong); integrity "
+                "failures %zu; done in %.1f s\n",
+                ds.name.c_str(), in_region, in_region_loc, in_region_wrong, us.integrity_failures, since(t0));
+  return true;
+}
 
-  const std::string table = product_markdown_table(rows);
+// localize.md: the table, the reference notes and the integrity failures.
+void write_localize_report(LocalizeRun& run) {
+  const LocalizePlan& plan = run.plan;
+  const std::string table = product_markdown_table(run.rows);
   std::ofstream md(plan.out_dir + "/localize.md");
   md << "# Localizer (mml-track) product evaluation\n\nSeed " << plan.seed << "; per dataset " << plan.whole_runs
      << " whole-log runs (kidnapped start drawn over the first " << plan.whole_start_fraction * 100
@@ -395,9 +409,41 @@ bool run_localize_evaluation(const LocalizePlan& plan, BenchJson* json, std::str
      << plan.step_rule.min_turn_rad
      << " rad of odometry motion. Bounds: dataset position bound (0.5 m; 1 m at mit-killian) and 5 deg. "
         "Definitions: sim/eval/mml_eval/README.md.\n\n"
-     << table << "\n## Reference quality\n\n" << refnotes.str() << "\n## Integrity failures\n\n"
-     << (notes.str().empty() ? std::string("none\n") : notes.str());
-  if (plan.verbose) std::printf("\n%s\nreference:\n%s\ntotal %.1f s\n", table.c_str(), refnotes.str().c_str(), since(t_all));
+     << table << "\n## Reference quality\n\n" << run.refnotes.str() << "\n## Integrity failures\n\n"
+     << (run.notes.str().empty() ? std::string("none\n") : run.notes.str());
+  if (plan.verbose)
+    std::printf("\n%s\nreference:\n%s\ntotal %.1f s\n", table.c_str(), run.refnotes.str().c_str(), since(run.t_all));
+}
+
+}  // namespace
+
+bool run_localize_evaluation(const LocalizePlan& plan, BenchJson* json, std::string* err) {
+  LocalizeRun run{plan, json, std::chrono::steady_clock::now(), {}, {}, {}, {}, {}, {},
+                  mml_track_config(plan.mml_config, plan.seed)};
+  run.mml_cfg.mml.pool_cluster_support = plan.pool_cluster_support;
+  std::filesystem::create_directories(plan.out_dir);
+  json->add_int("seed", static_cast<long long>(plan.seed));
+  json->add_int("whole_runs_per_dataset", static_cast<long long>(plan.whole_runs));
+  json->add_int("fix_trials_per_dataset", static_cast<long long>(plan.fix_trials));
+  json->add_int("fix_steps", static_cast<long long>(plan.fix_steps));
+  for (const auto& n : plan.datasets)
+    if (!evaluate_dataset(run, n, nullptr, err)) return false;
+  for (const auto& f : plan.custom)
+    if (!evaluate_dataset(run, f.name, &f, err)) return false;
+  if (!run.kidnap_all.empty()) {
+    SystemSummary ks = summarize("all", "mml-track kidnap", run.kidnap_all, 0, run.kidnap_bounds);
+    json->add("kidnap_refix_success", ks.kidnap_refix_success);
+    json->add_int("kidnap_integrity_failures", static_cast<long long>(ks.kidnap_integrity_failures));
+    json->add_int("kidnap_runs", static_cast<long long>(ks.kidnaps));
+    json->add("kidnap_detected_rate", ks.kidnaps ? static_cast<double>(ks.kidnaps_detected) / ks.kidnaps : NAN);
+    json->add("kidnap_delay_steps_median", ks.kidnap_delay_median);
+    json->add("kidnap_refix_m_median", ks.kidnap_refix_m_median);
+  }
+  if (plan.run_unknown && !run_unknown_area(run, err)) return false;
+  json->add("track_step_ms_p50", percentile(run.track_ms_all, 50));
+  json->add("track_step_ms_p99", percentile(run.track_ms_all, 99));
+  json->add("localize_eval_seconds", since(run.t_all));
+  write_localize_report(run);
   return true;
 }
 
