@@ -165,6 +165,9 @@ void PoseTracker::update_confidence_excess(const Point2f* points, std::size_t n,
   }
 }
 
+// One scan: (1) odometry prediction, (2) alignment, (3) the scan's verdict on the pose (fault
+// detection), (4) alias check, (5) the update and the odometry-consistency test, (6) the track's
+// state, (7) protection level and status.
 TrackStep PoseTracker::step(const Point2f* points, std::size_t n, const Se2f& odom, bool predict) {
   TrackStep out;
   if (!active_) {
@@ -179,125 +182,149 @@ TrackStep PoseTracker::step(const Point2f* points, std::size_t n, const Se2f& od
     odom_jump = !(std::hypot(d.x, d.y) <= o.max_odom_step_m && std::fabs(d.theta) <= o.max_odom_step_rad);
     predict_to(odom);
   }
-  const Se2f pred = pose_;
-  const ProtectionLevel pred_pl = protection_level(cov_, k_, bias_xy_m_, bias_theta_rad_);
-  out.alignment = align_from_prediction(points, n, pred, &out);
-  const ScanAlignment& a = out.alignment;
+  StepWork w;
+  w.pred = pose_;
+  w.pred_pl = protection_level(cov_, k_, bias_xy_m_, bias_theta_rad_);
+  w.p_post = cov_;
+  out.alignment = align_from_prediction(points, n, w.pred, &out);
+  judge_scan(points, n, odom_jump, &w, &out);
+  if (w.v == ScanVerdict::kSupported && o.alias_check) check_aliases(points, n, &w, &out);
+  const Update u = propose_update(odom, predict, &w, &out);
+  out.verdict = w.v;
+  apply_verdict(odom, w, u, &out);
+  publish(points, n, w, &out);
+  last_ = out;
+  return out;
+}
 
-  // Verdict of this scan on the pose (fault detection).
-  ScanVerdict v = ScanVerdict::kSupported;
-  bool innovation_fault = false;
-  Eigen::Matrix3f p_post = cov_;
-  Eigen::Vector3f e = Eigen::Vector3f::Zero();
+// (3) Verdict of this scan on the pose: outside the map, uninformative, a poor fit, or a fix that
+// fails the innovation test against the prediction (a fault; large beyond the alert limits).
+void PoseTracker::judge_scan(const Point2f* points, std::size_t n, bool odom_jump, StepWork* w, TrackStep* out) {
+  const TrackOptions& o = options_;
+  const ScanAlignment& a = out->alignment;
   if (odom_jump) {
-    v = ScanVerdict::kContradicting;  // the pose cannot be carried across a non-physical increment
-    out.large_fault = true;
-  } else if (a.points > 0 && a.unknown_fraction() > o.outside_map_fraction) {
-    v = ScanVerdict::kOutsideMap;
-  } else if (a.inliers + a.contradicting < o.min_points) {
-    v = ScanVerdict::kUninformative;
-  } else if (a.inlier_fraction() < o.min_inlier_fraction) {
-    v = ScanVerdict::kContradicting;
+    w->v = ScanVerdict::kContradicting;  // the pose cannot be carried across a non-physical increment
+    out->large_fault = true;
+    return;
+  }
+  if (a.points > 0 && a.unknown_fraction() > o.outside_map_fraction) {
+    w->v = ScanVerdict::kOutsideMap;
+    return;
+  }
+  if (a.inliers + a.contradicting < o.min_points) {
+    w->v = ScanVerdict::kUninformative;
+    return;
+  }
+  if (a.inlier_fraction() < o.min_inlier_fraction) {
+    w->v = ScanVerdict::kContradicting;
+    return;
+  }
+  // Innovation of the scan fix against the prediction: d² = eᵀ S⁻¹ e with S = P⁻ + H⁻¹, computed as
+  // S⁻¹ = H − H P⁺ H (P⁺ = (P⁻⁻¹ + H)⁻¹), which stays finite where H is singular (corridor axis).
+  const Se2f& pred = w->pred;
+  w->e = Eigen::Vector3f(a.pose.x - pred.x, a.pose.y - pred.y, wrap_angle(a.pose.theta - pred.theta));
+  const Eigen::Matrix3d pinv = cov_.cast<double>().inverse();
+  const Eigen::Matrix3d hd = a.information.cast<double>();
+  const Eigen::Matrix3d post = (pinv + hd).inverse();
+  const Eigen::Matrix3d sinv = hd - hd * post * hd;
+  const Eigen::Vector3d ed = w->e.cast<double>();
+  out->innovation_chi2 = static_cast<float>(ed.dot(sinv * ed));
+  if (!std::isfinite(out->innovation_chi2) || !post.allFinite()) {
+    w->v = ScanVerdict::kContradicting;
+  } else if (out->innovation_chi2 > o.innovation_chi2 && outside_bound(w->e, w->pred_pl)) {
+    // A significant innovation is a fault only when the scan fix lies outside what the prediction
+    // promises (its protection level): within it, the published bound already covers the
+    // disagreement, and the scan is fused (measurement models of real scans are never exact).
+    w->innovation_fault = true;
+    w->v = ScanVerdict::kContradicting;
+    // Beyond an alert limit: the robot may be somewhere else (the aces kidnap into a twin corridor
+    // showed as 0.27 m and 6° at the first scan: the target fits the map next to the prediction).
+    const float exy = std::hypot(w->e(0), w->e(1));
+    out->large_fault = exy > o.alert_limit_m || std::fabs(w->e(2)) > o.alert_limit_rad;
+    if (out->large_fault && o.heading_fault_local_recovery && exy <= w->pred_pl.xy_m && exy <= o.alert_limit_m) {
+      // Heading only (track_options.h): the scan must prefer its fix to the prediction significantly.
+      const std::size_t m = subsample_alias_points(points, n);
+      out->heading_fault = rival_significantly_better(map_, alias_points_, m, pred, a.pose, o.alias_clip_m,
+                                                      a.independent, o.alias_z);
+      out->large_fault = !out->heading_fault;
+    }
   } else {
-    // Innovation of the scan fix against the prediction: d² = eᵀ S⁻¹ e with S = P⁻ + H⁻¹, computed as
-    // S⁻¹ = H − H P⁺ H (P⁺ = (P⁻⁻¹ + H)⁻¹), which stays finite where H is singular (corridor axis).
-    e = Eigen::Vector3f(a.pose.x - pred.x, a.pose.y - pred.y, wrap_angle(a.pose.theta - pred.theta));
-    const Eigen::Matrix3d pinv = cov_.cast<double>().inverse();
-    const Eigen::Matrix3d hd = a.information.cast<double>();
-    const Eigen::Matrix3d post = (pinv + hd).inverse();
-    const Eigen::Matrix3d sinv = hd - hd * post * hd;
-    const Eigen::Vector3d ed = e.cast<double>();
-    out.innovation_chi2 = static_cast<float>(ed.dot(sinv * ed));
-    if (!std::isfinite(out.innovation_chi2) || !post.allFinite()) {
-      v = ScanVerdict::kContradicting;
-    } else if (out.innovation_chi2 > o.innovation_chi2 && outside_bound(e, pred_pl)) {
-      innovation_fault = true;
-      // Beyond an alert limit: the robot may be somewhere else. Heading counts too: the aces kidnap
-      // into a twin corridor showed as 0.27 m and 6° at the first scan (the target fits the map next
-      // to the prediction); odometry that turned 10–20° wrong (mit-killian) cannot be told from it by
-      // this scan alone, so it waits for MML as well (availability, never integrity).
-      const float exy = std::hypot(e(0), e(1));
-      out.large_fault = exy > o.alert_limit_m || std::fabs(e(2)) > o.alert_limit_rad;
-      if (out.large_fault && o.heading_fault_local_recovery && exy <= pred_pl.xy_m &&
-          exy <= o.alert_limit_m) {
-        // Heading only (track_options.h): the scan must prefer its fix to the prediction significantly.
-        const std::size_t m = subsample_alias_points(points, n);
-        out.heading_fault = rival_significantly_better(map_, alias_points_, m, pred, a.pose, o.alias_clip_m,
-                                                       a.independent, o.alias_z);
-        out.large_fault = !out.heading_fault;
-      }
-      // A significant innovation is a fault only when the scan fix lies outside what the prediction
-      // promises (its protection level): within it, the published bound already covers the
-      // disagreement, and the scan is fused (measurement models of real scans are never exact).
-      v = ScanVerdict::kContradicting;
-    } else {
-      p_post = post.cast<float>();
-    }
+    w->p_post = post.cast<float>();
   }
-  // Alias check at the scan fix: does the scan fit as well (or better) somewhere else nearby?
-  if (v == ScanVerdict::kSupported && o.alias_check) {
-    mml::UniquenessOptions uo;
-    uo.clip_m = o.alias_clip_m;
-    uo.max_shift_m = o.alias_max_shift_m;
-    uo.shift_step_m = o.alias_step_m;
-    uo.min_separation_m = o.alias_min_separation_m;
-    uo.margin = o.alias_margin;
-    uo.rotation_step_rad = o.alias_rotation_step_rad;
-    uo.max_rotation_rad = o.alias_max_rotation_rad;
-    uo.min_separation_rad = o.alias_min_separation_rad;
-    const std::size_t m = subsample_alias_points(points, n);
-    const mml::UniquenessResult u = mml::check_pose_uniqueness(map_, alias_points_, m, a.pose, uo);
-    out.alias_cost = u.cost;
-    out.alias_rival_cost = u.rival_cost;
-    if (u.rival_cost < u.cost - o.alias_margin &&
-        rival_significantly_better(map_, alias_points_, m, a.pose, u.rival, o.alias_clip_m, a.independent,
-                                   o.alias_z)) {
-      v = ScanVerdict::kContradicting;  // the scan says the robot is elsewhere
-      out.large_fault = std::hypot(u.rival.x - a.pose.x, u.rival.y - a.pose.y) > o.alert_limit_m ||
-                        std::fabs(wrap_angle(u.rival.theta - a.pose.theta)) > o.alert_limit_rad;
-    } else if (!u.unique) {
-      v = ScanVerdict::kAmbiguous;      // fused (odometry keeps the mode), never `localized`
-    }
-  }
-  // The update this scan would make; tested against the odometry over the last fused scans first.
-  const float scan_bias_xy = map_.geometry.resolution + a.rms_m;
-  const float scan_bias_theta = scan_bias_xy / std::fmax(a.lever_m, 1.0f);
-  bool fuse = false;
-  Se2f fused_pose = pose_;
-  Eigen::Matrix3f fused_cov = cov_;
-  if (v == ScanVerdict::kSupported || v == ScanVerdict::kAmbiguous) {
-    const Se2f since = odom_at_fuse_.between(odom);
-    const bool moved = !fused_once_ || !predict || std::hypot(since.x, since.y) >= o.update_min_d_m ||
-                       std::fabs(since.theta) >= o.update_min_a_rad;
-    // x = x⁻ + P⁺ H e (information-form Kalman update, linearised at the scan fix).
-    const Eigen::Vector3f dx = p_post * (a.information * e);
-    if (moved && dx.allFinite()) {
-      fuse = true;
-      fused_pose = Se2f(pred.x + dx(0), pred.y + dx(1), wrap_angle(pred.theta + dx(2)));
-      fused_cov = 0.5f * (p_post + p_post.transpose());
-      out.odometry_chi2 = odometry_check_.max_chi2(fused_pose, fused_cov, scan_bias_xy, scan_bias_theta);
-      if (out.odometry_chi2 > o.innovation_chi2) {
-        v = ScanVerdict::kContradicting;  // the scans hold the pose where the wheels say it is not
-        out.large_fault = true;           // a slow slide: its size is unknown, assume the worst
-        fuse = false;
-      }
-    }
-  }
-  out.verdict = v;
+}
 
+// (4) Alias check at the scan fix: does the scan fit as well (or better) somewhere else nearby?
+void PoseTracker::check_aliases(const Point2f* points, std::size_t n, StepWork* w, TrackStep* out) {
+  const TrackOptions& o = options_;
+  const ScanAlignment& a = out->alignment;
+  mml::UniquenessOptions uo;
+  uo.clip_m = o.alias_clip_m;
+  uo.max_shift_m = o.alias_max_shift_m;
+  uo.shift_step_m = o.alias_step_m;
+  uo.min_separation_m = o.alias_min_separation_m;
+  uo.margin = o.alias_margin;
+  uo.rotation_step_rad = o.alias_rotation_step_rad;
+  uo.max_rotation_rad = o.alias_max_rotation_rad;
+  uo.min_separation_rad = o.alias_min_separation_rad;
+  const std::size_t m = subsample_alias_points(points, n);
+  const mml::UniquenessResult u = mml::check_pose_uniqueness(map_, alias_points_, m, a.pose, uo);
+  out->alias_cost = u.cost;
+  out->alias_rival_cost = u.rival_cost;
+  if (u.rival_cost < u.cost - o.alias_margin &&
+      rival_significantly_better(map_, alias_points_, m, a.pose, u.rival, o.alias_clip_m, a.independent, o.alias_z)) {
+    w->v = ScanVerdict::kContradicting;  // the scan says the robot is elsewhere
+    out->large_fault = std::hypot(u.rival.x - a.pose.x, u.rival.y - a.pose.y) > o.alert_limit_m ||
+                       std::fabs(wrap_angle(u.rival.theta - a.pose.theta)) > o.alert_limit_rad;
+  } else if (!u.unique) {
+    w->v = ScanVerdict::kAmbiguous;  // fused (odometry keeps the mode), never `localized`
+  }
+}
+
+// (5) The update this scan would make (x = x⁻ + P⁺ H e, information-form Kalman update linearised at
+// the scan fix), once the robot moved; tested against the odometry over the last fused scans first.
+PoseTracker::Update PoseTracker::propose_update(const Se2f& odom, bool predict, StepWork* w, TrackStep* out) {
+  const TrackOptions& o = options_;
+  const ScanAlignment& a = out->alignment;
+  Update u;
+  u.bias_xy = map_.geometry.resolution + a.rms_m;
+  u.bias_theta = u.bias_xy / std::fmax(a.lever_m, 1.0f);
+  u.pose = pose_;
+  u.cov = cov_;
+  if (w->v != ScanVerdict::kSupported && w->v != ScanVerdict::kAmbiguous) return u;
+  const Se2f since = odom_at_fuse_.between(odom);
+  const bool moved = !fused_once_ || !predict || std::hypot(since.x, since.y) >= o.update_min_d_m ||
+                     std::fabs(since.theta) >= o.update_min_a_rad;
+  const Eigen::Vector3f dx = w->p_post * (a.information * w->e);
+  if (!moved || !dx.allFinite()) return u;
+  u.fuse = true;
+  u.pose = Se2f(w->pred.x + dx(0), w->pred.y + dx(1), wrap_angle(w->pred.theta + dx(2)));
+  u.cov = 0.5f * (w->p_post + w->p_post.transpose());
+  out->odometry_chi2 = odometry_check_.max_chi2(u.pose, u.cov, u.bias_xy, u.bias_theta);
+  if (out->odometry_chi2 > o.innovation_chi2) {
+    w->v = ScanVerdict::kContradicting;  // the scans hold the pose where the wheels say it is not
+    out->large_fault = true;             // a slow slide: its size is unknown, assume the worst
+    u.fuse = false;
+  }
+  return u;
+}
+
+// (6) The track's state after the verdict: fused (and the map bias of this scan), or the counters of
+// unsupported / faulty / outside scans and, after an innovation fault, a widened covariance.
+void PoseTracker::apply_verdict(const Se2f& odom, const StepWork& w, const Update& u, TrackStep* out) {
+  const ScanVerdict v = w.v;
   if (v == ScanVerdict::kSupported || v == ScanVerdict::kAmbiguous) {
-    if (fuse) {
-      pose_ = fused_pose;
-      cov_ = fused_cov;
+    if (u.fuse) {
+      pose_ = u.pose;
+      cov_ = u.cov;
       odom_at_fuse_ = odom;
       fused_once_ = true;
-      out.fused = true;
-      odometry_check_.push(pose_, cov_, scan_bias_xy, scan_bias_theta);
+      out->fused = true;
+      odometry_check_.push(pose_, cov_, u.bias_xy, u.bias_theta);
     }
     // The map's own error does not average out over scans: one cell of quantisation plus the
     // scan's residual RMS (how far the map's walls are from where this scan sees them).
-    bias_xy_m_ = scan_bias_xy;
-    bias_theta_rad_ = scan_bias_theta;
+    bias_xy_m_ = u.bias_xy;
+    bias_theta_rad_ = u.bias_theta;
     unsupported_ = 0;
     faulty_ = 0;
     outside_ = 0;
@@ -307,57 +334,60 @@ TrackStep PoseTracker::step(const Point2f* points, std::size_t n, const Se2f& od
     } else {
       ++consistent_since_fault_;
     }
-  } else {
-    ++unsupported_;
-    if (v == ScanVerdict::kContradicting && innovation_fault) {
-      // The scan fits the map well but not where the odometry says (wheel slip, a push, laser /
-      // odometry latency): the prediction is what failed. The scan sees the fault only along the
-      // axes it constrains; along a corridor the same odometry may be as wrong unseen. So the
-      // covariance widens by the size of the disagreement in every direction, and the status is
-      // not `localized` again until scans constrain every axis back under the alert limit.
-      const float exy2 = e(0) * e(0) + e(1) * e(1);
-      cov_(0, 0) += exy2;
-      cov_(1, 1) += exy2;
-      cov_(2, 2) += e(2) * e(2);
-      cov_ = 0.5f * (cov_ + cov_.transpose()).eval();
-      odometry_check_.widen(exy2, e(2) * e(2));
-    }
-    if (v == ScanVerdict::kContradicting) {
-      ++faulty_;
-      had_fault_ = true;
-      consistent_since_fault_ = 0;
-    } else {
-      faulty_ = 0;
-    }
-    if (v == ScanVerdict::kOutsideMap) ++outside_; else outside_ = 0;
+    return;
   }
+  ++unsupported_;
+  if (v == ScanVerdict::kContradicting && w.innovation_fault) {
+    // The scan fits the map well but not where the odometry says (wheel slip, a push, laser /
+    // odometry latency): the prediction is what failed. The scan sees the fault only along the
+    // axes it constrains; along a corridor the same odometry may be as wrong unseen. So the
+    // covariance widens by the size of the disagreement in every direction, and the status is
+    // not `localized` again until scans constrain every axis back under the alert limit.
+    const float exy2 = w.e(0) * w.e(0) + w.e(1) * w.e(1);
+    cov_(0, 0) += exy2;
+    cov_(1, 1) += exy2;
+    cov_(2, 2) += w.e(2) * w.e(2);
+    cov_ = 0.5f * (cov_ + cov_.transpose()).eval();
+    odometry_check_.widen(exy2, w.e(2) * w.e(2));
+  }
+  if (v == ScanVerdict::kContradicting) {
+    ++faulty_;
+    had_fault_ = true;
+    consistent_since_fault_ = 0;
+  } else {
+    faulty_ = 0;
+  }
+  if (v == ScanVerdict::kOutsideMap) ++outside_; else outside_ = 0;
+}
 
-  out.pose = pose_;
-  out.cov = cov_;
-  out.pl = protection_level(cov_, k_, bias_xy_m_, bias_theta_rad_);
+// (7) Protection level (with the confidence extent's excess), status and whether the track ends.
+void PoseTracker::publish(const Point2f* points, std::size_t n, const StepWork& w, TrackStep* out) {
+  const TrackOptions& o = options_;
+  const ScanVerdict v = w.v;
+  out->pose = pose_;
+  out->cov = cov_;
+  out->pl = protection_level(cov_, k_, bias_xy_m_, bias_theta_rad_);
   if ((o.confidence_extent_xy || o.confidence_extent_theta) &&
       (v == ScanVerdict::kSupported || v == ScanVerdict::kAmbiguous)) {
-    update_confidence_excess(points, n, a, pred_pl, out.pl, &out);
+    update_confidence_excess(points, n, out->alignment, w.pred_pl, out->pl, out);
   }
-  out.pl.xy_m += excess_xy_m_;
-  out.pl.theta_rad += excess_theta_rad_;
-  out.unsupported_steps = unsupported_;
-  out.faulty_steps = faulty_;
-  out.outside_steps = outside_;
-  const bool within = out.pl.xy_m <= o.alert_limit_m && out.pl.theta_rad <= o.alert_limit_rad;
+  out->pl.xy_m += excess_xy_m_;
+  out->pl.theta_rad += excess_theta_rad_;
+  out->unsupported_steps = unsupported_;
+  out->faulty_steps = faulty_;
+  out->outside_steps = outside_;
+  const bool within = out->pl.xy_m <= o.alert_limit_m && out->pl.theta_rad <= o.alert_limit_rad;
   if (v == ScanVerdict::kOutsideMap) {
-    out.status = hal::LocalizationStatus::kOutsideMap;
+    out->status = hal::LocalizationStatus::kOutsideMap;
   } else if (v != ScanVerdict::kContradicting && v != ScanVerdict::kAmbiguous && faulty_ == 0 && within &&
              (!had_fault_ || consistent_since_fault_ >= o.recovery_steps)) {
-    out.status = hal::LocalizationStatus::kLocalized;
+    out->status = hal::LocalizationStatus::kLocalized;
   } else {
-    out.status = hal::LocalizationStatus::kAmbiguous;
+    out->status = hal::LocalizationStatus::kAmbiguous;
   }
-  out.lost = faulty_ >= o.max_faulty_steps || outside_ >= o.max_outside_steps || !(out.pl.xy_m <= o.lost_limit_m) ||
-             !pose_.vector().allFinite();
-  if (out.lost) active_ = false;
-  last_ = out;
-  return out;
+  out->lost = faulty_ >= o.max_faulty_steps || outside_ >= o.max_outside_steps || !(out->pl.xy_m <= o.lost_limit_m) ||
+              !pose_.vector().allFinite();
+  if (out->lost) active_ = false;
 }
 
 }  // namespace track

@@ -86,7 +86,27 @@ class PoseTracker {
   const GlobalMap& map() const { return map_; }
 
  private:
+  // Working state of one step() between its stages (pose_tracker.cpp).
+  struct StepWork {
+    ScanVerdict v = ScanVerdict::kSupported;
+    bool innovation_fault = false;
+    Se2f pred;                                       // the odometry prediction
+    ProtectionLevel pred_pl;                         // its protection level
+    Eigen::Matrix3f p_post = Eigen::Matrix3f::Zero();  // posterior covariance if fused
+    Eigen::Vector3f e = Eigen::Vector3f::Zero();     // scan fix − prediction
+  };
+  struct Update {
+    bool fuse = false;
+    Se2f pose;
+    Eigen::Matrix3f cov = Eigen::Matrix3f::Zero();
+    float bias_xy = 0.0f, bias_theta = 0.0f;  // the map bias this scan shows
+  };
   void predict_to(const Se2f& odom);
+  void judge_scan(const Point2f* points, std::size_t n, bool odom_jump, StepWork* w, TrackStep* out);
+  void check_aliases(const Point2f* points, std::size_t n, StepWork* w, TrackStep* out);
+  Update propose_update(const Se2f& odom, bool predict, StepWork* w, TrackStep* out);
+  void apply_verdict(const Se2f& odom, const StepWork& w, const Update& u, TrackStep* out);
+  void publish(const Point2f* points, std::size_t n, const StepWork& w, TrackStep* out);
   std::size_t subsample_alias_points(const Point2f* points, std::size_t n);
   void update_confidence_excess(const Point2f* points, std::size_t n, const ScanAlignment& a,
                                 const ProtectionLevel& pred_pl, const ProtectionLevel& pl, TrackStep* out);
