@@ -183,6 +183,7 @@ TrackStep PoseTracker::step(const Point2f* points, std::size_t n, const Se2f& od
     predict_to(odom);
   }
   StepWork w;
+  w.predicted = predict;
   w.pred = pose_;
   w.pred_pl = protection_level(cov_, k_, bias_xy_m_, bias_theta_rad_);
   w.p_post = cov_;
@@ -367,7 +368,9 @@ void PoseTracker::publish(const Point2f* points, std::size_t n, const StepWork& 
   out->pose = pose_;
   out->cov = cov_;
   out->pl = protection_level(cov_, k_, bias_xy_m_, bias_theta_rad_);
-  if ((o.confidence_extent_xy || o.confidence_extent_theta) &&
+  // Not on the scan a track starts on: that pose is MML's, isolated from a local map of many
+  // scans that constrains what this one scan may leave open (a corridor's axis).
+  if ((o.confidence_extent_xy || o.confidence_extent_theta) && w.predicted &&
       (v == ScanVerdict::kSupported || v == ScanVerdict::kAmbiguous)) {
     update_confidence_excess(points, n, out->alignment, w.pred_pl, out->pl, out);
   }

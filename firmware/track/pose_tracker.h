@@ -89,6 +89,7 @@ class PoseTracker {
   // Working state of one step() between its stages (pose_tracker.cpp).
   struct StepWork {
     ScanVerdict v = ScanVerdict::kSupported;
+    bool predicted = true;   // an odometry step (false: the scan a track starts on)
     bool innovation_fault = false;
     Se2f pred;                                       // the odometry prediction
     ProtectionLevel pred_pl;                         // its protection level
