@@ -79,168 +79,195 @@ void add_pair(BenchJson* json, const std::string& key, const std::string& sys, c
   json->add_int(key + "_" + sys + "_localized", static_cast<long long>(s.localized));
 }
 
-}  // namespace
-
-bool run_evaluation(const EvalPlan& plan, BenchJson* json, std::string* err) {
-  std::filesystem::create_directories(plan.out_dir);
+// State of one evaluation shared by its steps.
+struct EvalRun {
+  const EvalPlan& plan;
+  BenchJson* json;
   std::vector<SystemSummary> rows;
   double static_mib = 0;
-  std::vector<double> track_err, track_ms;
-  json->add_int("trials_per_dataset", static_cast<long long>(plan.trials));
-  json->add_int("mcl_trials_per_dataset", static_cast<long long>(plan.mcl_trials ? plan.mcl_trials : plan.trials));
-  json->add_int("max_steps_per_trial", static_cast<long long>(plan.trial.max_steps));
-  json->add_int("seed", static_cast<long long>(plan.seed));
-  for (const std::string& name : plan.datasets) {
-    const auto t0 = std::chrono::steady_clock::now();
-    LoadedDataset ds;
-    if (!load_dataset(name, &ds, err)) return false;
-    if (plan.verbose) {
-      std::printf("dataset %s: %zu scans, %.0f m of path, map %ux%u @ %.2f m, %u points (loaded in %.1f s)\n",
-                  name.c_str(), ds.log.scans.size(), ds.travelled.back(), ds.map.geometry.width, ds.map.geometry.height,
-                  ds.map.geometry.resolution, ds.map.num_points, since(t0));
-    }
-    const bool mit = name == "mit-killian";
-    const TrialOptions& topt = mit ? plan.trial_mit : plan.trial;
-    const std::vector<std::size_t> starts = draw_starts(ds, plan.trials, plan.seed, topt);
-    std::vector<SystemRun> runs;
+  std::vector<double> track_err, track_ms;  // hand-off tracking steps
+};
 
-    // MML (main configuration, then the extra ones side by side).
-    std::vector<MmlVariant> configs = {mml_variant(plan, plan.mml_config, false, false)};
-    for (int c : plan.extra_mml_configs)
-      if (c != plan.mml_config) configs.push_back(mml_variant(plan, c, false, false));
-    if (plan.compare_local_map_options) {
-      if (!plan.mml_correct) configs.push_back(mml_variant(plan, plan.mml_config, true, false));
-      if (!plan.mml_reduce) configs.push_back(mml_variant(plan, plan.mml_config, false, true));
-    }
-    SystemSummary mml_main, mcl_main;
-    for (std::size_t ci = 0; ci < configs.size(); ++ci) {
-      std::string e;
-      const auto ti = std::chrono::steady_clock::now();
-      auto loc = OwnedLocalizer::make_mml(ds.map, ds.image, configs[ci].cfg, plan.threads, &e);
-      if (!loc) return (*err = e, false);
-      if (plan.verbose) {
-        std::printf("  %s init %.1f s (precomputed table: %s)\n", configs[ci].label.c_str(), since(ti),
-                    loc->mml()->using_precomputed_table() ? "yes" : "no");
-      }
-      SystemRun r = run_system(*loc, ds, configs[ci].label, starts, topt, plan.verbose);
-      if (plan.verbose) {
-        std::printf("  %-12s %-10s matched points per step %.0f, corrections %u, observations accepted %u (last trial)\n",
-                    ds.name.c_str(), configs[ci].label.c_str(), r.summary.matched_points_mean,
-                    loc->mml()->corrections_applied(), loc->mml()->observations_accepted());
-      }
-      if (ci > 0 && (configs[ci].cfg.mml.correct_local_map || configs[ci].cfg.mml.reduce_observations)) {
-        std::string key = "mml_c" + std::to_string(plan.mml_config);
-        if (configs[ci].cfg.mml.correct_local_map) key += "_corr";
-        if (configs[ci].cfg.mml.reduce_observations) key += "_red";
-        add_pair(json, ds.key, key, r.summary);
-        json->add(ds.key + "_" + key + "_matched_points_mean", r.summary.matched_points_mean);
-      }
-      if (ci == 0) {
-        mml_main = r.summary;
-        static_mib = std::max(static_mib, r.summary.memory_mib + ds.arena->used() / (1024.0 * 1024.0));
-      }
-      rows.push_back(r.summary);
-      runs.push_back(std::move(r));
-    }
-    // MCL baseline.
-    if (plan.run_mcl) {
-      std::string e;
-      const std::uint32_t particles = mit ? plan.mcl_particles_mit : plan.mcl_particles;
-      auto loc = OwnedLocalizer::make_mcl(ds.map, mcl_baseline_options(particles, plan.seed), plan.threads, &e);
-      if (!loc) return (*err = e, false);
-      std::vector<std::size_t> mstarts = starts;
-      const std::size_t mt = (mit && plan.mcl_trials_mit) ? plan.mcl_trials_mit : plan.mcl_trials;
-      if (mt && mt < mstarts.size()) mstarts.resize(mt);
-      SystemRun r = run_system(*loc, ds, "mcl-" + std::to_string(particles / 1000) + "k", mstarts, topt, plan.verbose);
-      mcl_main = r.summary;
-      rows.push_back(r.summary);
-      runs.push_back(std::move(r));
-    }
-    // Hand-off.
-    if (plan.run_handoff && std::find(plan.handoff_datasets.begin(), plan.handoff_datasets.end(), name) !=
-                                plan.handoff_datasets.end()) {
-      std::string e;
-      auto loc = OwnedLocalizer::make_handoff(ds.map, ds.image, mml_variant(plan, plan.mml_config, false, false).cfg,
-                                              mcl_tracking_options(plan.seed), fw::mml::HandoffOptions(), plan.threads,
-                                              &e);
-      if (!loc) return (*err = e, false);
-      TrialOptions ho = topt;
-      ho.max_steps = topt.max_steps + 100;  // leave time to track after the hand-off
-      SystemRun r = run_system(*loc, ds, "handoff", starts, ho, plan.verbose);
-      for (const auto& t : r.trials)
-        for (const auto& s : t.steps)
-          if (s.mode == hal::LocalizationMode::kTracking && std::isfinite(s.err_m) && s.ref_ok) {
-            track_err.push_back(s.err_m);
-            track_ms.push_back(s.step_ms);
-          }
-      if (plan.verbose) {
-        std::printf("  %-12s handoff    tracking median err %.3f m, step p50 %.3f ms, p99 %.3f ms, fallbacks %u\n",
-                    name.c_str(), r.summary.tracking_err_median_m, r.summary.tracking_step_ms_p50,
-                    r.summary.tracking_step_ms_p99, loc->handoff()->fallbacks());
-      }
-      rows.push_back(r.summary);
-      runs.push_back(std::move(r));
-    }
-    add_pair(json, ds.key, "mml", mml_main);
-    add_pair(json, ds.key, "mcl", mcl_main);
-    if (mit) {
-      json->add("mit_killian_mml_speedup_vs_mcl", mcl_main.step_ms_mean / mml_main.step_ms_mean);
-      json->add("mit_killian_mml_speedup_vs_mcl_p50", mcl_main.step_ms_p50 / mml_main.step_ms_p50);
-    }
-    // Plots.
-    for (const auto& r : runs) {
-      const std::string base = plan.out_dir + "/" + ds.key + "_" + r.label;
-      std::string e;
-      if (!write_error_plot(base + "_error.svg", ds.name + " - " + r.label + ": error over metres (kidnapped starts)",
-                            r.trials, ds.success_bound_m, &e) ||
-          !write_map_plot(base + "_map.svg", base + "_map.png", ds, ds.name + " - " + r.label, r.trials, nullptr, &e)) {
-        return (*err = e, false);
-      }
-    }
-    if (plan.verbose) std::printf("dataset %s done in %.1f s\n", name.c_str(), since(t0));
+// MML: the main configuration, then the extra ones side by side. Returns the main one's summary.
+bool run_mml_configs(EvalRun& run, const LoadedDataset& ds, const std::vector<std::size_t>& starts,
+                     const TrialOptions& topt, std::vector<SystemRun>* runs, SystemSummary* mml_main, std::string* err) {
+  const EvalPlan& plan = run.plan;
+  std::vector<MmlVariant> configs = {mml_variant(plan, plan.mml_config, false, false)};
+  for (int c : plan.extra_mml_configs)
+    if (c != plan.mml_config) configs.push_back(mml_variant(plan, c, false, false));
+  if (plan.compare_local_map_options) {
+    if (!plan.mml_correct) configs.push_back(mml_variant(plan, plan.mml_config, true, false));
+    if (!plan.mml_reduce) configs.push_back(mml_variant(plan, plan.mml_config, false, true));
   }
-
-  // Unknown area: a region around a mid-log pose is erased from the map; trials start 8–30 m
-  // before it, so the robot can localize first and then drive through the erased part.
-  if (plan.run_unknown) {
-    const auto t0 = std::chrono::steady_clock::now();
-    LoadedDataset ds;
-    double region[4];
-    std::vector<std::size_t> starts;
-    if (!prepare_unknown_area(plan.unknown_dataset, plan.seed, plan.unknown_trials, &ds, region, &starts, err))
-      return false;
-    TrialOptions uo = plan.trial;
-    uo.max_steps = plan.trial.max_steps + 60;
+  for (std::size_t ci = 0; ci < configs.size(); ++ci) {
     std::string e;
-    auto mml = OwnedLocalizer::make_mml(ds.map, ds.image, mml_variant(plan, plan.mml_config, false, false).cfg, plan.threads, &e);
-    if (!mml) return (*err = e, false);
-    SystemRun rm = run_system(*mml, ds, "mml-unknown", starts, uo, plan.verbose, region);
-    auto mcl = OwnedLocalizer::make_mcl(ds.map, mcl_baseline_options(plan.mcl_particles, plan.seed), plan.threads, &e);
-    if (!mcl) return (*err = e, false);
-    SystemRun rc2 = run_system(*mcl, ds, "mcl-unknown", starts, uo, plan.verbose, region);
-    json->add("unknown_area_mml_failure_rate", rm.summary.failure_rate);
-    json->add("unknown_area_mcl_failure_rate", rc2.summary.failure_rate);
-    json->add("unknown_area_mml_outside_map_fraction", rm.summary.outside_map_in_region);
-    json->add("unknown_area_mcl_success_rate", rc2.summary.success_rate);
-    json->add_int("unknown_area_trials", static_cast<long long>(starts.size()));
-    rows.push_back(rm.summary);
-    rows.push_back(rc2.summary);
-    for (const SystemRun* r : {&rm, &rc2}) {
-      const std::string base = plan.out_dir + "/unknown_" + ds.key + "_" + r->label;
-      if (!write_error_plot(base + "_error.svg", ds.name + " with an erased region - " + r->label, r->trials,
-                            ds.success_bound_m, &e) ||
-          !write_map_plot(base + "_map.svg", base + "_map.png", ds, ds.name + " with an erased region - " + r->label,
-                          r->trials, region, &e)) {
-        return (*err = e, false);
-      }
+    const auto ti = std::chrono::steady_clock::now();
+    auto loc = OwnedLocalizer::make_mml(ds.map, ds.image, configs[ci].cfg, plan.threads, &e);
+    if (!loc) return (*err = e, false);
+    if (plan.verbose) {
+      std::printf("  %s init %.1f s (precomputed table: %s)\n", configs[ci].label.c_str(), since(ti),
+                  loc->mml()->using_precomputed_table() ? "yes" : "no");
     }
-    if (plan.verbose) std::printf("unknown area done in %.1f s\n", since(t0));
+    SystemRun r = run_system(*loc, ds, configs[ci].label, starts, topt, plan.verbose);
+    if (plan.verbose) {
+      std::printf("  %-12s %-10s matched points per step %.0f, corrections %u, observations accepted %u (last trial)\n",
+                  ds.name.c_str(), configs[ci].label.c_str(), r.summary.matched_points_mean,
+                  loc->mml()->corrections_applied(), loc->mml()->observations_accepted());
+    }
+    if (ci > 0 && (configs[ci].cfg.mml.correct_local_map || configs[ci].cfg.mml.reduce_observations)) {
+      std::string key = "mml_c" + std::to_string(plan.mml_config);
+      if (configs[ci].cfg.mml.correct_local_map) key += "_corr";
+      if (configs[ci].cfg.mml.reduce_observations) key += "_red";
+      add_pair(run.json, ds.key, key, r.summary);
+      run.json->add(ds.key + "_" + key + "_matched_points_mean", r.summary.matched_points_mean);
+    }
+    if (ci == 0) {
+      *mml_main = r.summary;
+      run.static_mib = std::max(run.static_mib, r.summary.memory_mib + ds.arena->used() / (1024.0 * 1024.0));
+    }
+    run.rows.push_back(r.summary);
+    runs->push_back(std::move(r));
   }
-  json->add("handoff_tracking_err_m", percentile(track_err, 50));
-  json->add("handoff_step_ms_p50", percentile(track_ms, 50));
-  json->add("handoff_step_ms_p99", percentile(track_ms, 99));
-  json->add("static_memory_mib", static_mib);
+  return true;
+}
 
+// MCL baseline on the same starts (fewer trials where the plan says so).
+bool run_mcl(EvalRun& run, const LoadedDataset& ds, bool mit, const std::vector<std::size_t>& starts,
+             const TrialOptions& topt, std::vector<SystemRun>* runs, SystemSummary* mcl_main, std::string* err) {
+  const EvalPlan& plan = run.plan;
+  std::string e;
+  const std::uint32_t particles = mit ? plan.mcl_particles_mit : plan.mcl_particles;
+  auto loc = OwnedLocalizer::make_mcl(ds.map, mcl_baseline_options(particles, plan.seed), plan.threads, &e);
+  if (!loc) return (*err = e, false);
+  std::vector<std::size_t> mstarts = starts;
+  const std::size_t mt = (mit && plan.mcl_trials_mit) ? plan.mcl_trials_mit : plan.mcl_trials;
+  if (mt && mt < mstarts.size()) mstarts.resize(mt);
+  SystemRun r = run_system(*loc, ds, "mcl-" + std::to_string(particles / 1000) + "k", mstarts, topt, plan.verbose);
+  *mcl_main = r.summary;
+  run.rows.push_back(r.summary);
+  runs->push_back(std::move(r));
+  return true;
+}
+
+// MML → MCL hand-off, with its tracking error and step time.
+bool run_handoff(EvalRun& run, const LoadedDataset& ds, const std::vector<std::size_t>& starts,
+                 const TrialOptions& topt, std::vector<SystemRun>* runs, std::string* err) {
+  const EvalPlan& plan = run.plan;
+  std::string e;
+  auto loc = OwnedLocalizer::make_handoff(ds.map, ds.image, mml_variant(plan, plan.mml_config, false, false).cfg,
+                                          mcl_tracking_options(plan.seed), fw::mml::HandoffOptions(), plan.threads, &e);
+  if (!loc) return (*err = e, false);
+  TrialOptions ho = topt;
+  ho.max_steps = topt.max_steps + 100;  // leave time to track after the hand-off
+  SystemRun r = run_system(*loc, ds, "handoff", starts, ho, plan.verbose);
+  for (const auto& t : r.trials)
+    for (const auto& s : t.steps)
+      if (s.mode == hal::LocalizationMode::kTracking && std::isfinite(s.err_m) && s.ref_ok) {
+        run.track_err.push_back(s.err_m);
+        run.track_ms.push_back(s.step_ms);
+      }
+  if (plan.verbose) {
+    std::printf("  %-12s handoff    tracking median err %.3f m, step p50 %.3f ms, p99 %.3f ms, fallbacks %u\n",
+                ds.name.c_str(), r.summary.tracking_err_median_m, r.summary.tracking_step_ms_p50,
+                r.summary.tracking_step_ms_p99, loc->handoff()->fallbacks());
+  }
+  run.rows.push_back(r.summary);
+  runs->push_back(std::move(r));
+  return true;
+}
+
+// Error-over-metres and map pictures of every system run on a dataset.
+bool write_run_plots(const EvalPlan& plan, const LoadedDataset& ds, const std::vector<SystemRun>& runs,
+                     std::string* err) {
+  for (const auto& r : runs) {
+    const std::string base = plan.out_dir + "/" + ds.key + "_" + r.label;
+    std::string e;
+    if (!write_error_plot(base + "_error.svg", ds.name + " - " + r.label + ": error over metres (kidnapped starts)",
+                          r.trials, ds.success_bound_m, &e) ||
+        !write_map_plot(base + "_map.svg", base + "_map.png", ds, ds.name + " - " + r.label, r.trials, nullptr, &e)) {
+      return (*err = e, false);
+    }
+  }
+  return true;
+}
+
+// One dataset: MML configurations, MCL, hand-off, figures and pictures.
+bool evaluate_dataset(EvalRun& run, const std::string& name, std::string* err) {
+  const EvalPlan& plan = run.plan;
+  const auto t0 = std::chrono::steady_clock::now();
+  LoadedDataset ds;
+  if (!load_dataset(name, &ds, err)) return false;
+  if (plan.verbose) {
+    std::printf("dataset %s: %zu scans, %.0f m of path, map %ux%u @ %.2f m, %u points (loaded in %.1f s)\n",
+                name.c_str(), ds.log.scans.size(), ds.travelled.back(), ds.map.geometry.width, ds.map.geometry.height,
+                ds.map.geometry.resolution, ds.map.num_points, since(t0));
+  }
+  const bool mit = name == "mit-killian";
+  const TrialOptions& topt = mit ? plan.trial_mit : plan.trial;
+  const std::vector<std::size_t> starts = draw_starts(ds, plan.trials, plan.seed, topt);
+  std::vector<SystemRun> runs;
+  SystemSummary mml_main, mcl_main;
+  if (!run_mml_configs(run, ds, starts, topt, &runs, &mml_main, err)) return false;
+  if (plan.run_mcl && !run_mcl(run, ds, mit, starts, topt, &runs, &mcl_main, err)) return false;
+  if (plan.run_handoff &&
+      std::find(plan.handoff_datasets.begin(), plan.handoff_datasets.end(), name) != plan.handoff_datasets.end() &&
+      !run_handoff(run, ds, starts, topt, &runs, err)) {
+    return false;
+  }
+  add_pair(run.json, ds.key, "mml", mml_main);
+  add_pair(run.json, ds.key, "mcl", mcl_main);
+  if (mit) {
+    run.json->add("mit_killian_mml_speedup_vs_mcl", mcl_main.step_ms_mean / mml_main.step_ms_mean);
+    run.json->add("mit_killian_mml_speedup_vs_mcl_p50", mcl_main.step_ms_p50 / mml_main.step_ms_p50);
+  }
+  if (!write_run_plots(plan, ds, runs, err)) return false;
+  if (plan.verbose) std::printf("dataset %s done in %.1f s\n", name.c_str(), since(t0));
+  return true;
+}
+
+// Unknown area: a region around a mid-log pose is erased from the map; trials start 8–30 m
+// before it, so the robot can localize first and then drive through the erased part.
+bool run_unknown_area(EvalRun& run, std::string* err) {
+  const EvalPlan& plan = run.plan;
+  BenchJson* json = run.json;
+  const auto t0 = std::chrono::steady_clock::now();
+  LoadedDataset ds;
+  double region[4];
+  std::vector<std::size_t> starts;
+  if (!prepare_unknown_area(plan.unknown_dataset, plan.seed, plan.unknown_trials, &ds, region, &starts, err))
+    return false;
+  TrialOptions uo = plan.trial;
+  uo.max_steps = plan.trial.max_steps + 60;
+  std::string e;
+  auto mml = OwnedLocalizer::make_mml(ds.map, ds.image, mml_variant(plan, plan.mml_config, false, false).cfg, plan.threads, &e);
+  if (!mml) return (*err = e, false);
+  SystemRun rm = run_system(*mml, ds, "mml-unknown", starts, uo, plan.verbose, region);
+  auto mcl = OwnedLocalizer::make_mcl(ds.map, mcl_baseline_options(plan.mcl_particles, plan.seed), plan.threads, &e);
+  if (!mcl) return (*err = e, false);
+  SystemRun rc2 = run_system(*mcl, ds, "mcl-unknown", starts, uo, plan.verbose, region);
+  json->add("unknown_area_mml_failure_rate", rm.summary.failure_rate);
+  json->add("unknown_area_mcl_failure_rate", rc2.summary.failure_rate);
+  json->add("unknown_area_mml_outside_map_fraction", rm.summary.outside_map_in_region);
+  json->add("unknown_area_mcl_success_rate", rc2.summary.success_rate);
+  json->add_int("unknown_area_trials", static_cast<long long>(starts.size()));
+  run.rows.push_back(rm.summary);
+  run.rows.push_back(rc2.summary);
+  for (const SystemRun* r : {&rm, &rc2}) {
+    const std::string base = plan.out_dir + "/unknown_" + ds.key + "_" + r->label;
+    if (!write_error_plot(base + "_error.svg", ds.name + " with an erased region - " + r->label, r->trials,
+                          ds.success_bound_m, &e) ||
+        !write_map_plot(base + "_map.svg", base + "_map.png", ds, ds.name + " with an erased region - " + r->label,
+                        r->trials, region, &e)) {
+      return (*err = e, false);
+    }
+  }
+  if (plan.verbose) std::printf("unknown area done in %.1f s\n", since(t0));
+  return true;
+}
+
+// summary.md: the plan and the table.
+void write_summary(const EvalRun& run) {
+  const EvalPlan& plan = run.plan;
   std::ofstream md(plan.out_dir + "/summary.md");
   md << "# MML evaluation\n\nKidnapped starts drawn with seed " << plan.seed << "; " << plan.trials
      << " trials per dataset (MCL: " << (plan.mcl_trials ? plan.mcl_trials : plan.trials) << "), at most "
@@ -249,8 +276,27 @@ bool run_evaluation(const EvalPlan& plan, BenchJson* json, std::string* err) {
      << " rad of odometry motion. Success: first `localized` within 0.5 m / 20° (1 m at mit-killian) and never "
         "beyond; failure: any `localized` estimate beyond the bound. Step times are wall-clock on this machine ("
      << plan.threads << " threads).\n\n";
-  md << markdown_table(rows) << "\n";
+  md << markdown_table(run.rows) << "\n";
   md << "Plots: `<dataset>_<system>_error.svg` (error over metres, coloured by status) and `_map.svg/.png`.\n";
+}
+
+}  // namespace
+
+bool run_evaluation(const EvalPlan& plan, BenchJson* json, std::string* err) {
+  std::filesystem::create_directories(plan.out_dir);
+  EvalRun run{plan, json, {}, 0, {}, {}};
+  json->add_int("trials_per_dataset", static_cast<long long>(plan.trials));
+  json->add_int("mcl_trials_per_dataset", static_cast<long long>(plan.mcl_trials ? plan.mcl_trials : plan.trials));
+  json->add_int("max_steps_per_trial", static_cast<long long>(plan.trial.max_steps));
+  json->add_int("seed", static_cast<long long>(plan.seed));
+  for (const std::string& name : plan.datasets)
+    if (!evaluate_dataset(run, name, err)) return false;
+  if (plan.run_unknown && !run_unknown_area(run, err)) return false;
+  json->add("handoff_tracking_err_m", percentile(run.track_err, 50));
+  json->add("handoff_step_ms_p50", percentile(run.track_ms, 50));
+  json->add("handoff_step_ms_p99", percentile(run.track_ms, 99));
+  json->add("static_memory_mib", run.static_mib);
+  write_summary(run);
   return true;
 }
 
