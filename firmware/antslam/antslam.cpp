@@ -61,7 +61,7 @@ std::uint32_t max_edges(const AntSlamOptions& o) { return o.max_fragments + o.ma
 std::size_t AntSlam::required_arena_bytes(const AntSlamOptions& o) {
   const std::size_t f = o.max_fragments, e = max_edges(o), s = o.max_scans;
   std::size_t b = 0;
-  b += s * (sizeof(std::uint32_t) + sizeof(Se2d));
+  b += s * (sizeof(std::uint32_t) + sizeof(Se2d) + sizeof(float)) + f * sizeof(double);
   b += f * (2 * sizeof(Se2d) + 3 * sizeof(std::uint32_t) + sizeof(std::uint32_t) + sizeof(std::int32_t) +
             sizeof(std::uint32_t) + sizeof(std::uint32_t));
   b += f * o.max_points_per_fragment * sizeof(Point2f) + f * o.max_keyframes_per_fragment * sizeof(Se2d);
@@ -90,6 +90,8 @@ Status AntSlam::init(const AntSlamOptions& options, StartupArena& arena, WorkerP
   } while (0)
   FW_ANTSLAM_ALLOC(scan_fragment_, std::uint32_t, options.max_scans, "antslam scan fragment");
   FW_ANTSLAM_ALLOC(scan_rel_, Se2d, options.max_scans, "antslam scan poses");
+  FW_ANTSLAM_ALLOC(scan_along_, float, options.max_scans, "antslam scan distances");
+  FW_ANTSLAM_ALLOC(fragment_length_, double, f, "antslam fragment lengths");
   FW_ANTSLAM_ALLOC(frontend_frame_, Se2d, f, "antslam front-end frames");
   FW_ANTSLAM_ALLOC(world_, Se2d, f, "antslam fragment frames");
   FW_ANTSLAM_ALLOC(fragment_first_scan_, std::uint32_t, f, "antslam first scans");
@@ -152,6 +154,7 @@ Status AntSlam::start_fragment(const Se2d& frontend_pose) {
     cov = 0.5 * (cov + cov.transpose());
     std::uint32_t e = 0;
     FW_RETURN_IF_ERROR(add_edge(f - 1, f, rel_, cov, &e));
+    fragment_length_[f - 1] = travelled_;
     adjacent_edge_[f - 1] = e;
     world_[f] = world_[f - 1].compose(edges_[e].value);
   }
@@ -195,6 +198,8 @@ Status AntSlam::add_scan(const Se2d& pose, const Point2f* points, std::size_t co
   const std::uint32_t f = num_fragments_ - 1;
   scan_fragment_[num_scans_] = f;
   scan_rel_[num_scans_] = rel_;
+  scan_along_[num_scans_] = static_cast<float>(travelled_);
+  fragment_length_[f] = travelled_;
   ++num_scans_;
   // Keyframe: keep this scan's points (fragment frame) for loop closing.
   const bool key = !have_keyframe_ ||
@@ -263,6 +268,17 @@ std::uint32_t AntSlam::build_path(std::uint32_t c, std::uint32_t a) {
     node = forward ? e.to : e.from;
   }
   return node == a ? n : 0;
+}
+
+Se2d AntSlam::scan_pose(std::uint32_t i) const {
+  const std::uint32_t f = scan_fragment_[i];
+  if (f + 1 >= num_fragments_ || !(fragment_length_[f] > 0.0)) return world_[f].compose(scan_rel_[i]);
+  const SampledEdge& e = edges_[adjacent_edge_[f]];
+  const Se2d delta = e.value.compose(e.mean.inverse());
+  double alpha = static_cast<double>(scan_along_[i]) / fragment_length_[f];
+  alpha = alpha < 0.0 ? 0.0 : (alpha > 1.0 ? 1.0 : alpha);
+  const Se2d part(alpha * delta.x, alpha * delta.y, alpha * delta.theta);
+  return world_[f].compose(part).compose(scan_rel_[i]);
 }
 
 void AntSlam::recompute_world() {
@@ -388,20 +404,23 @@ Status AntSlam::close_loop(std::uint32_t a) {
       any_free = any_free || !steps_[i].edge->frozen;
     }
     const std::uint64_t t1 = now();
+    double w0 = 0, w1 = 0;
     if (any_free) {
       if (options_.optimizer == LoopOptimizer::kAntColony) {
         AntColonyReport rep;
         FW_RETURN_IF_ERROR(aco_.solve(problem, num_closures_, values_, &rep));
-        stats_.aco_initial_cost += rep.initial_cost;
-        stats_.aco_final_cost += rep.best_cost;
+        w0 = rep.initial_cost;
+        w1 = rep.best_cost;
       } else {
         LoopLmReport rep;
         FW_RETURN_IF_ERROR(lm_.solve(problem, values_, &rep));
-        stats_.aco_initial_cost += rep.initial_cost;
-        stats_.aco_final_cost += rep.final_cost;
+        w0 = rep.initial_cost;
+        w1 = rep.final_cost;
       }
     }
     stats_.optimizer_ns += now() - t1;
+    stats_.aco_initial_cost += w0;
+    stats_.aco_final_cost += w1;
     Se2d xc;
     for (std::uint32_t i = 0; i < n; ++i) {
       SampledEdge& e = edges_[steps_[i].edge - edges_];
@@ -416,7 +435,14 @@ Status AntSlam::close_loop(std::uint32_t a) {
     edges_[ei].closure = true;
     edges_[ei].value = xc;  // consistent with the corrected chain
     edges_[ei].frozen = true;
-    closures_[num_closures_++] = ClosureRecord{c, a, n, res.best.quality};
+    closures_[num_closures_++] = ClosureRecord{c,
+                                               a,
+                                               n,
+                                               res.best.quality,
+                                               static_cast<float>(chi2),
+                                               static_cast<float>(std::hypot(dh(0), dh(1))),
+                                               static_cast<float>(w0),
+                                               static_cast<float>(w1)};
     ++stats_.loops;
     recompute_world();
     return Status::ok();  // one loop per fragment

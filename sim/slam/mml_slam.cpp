@@ -1,4 +1,5 @@
 // mml-slam: AntSLAM (Ch. 3) from a raw CARMEN log — the map of your own building. See --help.
+#include <cerrno>
 #include <chrono>
 #include <cmath>
 #include <cstdio>
@@ -23,7 +24,7 @@ const char* kHelp =
     "  --trajectory FILE     corrected pose of every scan, 't x y theta' per line (t = ipc timestamp);\n"
     "                        score it with: mml-carmen eval RELATIONS FILE\n"
     "  --map FILE.yaml       ROS map_server map (YAML + PGM beside it); compile it with mml-mapc\n"
-    "  --svg FILE.svg        picture of fragments, edges and closed loops\n"
+    "  --svg FILE.svg        picture of fragments, edges and closed loops (FILE.png: a PNG)\n"
     "  --relations FILE      print the relations metric (Kuemmerle et al. 2009) of RBSM and AntSLAM\n"
     "                        (default with --dataset: the data set's relations)\n"
     "options:\n"
@@ -37,6 +38,13 @@ const char* kHelp =
     "  --resolution M        map cell size (default 0.05)\n"
     "  --max-range M         laser range used for the map (default 25)\n"
     "  --quiet               no progress line\n"
+    "tuning (defaults in fw::antslam::AntSlamOptions):\n"
+    "  --sigma-xy M          front-end drift, metres per sqrt(metre travelled) (Eq. 3.4 G; default 0.02)\n"
+    "  --sigma-theta R       front-end drift, radians per sqrt(metre travelled) (default 0.004)\n"
+    "  --gate CHI2           loop-closure gate on (h - x) (default 16.3)\n"
+    "  --closure-sigma M     loop-closure std in metres (Sigma_h; the angle scales with it, 0.05 m = 1 deg)\n"
+    "  --min-quality Q       pRANSAM quality a closure needs, 0..1 (default 0.55)\n"
+    "  --verbose             one line per closed loop\n"
     "  --help                this text\n";
 
 int fail(const std::string& msg) {
@@ -67,7 +75,7 @@ int run(int argc, char** argv) {
   sim::SlamConfig cfg;
   cfg.workers = 2;
   double resolution = 0.05, max_range = 25.0;
-  bool quiet = false;
+  bool quiet = false, verbose = false;
   for (int i = 1; i < argc; ++i) {
     const std::string a = argv[i];
     if (a == "--help" || a == "-h") {
@@ -76,6 +84,10 @@ int run(int argc, char** argv) {
     }
     if (a == "--quiet") {
       quiet = true;
+      continue;
+    }
+    if (a == "--verbose") {
+      verbose = true;
       continue;
     }
     if (a.rfind("--", 0) != 0) return fail("unexpected argument '" + a + "' (see --help)");
@@ -124,6 +136,22 @@ int run(int argc, char** argv) {
       if (!parse_pos(v, 0.01, 1.0, &resolution)) return fail("--resolution: '" + v + "' is not a cell size in 0.01..1 m");
     } else if (a == "--max-range") {
       if (!parse_pos(v, 1.0, 100.0, &max_range)) return fail("--max-range: '" + v + "' is not a range in 1..100 m");
+    } else if (a == "--sigma-xy") {
+      if (!parse_pos(v, 1e-4, 10.0, &d)) return fail("--sigma-xy: '" + v + "' is not a number in 1e-4..10");
+      cfg.slam.var_xy_per_m = d * d;
+    } else if (a == "--sigma-theta") {
+      if (!parse_pos(v, 1e-5, 1.0, &d)) return fail("--sigma-theta: '" + v + "' is not a number in 1e-5..1");
+      cfg.slam.var_theta_per_m = d * d;
+    } else if (a == "--gate") {
+      if (!parse_pos(v, 0.1, 1e6, &d)) return fail("--gate: '" + v + "' is not a number in 0.1..1e6");
+      cfg.slam.closure_gate_chi2 = d;
+    } else if (a == "--closure-sigma") {
+      if (!parse_pos(v, 1e-3, 10.0, &d)) return fail("--closure-sigma: '" + v + "' is not a number of metres in 0.001..10");
+      cfg.slam.closure_sigma_xy = d;
+      cfg.slam.closure_sigma_theta = d * 0.349;  // 5 cm ↔ 1°
+    } else if (a == "--min-quality") {
+      if (!parse_pos(v, 0.0, 1.0, &d)) return fail("--min-quality: '" + v + "' is not a number in 0..1");
+      cfg.slam.min_closure_quality = static_cast<float>(d);
     } else {
       return fail("unknown option '" + a + "' (see --help)");
     }
@@ -165,6 +193,12 @@ int run(int argc, char** argv) {
   std::printf("mml-slam: RBSM %.1f s + AntSLAM %.1f s (pRANSAM %.0f ms, %s %.0f ms) for %.0f s of log\n", run.frontend_s,
               run.backend_s, run.matcher_ms,
               cfg.slam.optimizer == fw::antslam::LoopOptimizer::kAntColony ? "ant colony" : "LM", run.optimizer_ms, log_s);
+  if (verbose) {
+    for (const auto& c : run.closures) {
+      std::printf("loop %u -> %u: %u edges, quality %.2f, chi2 %.1f, open %.3f m, W %.1f -> %.1f\n", c.from, c.to,
+                  c.path_edges, c.quality, c.gate_chi2, c.shift_m, c.cost_before, c.cost_after);
+    }
+  }
   if (!rel.empty()) {
     const auto mf = sim::evaluate_relations(rel, sim::make_trajectory(log, run.frontend));
     const auto ms = sim::evaluate_relations(rel, sim::make_trajectory(log, run.poses));

@@ -91,6 +91,8 @@ bool run_slam_backend(const CarmenLog& log, const std::vector<fw::Se2d>& fronten
     const auto& ed = slam->edge(e);
     out->edges.push_back({ed.from, ed.to, ed.closure, ed.frozen});
   }
+  out->closures.clear();
+  for (std::uint32_t c = 0; c < slam->num_closures(); ++c) out->closures.push_back(slam->closure(c));
   out->stats = slam->stats();
   out->optimizer_ms = static_cast<double>(out->stats.optimizer_ns) * 1e-6;
   out->matcher_ms = static_cast<double>(out->stats.matcher_ns) * 1e-6;
@@ -180,6 +182,7 @@ bool write_slam_svg(const SlamRun& run, const std::string& title, const std::str
   frames.label = "fragment frames (adjacent edges join them)";
   for (const auto& f : run.fragments) frames.points.push_back({f.pose.x, f.pose.y});
   pic.point_sets.push_back(std::move(frames));
+  if (path.size() > 4 && path.substr(path.size() - 4) == ".png") return write_png(pic, path, error);
   return write_svg(pic, path, error);
 }
 

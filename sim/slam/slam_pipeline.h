@@ -40,6 +40,7 @@ struct SlamRun {
   std::vector<fw::Se2d> poses;     // AntSLAM corrected (one per scan)
   std::vector<SlamFragmentInfo> fragments;
   std::vector<SlamEdgeInfo> edges;
+  std::vector<fw::antslam::ClosureRecord> closures;
   fw::antslam::AntSlamStats stats;
   double frontend_s = 0, backend_s = 0;  // wall time
   double optimizer_ms = 0, matcher_ms = 0;
