@@ -382,7 +382,19 @@ Status AntSlam::close_loop(std::uint32_t a) {
       ++stats_.rejected_quality;
       continue;
     }
-    const Se2d h = pransam::to_se2(res.best).cast<double>();
+    Se2d h = pransam::to_se2(res.best).cast<double>();
+    if (options_.refine_closure) {
+      const FieldFit fh = fit_on_field(matcher_.field(), scene, num_points_[a], h, options_.refine_iterations,
+                                       options_.refine_cutoff_start, options_.refine_cutoff_end);
+      const FieldFit fx = fit_on_field(matcher_.field(), scene, num_points_[a], x, options_.refine_iterations,
+                                       options_.refine_cutoff_start, options_.refine_cutoff_end);
+      if (fx.quality + options_.prefer_prediction_margin >= fh.quality) {
+        h = fx.pose;
+        ++stats_.prediction_kept;
+      } else {
+        h = fh.pose;
+      }
+    }
     Mat3 cov_h = Mat3::Zero();
     cov_h.diagonal() << options_.closure_sigma_xy * options_.closure_sigma_xy,
         options_.closure_sigma_xy * options_.closure_sigma_xy, options_.closure_sigma_theta * options_.closure_sigma_theta;

@@ -33,6 +33,7 @@
 #include <cstdint>
 
 #include "firmware/antslam/ant_colony.h"
+#include "firmware/antslam/field_fit.h"
 #include "firmware/antslam/loop_lm.h"
 #include "firmware/antslam/sampled_edge.h"
 #include "firmware/base/arena.h"
@@ -79,6 +80,13 @@ struct AntSlamOptions {
   double closure_sigma_xy = 0.05;        // Σ_h (m)
   double closure_sigma_theta = 0.01745;  // Σ_h (rad)
   double frozen_cov_scale = 0.1;         // a corrected (frozen) edge's covariance in the path prediction
+  // Closure refinement (field_fit.h, an addition): pRANSAM's h and the prediction x are both
+  // refined on the candidate's distance field; the prediction wins unless h fits better by this.
+  bool refine_closure = true;
+  std::uint32_t refine_iterations = 15;
+  float refine_cutoff_start = 0.5f, refine_cutoff_end = 0.15f;
+  float prefer_prediction_margin = -1.0f;  // < 0: always pRANSAM's h (measured on intel: preferring
+                                           // the prediction, 0.02, made the long relations worse)
   pransam::MatcherOptions matcher;       // sizes taken from max_points_per_fragment in validate()
   pransam::MatchParams match;
 
@@ -95,6 +103,7 @@ struct AntSlamStats {
   std::uint32_t candidates = 0;        // pRANSAM matches tried
   std::uint32_t rejected_quality = 0;  // best hypothesis below min_closure_quality
   std::uint32_t rejected_gate = 0;     // too far from the prediction
+  std::uint32_t prediction_kept = 0;   // refined prediction fitted as well as pRANSAM's h
   std::uint32_t loops = 0;             // loops closed and corrected
   std::uint32_t dropped_points = 0;    // points beyond a fragment's capacity
   double aco_initial_cost = 0, aco_final_cost = 0;  // sums over the loops

@@ -23,6 +23,7 @@ const char* kHelp =
     "outputs (each optional; nothing is written unless asked):\n"
     "  --trajectory FILE     corrected pose of every scan, 't x y theta' per line (t = ipc timestamp);\n"
     "                        score it with: mml-carmen eval RELATIONS FILE\n"
+    "  --rbsm-trajectory FILE  the same for the RBSM front end alone (before AntSLAM)\n"
     "  --map FILE.yaml       ROS map_server map (YAML + PGM beside it); compile it with mml-mapc\n"
     "  --svg FILE.svg        picture of fragments, edges and closed loops (FILE.png: a PNG)\n"
     "  --relations FILE      print the relations metric (Kuemmerle et al. 2009) of RBSM and AntSLAM\n"
@@ -43,6 +44,9 @@ const char* kHelp =
     "  --sigma-theta R       front-end drift, radians per sqrt(metre travelled) (default 0.004)\n"
     "  --gate CHI2           loop-closure gate on (h - x) (default 16.3)\n"
     "  --closure-sigma M     loop-closure std in metres (Sigma_h; the angle scales with it, 0.05 m = 1 deg)\n"
+    "  --closure-refine none|pransam|both  refine the loop closure on the distance field: not at all, pRANSAM's\n"
+    "                        hypothesis, or both it and the prediction, keeping the better fit (default pransam)\n"
+    "  --min-gap N           fragments between the two ends of a loop, at least (default 3)\n"
     "  --min-quality Q       pRANSAM quality a closure needs, 0..1 (default 0.55)\n"
     "  --verbose             one line per closed loop\n"
     "  --help                this text\n";
@@ -71,6 +75,7 @@ bool parse_pos(const std::string& s, double lo, double hi, double* out) {
 }
 
 int run(int argc, char** argv) {
+  std::string rbsm_traj_path;
   std::string log_path, dataset, traj_path, map_path, svg_path, rel_path;
   sim::SlamConfig cfg;
   cfg.workers = 2;
@@ -101,6 +106,8 @@ int run(int argc, char** argv) {
       dataset = v;
     } else if (a == "--trajectory") {
       traj_path = v;
+    } else if (a == "--rbsm-trajectory") {
+      rbsm_traj_path = v;
     } else if (a == "--map") {
       if (v.size() < 6 || v.substr(v.size() - 5) != ".yaml") return fail("--map: '" + v + "' must end in .yaml");
       map_path = v;
@@ -149,6 +156,21 @@ int run(int argc, char** argv) {
       if (!parse_pos(v, 1e-3, 10.0, &d)) return fail("--closure-sigma: '" + v + "' is not a number of metres in 0.001..10");
       cfg.slam.closure_sigma_xy = d;
       cfg.slam.closure_sigma_theta = d * 0.349;  // 5 cm ↔ 1°
+    } else if (a == "--closure-refine") {
+      if (v == "none") {
+        cfg.slam.refine_closure = false;
+      } else if (v == "pransam") {
+        cfg.slam.refine_closure = true;
+        cfg.slam.prefer_prediction_margin = -1.0f;
+      } else if (v == "both") {
+        cfg.slam.refine_closure = true;
+        cfg.slam.prefer_prediction_margin = 0.02f;
+      } else {
+        return fail("--closure-refine: '" + v + "' is not none, pransam or both");
+      }
+    } else if (a == "--min-gap") {
+      if (!parse_u64(v, 1, 100000, &u)) return fail("--min-gap: '" + v + "' is not a positive integer");
+      cfg.slam.min_fragment_gap = static_cast<std::uint32_t>(u);
     } else if (a == "--min-quality") {
       if (!parse_pos(v, 0.0, 1.0, &d)) return fail("--min-quality: '" + v + "' is not a number in 0..1");
       cfg.slam.min_closure_quality = static_cast<float>(d);
@@ -207,6 +229,10 @@ int run(int argc, char** argv) {
   }
   if (!traj_path.empty() && !sim::write_trajectory(traj_path, sim::make_trajectory(log, run.poses), &err)) {
     return fail("--trajectory: " + err);
+  }
+  if (!rbsm_traj_path.empty() &&
+      !sim::write_trajectory(rbsm_traj_path, sim::make_trajectory(log, run.frontend), &err)) {
+    return fail("--rbsm-trajectory: " + err);
   }
   if (!map_path.empty() && !sim::write_slam_map(log, run.poses, resolution, max_range, map_path, &err)) {
     return fail("--map: " + err);
