@@ -1,6 +1,6 @@
 // bench_slam (issue 12): AntSLAM on the raw logs of intel, fr079, aces, mit-killian and fr-clinic,
 // scored with the relations metric (sim/io/relations.h; mit-killian: relations between consecutive
-// GMapping-corrected poses, see mit_relations): the ant colony (D_slam_*), LM on the same
+// GMapping-corrected poses, see slam_dataset_relations): the ant colony (D_slam_*), LM on the same
 // front end and loops (D_slam_lm_*), RBSM alone (D_rbsm_*) and raw odometry (D_odom_*); mapping
 // time against the log's duration; time in the loop optimisers; and slam_deterministic (an intel
 // prefix twice with the same seed, once with 1 and once with 2 workers: identical poses).
@@ -27,26 +27,6 @@ double seconds_since(std::chrono::steady_clock::time_point t0) {
   return std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
 }
 
-// mit-killian's relation file cannot be looked up in the reconstructed log (synthetic timestamps,
-// ../shared/data/README.md), so its relations are made from the GMapping-corrected poses the data
-// set ships (every ~9th scan): each corrected pose related to the next one.
-bool mit_relations(const sim::CarmenLog& log, const sim::EvalDataset& d, std::vector<sim::Relation>* rel,
-                   std::string* err) {
-  std::vector<sim::CorrectedPose> ref;
-  if (!sim::read_corrected_poses(d.corrected_poses, &ref, err)) return false;
-  rel->clear();
-  for (std::size_t k = 0; k + 1 < ref.size(); ++k) {
-    if (ref[k + 1].flaser_index >= log.scans.size()) break;
-    sim::Relation r;
-    r.t1 = log.scans[ref[k].flaser_index].ipc_timestamp;
-    r.t2 = log.scans[ref[k + 1].flaser_index].ipc_timestamp;
-    r.delta = ref[k].pose.between(ref[k + 1].pose);
-    rel->push_back(r);
-  }
-  if (rel->empty()) *err = d.corrected_poses + ": no corrected pose inside the log";
-  return !rel->empty();
-}
-
 }  // namespace
 
 static int run_main(int argc, char** argv) {
@@ -69,7 +49,7 @@ static int run_main(int argc, char** argv) {
     sim::CarmenLog log;
     std::vector<sim::Relation> rel;
     if (!sim::find_eval_dataset(ds, &d, &err) || !sim::read_carmen_log(d.raw_log, {}, &log, &err) ||
-        !(ds == "mit-killian" ? mit_relations(log, d, &rel, &err) : sim::read_relations(d.relations, &rel, &err))) {
+        !sim::slam_dataset_relations(log, d, &rel, &err)) {
       std::fprintf(stderr, "bench_slam: %s (is MMLFW_DATA_DIR set?)\n", err.c_str());
       all_ok = false;
       continue;

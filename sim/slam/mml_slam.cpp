@@ -27,7 +27,8 @@ const char* kHelp =
     "  --map FILE.yaml       ROS map_server map (YAML + PGM beside it); compile it with mml-mapc\n"
     "  --svg FILE.svg        picture of fragments, edges and closed loops (FILE.png: a PNG)\n"
     "  --relations FILE      print the relations metric (Kuemmerle et al. 2009) of RBSM and AntSLAM\n"
-    "                        (default with --dataset: the data set's relations)\n"
+    "                        (default with --dataset: the data set's relations; mit-killian: relations\n"
+    "                        between its consecutive GMapping-corrected poses)\n"
     "options:\n"
     "  --optimizer aco|lm    loop optimiser (default aco: the ant colony of Eq. 3.13-3.14)\n"
     "  --ants N              ants per iteration (default 20)\n"
@@ -180,18 +181,23 @@ int run(int argc, char** argv) {
   }
   if (log_path.empty() == dataset.empty()) return fail("give exactly one of --log FILE or --dataset NAME (see --help)");
   std::string err;
+  sim::EvalDataset ds;
+  std::string ds_relations;
   if (!dataset.empty()) {
-    sim::EvalDataset ds;
     if (!sim::find_eval_dataset(dataset, &ds, &err)) {
       return fail("--dataset: " + err + " (names: intel, fr079, aces, mit-killian, fr-clinic; data under MMLFW_DATA_DIR)");
     }
     log_path = ds.raw_log;
-    if (rel_path.empty()) rel_path = ds.relations;
+    if (rel_path.empty()) rel_path = ds_relations = ds.relations;
   }
-  std::vector<sim::Relation> rel;
-  if (!rel_path.empty() && !sim::read_relations(rel_path, &rel, &err)) return fail("--relations: " + err);
   sim::CarmenLog log;
   if (!sim::read_carmen_log(log_path, sim::CarmenReadOptions{}, &log, &err)) return fail(err);
+  std::vector<sim::Relation> rel;
+  if (!dataset.empty() && rel_path == ds_relations) {
+    if (!sim::slam_dataset_relations(log, ds, &rel, &err)) return fail("--dataset: " + err);
+  } else if (!rel_path.empty() && !sim::read_relations(rel_path, &rel, &err)) {
+    return fail("--relations: " + err);
+  }
   if (log.scans.empty()) return fail(log_path + ": no laser scans in the log");
   const auto t0 = std::chrono::steady_clock::now();
   if (!quiet) {

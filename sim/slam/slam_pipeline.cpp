@@ -4,6 +4,7 @@
 #include <cmath>
 #include <memory>
 
+#include "sim/io/reference_trajectory.h"
 #include "sim/io/ros_map.h"
 #include "sim/map/occupancy_builder.h"
 #include "sim/viz/picture.h"
@@ -112,6 +113,24 @@ bool run_slam(const CarmenLog& log, const SlamConfig& config, SlamRun* out, std:
   if (!run_slam_backend(log, odo.poses, config, out, error)) return false;
   out->frontend_s = front_s;
   return true;
+}
+
+bool slam_dataset_relations(const CarmenLog& log, const EvalDataset& d, std::vector<Relation>* rel,
+                            std::string* err) {
+  if (d.name != "mit-killian") return read_relations(d.relations, rel, err);
+  std::vector<CorrectedPose> ref;
+  if (!read_corrected_poses(d.corrected_poses, &ref, err)) return false;
+  rel->clear();
+  for (std::size_t k = 0; k + 1 < ref.size(); ++k) {
+    if (ref[k + 1].flaser_index >= log.scans.size()) break;
+    Relation r;
+    r.t1 = log.scans[ref[k].flaser_index].ipc_timestamp;
+    r.t2 = log.scans[ref[k + 1].flaser_index].ipc_timestamp;
+    r.delta = ref[k].pose.between(ref[k + 1].pose);
+    rel->push_back(r);
+  }
+  if (rel->empty()) *err = d.corrected_poses + ": no corrected pose inside the log";
+  return !rel->empty();
 }
 
 bool write_slam_map(const CarmenLog& log, const std::vector<fw::Se2d>& poses, double resolution, double max_range,

@@ -52,6 +52,13 @@ bool run_slam(const CarmenLog& log, const SlamConfig& config, SlamRun* out, std:
 bool run_slam_backend(const CarmenLog& log, const std::vector<fw::Se2d>& frontend, const SlamConfig& config,
                       SlamRun* out, std::string* error);
 
+// The relations a data set is scored with: its relation file, except mit-killian, whose relation
+// timestamps cannot be looked up in the reconstructed log (synthetic timestamps,
+// ../shared/data/README.md): there each GMapping-corrected pose the data set ships (every ~9th
+// scan) is related to the next one.
+bool slam_dataset_relations(const CarmenLog& log, const EvalDataset& dataset, std::vector<Relation>* out,
+                            std::string* error);
+
 // Outputs.
 bool write_slam_map(const CarmenLog& log, const std::vector<fw::Se2d>& poses, double resolution, double max_range,
                     const std::string& yaml_path, std::string* error);
