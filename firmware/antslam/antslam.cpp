@@ -1,6 +1,5 @@
 #include "firmware/antslam/antslam.h"
 
-#include <Eigen/Eigenvalues>
 #include <Eigen/LU>
 #include <cmath>
 
@@ -315,8 +314,9 @@ Status AntSlam::close_loop(std::uint32_t a) {
       x = x.compose(t);
     }
     // Mahalanobis distance of a's poses to the nearest pose of c (beyond the overlap radius).
-    const Eigen::Matrix2d cxy = cov.topLeftCorner<2, 2>();
-    const double lmax = Eigen::SelfAdjointEigenSolver<Eigen::Matrix2d>(cxy, Eigen::EigenvaluesOnly).eigenvalues()(1);
+    // Largest eigenvalue of the 2×2 position covariance (closed form; no Eigen solver, no heap).
+    const double ca = cov(0, 0), cb = cov(0, 1), cc = cov(1, 1);
+    const double lmax = 0.5 * (ca + cc) + std::sqrt(0.25 * (ca - cc) * (ca - cc) + cb * cb);
     const double sigma = std::sqrt(lmax > 1e-12 ? lmax : 1e-12);
     const Se2d* kc = keyframes_ + static_cast<std::size_t>(c) * options_.max_keyframes_per_fragment;
     const Se2d* ka = keyframes_ + static_cast<std::size_t>(a) * options_.max_keyframes_per_fragment;

@@ -10,6 +10,7 @@
 
 #include "firmware/antslam/antslam.h"
 #include "firmware/rbsm/synthetic_world_test_util.h"
+#include "tests/alloc_counter.h"
 
 namespace fw::antslam {
 namespace {
@@ -124,6 +125,30 @@ TEST(AntSlamTest, SameSeedSamePoses) {
   for (std::size_t i = 0; i < a.size(); ++i) {
     ASSERT_EQ(a[i].x, b[i].x);
     ASSERT_EQ(a[i].theta, b[i].theta);
+  }
+}
+
+TEST(AntSlamTest, NoHeapAfterInit) {
+  if (!mmlfw_test::AllocCounter::available()) GTEST_SKIP() << "allocation counter unavailable under sanitizers";
+  const RingRun r = make_run();
+  for (LoopOptimizer opt : {LoopOptimizer::kAntColony, LoopOptimizer::kLevenbergMarquardt}) {
+    const AntSlamOptions o = test_options(opt);
+    std::vector<unsigned char> block(AntSlam::required_arena_bytes(o));
+    StartupArena arena;
+    ASSERT_TRUE(arena.init(block.data(), block.size(), "test").is_ok());
+    auto slam = std::make_unique<AntSlam>();
+    ASSERT_TRUE(slam->init(o, arena).is_ok());
+    arena.seal();
+    mmlfw_test::AllocCounter::begin();
+    bool ok = true;
+    for (std::size_t i = 0; i < r.truth.size(); ++i) {
+      ok = ok && slam->add_scan(r.frontend[i], r.scans[i].data(), r.scans[i].size()).is_ok();
+    }
+    ok = ok && slam->finish().is_ok();
+    const long allocations = mmlfw_test::AllocCounter::end();
+    EXPECT_TRUE(ok);
+    EXPECT_GT(slam->stats().loops, 0u);
+    EXPECT_EQ(allocations, 0) << "add_scan/finish allocated (loop closing, pRANSAM, optimiser)";
   }
 }
 
