@@ -4,6 +4,8 @@
 #include <cmath>
 #include <cstdio>
 #include <cstdlib>
+#include <filesystem>
+#include <utility>
 #include <string>
 
 #include "sim/common/cli_main.h"
@@ -189,6 +191,18 @@ int run(int argc, char** argv) {
     }
     log_path = ds.raw_log;
     if (rel_path.empty()) rel_path = ds_relations = ds.relations;
+  }
+  // Outputs go into existing directories: say so now, not after minutes of mapping.
+  for (const auto& [opt, path] : {std::pair<const char*, const std::string*>{"--trajectory", &traj_path},
+                                  {"--rbsm-trajectory", &rbsm_traj_path},
+                                  {"--map", &map_path},
+                                  {"--svg", &svg_path}}) {
+    if (path->empty()) continue;
+    const std::filesystem::path dir = std::filesystem::path(*path).parent_path();
+    std::error_code ec;
+    if (!dir.empty() && !std::filesystem::is_directory(dir, ec)) {
+      return fail(std::string(opt) + ": directory '" + dir.string() + "' does not exist");
+    }
   }
   sim::CarmenLog log;
   if (!sim::read_carmen_log(log_path, sim::CarmenReadOptions{}, &log, &err)) return fail(err);

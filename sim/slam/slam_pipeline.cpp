@@ -107,8 +107,11 @@ bool run_slam(const CarmenLog& log, const SlamConfig& config, SlamRun* out, std:
   MatcherConfig mc = config.front;
   mc.workers = config.workers;
   OdometryRun odo;
-  if (config.progress) config.progress(0, log.scans.size(), "rbsm");
-  if (!run_scan_matching_odometry(log, MatcherKind::kRbsm, mc, config.max_scans, &odo, error)) return false;
+  std::function<void(size_t, size_t)> front_progress;
+  if (config.progress) front_progress = [&config](size_t done, size_t total) { config.progress(done, total, "rbsm"); };
+  if (!run_scan_matching_odometry(log, MatcherKind::kRbsm, mc, config.max_scans, &odo, error, front_progress)) {
+    return false;
+  }
   const double front_s = seconds_since(t0);
   if (!run_slam_backend(log, odo.poses, config, out, error)) return false;
   out->frontend_s = front_s;
