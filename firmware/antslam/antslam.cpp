@@ -370,8 +370,13 @@ Status AntSlam::close_loop(std::uint32_t a) {
     // pRANSAM: a's points (scene, F_a) against c's (model, F_c) → h = F_a in F_c.
     ++stats_.candidates;
     const std::uint64_t t0 = now();
-    FW_RETURN_IF_ERROR(matcher_.set_model(points_ + static_cast<std::size_t>(c) * options_.max_points_per_fragment,
-                                          num_points_[c], "antslam fragment"));
+    // A fragment pRANSAM cannot take as a model (degenerate, too large for the field) is no candidate.
+    if (!matcher_.set_model(points_ + static_cast<std::size_t>(c) * options_.max_points_per_fragment, num_points_[c],
+                            "antslam fragment")
+             .is_ok()) {
+      ++stats_.rejected_quality;
+      continue;
+    }
     matcher_.reset();
     pransam::MatchParams mp = options_.match;
     mp.seed = options_.seed * 1000003u + a * 4099u + c;

@@ -38,6 +38,11 @@ bool run_slam_backend(const CarmenLog& log, const std::vector<fw::Se2d>& fronten
   }
   fw::antslam::AntSlamOptions o = config.slam;
   if (o.max_scans < n) o.max_scans = static_cast<std::uint32_t>(n);
+  // Enough fragments for the distance the front end travelled (a long log must not run out).
+  double travelled = 0;
+  for (std::size_t i = 1; i < n; ++i) travelled += std::hypot(frontend[i].x - frontend[i - 1].x, frontend[i].y - frontend[i - 1].y);
+  const double need = travelled / o.fragment_length_m + 16;
+  if (need > o.max_fragments) o.max_fragments = static_cast<std::uint32_t>(need);
   // Host arena: one block (the firmware would carve it from its start-up arena).
   std::vector<unsigned char> block(fw::antslam::AntSlam::required_arena_bytes(o));
   fw::StartupArena arena;
