@@ -130,7 +130,8 @@ uint64_t stamp_ns(const CarmenScan& s) {
 }  // namespace
 
 bool run_scan_matching_odometry(const CarmenLog& log, MatcherKind kind, const MatcherConfig& config, size_t max_scans,
-                                OdometryRun* out, std::string* error) {
+                                OdometryRun* out, std::string* error,
+                                const std::function<void(size_t, size_t)>& progress) {
   *out = OdometryRun{};
   auto inst = MatcherInstance::create(kind, config, error);
   if (!inst) return false;
@@ -145,6 +146,7 @@ bool run_scan_matching_odometry(const CarmenLog& log, MatcherKind kind, const Ma
   out->poses.reserve(n);
   auto scan = std::make_unique<hal::LaserScan>();
   for (size_t i = 0; i < n; ++i) {
+    if (progress && i % 500 == 0) progress(i, n);
     const CarmenScan& cs = log.scans[i];
     *scan = to_laser_scan(cs, stamp_ns(cs));
     hal::Odometry odom;

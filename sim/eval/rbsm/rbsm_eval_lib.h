@@ -5,6 +5,7 @@
 #pragma once
 
 #include <cstdint>
+#include <functional>
 #include <memory>
 #include <string>
 #include <vector>
@@ -70,9 +71,11 @@ struct OdometryRun {
   size_t failures = 0;             // scans the matcher refused (pose = odometry prediction)
   std::vector<std::string> failure_messages;  // first few
 };
-// Scan-matching odometry over the first max_scans scans (0 = all).
+// Scan-matching odometry over the first max_scans scans (0 = all). `progress` (optional) is called
+// every 500 scans with (scans done, scans to do), e.g. for a progress line (mml-slam).
 bool run_scan_matching_odometry(const CarmenLog& log, MatcherKind kind, const MatcherConfig& config, size_t max_scans,
-                                OdometryRun* out, std::string* error);
+                                OdometryRun* out, std::string* error,
+                                const std::function<void(size_t, size_t)>& progress = {});
 
 // Mean of scan_cpu_ms: CPU per scan including the map update (the throughput figure).
 double cpu_ms_per_scan(const OdometryRun& run);

@@ -1,0 +1,470 @@
+#include "firmware/antslam/antslam.h"
+
+#include <Eigen/LU>
+#include <cmath>
+
+namespace fw::antslam {
+
+namespace {
+constexpr std::uint32_t kMaxCandidates = 16;
+constexpr std::uint32_t kNoHops = 0xffffffffu;
+}  // namespace
+
+Status AntSlamOptions::validate() const {
+  if (max_scans == 0 || max_fragments < 2 || max_points_per_fragment < 16 || max_keyframes_per_fragment == 0 ||
+      max_loop_steps == 0) {
+    return Status::error(Errc::kInvalidArgument, "antslam: capacities must be positive (fragments >= 2, points >= 16)");
+  }
+  if (samples_per_edge == 0 || samples_per_edge > 4096) {
+    return Status::error(Errc::kInvalidArgument, "antslam: samples_per_edge %u not in 1..4096", samples_per_edge);
+  }
+  if (!(fragment_length_m > 0.0)) return Status::error(Errc::kInvalidArgument, "antslam: fragment_length_m must be > 0");
+  if (!(var_xy_per_m >= 0 && var_theta_per_m >= 0 && var_theta_per_rad >= 0 && var_floor > 0)) {
+    return Status::error(Errc::kInvalidArgument, "antslam: motion noise must be >= 0 (floor > 0)");
+  }
+  if (beam_stride == 0) return Status::error(Errc::kInvalidArgument, "antslam: beam_stride must be > 0");
+  if (max_candidates > kMaxCandidates) {
+    return Status::error(Errc::kInvalidArgument, "antslam: max_candidates %u > %u", max_candidates, kMaxCandidates);
+  }
+  if (!(closure_sigma_xy > 0 && closure_sigma_theta > 0)) {
+    return Status::error(Errc::kInvalidArgument, "antslam: closure sigmas must be > 0");
+  }
+  if (!(candidate_mahalanobis > 0 && closure_gate_chi2 > 0 && overlap_radius_m >= 0 && frozen_cov_scale > 0)) {
+    return Status::error(Errc::kInvalidArgument, "antslam: loop-closing gates must be > 0");
+  }
+  FW_RETURN_IF_ERROR(aco.validate());
+  return lm.validate();
+}
+
+AntSlamOptions default_antslam_options() {
+  AntSlamOptions o;
+  o.matcher.num_workers = 2;
+  o.matcher.field.resolution = 0.05f;
+  o.match.max_iterations = 40000;
+  o.match.omega_thres = 0.8f;
+  o.match.refine_iterations = 6;
+  o.match.refine_min_quality = 0.4f;
+  return o;
+}
+
+namespace {
+pransam::MatcherOptions sized_matcher(const AntSlamOptions& o) {
+  pransam::MatcherOptions m = o.matcher;
+  m.max_scene_points = o.max_points_per_fragment;
+  m.max_model_points = o.max_points_per_fragment;
+  return m;
+}
+std::uint32_t max_edges(const AntSlamOptions& o) { return o.max_fragments + o.max_closures; }
+}  // namespace
+
+std::size_t AntSlam::required_arena_bytes(const AntSlamOptions& o) {
+  const std::size_t f = o.max_fragments, e = max_edges(o), s = o.max_scans;
+  std::size_t b = 0;
+  b += s * (sizeof(std::uint32_t) + sizeof(Se2d) + sizeof(float)) + f * sizeof(double);
+  b += f * (2 * sizeof(Se2d) + 3 * sizeof(std::uint32_t) + sizeof(std::uint32_t) + sizeof(std::int32_t) +
+            sizeof(std::uint32_t) + sizeof(std::uint32_t));
+  b += f * o.max_points_per_fragment * sizeof(Point2f) + f * o.max_keyframes_per_fragment * sizeof(Se2d);
+  b += e * (sizeof(SampledEdge) + o.samples_per_edge * (sizeof(Se2d) + sizeof(double)));
+  b += o.max_closures * sizeof(ClosureRecord);
+  b += o.max_loop_steps * (sizeof(LoopStep) + sizeof(Se2d));
+  b += AntColony::required_arena_bytes(o.aco, o.max_loop_steps, o.samples_per_edge);
+  b += LoopLm::required_arena_bytes(o.max_loop_steps);
+  // pRANSAM: measured by the caller's arena (init reports capacity errors); a generous bound.
+  b += 64u << 20;
+  return b + 64 * 40;
+}
+
+Status AntSlam::init(const AntSlamOptions& options, StartupArena& arena, WorkerPool* pool, const hal::Clock* clock) {
+  FW_RETURN_IF_ERROR(options.validate());
+  options_ = options;
+  pool_ = pool;
+  clock_ = clock;
+  const std::uint32_t f = options.max_fragments;
+  max_edges_ = max_edges(options);
+#define FW_ANTSLAM_ALLOC(ptr, T, n, what)              \
+  do {                                                 \
+    auto r_ = arena.allocate_array<T>((n), (what));    \
+    if (!r_) return r_.status();                       \
+    ptr = *r_;                                         \
+  } while (0)
+  FW_ANTSLAM_ALLOC(scan_fragment_, std::uint32_t, options.max_scans, "antslam scan fragment");
+  FW_ANTSLAM_ALLOC(scan_rel_, Se2d, options.max_scans, "antslam scan poses");
+  FW_ANTSLAM_ALLOC(scan_along_, float, options.max_scans, "antslam scan distances");
+  FW_ANTSLAM_ALLOC(fragment_length_, double, f, "antslam fragment lengths");
+  FW_ANTSLAM_ALLOC(frontend_frame_, Se2d, f, "antslam front-end frames");
+  FW_ANTSLAM_ALLOC(world_, Se2d, f, "antslam fragment frames");
+  FW_ANTSLAM_ALLOC(fragment_first_scan_, std::uint32_t, f, "antslam first scans");
+  FW_ANTSLAM_ALLOC(adjacent_edge_, std::uint32_t, f, "antslam adjacent edges");
+  FW_ANTSLAM_ALLOC(num_points_, std::uint32_t, f, "antslam point counts");
+  FW_ANTSLAM_ALLOC(num_keyframes_, std::uint32_t, f, "antslam keyframe counts");
+  FW_ANTSLAM_ALLOC(points_, Point2f, static_cast<std::size_t>(f) * options.max_points_per_fragment, "antslam points");
+  FW_ANTSLAM_ALLOC(keyframes_, Se2d, static_cast<std::size_t>(f) * options.max_keyframes_per_fragment,
+                   "antslam keyframes");
+  FW_ANTSLAM_ALLOC(edges_, SampledEdge, max_edges_, "antslam edges");
+  FW_ANTSLAM_ALLOC(edge_options_, Se2d, static_cast<std::size_t>(max_edges_) * options.samples_per_edge,
+                   "antslam edge options");
+  FW_ANTSLAM_ALLOC(edge_option_cost_, double, static_cast<std::size_t>(max_edges_) * options.samples_per_edge,
+                   "antslam option costs");
+  FW_ANTSLAM_ALLOC(closures_, ClosureRecord, options.max_closures, "antslam closures");
+  FW_ANTSLAM_ALLOC(parent_edge_, std::int32_t, f, "antslam bfs parents");
+  FW_ANTSLAM_ALLOC(hops_, std::uint32_t, f, "antslam bfs hops");
+  FW_ANTSLAM_ALLOC(queue_, std::uint32_t, f, "antslam bfs queue");
+  FW_ANTSLAM_ALLOC(steps_, LoopStep, options.max_loop_steps, "antslam loop steps");
+  FW_ANTSLAM_ALLOC(values_, Se2d, options.max_loop_steps, "antslam loop values");
+#undef FW_ANTSLAM_ALLOC
+  FW_RETURN_IF_ERROR(aco_.init(options.aco, options.max_loop_steps, options.samples_per_edge, arena, pool));
+  FW_RETURN_IF_ERROR(lm_.init(options.lm, options.max_loop_steps, arena));
+  FW_RETURN_IF_ERROR(matcher_.init(sized_matcher(options), arena, pool));
+  edge_rng_.reseed(options.seed, 0xED6E);
+  num_scans_ = num_fragments_ = num_edges_ = num_closures_ = 0;
+  stats_ = AntSlamStats{};
+  initialized_ = true;
+  return Status::ok();
+}
+
+Status AntSlam::add_edge(std::uint32_t from, std::uint32_t to, const Se2d& mean, const Mat3& cov,
+                         std::uint32_t* index) {
+  if (num_edges_ >= max_edges_) {
+    return Status::error(Errc::kCapacityExceeded, "antslam: more than %u edges", max_edges_);
+  }
+  const std::size_t off = static_cast<std::size_t>(num_edges_) * options_.samples_per_edge;
+  FW_RETURN_IF_ERROR(init_sampled_edge(from, to, mean, cov, edge_options_ + off, edge_option_cost_ + off,
+                                       options_.samples_per_edge, edge_rng_, &edges_[num_edges_]));
+  *index = num_edges_++;
+  return Status::ok();
+}
+
+Status AntSlam::start_fragment(const Se2d& frontend_pose) {
+  if (num_fragments_ >= options_.max_fragments) {
+    return Status::error(Errc::kCapacityExceeded, "antslam: more than %u fragments (max_fragments)",
+                         options_.max_fragments);
+  }
+  const std::uint32_t f = num_fragments_;
+  frontend_frame_[f] = frontend_pose;
+  fragment_first_scan_[f] = num_scans_;
+  num_points_[f] = 0;
+  num_keyframes_[f] = 0;
+  if (f == 0) {
+    world_[0] = frontend_pose;
+  } else {
+    // Adjacent edge T(F_f−1 → F_f) ~ N(μ, Σ) from the tracked pose (Eq. 3.4), sampled (Eq. 3.10).
+    Mat3 cov = rel_cov_;
+    cov.diagonal().array() += options_.var_floor;
+    cov = 0.5 * (cov + cov.transpose());
+    std::uint32_t e = 0;
+    FW_RETURN_IF_ERROR(add_edge(f - 1, f, rel_, cov, &e));
+    fragment_length_[f - 1] = travelled_;
+    adjacent_edge_[f - 1] = e;
+    world_[f] = world_[f - 1].compose(edges_[e].value);
+  }
+  ++num_fragments_;
+  rel_ = Se2d();
+  rel_cov_ = Mat3::Zero();
+  travelled_ = 0.0;
+  have_keyframe_ = false;
+  return Status::ok();
+}
+
+Status AntSlam::add_scan(const Se2d& pose, const Point2f* points, std::size_t count) {
+  if (!initialized_) return Status::error(Errc::kNotInitialized, "antslam: init() not called");
+  if (!std::isfinite(pose.x) || !std::isfinite(pose.y) || !std::isfinite(pose.theta)) {
+    return Status::error(Errc::kInvalidArgument, "antslam: scan %u: non-finite front-end pose", num_scans_);
+  }
+  if (num_scans_ >= options_.max_scans) {
+    return Status::error(Errc::kCapacityExceeded, "antslam: more than %u scans (max_scans)", options_.max_scans);
+  }
+  bool closed_fragment = false;
+  if (num_fragments_ == 0) {
+    FW_RETURN_IF_ERROR(start_fragment(pose));
+  } else {
+    const Se2d u = last_frontend_.between(pose);
+    // Eq. 3.4: x_t = x_{t−1} ⊕ u_t, Σ_t = J_x Σ_{t−1} J_xᵀ + J_u G J_uᵀ.
+    const double d = std::hypot(u.x, u.y);
+    Mat3 g = Mat3::Zero();
+    g(0, 0) = g(1, 1) = options_.var_xy_per_m * d;
+    g(2, 2) = options_.var_theta_per_m * d + options_.var_theta_per_rad * std::fabs(u.theta);
+    const Mat3 jx = rel_.jacobian_compose_first(u);
+    const Mat3 ju = rel_.jacobian_compose_second();
+    rel_cov_ = jx * rel_cov_ * jx.transpose() + ju * g * ju.transpose();
+    rel_ = rel_.compose(u);
+    travelled_ += d;
+    if (travelled_ >= options_.fragment_length_m) {
+      FW_RETURN_IF_ERROR(start_fragment(pose));
+      closed_fragment = true;
+    }
+  }
+  last_frontend_ = pose;
+  const std::uint32_t f = num_fragments_ - 1;
+  scan_fragment_[num_scans_] = f;
+  scan_rel_[num_scans_] = rel_;
+  scan_along_[num_scans_] = static_cast<float>(travelled_);
+  fragment_length_[f] = travelled_;
+  ++num_scans_;
+  // Keyframe: keep this scan's points (fragment frame) for loop closing.
+  const bool key = !have_keyframe_ ||
+                   std::hypot(rel_.x - last_keyframe_.x, rel_.y - last_keyframe_.y) >= options_.keyframe_step_m ||
+                   std::fabs(wrap_angle(rel_.theta - last_keyframe_.theta)) >= options_.keyframe_turn_rad;
+  if (key && points != nullptr && count > 0) {
+    have_keyframe_ = true;
+    last_keyframe_ = rel_;
+    if (num_keyframes_[f] < options_.max_keyframes_per_fragment) {
+      keyframes_[static_cast<std::size_t>(f) * options_.max_keyframes_per_fragment + num_keyframes_[f]++] = rel_;
+    }
+    Point2f* dst = points_ + static_cast<std::size_t>(f) * options_.max_points_per_fragment;
+    const float c = static_cast<float>(std::cos(rel_.theta)), s = static_cast<float>(std::sin(rel_.theta));
+    const float tx = static_cast<float>(rel_.x), ty = static_cast<float>(rel_.y);
+    for (std::size_t k = 0; k < count; k += options_.beam_stride) {
+      if (num_points_[f] >= options_.max_points_per_fragment) {
+        ++stats_.dropped_points;
+        continue;
+      }
+      const Point2f& p = points[k];
+      if (!std::isfinite(p(0)) || !std::isfinite(p(1))) continue;
+      dst[num_points_[f]++] = Point2f(tx + c * p(0) - s * p(1), ty + s * p(0) + c * p(1));
+    }
+  }
+  if (closed_fragment && num_fragments_ >= 2) return close_loop(num_fragments_ - 2);
+  return Status::ok();
+}
+
+Status AntSlam::finish() {
+  if (!initialized_) return Status::error(Errc::kNotInitialized, "antslam: init() not called");
+  if (num_fragments_ == 0) return Status::ok();
+  return close_loop(num_fragments_ - 1);
+}
+
+void AntSlam::shortest_paths(std::uint32_t a) {
+  // All edges weigh 1: Dijkstra's shortest fragment sequence is a breadth-first search.
+  for (std::uint32_t i = 0; i < num_fragments_; ++i) {
+    hops_[i] = kNoHops;
+    parent_edge_[i] = -1;
+  }
+  std::uint32_t head = 0, tail = 0;
+  hops_[a] = 0;
+  queue_[tail++] = a;
+  while (head < tail) {
+    const std::uint32_t n = queue_[head++];
+    for (std::uint32_t e = 0; e < num_edges_; ++e) {
+      const SampledEdge& ed = edges_[e];
+      std::uint32_t m = kNoHops;
+      if (ed.from == n) m = ed.to;
+      else if (ed.to == n) m = ed.from;
+      if (m == kNoHops || m >= num_fragments_ || hops_[m] != kNoHops) continue;
+      hops_[m] = hops_[n] + 1;
+      parent_edge_[m] = static_cast<std::int32_t>(e);
+      queue_[tail++] = m;
+    }
+  }
+}
+
+std::uint32_t AntSlam::build_path(std::uint32_t c, std::uint32_t a) {
+  // Walk from c toward a along the BFS parents: the steps come out in the order c → a.
+  std::uint32_t n = 0, node = c;
+  while (node != a && n < options_.max_loop_steps) {
+    const SampledEdge& e = edges_[parent_edge_[node]];
+    const bool forward = e.from == node;
+    steps_[n++] = LoopStep{&e, forward};
+    node = forward ? e.to : e.from;
+  }
+  return node == a ? n : 0;
+}
+
+Se2d AntSlam::scan_pose(std::uint32_t i) const {
+  const std::uint32_t f = scan_fragment_[i];
+  if (f + 1 >= num_fragments_ || !(fragment_length_[f] > 0.0)) return world_[f].compose(scan_rel_[i]);
+  const SampledEdge& e = edges_[adjacent_edge_[f]];
+  const Se2d delta = e.value.compose(e.mean.inverse());
+  double alpha = static_cast<double>(scan_along_[i]) / fragment_length_[f];
+  alpha = alpha < 0.0 ? 0.0 : (alpha > 1.0 ? 1.0 : alpha);
+  const Se2d part(alpha * delta.x, alpha * delta.y, alpha * delta.theta);
+  return world_[f].compose(part).compose(scan_rel_[i]);
+}
+
+void AntSlam::recompute_world() {
+  for (std::uint32_t f = 1; f < num_fragments_; ++f) {
+    world_[f] = world_[f - 1].compose(edges_[adjacent_edge_[f - 1]].value);
+  }
+}
+
+Status AntSlam::close_loop(std::uint32_t a) {
+  if (num_closures_ >= options_.max_closures || a < options_.min_fragment_gap) return Status::ok();
+  if (num_points_[a] < options_.min_fragment_points) return Status::ok();
+  shortest_paths(a);
+  // Candidates, nearest (Mahalanobis) first.
+  std::uint32_t cand[kMaxCandidates];
+  double cand_m[kMaxCandidates];
+  std::uint32_t num_cand = 0;
+  for (std::uint32_t c = 0; c + options_.min_fragment_gap <= a; ++c) {
+    if (hops_[c] == kNoHops || num_points_[c] < options_.min_fragment_points) continue;
+    const std::uint32_t n = build_path(c, a);
+    if (n == 0) continue;
+    // Predicted x = F_a in F_c along the path and its covariance (Eq. 3.4 compounding).
+    Se2d x;
+    Mat3 cov = Mat3::Zero();
+    for (std::uint32_t i = 0; i < n; ++i) {
+      const SampledEdge& e = *steps_[i].edge;
+      const Se2d t = step_transform(steps_[i], e.value);
+      Mat3 ct = e.frozen ? Mat3(e.cov * options_.frozen_cov_scale) : e.cov;
+      if (!steps_[i].forward) {
+        const Mat3 ji = e.value.jacobian_inverse();
+        ct = ji * ct * ji.transpose();
+      }
+      const Mat3 j1 = x.jacobian_compose_first(t), j2 = x.jacobian_compose_second();
+      cov = j1 * cov * j1.transpose() + j2 * ct * j2.transpose();
+      x = x.compose(t);
+    }
+    // Mahalanobis distance of a's poses to the nearest pose of c (beyond the overlap radius).
+    // Largest eigenvalue of the 2×2 position covariance (closed form; no Eigen solver, no heap).
+    const double ca = cov(0, 0), cb = cov(0, 1), cc = cov(1, 1);
+    const double lmax = 0.5 * (ca + cc) + std::sqrt(0.25 * (ca - cc) * (ca - cc) + cb * cb);
+    const double sigma = std::sqrt(lmax > 1e-12 ? lmax : 1e-12);
+    const Se2d* kc = keyframes_ + static_cast<std::size_t>(c) * options_.max_keyframes_per_fragment;
+    const Se2d* ka = keyframes_ + static_cast<std::size_t>(a) * options_.max_keyframes_per_fragment;
+    // Cheap bound first: fragment radii around their frames.
+    double ra = 0.0, rc = 0.0;
+    for (std::uint32_t i = 0; i < num_keyframes_[a]; ++i) ra = std::fmax(ra, std::hypot(ka[i].x, ka[i].y));
+    for (std::uint32_t j = 0; j < num_keyframes_[c]; ++j) rc = std::fmax(rc, std::hypot(kc[j].x, kc[j].y));
+    const double lower = std::hypot(x.x, x.y) - ra - rc - options_.overlap_radius_m;
+    if (lower > options_.candidate_mahalanobis * sigma) continue;
+    double dmin = 1e300;
+    for (std::uint32_t i = 0; i < num_keyframes_[a]; ++i) {
+      const Se2d pa = x.compose(ka[i]);
+      for (std::uint32_t j = 0; j < num_keyframes_[c]; ++j) {
+        const double d = std::hypot(pa.x - kc[j].x, pa.y - kc[j].y);
+        if (d < dmin) dmin = d;
+      }
+    }
+    const double m = (dmin > options_.overlap_radius_m ? dmin - options_.overlap_radius_m : 0.0) / sigma;
+    if (!(m <= options_.candidate_mahalanobis)) continue;
+    // Insert into the sorted short list (ties: older fragment first).
+    std::uint32_t pos = num_cand;
+    while (pos > 0 && cand_m[pos - 1] > m) --pos;
+    if (pos >= options_.max_candidates) continue;
+    const std::uint32_t last = num_cand < options_.max_candidates ? num_cand : options_.max_candidates - 1;
+    for (std::uint32_t k = last; k > pos; --k) {
+      cand[k] = cand[k - 1];
+      cand_m[k] = cand_m[k - 1];
+    }
+    cand[pos] = c;
+    cand_m[pos] = m;
+    if (num_cand < options_.max_candidates) ++num_cand;
+  }
+  const Point2f* scene = points_ + static_cast<std::size_t>(a) * options_.max_points_per_fragment;
+  for (std::uint32_t k = 0; k < num_cand; ++k) {
+    const std::uint32_t c = cand[k];
+    const std::uint32_t n = build_path(c, a);
+    Se2d x;
+    Mat3 cov = Mat3::Zero();
+    for (std::uint32_t i = 0; i < n; ++i) {
+      const SampledEdge& e = *steps_[i].edge;
+      const Se2d t = step_transform(steps_[i], e.value);
+      Mat3 ct = e.frozen ? Mat3(e.cov * options_.frozen_cov_scale) : e.cov;
+      if (!steps_[i].forward) {
+        const Mat3 ji = e.value.jacobian_inverse();
+        ct = ji * ct * ji.transpose();
+      }
+      const Mat3 j1 = x.jacobian_compose_first(t), j2 = x.jacobian_compose_second();
+      cov = j1 * cov * j1.transpose() + j2 * ct * j2.transpose();
+      x = x.compose(t);
+    }
+    // pRANSAM: a's points (scene, F_a) against c's (model, F_c) → h = F_a in F_c.
+    ++stats_.candidates;
+    const std::uint64_t t0 = now();
+    // A fragment pRANSAM cannot take as a model (degenerate, too large for the field) is no candidate.
+    if (!matcher_.set_model(points_ + static_cast<std::size_t>(c) * options_.max_points_per_fragment, num_points_[c],
+                            "antslam fragment")
+             .is_ok()) {
+      ++stats_.rejected_quality;
+      continue;
+    }
+    matcher_.reset();
+    pransam::MatchParams mp = options_.match;
+    mp.seed = options_.seed * 1000003u + a * 4099u + c;
+    pransam::MatchResult<2> res;
+    const Status st = matcher_.match(scene, num_points_[a], mp, &res);
+    stats_.matcher_ns += now() - t0;
+    if (!st.is_ok() || !res.best_valid || res.best.quality < options_.min_closure_quality) {
+      ++stats_.rejected_quality;
+      continue;
+    }
+    Se2d h = pransam::to_se2(res.best).cast<double>();
+    if (options_.refine_closure) {
+      const FieldFit fh = fit_on_field(matcher_.field(), scene, num_points_[a], h, options_.refine_iterations,
+                                       options_.refine_cutoff_start, options_.refine_cutoff_end);
+      const FieldFit fx = fit_on_field(matcher_.field(), scene, num_points_[a], x, options_.refine_iterations,
+                                       options_.refine_cutoff_start, options_.refine_cutoff_end);
+      if (fx.quality + options_.prefer_prediction_margin >= fh.quality) {
+        h = fx.pose;
+        ++stats_.prediction_kept;
+      } else {
+        h = fh.pose;
+      }
+    }
+    Mat3 cov_h = Mat3::Zero();
+    cov_h.diagonal() << options_.closure_sigma_xy * options_.closure_sigma_xy,
+        options_.closure_sigma_xy * options_.closure_sigma_xy, options_.closure_sigma_theta * options_.closure_sigma_theta;
+    const Vec3 dh = se2_difference(h, x);
+    const double chi2 = dh.dot((cov + cov_h).inverse() * dh);
+    if (!(chi2 <= options_.closure_gate_chi2)) {
+      ++stats_.rejected_gate;
+      continue;
+    }
+    // The loop L (c → a) with the closure h ~ N(μ_h, Σ_h), corrected by the selected optimiser.
+    LoopProblem problem;
+    problem.steps = steps_;
+    problem.num_steps = n;
+    problem.closure_mean = h;
+    problem.closure_info = cov_h.inverse();
+    bool any_free = false;
+    for (std::uint32_t i = 0; i < n; ++i) {
+      values_[i] = steps_[i].edge->value;
+      any_free = any_free || !steps_[i].edge->frozen;
+    }
+    const std::uint64_t t1 = now();
+    double w0 = 0, w1 = 0;
+    if (any_free) {
+      if (options_.optimizer == LoopOptimizer::kAntColony) {
+        AntColonyReport rep;
+        FW_RETURN_IF_ERROR(aco_.solve(problem, num_closures_, values_, &rep));
+        w0 = rep.initial_cost;
+        w1 = rep.best_cost;
+      } else {
+        LoopLmReport rep;
+        FW_RETURN_IF_ERROR(lm_.solve(problem, values_, &rep));
+        w0 = rep.initial_cost;
+        w1 = rep.final_cost;
+      }
+    }
+    stats_.optimizer_ns += now() - t1;
+    stats_.aco_initial_cost += w0;
+    stats_.aco_final_cost += w1;
+    Se2d xc;
+    for (std::uint32_t i = 0; i < n; ++i) {
+      SampledEdge& e = edges_[steps_[i].edge - edges_];
+      if (!e.frozen) {
+        e.value = values_[i];
+        e.frozen = true;  // corrected loops are frozen
+      }
+      xc = xc.compose(step_transform(steps_[i], e.value));
+    }
+    std::uint32_t ei = 0;
+    FW_RETURN_IF_ERROR(add_edge(c, a, h, cov_h, &ei));
+    edges_[ei].closure = true;
+    edges_[ei].value = xc;  // consistent with the corrected chain
+    edges_[ei].frozen = true;
+    closures_[num_closures_++] = ClosureRecord{c,
+                                               a,
+                                               n,
+                                               res.best.quality,
+                                               static_cast<float>(chi2),
+                                               static_cast<float>(std::hypot(dh(0), dh(1))),
+                                               static_cast<float>(w0),
+                                               static_cast<float>(w1)};
+    ++stats_.loops;
+    recompute_world();
+    return Status::ok();  // one loop per fragment
+  }
+  return Status::ok();
+}
+
+}  // namespace fw::antslam

@@ -1,0 +1,215 @@
+// AntSLAM (dissertation Ch. 3, Alg. 3; SPEC §2): global map optimisation by ant colony over a map
+// built in fragments.
+//
+// Input per scan: the front end's pose (RBSM scan-matching odometry, firmware/rbsm) and the scan's
+// points in the robot frame. The map is cut into fragments: a new one every fragment_length_m
+// travelled; its frame F_i is the pose of its first scan. Every scan is stored relative to its
+// fragment's frame, so correcting the fragment frames corrects the trajectory. The pose relative
+// to the active fragment is tracked with its covariance (Eq. 3.4: x_t = x_{t−1} ⊕ u_t,
+// Σ_t = J_x Σ J_xᵀ + J_u G J_uᵀ); when the fragment ends, that gives the adjacent edge
+// T(F_i → F_i+1) ~ N(μ, Σ), holding S sampled options (Eq. 3.10, sampled_edge.h).
+//
+// Loop closing, when a fragment a ends: a breadth-first search over the fragment graph (all edge
+// weights 1, so it is Dijkstra's shortest fragment sequence) gives for every older fragment c the
+// path L from c to a, the predicted transform x = ⊕ L and its covariance (Eq. 3.4 compounding).
+// c is a candidate when the Mahalanobis distance between a's poses (mapped by x) and the nearest
+// pose of c is below a threshold; candidates are tried nearest first by matching a's points
+// against c's with pRANSAM (firmware/pransam): h ~ N(μ_h, Σ_h), accepted when its quality and its
+// Mahalanobis distance to x pass the gates. The loop L is then corrected by the ant colony
+// (Eq. 3.13–3.14, ant_colony.h) or Levenberg–Marquardt (loop_lm.h) — options.optimizer — and its
+// edges, with the new closing edge, are frozen ("corrected loops are frozen").
+//
+// Not implemented (issue 12 item 1): fragment borders, the convex hull and the EXPLORE → TRAVERSAL
+// states (a revisited area gets new fragments, which close loops with the old ones), the
+// covariance of the pose w.r.t. every fragment (only the active one), and edge covariances from
+// K sensor-model-weighted poses (Eq. 3.9): the Eq. 3.4 propagated covariance is used instead.
+//
+// Embedded rules: all storage from the StartupArena in init(), sized by AntSlamOptions; errors
+// as Status; deterministic per seed (pRANSAM and the ants own their streams; the optional
+// WorkerPool does not change results).
+#pragma once
+
+#include <cstddef>
+#include <cstdint>
+
+#include "firmware/antslam/ant_colony.h"
+#include "firmware/antslam/field_fit.h"
+#include "firmware/antslam/loop_lm.h"
+#include "firmware/antslam/sampled_edge.h"
+#include "firmware/base/arena.h"
+#include "firmware/base/status.h"
+#include "firmware/base/worker_pool.h"
+#include "firmware/pransam/matcher.h"
+#include "firmware/scan/scan_points.h"
+#include "hal/clock.h"
+
+namespace fw::antslam {
+
+enum class LoopOptimizer : std::uint8_t { kAntColony, kLevenbergMarquardt };
+
+struct AntSlamOptions {
+  // Capacities (arena).
+  std::uint32_t max_scans = 32768;
+  std::uint32_t max_fragments = 1024;
+  std::uint32_t max_closures = 1024;
+  std::uint32_t max_points_per_fragment = 2048;
+  std::uint32_t max_keyframes_per_fragment = 128;
+  std::uint32_t max_loop_steps = 1024;
+  std::uint32_t samples_per_edge = 40;  // S = |T| (Eq. 3.10)
+
+  double fragment_length_m = 5.0;  // thesis: 5 m (10 m for long loops)
+  // Eq. 3.4 motion noise G of an increment u: var_xy = a·|u| + floor, var_θ = b·|u| + c·|u_θ| + floor.
+  double var_xy_per_m = 0.02 * 0.02;
+  double var_theta_per_m = 0.004 * 0.004;
+  double var_theta_per_rad = 0.01 * 0.01;
+  double var_floor = 1e-8;
+
+  // Points kept for matching: a keyframe every keyframe_step_m or keyframe_turn_rad.
+  double keyframe_step_m = 0.3;
+  double keyframe_turn_rad = 0.3;
+  std::uint32_t beam_stride = 2;
+  std::uint32_t min_fragment_points = 60;
+
+  // Loop closing.
+  std::uint32_t min_fragment_gap = 3;    // c ≤ a − gap
+  double overlap_radius_m = 1.5;         // poses this close count as the same place …
+  double candidate_mahalanobis = 3.0;    // … and beyond it the Mahalanobis gate
+  std::uint32_t max_candidates = 3;      // pRANSAM tries per fragment, nearest first
+  float min_closure_quality = 0.55f;     // pRANSAM Ω of the accepted hypothesis
+  double closure_gate_chi2 = 16.3;       // (h − x)ᵀ(Σ_x + Σ_h)⁻¹(h − x), 3 dof, 99.9 %
+  double closure_sigma_xy = 0.05;        // Σ_h (m)
+  double closure_sigma_theta = 0.01745;  // Σ_h (rad)
+  double frozen_cov_scale = 0.1;         // a corrected (frozen) edge's covariance in the path prediction
+  // Closure refinement (field_fit.h, an addition): pRANSAM's h and the prediction x are both
+  // refined on the candidate's distance field; the prediction wins unless h fits better by this.
+  bool refine_closure = true;
+  std::uint32_t refine_iterations = 15;
+  float refine_cutoff_start = 0.5f, refine_cutoff_end = 0.15f;
+  float prefer_prediction_margin = -1.0f;  // < 0: always pRANSAM's h (measured on intel: preferring
+                                           // the prediction, 0.02, made the long relations worse)
+  pransam::MatcherOptions matcher;       // sizes taken from max_points_per_fragment in validate()
+  pransam::MatchParams match;
+
+  LoopOptimizer optimizer = LoopOptimizer::kAntColony;
+  AntColonyOptions aco;
+  LoopLmOptions lm;
+  std::uint64_t seed = 1;
+  Status validate() const;
+};
+// Defaults tuned for the CARMEN logs (pRANSAM parameters for whole fragments).
+AntSlamOptions default_antslam_options();
+
+struct AntSlamStats {
+  std::uint32_t candidates = 0;        // pRANSAM matches tried
+  std::uint32_t rejected_quality = 0;  // best hypothesis below min_closure_quality
+  std::uint32_t rejected_gate = 0;     // too far from the prediction
+  std::uint32_t prediction_kept = 0;   // refined prediction fitted as well as pRANSAM's h
+  std::uint32_t loops = 0;             // loops closed and corrected
+  std::uint32_t dropped_points = 0;    // points beyond a fragment's capacity
+  double aco_initial_cost = 0, aco_final_cost = 0;  // sums over the loops
+  std::uint64_t optimizer_ns = 0;      // time in the loop optimiser (with a clock)
+  std::uint64_t matcher_ns = 0;        // time in pRANSAM (with a clock)
+};
+
+struct ClosureRecord {
+  std::uint32_t from = 0, to = 0;  // candidate c, active fragment a
+  std::uint32_t path_edges = 0;
+  float quality = 0;         // pRANSAM Ω
+  float gate_chi2 = 0;       // (h − x)ᵀ(Σ_x + Σ_h)⁻¹(h − x)
+  float shift_m = 0;         // |h − x| (translation): how far the loop was open
+  float cost_before = 0, cost_after = 0;  // W of the loop (Eq. 3.13) before/after the optimiser
+};
+
+class AntSlam {
+ public:
+  static std::size_t required_arena_bytes(const AntSlamOptions& options);
+  // `clock` (optional) times the optimiser and pRANSAM; `pool` (optional) runs pRANSAM and the ants.
+  Status init(const AntSlamOptions& options, StartupArena& arena, WorkerPool* pool = nullptr,
+              const hal::Clock* clock = nullptr);
+  const AntSlamOptions& options() const { return options_; }
+
+  // One scan: the front end's pose (world) and the scan's points in the robot frame.
+  Status add_scan(const Se2d& frontend_pose, const Point2f* points, std::size_t count);
+  // End of the run: tries to close a loop with the last fragment.
+  Status finish();
+
+  std::uint32_t num_scans() const { return num_scans_; }
+  std::uint32_t num_fragments() const { return num_fragments_; }
+  std::uint32_t num_edges() const { return num_edges_; }
+  std::uint32_t num_closures() const { return num_closures_; }
+  // The corrected pose of scan i (world = frame of the first scan's front-end pose):
+  // F_f ⊕ δ(α) ⊕ x_rel. Addition to Ch. 3 (not in the dissertation): the correction of the
+  // fragment's outgoing edge, δ = t_f ⊕ ⊖μ_f (the chosen option against the measured mean), is
+  // spread over the fragment in proportion to the distance travelled (α from 0 at F_f to 1 at
+  // F_f+1), so the trajectory stays continuous where fragments meet instead of jumping by the
+  // whole correction (measured on intel: see README, AntSLAM section).
+  Se2d scan_pose(std::uint32_t i) const;
+  Se2d fragment_pose(std::uint32_t f) const { return world_[f]; }
+  std::uint32_t fragment_first_scan(std::uint32_t f) const { return fragment_first_scan_[f]; }
+  const Point2f* fragment_points(std::uint32_t f, std::uint32_t* count) const {
+    *count = num_points_[f];
+    return points_ + static_cast<std::size_t>(f) * options_.max_points_per_fragment;
+  }
+  const SampledEdge& edge(std::uint32_t i) const { return edges_[i]; }
+  const ClosureRecord& closure(std::uint32_t i) const { return closures_[i]; }
+  const AntSlamStats& stats() const { return stats_; }
+
+ private:
+  Status start_fragment(const Se2d& frontend_pose);
+  Status add_edge(std::uint32_t from, std::uint32_t to, const Se2d& mean, const Mat3& cov, std::uint32_t* index);
+  Status close_loop(std::uint32_t a);
+  void shortest_paths(std::uint32_t a);  // BFS from a: parent_edge_, hops_
+  // Path c → a as steps (forward/backward) into steps_; returns the number of steps.
+  std::uint32_t build_path(std::uint32_t c, std::uint32_t a);
+  void recompute_world();
+  std::uint64_t now() const { return clock_ ? clock_->now_ns() : 0; }
+
+  AntSlamOptions options_;
+  bool initialized_ = false;
+  WorkerPool* pool_ = nullptr;
+  const hal::Clock* clock_ = nullptr;
+  RandomStream edge_rng_;
+  pransam::Matcher<2> matcher_;
+  AntColony aco_;
+  LoopLm lm_;
+  AntSlamStats stats_;
+
+  // Scans.
+  std::uint32_t num_scans_ = 0;
+  std::uint32_t* scan_fragment_ = nullptr;
+  Se2d* scan_rel_ = nullptr;  // scan pose in its fragment's frame
+  float* scan_along_ = nullptr;  // distance travelled in its fragment before this scan (m)
+  // Fragments.
+  std::uint32_t num_fragments_ = 0;
+  Se2d* frontend_frame_ = nullptr;  // F_i in the front end's world
+  Se2d* world_ = nullptr;           // F_i corrected
+  std::uint32_t* fragment_first_scan_ = nullptr;
+  double* fragment_length_ = nullptr;  // distance travelled in the fragment (m)
+  std::uint32_t* adjacent_edge_ = nullptr;  // edge index of F_i → F_i+1
+  Point2f* points_ = nullptr;               // [fragment][max_points_per_fragment], fragment frame
+  std::uint32_t* num_points_ = nullptr;
+  Se2d* keyframes_ = nullptr;               // [fragment][max_keyframes_per_fragment], fragment frame
+  std::uint32_t* num_keyframes_ = nullptr;
+  // Edges (adjacent and closing) and their options.
+  std::uint32_t num_edges_ = 0, max_edges_ = 0;
+  SampledEdge* edges_ = nullptr;
+  Se2d* edge_options_ = nullptr;
+  double* edge_option_cost_ = nullptr;
+  std::uint32_t num_closures_ = 0;
+  ClosureRecord* closures_ = nullptr;
+  // Active fragment tracking (Eq. 3.4).
+  Se2d last_frontend_;
+  Se2d rel_;
+  Mat3 rel_cov_ = Mat3::Zero();
+  double travelled_ = 0.0;
+  Se2d last_keyframe_;
+  bool have_keyframe_ = false;
+  // Loop-closing scratch.
+  std::int32_t* parent_edge_ = nullptr;
+  std::uint32_t* hops_ = nullptr;
+  std::uint32_t* queue_ = nullptr;
+  LoopStep* steps_ = nullptr;
+  Se2d* values_ = nullptr;
+};
+
+}  // namespace fw::antslam

@@ -1,0 +1,176 @@
+// AntSLAM end to end on a synthetic ring corridor with a known answer: the robot drives two laps,
+// the front end's poses drift (heading bias and scale error), the scans are exact. AntSLAM must
+// close loops with pRANSAM and bring the trajectory closer to the truth, with either optimiser,
+// deterministically per seed.
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <memory>
+#include <vector>
+
+#include "firmware/antslam/antslam.h"
+#include "firmware/rbsm/synthetic_world_test_util.h"
+#include "tests/alloc_counter.h"
+
+namespace fw::antslam {
+namespace {
+
+using rbsm_test::Segment;
+
+std::vector<Segment> ring_world() {
+  std::vector<Segment> w = rbsm_test::box(0, 0, 16, 16);
+  const auto inner = rbsm_test::box(3, 3, 13, 13);
+  w.insert(w.end(), inner.begin(), inner.end());
+  // Recesses and pillars so that no stretch of the corridor looks like another.
+  const std::vector<Segment> extra = {{4, 0.0f, 4, 0.8f},   {6, 0.0f, 6, 0.5f},   {9, 3, 9, 2.2f},
+                                      {16, 5, 15.2f, 5},    {13, 9, 13.6f, 9},    {15.4f, 12, 16, 12.5f},
+                                      {11, 16, 11, 15.0f},  {7, 13, 7, 13.7f},    {0, 10, 0.9f, 10.4f},
+                                      {3, 6, 2.3f, 6.3f},   {1.0f, 2.0f, 1.3f, 2.0f}, {14, 1.0f, 14.3f, 1.3f}};
+  w.insert(w.end(), extra.begin(), extra.end());
+  return w;
+}
+
+struct RingRun {
+  std::vector<Se2d> truth, frontend;
+  std::vector<std::vector<Point2f>> scans;
+};
+
+// Two laps of the corridor's centre line, a scan every 0.1 m.
+RingRun make_run() {
+  RingRun r;
+  const auto world = ring_world();
+  const double corners[5][2] = {{1.5, 1.5}, {14.5, 1.5}, {14.5, 14.5}, {1.5, 14.5}, {1.5, 1.5}};
+  for (int lap = 0; lap < 2; ++lap) {
+    for (int s = 0; s < 4; ++s) {
+      const double x0 = corners[s][0], y0 = corners[s][1], x1 = corners[s + 1][0], y1 = corners[s + 1][1];
+      const double th = std::atan2(y1 - y0, x1 - x0);
+      const int n = static_cast<int>(std::hypot(x1 - x0, y1 - y0) / 0.1);
+      for (int i = 0; i < n; ++i) {
+        const double a = static_cast<double>(i) / n;
+        r.truth.emplace_back(x0 + a * (x1 - x0), y0 + a * (y1 - y0), th);
+      }
+    }
+  }
+  // Front end: true increments with a heading bias of 0.15°/m and 1 % too long.
+  r.frontend.push_back(r.truth[0]);
+  for (std::size_t i = 1; i < r.truth.size(); ++i) {
+    Se2d u = r.truth[i - 1].between(r.truth[i]);
+    const double d = std::hypot(u.x, u.y);
+    u = Se2d(u.x * 1.01, u.y * 1.01, wrap_angle(u.theta + d * 0.15 * M_PI / 180));
+    r.frontend.push_back(r.frontend.back().compose(u));
+  }
+  for (const Se2d& p : r.truth) r.scans.push_back(rbsm_test::cast_scan(world, p.cast<float>(), 181, 8.0f));
+  return r;
+}
+
+double mean_error(const std::vector<Se2d>& a, const std::vector<Se2d>& b) {
+  double s = 0;
+  for (std::size_t i = 0; i < a.size(); ++i) s += std::hypot(a[i].x - b[i].x, a[i].y - b[i].y);
+  return s / static_cast<double>(a.size());
+}
+
+AntSlamOptions test_options(LoopOptimizer opt) {
+  AntSlamOptions o = default_antslam_options();
+  o.max_scans = 2000;
+  o.max_fragments = 64;
+  o.max_closures = 64;
+  o.max_loop_steps = 64;
+  o.var_theta_per_m = 0.01 * 0.01;
+  o.aco.iterations = 1500;
+  o.optimizer = opt;
+  return o;
+}
+
+std::vector<Se2d> run_slam(const RingRun& r, const AntSlamOptions& o, std::uint32_t* loops) {
+  std::vector<unsigned char> block(AntSlam::required_arena_bytes(o));
+  StartupArena arena;
+  EXPECT_TRUE(arena.init(block.data(), block.size(), "test").is_ok());
+  auto slam = std::make_unique<AntSlam>();
+  const Status st = slam->init(o, arena);
+  EXPECT_TRUE(st.is_ok()) << st.message();
+  for (std::size_t i = 0; i < r.truth.size(); ++i) {
+    const Status s = slam->add_scan(r.frontend[i], r.scans[i].data(), r.scans[i].size());
+    EXPECT_TRUE(s.is_ok()) << s.message();
+  }
+  EXPECT_TRUE(slam->finish().is_ok());
+  std::vector<Se2d> out;
+  for (std::uint32_t i = 0; i < slam->num_scans(); ++i) out.push_back(slam->scan_pose(i));
+  *loops = slam->stats().loops;
+  return out;
+}
+
+TEST(AntSlamTest, ClosesTheRingAndBeatsTheDriftingFrontEnd) {
+  const RingRun r = make_run();
+  const double e_front = mean_error(r.frontend, r.truth);
+  ASSERT_GT(e_front, 0.5);  // the drift is real
+  for (LoopOptimizer opt : {LoopOptimizer::kAntColony, LoopOptimizer::kLevenbergMarquardt}) {
+    std::uint32_t loops = 0;
+    const std::vector<Se2d> poses = run_slam(r, test_options(opt), &loops);
+    ASSERT_EQ(poses.size(), r.truth.size());
+    const double e = mean_error(poses, r.truth);
+    std::printf("%s: front end %.3f m, AntSLAM %.3f m, %u loops\n",
+                opt == LoopOptimizer::kAntColony ? "ACO" : "LM", e_front, e, loops);
+    EXPECT_GT(loops, 0u);
+    EXPECT_LT(e, 0.6 * e_front);
+  }
+}
+
+TEST(AntSlamTest, SameSeedSamePoses) {
+  const RingRun r = make_run();
+  std::uint32_t la = 0, lb = 0;
+  const auto a = run_slam(r, test_options(LoopOptimizer::kAntColony), &la);
+  const auto b = run_slam(r, test_options(LoopOptimizer::kAntColony), &lb);
+  ASSERT_EQ(a.size(), b.size());
+  EXPECT_EQ(la, lb);
+  for (std::size_t i = 0; i < a.size(); ++i) {
+    ASSERT_EQ(a[i].x, b[i].x);
+    ASSERT_EQ(a[i].theta, b[i].theta);
+  }
+}
+
+TEST(AntSlamTest, NoHeapAfterInit) {
+  if (!mmlfw_test::AllocCounter::available()) GTEST_SKIP() << "allocation counter unavailable under sanitizers";
+  const RingRun r = make_run();
+  for (LoopOptimizer opt : {LoopOptimizer::kAntColony, LoopOptimizer::kLevenbergMarquardt}) {
+    const AntSlamOptions o = test_options(opt);
+    std::vector<unsigned char> block(AntSlam::required_arena_bytes(o));
+    StartupArena arena;
+    ASSERT_TRUE(arena.init(block.data(), block.size(), "test").is_ok());
+    auto slam = std::make_unique<AntSlam>();
+    ASSERT_TRUE(slam->init(o, arena).is_ok());
+    arena.seal();
+    mmlfw_test::AllocCounter::begin();
+    bool ok = true;
+    for (std::size_t i = 0; i < r.truth.size(); ++i) {
+      ok = ok && slam->add_scan(r.frontend[i], r.scans[i].data(), r.scans[i].size()).is_ok();
+    }
+    ok = ok && slam->finish().is_ok();
+    const long allocations = mmlfw_test::AllocCounter::end();
+    EXPECT_TRUE(ok);
+    EXPECT_GT(slam->stats().loops, 0u);
+    EXPECT_EQ(allocations, 0) << "add_scan/finish allocated (loop closing, pRANSAM, optimiser)";
+  }
+}
+
+TEST(AntSlamTest, RejectsBadOptionsAndFullCapacity) {
+  AntSlamOptions o = default_antslam_options();
+  o.fragment_length_m = 0;
+  EXPECT_FALSE(o.validate().is_ok());
+  o = default_antslam_options();
+  o.max_scans = 3;
+  o.max_fragments = 4;
+  o.max_closures = 2;
+  o.max_loop_steps = 4;
+  std::vector<unsigned char> block(AntSlam::required_arena_bytes(o));
+  StartupArena arena;
+  ASSERT_TRUE(arena.init(block.data(), block.size(), "test").is_ok());
+  auto slam = std::make_unique<AntSlam>();
+  ASSERT_TRUE(slam->init(o, arena).is_ok());
+  for (int i = 0; i < 3; ++i) EXPECT_TRUE(slam->add_scan(Se2d(0.1 * i, 0, 0), nullptr, 0).is_ok());
+  const Status st = slam->add_scan(Se2d(1, 0, 0), nullptr, 0);
+  EXPECT_EQ(st.code(), Errc::kCapacityExceeded);
+  EXPECT_FALSE(slam->add_scan(Se2d(NAN, 0, 0), nullptr, 0).is_ok());
+}
+
+}  // namespace
+}  // namespace fw::antslam

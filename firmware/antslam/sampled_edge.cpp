@@ -1,0 +1,47 @@
+#include "firmware/antslam/sampled_edge.h"
+
+#include <Eigen/Cholesky>
+#include <cmath>
+
+namespace fw::antslam {
+
+Status init_sampled_edge(std::uint32_t from, std::uint32_t to, const Se2d& mean, const Mat3& cov, Se2d* options,
+                         double* option_cost, std::uint32_t count, RandomStream& rng, SampledEdge* edge) {
+  if (count == 0 || options == nullptr || option_cost == nullptr) {
+    return Status::error(Errc::kInvalidArgument, "edge %u->%u: no storage for its options", from, to);
+  }
+  if (!std::isfinite(mean.x) || !std::isfinite(mean.y) || !std::isfinite(mean.theta)) {
+    return Status::error(Errc::kInvalidArgument, "edge %u->%u: non-finite mean", from, to);
+  }
+  if (!cov.allFinite() || (cov - cov.transpose()).cwiseAbs().maxCoeff() > 1e-9 * (1.0 + cov.cwiseAbs().maxCoeff())) {
+    return Status::error(Errc::kNumerical, "edge %u->%u: covariance not finite and symmetric", from, to);
+  }
+  Eigen::LLT<Mat3> llt(cov);
+  if (llt.info() != Eigen::Success) {
+    return Status::error(Errc::kNumerical, "edge %u->%u: covariance not positive definite", from, to);
+  }
+  const Mat3 l = llt.matrixL();
+  edge->from = from;
+  edge->to = to;
+  edge->mean = mean;
+  edge->cov = cov;
+  edge->info = llt.solve(Mat3::Identity());
+  edge->value = mean;
+  edge->frozen = false;
+  edge->closure = false;
+  edge->options = options;
+  edge->option_cost = option_cost;
+  edge->num_options = count;
+  for (std::uint32_t k = 0; k < count; ++k) {
+    Vec3 t(mean.x, mean.y, mean.theta);
+    if (k > 0) {  // Eq. 3.10: a draw from N(μ_ij, Σ_ij)
+      const Vec3 z(rng.gaussian(), rng.gaussian(), rng.gaussian());
+      t += l * z;
+    }
+    options[k] = Se2d(t(0), t(1), wrap_angle(t(2)));
+    option_cost[k] = mahalanobis2(options[k], mean, edge->info);
+  }
+  return Status::ok();
+}
+
+}  // namespace fw::antslam

@@ -1,0 +1,270 @@
+// mml-slam: AntSLAM (Ch. 3) from a raw CARMEN log — the map of your own building. See --help.
+#include <cerrno>
+#include <chrono>
+#include <cmath>
+#include <cstdio>
+#include <cstdlib>
+#include <filesystem>
+#include <utility>
+#include <string>
+
+#include "sim/common/cli_main.h"
+#include "sim/io/datasets.h"
+#include "sim/io/reference_trajectory.h"
+#include "sim/slam/slam_pipeline.h"
+
+namespace {
+
+const char* kHelp =
+    "usage: mml-slam --log RAW.clf[.gz] [options]\n"
+    "       mml-slam --dataset intel|fr079|aces|mit-killian|fr-clinic [options]\n"
+    "\n"
+    "AntSLAM (dissertation Ch. 3): RBSM scan matching builds the map in fragments, pRANSAM closes\n"
+    "loops between fragments, an ant colony (or Levenberg-Marquardt) corrects every loop.\n"
+    "\n"
+    "outputs (each optional; nothing is written unless asked):\n"
+    "  --trajectory FILE     corrected pose of every scan, 't x y theta' per line (t = ipc timestamp);\n"
+    "                        score it with: mml-carmen eval RELATIONS FILE\n"
+    "  --rbsm-trajectory FILE  the same for the RBSM front end alone (before AntSLAM)\n"
+    "  --map FILE.yaml       ROS map_server map (YAML + PGM beside it); compile it with mml-mapc\n"
+    "  --svg FILE.svg        picture of fragments, edges and closed loops (FILE.png: a PNG)\n"
+    "  --relations FILE      print the relations metric (Kuemmerle et al. 2009) of RBSM and AntSLAM\n"
+    "                        (default with --dataset: the data set's relations; mit-killian: relations\n"
+    "                        between its consecutive GMapping-corrected poses)\n"
+    "options:\n"
+    "  --optimizer aco|lm    loop optimiser (default aco: the ant colony of Eq. 3.13-3.14)\n"
+    "  --ants N              ants per iteration (default 20)\n"
+    "  --iterations N        ant-colony iterations per loop (default 5000)\n"
+    "  --fragment-length M   metres travelled per fragment (default 5; 10 for long loops)\n"
+    "  --seed N              seed (same seed, same log: same map; default 1)\n"
+    "  --workers N           threads for RBSM, pRANSAM and the ants (default 2; results do not depend on it)\n"
+    "  --max-scans N         only the first N scans (default: all)\n"
+    "  --resolution M        map cell size (default 0.05)\n"
+    "  --max-range M         laser range used for the map (default 25)\n"
+    "  --quiet               no progress line\n"
+    "tuning (defaults in fw::antslam::AntSlamOptions):\n"
+    "  --sigma-xy M          front-end drift, metres per sqrt(metre travelled) (Eq. 3.4 G; default 0.02)\n"
+    "  --sigma-theta R       front-end drift, radians per sqrt(metre travelled) (default 0.004)\n"
+    "  --gate CHI2           loop-closure gate on (h - x) (default 16.3)\n"
+    "  --closure-sigma M     loop-closure std in metres (Sigma_h; the angle scales with it, 0.05 m = 1 deg)\n"
+    "  --closure-refine none|pransam|both  refine the loop closure on the distance field: not at all, pRANSAM's\n"
+    "                        hypothesis, or both it and the prediction, keeping the better fit (default pransam)\n"
+    "  --min-gap N           fragments between the two ends of a loop, at least (default 3)\n"
+    "  --min-quality Q       pRANSAM quality a closure needs, 0..1 (default 0.55)\n"
+    "  --verbose             one line per closed loop\n"
+    "  --help                this text\n";
+
+int fail(const std::string& msg) {
+  std::fprintf(stderr, "mml-slam: %s\n", msg.c_str());
+  return 2;
+}
+
+bool parse_u64(const std::string& s, unsigned long long lo, unsigned long long hi, unsigned long long* out) {
+  if (s.empty() || s[0] == '-' || s[0] == '+') return false;
+  char* end = nullptr;
+  errno = 0;
+  const unsigned long long v = std::strtoull(s.c_str(), &end, 10);
+  if (errno != 0 || *end != '\0' || v < lo || v > hi) return false;
+  *out = v;
+  return true;
+}
+
+bool parse_pos(const std::string& s, double lo, double hi, double* out) {
+  char* end = nullptr;
+  const double v = std::strtod(s.c_str(), &end);
+  if (s.empty() || *end != '\0' || !std::isfinite(v) || v < lo || v > hi) return false;
+  *out = v;
+  return true;
+}
+
+int run(int argc, char** argv) {
+  std::string rbsm_traj_path;
+  std::string log_path, dataset, traj_path, map_path, svg_path, rel_path;
+  sim::SlamConfig cfg;
+  cfg.workers = 2;
+  double resolution = 0.05, max_range = 25.0;
+  bool quiet = false, verbose = false;
+  for (int i = 1; i < argc; ++i) {
+    const std::string a = argv[i];
+    if (a == "--help" || a == "-h") {
+      std::fputs(kHelp, stdout);
+      return 0;
+    }
+    if (a == "--quiet") {
+      quiet = true;
+      continue;
+    }
+    if (a == "--verbose") {
+      verbose = true;
+      continue;
+    }
+    if (a.rfind("--", 0) != 0) return fail("unexpected argument '" + a + "' (see --help)");
+    if (i + 1 >= argc) return fail(a + ": missing value (see --help)");
+    const std::string v = argv[++i];
+    unsigned long long u = 0;
+    double d = 0;
+    if (a == "--log") {
+      log_path = v;
+    } else if (a == "--dataset") {
+      dataset = v;
+    } else if (a == "--trajectory") {
+      traj_path = v;
+    } else if (a == "--rbsm-trajectory") {
+      rbsm_traj_path = v;
+    } else if (a == "--map") {
+      if (v.size() < 6 || v.substr(v.size() - 5) != ".yaml") return fail("--map: '" + v + "' must end in .yaml");
+      map_path = v;
+    } else if (a == "--svg") {
+      svg_path = v;
+    } else if (a == "--relations") {
+      rel_path = v;
+    } else if (a == "--optimizer") {
+      if (v == "aco") cfg.slam.optimizer = fw::antslam::LoopOptimizer::kAntColony;
+      else if (v == "lm") cfg.slam.optimizer = fw::antslam::LoopOptimizer::kLevenbergMarquardt;
+      else return fail("--optimizer: '" + v + "' is not aco or lm");
+    } else if (a == "--ants") {
+      if (!parse_u64(v, 1, 1024, &u)) return fail("--ants: '" + v + "' is not an integer in 1..1024");
+      cfg.slam.aco.ants = static_cast<std::uint32_t>(u);
+    } else if (a == "--iterations") {
+      if (!parse_u64(v, 1, 1000000, &u)) return fail("--iterations: '" + v + "' is not an integer in 1..1000000");
+      cfg.slam.aco.iterations = static_cast<std::uint32_t>(u);
+    } else if (a == "--fragment-length") {
+      if (!parse_pos(v, 0.5, 100.0, &d)) return fail("--fragment-length: '" + v + "' is not a number of metres in 0.5..100");
+      cfg.slam.fragment_length_m = d;
+    } else if (a == "--seed") {
+      if (!parse_u64(v, 0, ~0ull, &u)) return fail("--seed: '" + v + "' is not a non-negative integer");
+      cfg.slam.seed = u;
+      cfg.slam.aco.seed = u;
+      cfg.front.rbsm.seed = u;
+    } else if (a == "--workers") {
+      if (!parse_u64(v, 1, 16, &u)) return fail("--workers: '" + v + "' is not an integer in 1..16");
+      cfg.workers = static_cast<int>(u);
+    } else if (a == "--max-scans") {
+      if (!parse_u64(v, 1, 10000000, &u)) return fail("--max-scans: '" + v + "' is not a positive integer");
+      cfg.max_scans = u;
+    } else if (a == "--resolution") {
+      if (!parse_pos(v, 0.01, 1.0, &resolution)) return fail("--resolution: '" + v + "' is not a cell size in 0.01..1 m");
+    } else if (a == "--max-range") {
+      if (!parse_pos(v, 1.0, 100.0, &max_range)) return fail("--max-range: '" + v + "' is not a range in 1..100 m");
+    } else if (a == "--sigma-xy") {
+      if (!parse_pos(v, 1e-4, 10.0, &d)) return fail("--sigma-xy: '" + v + "' is not a number in 1e-4..10");
+      cfg.slam.var_xy_per_m = d * d;
+    } else if (a == "--sigma-theta") {
+      if (!parse_pos(v, 1e-5, 1.0, &d)) return fail("--sigma-theta: '" + v + "' is not a number in 1e-5..1");
+      cfg.slam.var_theta_per_m = d * d;
+    } else if (a == "--gate") {
+      if (!parse_pos(v, 0.1, 1e6, &d)) return fail("--gate: '" + v + "' is not a number in 0.1..1e6");
+      cfg.slam.closure_gate_chi2 = d;
+    } else if (a == "--closure-sigma") {
+      if (!parse_pos(v, 1e-3, 10.0, &d)) return fail("--closure-sigma: '" + v + "' is not a number of metres in 0.001..10");
+      cfg.slam.closure_sigma_xy = d;
+      cfg.slam.closure_sigma_theta = d * 0.349;  // 5 cm ↔ 1°
+    } else if (a == "--closure-refine") {
+      if (v == "none") {
+        cfg.slam.refine_closure = false;
+      } else if (v == "pransam") {
+        cfg.slam.refine_closure = true;
+        cfg.slam.prefer_prediction_margin = -1.0f;
+      } else if (v == "both") {
+        cfg.slam.refine_closure = true;
+        cfg.slam.prefer_prediction_margin = 0.02f;
+      } else {
+        return fail("--closure-refine: '" + v + "' is not none, pransam or both");
+      }
+    } else if (a == "--min-gap") {
+      if (!parse_u64(v, 1, 100000, &u)) return fail("--min-gap: '" + v + "' is not a positive integer");
+      cfg.slam.min_fragment_gap = static_cast<std::uint32_t>(u);
+    } else if (a == "--min-quality") {
+      if (!parse_pos(v, 0.0, 1.0, &d)) return fail("--min-quality: '" + v + "' is not a number in 0..1");
+      cfg.slam.min_closure_quality = static_cast<float>(d);
+    } else {
+      return fail("unknown option '" + a + "' (see --help)");
+    }
+  }
+  if (log_path.empty() == dataset.empty()) return fail("give exactly one of --log FILE or --dataset NAME (see --help)");
+  std::string err;
+  sim::EvalDataset ds;
+  std::string ds_relations;
+  if (!dataset.empty()) {
+    if (!sim::find_eval_dataset(dataset, &ds, &err)) {
+      return fail("--dataset: " + err + " (names: intel, fr079, aces, mit-killian, fr-clinic; data under MMLFW_DATA_DIR)");
+    }
+    log_path = ds.raw_log;
+    if (rel_path.empty()) rel_path = ds_relations = ds.relations;
+  }
+  // Outputs go into existing directories: say so now, not after minutes of mapping.
+  for (const auto& [opt, path] : {std::pair<const char*, const std::string*>{"--trajectory", &traj_path},
+                                  {"--rbsm-trajectory", &rbsm_traj_path},
+                                  {"--map", &map_path},
+                                  {"--svg", &svg_path}}) {
+    if (path->empty()) continue;
+    const std::filesystem::path dir = std::filesystem::path(*path).parent_path();
+    std::error_code ec;
+    if (!dir.empty() && !std::filesystem::is_directory(dir, ec)) {
+      return fail(std::string(opt) + ": directory '" + dir.string() + "' does not exist");
+    }
+  }
+  sim::CarmenLog log;
+  if (!sim::read_carmen_log(log_path, sim::CarmenReadOptions{}, &log, &err)) return fail(err);
+  std::vector<sim::Relation> rel;
+  if (!dataset.empty() && rel_path == ds_relations) {
+    if (!sim::slam_dataset_relations(log, ds, &rel, &err)) return fail("--dataset: " + err);
+  } else if (!rel_path.empty() && !sim::read_relations(rel_path, &rel, &err)) {
+    return fail("--relations: " + err);
+  }
+  if (log.scans.empty()) return fail(log_path + ": no laser scans in the log");
+  const auto t0 = std::chrono::steady_clock::now();
+  if (!quiet) {
+    cfg.progress = [t0](std::size_t done, std::size_t total, const char* phase) {
+      const double s = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+      std::fprintf(stderr, "\rmml-slam: %s %zu/%zu scans, %.0f s   ", phase, done, total, s);
+      std::fflush(stderr);
+    };
+  }
+  sim::SlamRun run;
+  if (!sim::run_slam(log, cfg, &run, &err)) {
+    if (!quiet) std::fputc('\n', stderr);
+    std::fprintf(stderr, "mml-slam: %s\n", err.c_str());
+    return 1;
+  }
+  if (!quiet) std::fputc('\n', stderr);
+  const double log_s = log.scans.size() > 1 ? log.scans[run.poses.size() - 1].ipc_timestamp - log.scans[0].ipc_timestamp : 0;
+  std::printf("mml-slam: %zu scans, %zu fragments, %u loops closed (%u candidates: %u below quality, %u outside the gate)\n",
+              run.poses.size(), run.fragments.size(), run.stats.loops, run.stats.candidates, run.stats.rejected_quality,
+              run.stats.rejected_gate);
+  std::printf("mml-slam: RBSM %.1f s + AntSLAM %.1f s (pRANSAM %.0f ms, %s %.0f ms) for %.0f s of log\n", run.frontend_s,
+              run.backend_s, run.matcher_ms,
+              cfg.slam.optimizer == fw::antslam::LoopOptimizer::kAntColony ? "ant colony" : "LM", run.optimizer_ms, log_s);
+  if (verbose) {
+    for (const auto& c : run.closures) {
+      std::printf("loop %u -> %u: %u edges, quality %.2f, chi2 %.1f, open %.3f m, W %.1f -> %.1f\n", c.from, c.to,
+                  c.path_edges, c.quality, c.gate_chi2, c.shift_m, c.cost_before, c.cost_after);
+    }
+  }
+  if (!rel.empty()) {
+    const auto mf = sim::evaluate_relations(rel, sim::make_trajectory(log, run.frontend));
+    const auto ms = sim::evaluate_relations(rel, sim::make_trajectory(log, run.poses));
+    std::printf("relations, RBSM alone: %s\nrelations, AntSLAM:    %s\n", sim::to_string(mf).c_str(),
+                sim::to_string(ms).c_str());
+  }
+  if (!traj_path.empty() && !sim::write_trajectory(traj_path, sim::make_trajectory(log, run.poses), &err)) {
+    return fail("--trajectory: " + err);
+  }
+  if (!rbsm_traj_path.empty() &&
+      !sim::write_trajectory(rbsm_traj_path, sim::make_trajectory(log, run.frontend), &err)) {
+    return fail("--rbsm-trajectory: " + err);
+  }
+  if (!map_path.empty() && !sim::write_slam_map(log, run.poses, resolution, max_range, map_path, &err)) {
+    return fail("--map: " + err);
+  }
+  if (!svg_path.empty() && !sim::write_slam_svg(run, "AntSLAM: " + log_path, svg_path, &err)) {
+    return fail("--svg: " + err);
+  }
+  return 0;
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  return sim::guarded_main("mml-slam", [&] { return run(argc, argv); });
+}
