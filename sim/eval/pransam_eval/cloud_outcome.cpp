@@ -19,7 +19,12 @@ std::size_t MethodRun::wrong() const {
 }
 std::size_t MethodRun::nothing() const {
   std::size_t k = 0;
-  for (const auto& o : outcomes) k += !o.reported;
+  for (const auto& o : outcomes) k += !o.reported && !o.ambiguous;
+  return k;
+}
+std::size_t MethodRun::ambiguous() const {
+  std::size_t k = 0;
+  for (const auto& o : outcomes) k += o.ambiguous;
   return k;
 }
 double MethodRun::ms_p50() const {
@@ -73,8 +78,8 @@ double agreement(const CloudDraw& d, const std::vector<CloudOutcome>& runs) {
 
 std::string summary_line(const std::string& what, const MethodRun& r) {
   char buf[256];
-  std::snprintf(buf, sizeof(buf), "%-32s success %3zu/%zu  wrong %2zu  nothing %3zu  p50 %8.1f ms  p99 %8.1f ms",
-                what.c_str(), r.successes(), r.n(), r.wrong(), r.nothing(), r.ms_p50(), r.ms_p99());
+  std::snprintf(buf, sizeof(buf), "%-32s success %3zu/%zu  wrong %2zu  ambiguous %2zu  nothing %3zu  p50 %8.1f ms  p99 %8.1f ms",
+                what.c_str(), r.successes(), r.n(), r.wrong(), r.ambiguous(), r.nothing(), r.ms_p50(), r.ms_p99());
   return buf;
 }
 

@@ -3,7 +3,9 @@
 // truth. Correct = within max(0.4 voxel) of the truth at the scene centroid and 2° (office: 2 cm at
 // the 5 cm voxel); reported = the method itself says it found a match (pRANSAM: Ω ≥ Ω_thres; FPFH +
 // prerejective: converged with the inlier fraction; K-4PCS: converged). success = reported and
-// correct; wrong = reported but not correct (the dangerous case); nothing = not reported.
+// correct; wrong = reported but not correct (the dangerous case); nothing = not reported;
+// ambiguous = the method had an answer but a distinct rival explains the data about as well
+// (ambiguity3d.h, pRANSAM only): not reported, counted in its own column (neither success nor wrong).
 #pragma once
 
 #include <Eigen/Core>
@@ -21,6 +23,7 @@ constexpr double kRotTolDeg = 2.0;
 struct CloudOutcome {
   double ms = 0;                 // the method's own time (model preparation + matching)
   bool reported = false;
+  bool ambiguous = false;        // withheld as ambiguous (then reported = false)
   bool correct = false;          // after refinement (false without truth)
   double trans_err = NAN, rot_err_deg = NAN;
   double inlier_rms = NAN, inlier_fraction = NAN;
@@ -34,7 +37,8 @@ struct MethodRun {
   std::size_t n() const { return outcomes.size(); }
   std::size_t successes() const;
   std::size_t wrong() const;
-  std::size_t nothing() const;
+  std::size_t nothing() const;    // not reported and not ambiguous
+  std::size_t ambiguous() const;
   double success() const { return n() ? static_cast<double>(successes()) / static_cast<double>(n()) : 0.0; }
   double ms_p50() const;
   double ms_p99() const;
@@ -50,7 +54,7 @@ CloudOutcome score_answer(const CloudDraw& d, const PlaneModel& model, const Eig
 // the transform most of them agree with; 1.0 = all runs agree on one transform.
 double agreement(const CloudDraw& d, const std::vector<CloudOutcome>& runs);
 
-// "office1 pransam: success 97/100, wrong 0, nothing 3, p50 … ms, p99 … ms".
+// "office1 pransam: success 97/100, wrong 0, ambiguous 1, nothing 2, p50 … ms, p99 … ms".
 std::string summary_line(const std::string& what, const MethodRun& r);
 
 }  // namespace sim::pransam_eval

@@ -96,7 +96,7 @@ bool run_pransam3d(const std::vector<CloudDraw>& draws, const Pransam3dConfig& c
     const double t0 = now_ms();
     s = matcher->set_model(d.model.data(), d.model.size(), d.cloud.c_str());
     if (s.is_ok()) s = matcher->match(d.scene.data(), d.scene.size(), p, &r);
-    const double ms = now_ms() - t0;
+    double ms = now_ms() - t0;
     if (!s.is_ok()) break;
     const bool reported = r.best_valid && r.best.quality >= config.omega_thres;
     const Eigen::Matrix3f rot = r.best_valid ? r.best.rotation : Eigen::Matrix3f::Identity();
@@ -104,14 +104,37 @@ bool run_pransam3d(const std::vector<CloudDraw>& draws, const Pransam3dConfig& c
     PlaneModel pm;
     pm.build(&d.model, 3.0f * d.voxel);
     CloudOutcome oc = score_answer(d, pm, rot, tr, reported, ms);
+    AmbiguityVerdict av;
+    if (reported && config.ambiguity) {
+      // The verdict is part of pRANSAM's answer here: its time (the rivals' refinements) is added.
+      const double ta = now_ms();
+      PoseCandidate best;
+      best.rotation = oc.rotation;
+      best.translation = oc.translation;
+      av = check_ambiguity(d.scene, pm, d.voxel, best, {}, config.ambiguity_options);
+      ms += now_ms() - ta;
+      oc.ms = ms;
+      if (av.ambiguous) {
+        oc.ambiguous = true;
+        oc.reported = false;
+      }
+    }
     if (verbose) {
-      std::printf("  %s #%zu |A| %zu |B| %zu ov %.2f: %.1f ms it %llu coll %llu fs-rej %llu Ω %.3f %s  err %.4f m %.2f°  rms %.4f\n",
+      double k_truth = -1;
+      if (d.has_truth) {
+        const IcpResult t = refine_point_to_plane(d.scene, pm, d.voxel, d.truth_rotation, d.truth_translation);
+        k_truth = t.inlier_fraction * static_cast<double>(d.scene.size());
+      }
+      std::printf("  %s #%zu |A| %zu |B| %zu ov %.2f: %.1f ms it %llu coll %llu fs-rej %llu Ω %.3f %s  err %.4f m %.2f°  rms %.4f"
+                  "  k %.0f ±%.0f rival %s %.0f (%.1f° %.3f m) k_truth %.0f\n",
                   d.cloud.c_str(), d.index, d.scene.size(), d.model.size(), d.overlap, ms,
                   static_cast<unsigned long long>(r.stats.iterations), static_cast<unsigned long long>(r.stats.collisions),
                   static_cast<unsigned long long>(r.stats.free_space_rejected),
                   r.best_valid ? r.best.quality : 0.0f,
-                  reported ? (oc.correct || !d.has_truth ? "reported" : "REPORTED-WRONG") : (oc.correct ? "missed(correct)" : "nothing"),
-                  oc.trans_err, oc.rot_err_deg, oc.inlier_rms);
+                  oc.ambiguous ? (oc.correct ? "ambiguous(correct)" : "ambiguous(wrong)")
+                  : reported ? (oc.correct || !d.has_truth ? "reported" : "REPORTED-WRONG") : (oc.correct ? "missed(correct)" : "nothing"),
+                  oc.trans_err, oc.rot_err_deg, oc.inlier_rms, av.best_inliers, av.margin, rival_kind_name(av.rival),
+                  av.rival_inliers, av.rival_rot_deg, av.rival_trans_m, k_truth);
     }
     out->outcomes.push_back(oc);
   }

@@ -8,6 +8,7 @@
 #include <string>
 #include <vector>
 
+#include "sim/eval/pransam_eval/ambiguity3d.h"
 #include "sim/eval/pransam_eval/cloud_draws.h"
 #include "sim/eval/pransam_eval/cloud_outcome.h"
 
@@ -33,6 +34,10 @@ struct Pransam3dConfig {
   float free_space_margin_voxels = 2.0f;
   float free_space_block_voxels = 0.75f;
   float max_blocked = 0.1f;
+  // Ambiguity verdict after refinement (ambiguity3d.h; extension, not in the dissertation): an
+  // answer with a distinct rival within the counting margin is withheld as "ambiguous".
+  bool ambiguity = true;
+  AmbiguityOptions ambiguity_options;
   int workers = 2;               // T
   std::uint64_t seed = 1;
 };

@@ -1,0 +1,113 @@
+#include "sim/eval/pransam_eval/ambiguity3d.h"
+
+#include <Eigen/Eigenvalues>
+#include <Eigen/Geometry>
+#include <cmath>
+
+namespace sim::pransam_eval {
+
+const char* rival_kind_name(RivalKind k) {
+  switch (k) {
+    case RivalKind::kKept: return "kept";
+    case RivalKind::kFlip: return "flip";
+    case RivalKind::kSlide: return "slide";
+    default: return "none";
+  }
+}
+
+int count_inliers(const std::vector<Eigen::Vector3f>& scene, const PlaneModel& model, const Eigen::Matrix3f& r,
+                  const Eigen::Vector3f& t, float max_dist) {
+  int k = 0;
+  for (const auto& a : scene) k += model.nearest(r * a + t, max_dist) >= 0;
+  return k;
+}
+
+AmbiguityVerdict check_ambiguity(const std::vector<Eigen::Vector3f>& scene, const PlaneModel& model, float voxel,
+                                 const PoseCandidate& best, const std::vector<PoseCandidate>& kept,
+                                 const AmbiguityOptions& options) {
+  AmbiguityVerdict v;
+  if (scene.empty()) return v;
+  v.best_inliers = count_inliers(scene, model, best.rotation, best.translation, voxel);
+  v.margin = options.z * std::sqrt(v.best_inliers);
+  // Scene centroid (scene frame) and, moved by the best pose, its shape in the model frame.
+  Eigen::Vector3d cs = Eigen::Vector3d::Zero();
+  for (const auto& a : scene) cs += a.cast<double>();
+  cs /= static_cast<double>(scene.size());
+  const Eigen::Vector3f c_scene = cs.cast<float>();
+  const Eigen::Vector3f c = best.rotation * c_scene + best.translation;
+  Eigen::Matrix3d cov = Eigen::Matrix3d::Zero();
+  for (const auto& a : scene) {
+    const Eigen::Vector3d q = (best.rotation * (a - c_scene)).cast<double>();
+    cov += q * q.transpose();
+  }
+  cov /= static_cast<double>(scene.size());
+  const double radius = std::max(std::sqrt(cov.trace()), static_cast<double>(voxel));
+
+  std::vector<std::pair<RivalKind, PoseCandidate>> starts;
+  for (const auto& k : kept) starts.emplace_back(RivalKind::kKept, k);
+  // Moves about the best pose's scene centroid: R' = ΔR·R, t' = ΔR·(t − c) + c + Δt.
+  const auto moved = [&](const Eigen::Matrix3f& dr, const Eigen::Vector3f& dt) {
+    PoseCandidate p;
+    p.rotation = dr * best.rotation;
+    p.translation = dr * (best.translation - c) + c + dt;
+    return p;
+  };
+  if (options.flips) {
+    Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> es(cov);
+    for (int a = 0; a < 3; ++a) {
+      const Eigen::Vector3f axis = es.eigenvectors().col(a).cast<float>().normalized();
+      starts.emplace_back(RivalKind::kFlip, moved(Eigen::AngleAxisf(static_cast<float>(M_PI), axis).toRotationMatrix(),
+                                                  Eigen::Vector3f::Zero()));
+    }
+  }
+  if (options.slides) {
+    // Point-to-plane information of the contact at the best pose, parameters (δt, radius·δω).
+    Eigen::Matrix<double, 6, 6> h = Eigen::Matrix<double, 6, 6>::Zero();
+    int used = 0;
+    for (const auto& a : scene) {
+      const Eigen::Vector3f p = best.rotation * a + best.translation;
+      const int j = model.nearest(p, voxel);
+      if (j < 0) continue;
+      const Eigen::Vector3d n = model.normal(j).cast<double>();
+      Eigen::Matrix<double, 6, 1> jac;
+      jac << n, (p - c).cast<double>().cross(n) / radius;
+      h += jac * jac.transpose();
+      ++used;
+    }
+    if (used >= 12) {
+      Eigen::SelfAdjointEigenSolver<Eigen::Matrix<double, 6, 6>> es(h);
+      const Eigen::Matrix<double, 6, 1> w = es.eigenvectors().col(0);  // weakest direction
+      for (float s : options.slide_voxels) {
+        for (float sign : {1.0f, -1.0f}) {
+          const double step = static_cast<double>(sign * s * voxel);
+          const Eigen::Vector3d dt = step * w.head<3>();
+          const Eigen::Vector3d dw = step * w.tail<3>() / radius;
+          Eigen::Matrix3f dr = Eigen::Matrix3f::Identity();
+          if (dw.norm() > 1e-12) dr = Eigen::AngleAxisf(static_cast<float>(dw.norm()), dw.normalized().cast<float>()).toRotationMatrix();
+          starts.emplace_back(RivalKind::kSlide, moved(dr, dt.cast<float>()));
+        }
+      }
+    }
+  }
+  for (const auto& [kind, start] : starts) {
+    const IcpResult r = refine_point_to_plane(scene, model, voxel, start.rotation, start.translation);
+    ++v.refinements;
+    const double rot_deg =
+        Eigen::AngleAxisf(r.rotation * best.rotation.transpose()).angle() * 180.0 / M_PI;
+    const double trans = ((r.rotation * c_scene + r.translation) - c).norm();
+    if (!(rot_deg > options.rot_sep_deg || trans > options.trans_sep_voxels * voxel)) continue;  // same pose
+    const double k = r.inlier_fraction * static_cast<double>(scene.size());
+    if (k > v.rival_inliers) {
+      v.rival_inliers = k;
+      v.rival = kind;
+      v.rival_rot_deg = rot_deg;
+      v.rival_trans_m = trans;
+      v.rival_pose.rotation = r.rotation;
+      v.rival_pose.translation = r.translation;
+    }
+  }
+  v.ambiguous = v.rival_inliers >= 0 && v.rival_inliers >= v.best_inliers - v.margin;
+  return v;
+}
+
+}  // namespace sim::pransam_eval

@@ -1,0 +1,70 @@
+// Ambiguity verdict for a 3-D registration answer (issue 17). EXTENSION of the dissertation: Ch. 4
+// reports the best hypothesis once Ω ≥ Ω_thres; it has no notion of a second, distinct transform
+// that explains the data as well. On real clouds such rivals exist: a nearly symmetric object (the
+// milk carton) turned by 180° fits its own surface, and a cut of a room whose contact is mostly
+// floor + one wall can slide along the line the two planes share. Reporting either as "the" pose is
+// the dangerous case (wrong reported as good), so the answer is checked against its rivals after
+// refinement and called AMBIGUOUS (not success, not wrong, a column of its own) when a distinct
+// rival scores about as well.
+//
+// Score of a pose = the number k of scene points within 1 voxel of the model after the common
+// point-to-plane refinement (icp3d.h), i.e. the refined Ω. Rivals, each refined the same way:
+//  - the hypotheses the matcher kept besides its best (passed in by the caller, may be none);
+//  - the best pose turned by 180° about each principal axis of the (moved) scene, about its centroid
+//    (a near-symmetric object's flips);
+//  - the best pose moved by ±s along the weakest eigenvector of the contact's point-to-plane
+//    information matrix (6×6, rotations scaled by the scene's RMS radius so both parts are metres),
+//    s = 4 and 8 voxels: where the contact does not constrain the pose, refinement does not pull it
+//    back, and the score says whether the data support the moved pose equally.
+// Distinct = after refinement the rival's rotation differs from the best by more than rot_sep_deg
+// (2× the 2° success threshold) or it moves the scene's centroid by more than trans_sep_voxels.
+// About as well = k_rival ≥ k_best − z·√k_best: the inlier count of a voxelised surface varies like
+// a counting (Poisson) variable between two samplings of the same surfaces, so a rival within z = 3
+// standard deviations is not distinguishable from the best by the data. Nothing here depends on the
+// particular clouds; the constants are stated in voxels / in the success thresholds.
+#pragma once
+
+#include <Eigen/Core>
+#include <vector>
+
+#include "sim/eval/pransam_eval/icp3d.h"
+
+namespace sim::pransam_eval {
+
+struct AmbiguityOptions {
+  double rot_sep_deg = 4.0;        // 2 × kRotTolDeg
+  double trans_sep_voxels = 3.0;   // "a few voxels"
+  double z = 3.0;                  // margin = z·√k_best (counting noise of the inlier count)
+  std::vector<float> slide_voxels = {4.0f, 8.0f};
+  bool flips = true, slides = true;
+};
+
+struct PoseCandidate {
+  Eigen::Matrix3f rotation = Eigen::Matrix3f::Identity();
+  Eigen::Vector3f translation = Eigen::Vector3f::Zero();
+};
+
+enum class RivalKind { kNone, kKept, kFlip, kSlide };
+const char* rival_kind_name(RivalKind k);
+
+struct AmbiguityVerdict {
+  bool ambiguous = false;
+  double best_inliers = 0;        // k_best
+  double margin = 0;              // z·√k_best
+  double rival_inliers = -1;      // best distinct rival's k (−1: no distinct rival)
+  RivalKind rival = RivalKind::kNone;
+  double rival_rot_deg = 0, rival_trans_m = 0;  // its distance from the best
+  PoseCandidate rival_pose;
+  int refinements = 0;            // ICP runs spent
+};
+
+// Number of scene points within max_dist of the model under (r, t).
+int count_inliers(const std::vector<Eigen::Vector3f>& scene, const PlaneModel& model, const Eigen::Matrix3f& r,
+                  const Eigen::Vector3f& t, float max_dist);
+
+// `best` is the refined answer (scene → model). `kept`: further hypotheses of the method (unrefined).
+AmbiguityVerdict check_ambiguity(const std::vector<Eigen::Vector3f>& scene, const PlaneModel& model, float voxel,
+                                 const PoseCandidate& best, const std::vector<PoseCandidate>& kept = {},
+                                 const AmbiguityOptions& options = AmbiguityOptions());
+
+}  // namespace sim::pransam_eval
