@@ -89,14 +89,21 @@ AmbiguityVerdict check_ambiguity(const std::vector<Eigen::Vector3f>& scene, cons
       }
     }
   }
+  std::vector<Eigen::Vector3f> subset;
+  const std::vector<Eigen::Vector3f>* refine_on = &scene;
+  if (options.refine_points > 0 && scene.size() > options.refine_points) {
+    const std::size_t stride = (scene.size() + options.refine_points - 1) / options.refine_points;
+    for (std::size_t i = 0; i < scene.size(); i += stride) subset.push_back(scene[i]);
+    refine_on = &subset;
+  }
   for (const auto& [kind, start] : starts) {
-    const IcpResult r = refine_point_to_plane(scene, model, voxel, start.rotation, start.translation);
+    const IcpResult r = refine_point_to_plane(*refine_on, model, voxel, start.rotation, start.translation);
     ++v.refinements;
     const double rot_deg =
         Eigen::AngleAxisf(r.rotation * best.rotation.transpose()).angle() * 180.0 / M_PI;
     const double trans = ((r.rotation * c_scene + r.translation) - c).norm();
     if (!(rot_deg > options.rot_sep_deg || trans > options.trans_sep_voxels * voxel)) continue;  // same pose
-    const double k = r.inlier_fraction * static_cast<double>(scene.size());
+    const double k = count_inliers(scene, model, r.rotation, r.translation, voxel);
     if (k > v.rival_inliers) {
       v.rival_inliers = k;
       v.rival = kind;

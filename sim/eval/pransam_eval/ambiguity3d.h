@@ -37,6 +37,9 @@ struct AmbiguityOptions {
   double z = 3.0;                  // margin = z·√k_best (counting noise of the inlier count)
   std::vector<float> slide_voxels = {4.0f, 8.0f};
   bool flips = true, slides = true;
+  // Rivals are refined on an evenly strided subset of at most this many scene points (cost), then
+  // counted on the whole scene, so k and the margin are always whole-scene counts.
+  std::size_t refine_points = 2000;
 };
 
 struct PoseCandidate {

@@ -224,6 +224,7 @@ static int run_main(int argc, char** argv) {
                 summary_line("office1 pransam (1 thread)", r1).c_str());
     json.add("pransam3d_office_success", r2.success());
     json.add_int("pransam3d_office_wrong", static_cast<long long>(r2.wrong()));
+    json.add_int("pransam3d_office_ambiguous", static_cast<long long>(r2.ambiguous()));
     json.add("pransam3d_office_ms_p50", r2.ms_p50());
     json.add("pransam3d_office_ms_p99", r2.ms_p99());
     json.add("pransam3d_office_ms_p50_1t", r1.ms_p50());
@@ -243,6 +244,7 @@ static int run_main(int argc, char** argv) {
     }
     json.add("pransam3d_objects_success", objects.success());
     json.add_int("pransam3d_objects_wrong", static_cast<long long>(objects.wrong()));
+    json.add_int("pransam3d_objects_ambiguous", static_cast<long long>(objects.ambiguous()));
     json.add("pransam3d_objects_ms_p50", objects.ms_p50());
     CloudDraw bunny;
     if (!load_bunny(&bunny, &err)) return fail(err);
@@ -255,7 +257,8 @@ static int run_main(int argc, char** argv) {
     json.add("pransam3d_bunny_inlier_rms_m", percentile(rms, 0.5));
     json.add("pransam3d_bunny_inlier_fraction", rb.outcomes.empty() ? 0.0 : rb.outcomes[0].inlier_fraction);
     json.add("pransam3d_bunny_runs_agree", agreement(bunny, rb.outcomes));
-    json.add_int("pransam3d_bunny_reported", static_cast<long long>(rb.n() - rb.nothing()));
+    json.add_int("pransam3d_bunny_reported", static_cast<long long>(rb.n() - rb.nothing() - rb.ambiguous()));
+    json.add_int("pransam3d_bunny_ambiguous", static_cast<long long>(rb.ambiguous()));
     json.add("pransam3d_bunny_ms_p50", rb.ms_p50());
   }
   return json.write(argv[1]) ? 0 : 1;

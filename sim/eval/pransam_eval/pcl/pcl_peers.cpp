@@ -10,8 +10,36 @@
 #include <pcl/registration/sample_consensus_prerejective.h>
 #include <pcl/search/kdtree.h>
 
+#include <atomic>
 #include <chrono>
 #include <cstdio>
+#include <cstdlib>
+#include <ctime>
+
+// Reproducible K-4PCS (issue 17). PCL 1.13 seeds the C library's generator from the clock inside
+// the algorithm: FPCSInitialAlignment::initCompute() calls std::srand(std::time(nullptr)) and
+// computeTransformation() calls std::srand(std::time(NULL) ^ omp_get_thread_num()) in its OpenMP
+// region, after any std::srand() of ours. Its templates are instantiated here (header-only in
+// libpcl-dev: libpcl_registration.so exports no KFPCS symbol), so this object's calls of time() are
+// redirected by the linker option --wrap=time (CMakeLists.txt, this tool only) to __wrap_time below:
+// while a K-4PCS run is armed it returns a value derived from the draw's seed, otherwise the real
+// clock (__real_time). Unlike defining time() in the executable, this affects no shared library and
+// no other object. Deterministic only with one OpenMP thread: with more, the threads share rand()'s
+// single state in an order the scheduler decides. The wall-clock bound (setMaxComputationTime) must
+// be off too.
+extern "C" std::time_t __real_time(std::time_t* t);
+namespace {
+std::atomic<bool> g_time_armed{false};
+std::atomic<long long> g_time_value{0};
+}  // namespace
+extern "C" std::time_t __wrap_time(std::time_t* t) {
+  if (g_time_armed.load()) {
+    const auto v = static_cast<std::time_t>(g_time_value.load());
+    if (t != nullptr) *t = v;
+    return v;
+  }
+  return __real_time(t);
+}
 
 namespace sim::pransam_eval {
 
@@ -44,7 +72,21 @@ void normals(const CloudNT::Ptr& c, float radius, int threads, const Eigen::Vect
   ne.compute(*c);
 }
 
-bool fpfh_prerejective(const CloudDraw& d, int threads, Eigen::Matrix4f* tf, bool* converged) {
+// Seed of one draw's run (as pRANSAM's: seed·1000003 + draw), folded to the generator's width.
+unsigned draw_seed(std::uint64_t seed, std::size_t index) {
+  const std::uint64_t s = seed * 1000003ull + index;
+  return static_cast<unsigned>(s ^ (s >> 32));
+}
+
+struct ArmedClock {  // time() returns `value` while alive
+  explicit ArmedClock(unsigned value) {
+    g_time_value.store(value);
+    g_time_armed.store(true);
+  }
+  ~ArmedClock() { g_time_armed.store(false); }
+};
+
+bool fpfh_prerejective(const CloudDraw& d, int threads, unsigned seed, Eigen::Matrix4f* tf, bool* converged) {
   const float leaf = d.voxel;
   CloudNT::Ptr src = to_pcl(d.scene), tgt = to_pcl(d.model);
   normals(src, 2.0f * leaf, threads, d.scene_sensor);
@@ -71,13 +113,14 @@ bool fpfh_prerejective(const CloudDraw& d, int threads, Eigen::Matrix4f* tf, boo
   align.setMaxCorrespondenceDistance(2.5f * leaf);
   align.setInlierFraction(0.25f);
   CloudNT aligned;
+  std::srand(seed);  // SampleConsensusPrerejective draws with rand() and never seeds it
   align.align(aligned);
   *converged = align.hasConverged();
   *tf = align.getFinalTransformation();
   return true;
 }
 
-bool k4pcs(const CloudDraw& d, int threads, int max_seconds, Eigen::Matrix4f* tf, bool* converged) {
+bool k4pcs(const CloudDraw& d, int threads, int max_seconds, unsigned seed, Eigen::Matrix4f* tf, bool* converged) {
   pcl::PointCloud<pcl::PointXYZ>::Ptr src(new pcl::PointCloud<pcl::PointXYZ>),
       tgt(new pcl::PointCloud<pcl::PointXYZ>);
   for (const auto& p : d.scene) src->push_back(pcl::PointXYZ(p.x(), p.y(), p.z()));
@@ -90,6 +133,7 @@ bool k4pcs(const CloudDraw& d, int threads, int max_seconds, Eigen::Matrix4f* tf
   ia.setApproxOverlap(0.6f);
   if (max_seconds > 0) ia.setMaxComputationTime(max_seconds);
   pcl::PointCloud<pcl::PointXYZ> aligned;
+  const ArmedClock clock(seed);
   ia.align(aligned);
   *converged = ia.hasConverged();
   *tf = ia.getFinalTransformation();
@@ -101,7 +145,7 @@ bool k4pcs(const CloudDraw& d, int threads, int max_seconds, Eigen::Matrix4f* tf
 const char* pcl_method_name(PclMethod m) { return m == PclMethod::kFpfhPrerejective ? "pcl_fpfh" : "pcl_k4pcs"; }
 
 bool run_pcl(PclMethod method, const std::vector<CloudDraw>& draws, int threads, MethodRun* out, std::string* error,
-             bool verbose, int max_seconds) {
+             bool verbose, int max_seconds, std::uint64_t seed) {
   out->method = pcl_method_name(method);
   out->outcomes.clear();
   if (threads < 1) {
@@ -112,8 +156,9 @@ bool run_pcl(PclMethod method, const std::vector<CloudDraw>& draws, int threads,
     Eigen::Matrix4f tf = Eigen::Matrix4f::Identity();
     bool converged = false;
     const double t0 = now_ms();
-    if (method == PclMethod::kFpfhPrerejective) fpfh_prerejective(d, threads, &tf, &converged);
-    else k4pcs(d, threads, max_seconds, &tf, &converged);
+    const unsigned ds = draw_seed(seed, d.index);
+    if (method == PclMethod::kFpfhPrerejective) fpfh_prerejective(d, threads, ds, &tf, &converged);
+    else k4pcs(d, threads, max_seconds, ds, &tf, &converged);
     const double ms = now_ms() - t0;
     if (!tf.allFinite()) {
       tf.setIdentity();
@@ -123,11 +168,11 @@ bool run_pcl(PclMethod method, const std::vector<CloudDraw>& draws, int threads,
     pm.build(&d.model, 3.0f * d.voxel);
     const CloudOutcome oc = score_answer(d, pm, tf.topLeftCorner<3, 3>(), tf.topRightCorner<3, 1>(), converged, ms);
     if (verbose) {
-      std::printf("  %s %s #%zu: %.1f ms %s  err %.4f m %.2f°  rms %.4f\n", out->method.c_str(), d.cloud.c_str(),
-                  d.index, ms,
+      std::printf("  %s %s #%zu: %.1f ms %s  err %.4f m %.2f°  rms %.4f  R|t %.5f %.5f %.5f %.5f\n",
+                  out->method.c_str(), d.cloud.c_str(), d.index, ms,
                   converged ? (oc.correct || !d.has_truth ? "reported" : "REPORTED-WRONG")
                             : (oc.correct ? "missed(correct)" : "nothing"),
-                  oc.trans_err, oc.rot_err_deg, oc.inlier_rms);
+                  oc.trans_err, oc.rot_err_deg, oc.inlier_rms, tf(0, 0), tf(0, 3), tf(1, 3), tf(2, 3));
     }
     out->outcomes.push_back(oc);
   }

@@ -11,6 +11,7 @@
 // Time: everything the method needs from the two clouds (normals, features, alignment).
 #pragma once
 
+#include <cstdint>
 #include <string>
 #include <vector>
 
@@ -23,7 +24,10 @@ const char* pcl_method_name(PclMethod m);
 
 // `threads`: OpenMP threads of the OMP normal / FPFH estimators and of K-4PCS (1 = one thread).
 // max_seconds bounds one K-4PCS run (PCL's setMaxComputationTime; 0 = PCL's default, unbounded).
+// seed: each draw's run is seeded from (seed, draw index) like pRANSAM's — FPFH + prerejective by
+// std::srand before align(), K-4PCS through the wrapped time() (pcl_peers.cpp). Reproducible with
+// threads = 1 for K-4PCS and max_seconds = 0 (a wall-clock bound cuts runs at different points).
 bool run_pcl(PclMethod method, const std::vector<CloudDraw>& draws, int threads, MethodRun* out, std::string* error,
-             bool verbose = false, int max_seconds = 0);
+             bool verbose = false, int max_seconds = 0, std::uint64_t seed = 1);
 
 }  // namespace sim::pransam_eval

@@ -1,11 +1,14 @@
 // mml-pransam-pcl: the PCL peers of pRANSAM 3-D (issue 17) on the draws of cloud_draws.h.
 //   mml-pransam-pcl [--cloud office1|car6|milk|bunny|all] [--method fpfh|k4pcs|both] [--draws 100]
-//                   [--threads 2] [--max-seconds 0] [--verbose]
+//                   [--threads 2] [--max-seconds 0] [--seed 1] [--verbose]
+// Reproducible per --seed: FPFH + prerejective always; K-4PCS with --threads 1 and --max-seconds 0
+// (pcl_peers.cpp: PCL seeds rand() from time(), which is wrapped in this tool).
 // bench_pransam_pcl OUT.json (same source, MMLFW_PCL_BENCH): reads the figures bench_pransam wrote to
 // OUT.json, runs both peers on the first N draws of each cloud (the same draws pRANSAM had; N =
 // MMLFW_PCL_DRAWS, default 3: one FPFH + prerejective run takes 15–30 s on these clouds, so 300 draws
-// would take hours), on 2 OpenMP threads and on one thread (office), runs pRANSAM again on exactly
-// those draws, and writes OUT.json back with the pcl_* figures and the comparison added.
+// would take hours), FPFH on 2 OpenMP threads (and the first office draw on one thread), K-4PCS on
+// one thread without a time bound (the only reproducible setting, pcl_peers.cpp), runs pRANSAM again
+// on exactly those draws, and writes OUT.json back with the pcl_* figures and the comparison added.
 #include <algorithm>
 #include <cmath>
 #include <cstdlib>
@@ -48,7 +51,6 @@ bool draws_of(const std::string& cloud, std::size_t n, std::vector<CloudDraw>* o
 }
 
 #ifdef MMLFW_PCL_BENCH
-constexpr int kK4pcsMaxSeconds = 10;  // PCL's setMaxComputationTime bound per K-4PCS run
 
 int bench(const std::string& path) {
   sim::BenchJson json;
@@ -97,18 +99,24 @@ int bench(const std::string& path) {
   for (PclMethod m : {PclMethod::kFpfhPrerejective, PclMethod::kK4pcs}) {
     const std::string name = pcl_method_name(m);
     MethodRun office, objects, office1t;
-    if (!run_pcl(m, draws["office1"], 2, &office, &err, true, kK4pcsMaxSeconds)) return fail(err);
+    const int threads = m == PclMethod::kK4pcs ? 1 : 2;  // K-4PCS: reproducible only on one thread
+    if (!run_pcl(m, draws["office1"], threads, &office, &err, true)) return fail(err);
     for (const char* c : {"car6", "milk"}) {
       MethodRun r;
-      if (!run_pcl(m, draws[c], 2, &r, &err, true, kK4pcsMaxSeconds)) return fail(err);
+      if (!run_pcl(m, draws[c], threads, &r, &err, true)) return fail(err);
       std::printf("%s\n", summary_line(std::string(c) + " " + name, r).c_str());
       objects.append(r);
     }
-    const std::vector<CloudDraw> first(draws["office1"].begin(), draws["office1"].begin() + std::min<std::size_t>(n, 2));
-    if (!run_pcl(m, first, 1, &office1t, &err, true, kK4pcsMaxSeconds)) return fail(err);
-    std::printf("%s\n%s\n%s\n", summary_line("office1 " + name + " (2 threads)", office).c_str(),
+    if (threads == 1) {
+      office1t = office;
+    } else {
+      const std::vector<CloudDraw> first(draws["office1"].begin(), draws["office1"].begin() + 1);
+      if (!run_pcl(m, first, 1, &office1t, &err, true)) return fail(err);
+    }
+    std::printf("%s\n%s\n%s\n", summary_line("office1 " + name + " (" + std::to_string(threads) + " threads)", office).c_str(),
                 summary_line("car6+milk " + name, objects).c_str(),
-                summary_line("office1 " + name + " (1 thread, first 2)", office1t).c_str());
+                summary_line("office1 " + name + " (1 thread)", office1t).c_str());
+    json.add_int(name + "_threads", threads);
     json.add(name + "_office_success", office.success());
     json.add_int(name + "_office_wrong", static_cast<long long>(office.wrong()));
     json.add(name + "_office_ms_p50", office.ms_p50());
@@ -116,6 +124,7 @@ int bench(const std::string& path) {
     json.add(name + "_office_ms_p50_1t", office1t.ms_p50());
     json.add(name + "_objects_success", objects.success());
     json.add_int(name + "_objects_wrong", static_cast<long long>(objects.wrong()));
+    json.add_int(name + "_objects_draws", static_cast<long long>(objects.n()));
     json.add(name + "_objects_ms_p50", objects.ms_p50());
     if (office.success() > best_success || (office.success() == best_success && office.ms_p50() < best_p50)) {
       best_success = office.success();
@@ -142,6 +151,7 @@ static int run_main(int argc, char** argv) {
   const int threads = std::stoi(get(a, "threads", "2"));
   const int max_seconds = std::stoi(get(a, "max-seconds", "0"));
   const std::size_t n = std::stoul(get(a, "draws", "100"));
+  const std::uint64_t seed = std::stoull(get(a, "seed", "1"));
   std::string err;
   for (const char* c : {"office1", "car6", "milk", "bunny"}) {
     if (which != "all" && which != c) continue;
@@ -150,7 +160,7 @@ static int run_main(int argc, char** argv) {
     for (PclMethod m : {PclMethod::kFpfhPrerejective, PclMethod::kK4pcs}) {
       if (method != "both" && method != (m == PclMethod::kK4pcs ? "k4pcs" : "fpfh")) continue;
       MethodRun r;
-      if (!run_pcl(m, draws, threads, &r, &err, a.count("verbose") != 0, max_seconds)) return fail(err);
+      if (!run_pcl(m, draws, threads, &r, &err, a.count("verbose") != 0, max_seconds, seed)) return fail(err);
       if (std::string(c) == "bunny") {
         std::vector<double> rms;
         for (const auto& oc : r.outcomes) rms.push_back(oc.inlier_rms);
