@@ -22,10 +22,13 @@ int count_inliers(const std::vector<Eigen::Vector3f>& scene, const PlaneModel& m
   return k;
 }
 
-AmbiguityVerdict check_ambiguity(const std::vector<Eigen::Vector3f>& scene, const PlaneModel& model, float voxel,
-                                 const PoseCandidate& best, const std::vector<PoseCandidate>& kept,
-                                 const AmbiguityOptions& options) {
+namespace {
+
+AmbiguityVerdict judge(const std::vector<Eigen::Vector3f>& scene, const PlaneModel& model, float voxel,
+                       const PoseCandidate& best, const std::vector<PoseCandidate>& kept,
+                       const AmbiguityOptions& options) {
   AmbiguityVerdict v;
+  v.answer = best;
   if (scene.empty()) return v;
   v.best_inliers = count_inliers(scene, model, best.rotation, best.translation, voxel);
   v.margin = options.z * std::sqrt(v.best_inliers);
@@ -114,6 +117,25 @@ AmbiguityVerdict check_ambiguity(const std::vector<Eigen::Vector3f>& scene, cons
     }
   }
   v.ambiguous = v.rival_inliers >= 0 && v.rival_inliers >= v.best_inliers - v.margin;
+  return v;
+}
+
+}  // namespace
+
+AmbiguityVerdict check_ambiguity(const std::vector<Eigen::Vector3f>& scene, const PlaneModel& model, float voxel,
+                                 const PoseCandidate& best, const std::vector<PoseCandidate>& kept,
+                                 const AmbiguityOptions& options) {
+  AmbiguityVerdict v = judge(scene, model, voxel, best, kept, options);
+  int adoptions = 0, refinements = v.refinements;
+  while (adoptions < options.max_adoptions && v.rival_inliers > v.best_inliers + v.margin) {
+    ++adoptions;
+    v = judge(scene, model, voxel, v.rival_pose, {}, options);
+    refinements += v.refinements;
+  }
+  v.adoptions = adoptions;
+  v.refinements = refinements;
+  // Still a clearly better rival after the last adoption: the answer is not settled.
+  if (v.rival_inliers > v.best_inliers + v.margin) v.ambiguous = true;
   return v;
 }
 

@@ -133,5 +133,22 @@ TEST(Ambiguity3d, EndWallStopsTheSlide) {
                             << v.rival_inliers << " margin " << v.margin;
 }
 
+// An answer slid 7 voxels along the wall (where the end wall no longer fits) is replaced by the
+// clearly better rival one slide away, the true pose, which then passes the check.
+TEST(Ambiguity3d, ClearlyBetterRivalIsAdopted) {
+  Case c = corner_case(true);
+  PlaneModel pm;
+  pm.build(&c.model, 3.0f * c.voxel);
+  PoseCandidate off = c.truth;
+  off.translation += Eigen::Vector3f(7.0f * c.voxel, 0, 0);  // the slides (4, 8) + ICP reach it
+  const AmbiguityVerdict v = check_ambiguity(c.scene, pm, c.voxel, off);
+  EXPECT_GE(v.adoptions, 1);
+  EXPECT_FALSE(v.ambiguous);
+  EXPECT_LT((v.answer.translation - c.truth.translation).norm(), 0.5f * c.voxel);
+  AmbiguityOptions judge_only;
+  judge_only.max_adoptions = 0;
+  EXPECT_TRUE(check_ambiguity(c.scene, pm, c.voxel, off, {}, judge_only).ambiguous);
+}
+
 }  // namespace
 }  // namespace sim::pransam_eval

@@ -113,6 +113,13 @@ bool run_pransam3d(const std::vector<CloudDraw>& draws, const Pransam3dConfig& c
       best.translation = oc.translation;
       av = check_ambiguity(d.scene, pm, d.voxel, best, {}, config.ambiguity_options);
       ms += now_ms() - ta;
+      if (av.adoptions > 0) {
+        // A distinct rival explained the data clearly better and was adopted: score that pose.
+        const bool correct_before = oc.correct;
+        oc = score_answer(d, pm, av.answer.rotation, av.answer.translation, reported, ms);
+        if (verbose) std::printf("  (adopted %d× a better rival; correct before %d, after %d)\n", av.adoptions,
+                                 correct_before ? 1 : 0, oc.correct ? 1 : 0);
+      }
       oc.ms = ms;
       if (av.ambiguous) {
         oc.ambiguous = true;
