@@ -21,7 +21,8 @@ constexpr double kTransTolVoxels = 0.4;  // office: 2 cm at 5 cm voxels
 constexpr double kRotTolDeg = 2.0;
 
 struct CloudOutcome {
-  double ms = 0;                 // the method's own time (model preparation + matching)
+  double ms = 0;                 // the method's own time (model preparation + matching [+ verdict])
+  double verdict_ms = 0;         // of which the ambiguity verdict (pRANSAM, ambiguity3d.h)
   bool reported = false;
   bool ambiguous = false;        // withheld as ambiguous (then reported = false)
   bool correct = false;          // after refinement (false without truth)

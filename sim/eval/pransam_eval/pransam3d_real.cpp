@@ -112,7 +112,8 @@ bool run_pransam3d(const std::vector<CloudDraw>& draws, const Pransam3dConfig& c
       best.rotation = oc.rotation;
       best.translation = oc.translation;
       av = check_ambiguity(d.scene, pm, d.voxel, best, {}, config.ambiguity_options);
-      ms += now_ms() - ta;
+      const double verdict_ms = now_ms() - ta;
+      ms += verdict_ms;
       if (av.adoptions > 0) {
         // A distinct rival explained the data clearly better and was adopted: score that pose.
         const bool correct_before = oc.correct;
@@ -121,6 +122,7 @@ bool run_pransam3d(const std::vector<CloudDraw>& draws, const Pransam3dConfig& c
                                  correct_before ? 1 : 0, oc.correct ? 1 : 0);
       }
       oc.ms = ms;
+      oc.verdict_ms = verdict_ms;
       if (av.ambiguous) {
         oc.ambiguous = true;
         oc.reported = false;

@@ -225,6 +225,12 @@ static int run_main(int argc, char** argv) {
     json.add("pransam3d_office_success", r2.success());
     json.add_int("pransam3d_office_wrong", static_cast<long long>(r2.wrong()));
     json.add_int("pransam3d_office_ambiguous", static_cast<long long>(r2.ambiguous()));
+    {
+      std::vector<double> vms;
+      for (const auto& oc : r2.outcomes)
+        if (oc.verdict_ms > 0) vms.push_back(oc.verdict_ms);
+      json.add("pransam3d_office_verdict_ms_p50", percentile(vms, 0.5));  // included in ms_p50
+    }
     json.add("pransam3d_office_ms_p50", r2.ms_p50());
     json.add("pransam3d_office_ms_p99", r2.ms_p99());
     json.add("pransam3d_office_ms_p50_1t", r1.ms_p50());

@@ -66,6 +66,11 @@ int run_real_3d(const std::map<std::string, std::string>& a) {
     MethodRun r;
     if (!run_pransam3d(draws, c, threads, &r, &err, verbose)) { std::fprintf(stderr, "%s\n", err.c_str()); return 1; }
     std::printf("%s\n", summary_line(cloud + " pransam (" + std::to_string(threads) + " threads)", r).c_str());
+    std::vector<double> vms;
+    for (const auto& oc : r.outcomes)
+      if (oc.verdict_ms > 0) vms.push_back(oc.verdict_ms);  // draws that had an answer to judge
+    std::printf("%s ambiguity verdict: p50 %.1f ms p99 %.1f ms (included in the times above)\n", cloud.c_str(),
+                percentile(vms, 0.5), percentile(vms, 0.99));
   }
   if (which == "all" || which == "bunny") {
     CloudDraw bunny;
