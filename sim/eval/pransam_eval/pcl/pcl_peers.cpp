@@ -120,7 +120,8 @@ bool fpfh_prerejective(const CloudDraw& d, int threads, unsigned seed, Eigen::Ma
   return true;
 }
 
-bool k4pcs(const CloudDraw& d, int threads, int max_seconds, unsigned seed, Eigen::Matrix4f* tf, bool* converged) {
+bool k4pcs(const CloudDraw& d, int threads, int max_seconds, int samples, unsigned seed, Eigen::Matrix4f* tf,
+           bool* converged) {
   pcl::PointCloud<pcl::PointXYZ>::Ptr src(new pcl::PointCloud<pcl::PointXYZ>),
       tgt(new pcl::PointCloud<pcl::PointXYZ>);
   for (const auto& p : d.scene) src->push_back(pcl::PointXYZ(p.x(), p.y(), p.z()));
@@ -132,6 +133,10 @@ bool k4pcs(const CloudDraw& d, int threads, int max_seconds, unsigned seed, Eige
   ia.setDelta(d.voxel, false);  // "absolute value … the point accuracy"
   ia.setApproxOverlap(0.6f);
   if (max_seconds > 0) ia.setMaxComputationTime(max_seconds);
+  // Cost bound (ours, not PCL's documentation): K-4PCS is meant for keypoints; on a whole voxelised
+  // cloud its pair search is quadratic in the source size (> 5 min per milk draw on one thread).
+  // setNumberOfSamples keeps a seeded random share of the source of about this many points.
+  if (samples > 0) ia.setNumberOfSamples(samples);
   pcl::PointCloud<pcl::PointXYZ> aligned;
   const ArmedClock clock(seed);
   ia.align(aligned);
@@ -145,7 +150,7 @@ bool k4pcs(const CloudDraw& d, int threads, int max_seconds, unsigned seed, Eige
 const char* pcl_method_name(PclMethod m) { return m == PclMethod::kFpfhPrerejective ? "pcl_fpfh" : "pcl_k4pcs"; }
 
 bool run_pcl(PclMethod method, const std::vector<CloudDraw>& draws, int threads, MethodRun* out, std::string* error,
-             bool verbose, int max_seconds, std::uint64_t seed) {
+             bool verbose, int max_seconds, std::uint64_t seed, int k4pcs_samples) {
   out->method = pcl_method_name(method);
   out->outcomes.clear();
   if (threads < 1) {
@@ -158,7 +163,7 @@ bool run_pcl(PclMethod method, const std::vector<CloudDraw>& draws, int threads,
     const double t0 = now_ms();
     const unsigned ds = draw_seed(seed, d.index);
     if (method == PclMethod::kFpfhPrerejective) fpfh_prerejective(d, threads, ds, &tf, &converged);
-    else k4pcs(d, threads, max_seconds, ds, &tf, &converged);
+    else k4pcs(d, threads, max_seconds, k4pcs_samples, ds, &tf, &converged);
     const double ms = now_ms() - t0;
     if (!tf.allFinite()) {
       tf.setIdentity();

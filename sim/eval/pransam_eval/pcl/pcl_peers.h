@@ -27,7 +27,8 @@ const char* pcl_method_name(PclMethod m);
 // seed: each draw's run is seeded from (seed, draw index) like pRANSAM's — FPFH + prerejective by
 // std::srand before align(), K-4PCS through the wrapped time() (pcl_peers.cpp). Reproducible with
 // threads = 1 for K-4PCS and max_seconds = 0 (a wall-clock bound cuts runs at different points).
+// k4pcs_samples > 0: K-4PCS uses about that many source points (setNumberOfSamples; 0 = all).
 bool run_pcl(PclMethod method, const std::vector<CloudDraw>& draws, int threads, MethodRun* out, std::string* error,
-             bool verbose = false, int max_seconds = 0, std::uint64_t seed = 1);
+             bool verbose = false, int max_seconds = 0, std::uint64_t seed = 1, int k4pcs_samples = 0);
 
 }  // namespace sim::pransam_eval

@@ -1,6 +1,6 @@
 // mml-pransam-pcl: the PCL peers of pRANSAM 3-D (issue 17) on the draws of cloud_draws.h.
 //   mml-pransam-pcl [--cloud office1|car6|milk|bunny|all] [--method fpfh|k4pcs|both] [--draws 100]
-//                   [--threads 2] [--max-seconds 0] [--seed 1] [--verbose]
+//                   [--threads 2] [--max-seconds 0] [--seed 1] [--k4pcs-samples 0] [--verbose]
 // Reproducible per --seed: FPFH + prerejective always; K-4PCS with --threads 1 and --max-seconds 0
 // (pcl_peers.cpp: PCL seeds rand() from time(), which is wrapped in this tool).
 // bench_pransam_pcl OUT.json (same source, MMLFW_PCL_BENCH): reads the figures bench_pransam wrote to
@@ -72,6 +72,10 @@ int bench(const std::string& path) {
   const char* env = std::getenv("MMLFW_PCL_DRAWS");
   const std::size_t n = env != nullptr && std::atoi(env) > 0 ? static_cast<std::size_t>(std::atoi(env)) : 3;
   json.add_int("pcl_draws_per_cloud", static_cast<long long>(n));
+  // K-4PCS source sample bound (pcl_peers.cpp): MMLFW_K4PCS_SAMPLES, default 1000.
+  const char* ks = std::getenv("MMLFW_K4PCS_SAMPLES");
+  const int k4pcs_samples = ks != nullptr && std::atoi(ks) >= 0 ? std::atoi(ks) : 1000;
+  json.add_int("pcl_k4pcs_source_samples", k4pcs_samples);
   std::map<std::string, std::vector<CloudDraw>> draws;
   for (const char* c : {"office1", "car6", "milk"}) {
     if (!draws_of(c, n, &draws[c], &err)) return fail(err);
@@ -100,10 +104,10 @@ int bench(const std::string& path) {
     const std::string name = pcl_method_name(m);
     MethodRun office, objects, office1t;
     const int threads = m == PclMethod::kK4pcs ? 1 : 2;  // K-4PCS: reproducible only on one thread
-    if (!run_pcl(m, draws["office1"], threads, &office, &err, true)) return fail(err);
+    if (!run_pcl(m, draws["office1"], threads, &office, &err, true, 0, 1, k4pcs_samples)) return fail(err);
     for (const char* c : {"car6", "milk"}) {
       MethodRun r;
-      if (!run_pcl(m, draws[c], threads, &r, &err, true)) return fail(err);
+      if (!run_pcl(m, draws[c], threads, &r, &err, true, 0, 1, k4pcs_samples)) return fail(err);
       std::printf("%s\n", summary_line(std::string(c) + " " + name, r).c_str());
       objects.append(r);
     }
@@ -152,6 +156,7 @@ static int run_main(int argc, char** argv) {
   const int max_seconds = std::stoi(get(a, "max-seconds", "0"));
   const std::size_t n = std::stoul(get(a, "draws", "100"));
   const std::uint64_t seed = std::stoull(get(a, "seed", "1"));
+  const int k4pcs_samples = std::stoi(get(a, "k4pcs-samples", "0"));
   std::string err;
   for (const char* c : {"office1", "car6", "milk", "bunny"}) {
     if (which != "all" && which != c) continue;
@@ -160,7 +165,7 @@ static int run_main(int argc, char** argv) {
     for (PclMethod m : {PclMethod::kFpfhPrerejective, PclMethod::kK4pcs}) {
       if (method != "both" && method != (m == PclMethod::kK4pcs ? "k4pcs" : "fpfh")) continue;
       MethodRun r;
-      if (!run_pcl(m, draws, threads, &r, &err, a.count("verbose") != 0, max_seconds, seed)) return fail(err);
+      if (!run_pcl(m, draws, threads, &r, &err, a.count("verbose") != 0, max_seconds, seed, k4pcs_samples)) return fail(err);
       if (std::string(c) == "bunny") {
         std::vector<double> rms;
         for (const auto& oc : r.outcomes) rms.push_back(oc.inlier_rms);
