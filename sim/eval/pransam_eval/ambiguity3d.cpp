@@ -62,6 +62,27 @@ AmbiguityVerdict judge(const std::vector<Eigen::Vector3f>& scene, const PlaneMod
       starts.emplace_back(RivalKind::kFlip, moved(Eigen::AngleAxisf(static_cast<float>(M_PI), axis).toRotationMatrix(),
                                                   Eigen::Vector3f::Zero()));
     }
+    // The model's own near-symmetries: 180° about its principal axes through its centroid, applied
+    // after the answer (a part of a symmetric object placed on the wrong end turns into the right
+    // one; the scene-centred turns above keep the part where it is).
+    const std::vector<Eigen::Vector3f>& m = model.points();
+    if (m.size() >= 3) {
+      Eigen::Vector3d cm = Eigen::Vector3d::Zero();
+      for (const auto& q : m) cm += q.cast<double>();
+      cm /= static_cast<double>(m.size());
+      Eigen::Matrix3d mcov = Eigen::Matrix3d::Zero();
+      for (const auto& q : m) mcov += (q.cast<double>() - cm) * (q.cast<double>() - cm).transpose();
+      Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> em(mcov / static_cast<double>(m.size()));
+      const Eigen::Vector3f cmf = cm.cast<float>();
+      for (int a = 0; a < 3; ++a) {
+        const Eigen::Matrix3f s =
+            Eigen::AngleAxisf(static_cast<float>(M_PI), em.eigenvectors().col(a).cast<float>().normalized()).toRotationMatrix();
+        PoseCandidate p;
+        p.rotation = s * best.rotation;
+        p.translation = s * (best.translation - cmf) + cmf;
+        starts.emplace_back(RivalKind::kFlip, p);
+      }
+    }
   }
   if (options.slides) {
     // Point-to-plane information of the contact at the best pose, parameters (δt, radius·δω).

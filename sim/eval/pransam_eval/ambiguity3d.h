@@ -10,8 +10,9 @@
 // Score of a pose = the number k of scene points within 1 voxel of the model after the common
 // point-to-plane refinement (icp3d.h), i.e. the refined Ω. Rivals, each refined the same way:
 //  - the hypotheses the matcher kept besides its best (passed in by the caller, may be none);
-//  - the best pose turned by 180° about each principal axis of the (moved) scene, about its centroid
-//    (a near-symmetric object's flips);
+//  - the best pose turned by 180° about each principal axis of the (moved) scene, about its centroid,
+//    and by 180° about each principal axis of the model through the model's centroid (a
+//    near-symmetric object's flips; the second kind also moves a part placed on the wrong end);
 //  - the best pose moved by ±s along the weakest eigenvector of the contact's point-to-plane
 //    information matrix (6×6, rotations scaled by the scene's RMS radius so both parts are metres),
 //    s = 4 and 8 voxels: where the contact does not constrain the pose, refinement does not pull it

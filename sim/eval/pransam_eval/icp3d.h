@@ -20,6 +20,7 @@ class PlaneModel {
   int nearest(const Eigen::Vector3f& p, float max_dist) const;
   const Eigen::Vector3f& point(int i) const { return (*points_)[static_cast<std::size_t>(i)]; }
   const Eigen::Vector3f& normal(int i) const { return normals_[static_cast<std::size_t>(i)]; }
+  const std::vector<Eigen::Vector3f>& points() const { return *points_; }
 
  private:
   std::uint64_t key(const Eigen::Vector3f& p) const;
