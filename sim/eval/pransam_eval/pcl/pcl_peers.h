@@ -7,7 +7,9 @@
 //  - K-4PCS (pcl::registration::KFPCSInitialAlignment) as its documentation says: delta = the point
 //    accuracy (absolute, one voxel), approximate overlap = the smallest drawn overlap (0.6), score
 //    threshold and iterations left to their overlap-derived defaults, the OpenMP thread count;
-//    reported = hasConverged() (fitness below the score threshold).
+//    reported = hasConverged() (fitness below the score threshold). Reproducible per seed on one
+//    thread without a time bound (pcl_peers.cpp: PCL's time() seeding is wrapped); optionally a
+//    source sample bound (setNumberOfSamples) to make it fit the time.
 // Time: everything the method needs from the two clouds (normals, features, alignment).
 #pragma once
 
