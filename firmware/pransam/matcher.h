@@ -191,6 +191,7 @@ class Matcher {
   const ContactField<D>& field() const { return field_; }
 
  private:
+  static constexpr std::size_t kMaxTouched = 1u << 18;  // touched-slot list per table
   struct InsertRecord {
     std::uint32_t slot;
     Triple triple;
