@@ -257,6 +257,23 @@ void AntSlam::shortest_paths(std::uint32_t a) {
   }
 }
 
+// F_a in F_c along the first n steps of the current path and its covariance (Eq. 3.4 compounding;
+// frozen edges count with frozen_cov_scale, reversed steps with the inverse's Jacobian).
+void AntSlam::compound_path(std::uint32_t n, Se2d* x, Mat3* cov) const {
+  for (std::uint32_t i = 0; i < n; ++i) {
+    const SampledEdge& e = *steps_[i].edge;
+    const Se2d t = step_transform(steps_[i], e.value);
+    Mat3 ct = e.frozen ? Mat3(e.cov * options_.frozen_cov_scale) : e.cov;
+    if (!steps_[i].forward) {
+      const Mat3 ji = e.value.jacobian_inverse();
+      ct = ji * ct * ji.transpose();
+    }
+    const Mat3 j1 = x->jacobian_compose_first(t), j2 = x->jacobian_compose_second();
+    *cov = j1 * *cov * j1.transpose() + j2 * ct * j2.transpose();
+    *x = x->compose(t);
+  }
+}
+
 std::uint32_t AntSlam::build_path(std::uint32_t c, std::uint32_t a) {
   // Walk from c toward a along the BFS parents: the steps come out in the order c → a.
   std::uint32_t n = 0, node = c;
@@ -301,18 +318,7 @@ Status AntSlam::close_loop(std::uint32_t a) {
     // Predicted x = F_a in F_c along the path and its covariance (Eq. 3.4 compounding).
     Se2d x;
     Mat3 cov = Mat3::Zero();
-    for (std::uint32_t i = 0; i < n; ++i) {
-      const SampledEdge& e = *steps_[i].edge;
-      const Se2d t = step_transform(steps_[i], e.value);
-      Mat3 ct = e.frozen ? Mat3(e.cov * options_.frozen_cov_scale) : e.cov;
-      if (!steps_[i].forward) {
-        const Mat3 ji = e.value.jacobian_inverse();
-        ct = ji * ct * ji.transpose();
-      }
-      const Mat3 j1 = x.jacobian_compose_first(t), j2 = x.jacobian_compose_second();
-      cov = j1 * cov * j1.transpose() + j2 * ct * j2.transpose();
-      x = x.compose(t);
-    }
+    compound_path(n, &x, &cov);
     // Mahalanobis distance of a's poses to the nearest pose of c (beyond the overlap radius).
     // Largest eigenvalue of the 2×2 position covariance (closed form; no Eigen solver, no heap).
     const double ca = cov(0, 0), cb = cov(0, 1), cc = cov(1, 1);
@@ -355,18 +361,7 @@ Status AntSlam::close_loop(std::uint32_t a) {
     const std::uint32_t n = build_path(c, a);
     Se2d x;
     Mat3 cov = Mat3::Zero();
-    for (std::uint32_t i = 0; i < n; ++i) {
-      const SampledEdge& e = *steps_[i].edge;
-      const Se2d t = step_transform(steps_[i], e.value);
-      Mat3 ct = e.frozen ? Mat3(e.cov * options_.frozen_cov_scale) : e.cov;
-      if (!steps_[i].forward) {
-        const Mat3 ji = e.value.jacobian_inverse();
-        ct = ji * ct * ji.transpose();
-      }
-      const Mat3 j1 = x.jacobian_compose_first(t), j2 = x.jacobian_compose_second();
-      cov = j1 * cov * j1.transpose() + j2 * ct * j2.transpose();
-      x = x.compose(t);
-    }
+    compound_path(n, &x, &cov);
     // pRANSAM: a's points (scene, F_a) against c's (model, F_c) → h = F_a in F_c.
     ++stats_.candidates;
     const std::uint64_t t0 = now();

@@ -161,6 +161,7 @@ class AntSlam {
   void shortest_paths(std::uint32_t a);  // BFS from a: parent_edge_, hops_
   // Path c → a as steps (forward/backward) into steps_; returns the number of steps.
   std::uint32_t build_path(std::uint32_t c, std::uint32_t a);
+  void compound_path(std::uint32_t n, Se2d* x, Mat3* cov) const;
   void recompute_world();
   std::uint64_t now() const { return clock_ ? clock_->now_ns() : 0; }
 
