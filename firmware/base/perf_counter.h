@@ -1,13 +1,14 @@
 // PerfCounter: per-stage timing (PX4's perf_counter): count, mean, p50, p99, max. Always on and
 // cheap: O(1) per sample into a fixed ring of the last kWindow samples; percentiles are computed
-// on request (never on the hot path). Time comes from the HAL clock so the simulator can step it.
+// on request (never on the hot path). Time comes from the clock interface (firmware/base/clock.h,
+// implemented by the HAL backends) so the simulator can step it.
 #pragma once
 
 #include <cstddef>
 #include <cstdint>
 #include <cstdio>
 
-#include "hal/clock.h"
+#include "firmware/base/clock.h"
 
 namespace fw {
 
@@ -40,14 +41,14 @@ class PerfCounter {
 // Scoped timer: adds the elapsed time of its scope to a counter.
 class PerfScope {
  public:
-  PerfScope(PerfCounter& counter, const hal::Clock& clock) : counter_(counter), clock_(clock), start_(clock.now_ns()) {}
+  PerfScope(PerfCounter& counter, const fw::Clock& clock) : counter_(counter), clock_(clock), start_(clock.now_ns()) {}
   ~PerfScope() { counter_.add_ns(clock_.now_ns() - start_); }
   PerfScope(const PerfScope&) = delete;
   PerfScope& operator=(const PerfScope&) = delete;
 
  private:
   PerfCounter& counter_;
-  const hal::Clock& clock_;
+  const fw::Clock& clock_;
   std::uint64_t start_;
 };
 

@@ -4,7 +4,7 @@
 #include <cstring>
 
 #include "firmware/base/memory_report.h"
-#include "firmware/map/crc32.h"
+#include "firmware/base/crc32.h"
 #include "firmware/map/edt.h"
 
 // The format is little-endian; bulk arrays are copied with memcpy, so the host must be too (x86-64,

@@ -15,18 +15,6 @@ constexpr std::size_t kOdomPayload = kOdomParts * kPartBytes;        // 28
 constexpr std::size_t kPosePayload = kPoseParts * kPartBytes;        // 42
 constexpr std::size_t kHealthPayload = kHealthParts * kPartBytes;    // 35
 
-struct Crc32Table {
-  std::uint32_t v[256];
-  constexpr Crc32Table() : v() {
-    for (std::uint32_t i = 0; i < 256; ++i) {
-      std::uint32_t c = i;
-      for (int k = 0; k < 8; ++k) c = (c & 1u) ? (0xEDB88320u ^ (c >> 1)) : (c >> 1);
-      v[i] = c;
-    }
-  }
-};
-constexpr Crc32Table kCrcTable;
-
 std::int32_t clamp_i32(double v) {
   if (!(v == v)) return 0;
   if (v > 2147483647.0) return 2147483647;
@@ -142,11 +130,6 @@ float protection_value(std::uint16_t code, double lsb_per_unit) {
   // than a smaller number that would not hold.
   if (code == kProtectionSaturated) return std::numeric_limits<float>::infinity();
   return static_cast<float>(code / lsb_per_unit);
-}
-
-std::uint32_t crc32_update(std::uint32_t crc, const std::uint8_t* data, std::size_t len) {
-  for (std::size_t i = 0; i < len; ++i) crc = kCrcTable.v[(crc ^ data[i]) & 0xFFu] ^ (crc >> 8);
-  return crc;
 }
 
 std::size_t scan_frame_count(std::uint32_t beam_count, bool fd) {

@@ -4,53 +4,13 @@
 // "handoff" by their owners.
 #pragma once
 
-#include <cstdint>
-#include <functional>
-#include <map>
 #include <memory>
 #include <string>
 #include <vector>
 
-#include "firmware/base/se2.h"
-#include "firmware/map/global_map.h"
-#include "firmware/runtime/localizer.h"
-#include "sim/io/ros_map.h"
+#include "sim/localizers/localizer_context.h"
 
 namespace sim {
-
-// One hypothesis as drawn in pictures (map frame); weight ∈ [0, 1] (e.g. normalised rating).
-struct HypothesisPoint {
-  double x = 0, y = 0, theta = 0, weight = 1;
-};
-
-// Optional views a factory may fill to expose localizer internals to the simulator. The hook is
-// called after each step; it must not change the localizer's state.
-struct LocalizerHooks {
-  std::function<void(std::vector<HypothesisPoint>*)> hypotheses;
-};
-
-struct LocalizerContext {
-  // The global map: the compiled map image as the firmware loaded it (nullptr when the run has no
-  // map, e.g. a log replay without --map), its bytes (for extra sections such as pRANSAM's relation
-  // table) and the host grid it was built from.
-  const fw::GlobalMap* global_map = nullptr;
-  const std::vector<std::uint8_t>* map_image = nullptr;
-  const OccupancyGrid* grid = nullptr;
-  std::string map_name;
-  std::uint64_t seed = 1;
-  int threads = 1;
-  // True start pose when known (synthetic worlds, logs with a reference). Only for baselines that
-  // need an anchor (odom with anchor=truth); a global localizer must not look at it.
-  bool has_true_start = false;
-  fw::Se2d true_start;
-  // --opt key=value pairs for the chosen localizer. A factory must reject keys it does not know.
-  std::map<std::string, std::string> options;
-  // Filled by the factory if it can expose hypotheses (may be nullptr).
-  LocalizerHooks* hooks = nullptr;
-};
-
-using LocalizerFactoryFn =
-    std::function<std::unique_ptr<fw::Localizer>(const LocalizerContext& ctx, std::string* err)>;
 
 // nullptr with *err naming the unknown localizer (and listing the known ones) or the bad option.
 std::unique_ptr<fw::Localizer> make_localizer(const std::string& name, const LocalizerContext& ctx, std::string* err);
@@ -63,9 +23,5 @@ std::vector<LocalizerInfo> localizer_names();
 // Adds (or replaces) a localizer at run time; used by tests and by owners before their entry is in
 // the built-in table.
 void register_localizer(const std::string& name, const std::string& description, LocalizerFactoryFn fn);
-
-// Helper for factories: error text for option keys not in `known`, or empty.
-std::string unknown_option_keys(const std::string& localizer, const std::map<std::string, std::string>& options,
-                                const std::vector<std::string>& known);
 
 }  // namespace sim

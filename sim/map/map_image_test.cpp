@@ -14,7 +14,7 @@
 #include "firmware/base/arena.h"
 #include "firmware/base/memory_report.h"
 #include "firmware/base/rng.h"
-#include "firmware/map/crc32.h"
+#include "firmware/base/crc32.h"
 #include "firmware/map/map_image.h"
 #include "firmware/map/map_image_file.h"
 #include "sim/map/map_image_writer.h"

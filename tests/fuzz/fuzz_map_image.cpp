@@ -11,7 +11,7 @@
 #include <vector>
 
 #include "firmware/base/arena.h"
-#include "firmware/map/crc32.h"
+#include "firmware/base/crc32.h"
 #include "firmware/map/global_map.h"
 #include "firmware/map/map_image.h"
 #include "firmware/pransam/matcher.h"

@@ -1,16 +1,12 @@
-// Clock: monotonic time as the firmware sees it. Backends: hal/linux (CLOCK_MONOTONIC) and
-// hal/sim (a stepped clock the simulator advances, so replays are deterministic).
+// hal::Clock: the HAL's clock interface. It is defined in the common layer (firmware/base/clock.h,
+// fw::Clock) because perf counters below the HAL need it; this header is the HAL's name for it, so
+// backends (hal/linux LinuxClock, hal/sim SteppedClock) and algorithms keep writing hal::Clock.
 #pragma once
 
-#include <cstdint>
+#include "firmware/base/clock.h"
 
 namespace hal {
 
-class Clock {
- public:
-  virtual ~Clock() = default;
-  // Monotonic nanoseconds since an arbitrary epoch.
-  virtual std::uint64_t now_ns() const = 0;
-};
+using Clock = fw::Clock;
 
 }  // namespace hal

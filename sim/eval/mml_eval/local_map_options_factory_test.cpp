@@ -4,7 +4,7 @@
 
 #include "firmware/base/arena.h"
 #include "firmware/map/map_image.h"
-#include "sim/cli/localizer_factory.h"
+#include "sim/localizers/localizer_context.h"
 #include "sim/eval/mml_eval/mml_systems.h"
 #include "sim/map/map_image_writer.h"
 #include "sim/world/builtin_worlds.h"

@@ -2,7 +2,7 @@
 // Uses only the registry's header types, so sim_mml does not link the registry (no cycle).
 #include <cstdlib>
 
-#include "sim/cli/localizer_factory.h"
+#include "sim/localizers/localizer_context.h"
 #include "sim/eval/mml_eval/mml_systems.h"
 
 namespace sim::mmleval {

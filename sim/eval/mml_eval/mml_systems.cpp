@@ -8,7 +8,7 @@
 #include "firmware/map/map_image.h"
 #include "firmware/mcl/global_map_view.h"
 #include "firmware/mml/mml_presets.h"
-#include "sim/cli/localizer_factory.h"  // HypothesisPoint (header only)
+#include "sim/localizers/localizer_context.h"  // HypothesisPoint (header only)
 
 namespace sim::mmleval {
 

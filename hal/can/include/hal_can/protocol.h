@@ -16,6 +16,8 @@
 #include <cstddef>
 #include <cstdint>
 
+#include "firmware/base/crc32.h"
+
 namespace hal_can {
 
 constexpr std::uint32_t kFdIdFlag = 0x400;  // FD variant of a record / data frame: base | 0x400
@@ -74,12 +76,14 @@ inline std::uint64_t get_u48(const std::uint8_t* p) {
   return v;
 }
 
-// CRC-32 (IEEE 802.3, reflected, init/xorout 0xFFFFFFFF; same as zlib's crc32).
-std::uint32_t crc32_update(std::uint32_t crc, const std::uint8_t* data, std::size_t len);
-inline std::uint32_t crc32_begin() { return 0xFFFFFFFFu; }
-inline std::uint32_t crc32_end(std::uint32_t crc) { return crc ^ 0xFFFFFFFFu; }
-inline std::uint32_t crc32(const std::uint8_t* data, std::size_t len) {
-  return crc32_end(crc32_update(crc32_begin(), data, len));
+// CRC-32 (IEEE 802.3, reflected, init/xorout 0xFFFFFFFF; same as zlib's crc32): the one
+// implementation of the common layer (firmware/base/crc32.h), also used by the map image. The
+// running value is zlib's (already finalised), so begin is 0 and end is the identity.
+inline std::uint32_t crc32_begin() { return 0u; }
+inline std::uint32_t crc32_update(std::uint32_t crc, const std::uint8_t* data, std::size_t len) {
+  return fw::crc32_update(crc, data, len);
 }
+inline std::uint32_t crc32_end(std::uint32_t crc) { return crc; }
+inline std::uint32_t crc32(const std::uint8_t* data, std::size_t len) { return fw::crc32(data, len); }
 
 }  // namespace hal_can

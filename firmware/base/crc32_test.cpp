@@ -1,4 +1,4 @@
-#include "firmware/map/crc32.h"
+#include "firmware/base/crc32.h"
 
 #include <gtest/gtest.h>
 
