@@ -79,6 +79,11 @@ run:
   --deadline-ms MS        count localizer steps longer than MS as deadline misses (default off)
   --out DIR               output directory (default build/run)
   --timing wall|none      measure step times with the wall clock (default) or not (byte-identical CSV)
+  --transport none|can    how scans and odometry reach the firmware: straight into the hal/sim rings
+                          (none, default) or through our CAN encoder, the hal/sim loopback bus and the
+                          firmware's CanNode decoder (can); same steps.csv with --timing none
+  --byte-fault-rate P     with --transport can: drop or bit-flip each frame with probability P (seeded
+                          by --seed); the decoder drops and counts what it cannot use (summary.json)
   --quiet                 no progress line
   --no-pictures           skip run.svg / run.png
 synthetic world:
@@ -194,6 +199,14 @@ bool parse_sim_args(const std::vector<std::string>& args, SimConfig* cfg, SimArg
         return false;
       }
       cfg->wall_timing = v == "wall";
+    } else if (a == "--transport") {
+      if (!value(&v)) return false;
+      if (!parse_transport(v, &cfg->transport.transport)) {
+        *err = "--transport: '" + v + "' (expected none or can)";
+        return false;
+      }
+    } else if (a == "--byte-fault-rate") {
+      if (!value(&v) || !parse_double(a, v, 0, 1, &cfg->transport.byte_fault_rate, err)) return false;
     } else if (a == "--quiet") {
       cfg->progress = false;
     } else if (a == "--no-pictures") {

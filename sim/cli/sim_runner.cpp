@@ -484,6 +484,43 @@ bool write_steps_csv(const std::string& path, const std::vector<StepRecord>& ste
   return ok;
 }
 
+// --transport: what went over the simulated bus and what the firmware's decoder made of it.
+static void write_transport_json(std::FILE* f, const SimSummary& s) {
+  const TransportStats& t = s.transport_stats;
+  const hal_can::DecoderStats& d = t.decoder;
+  auto u = [](std::uint64_t v) { return static_cast<unsigned long long>(v); };
+  std::fprintf(f, "  \"transport\": \"%s\",\n", s.transport.c_str());
+  std::fprintf(f, "  \"transport_scans_sent\": %llu,\n  \"transport_odometry_sent\": %llu,\n  \"transport_frames_sent\": %llu,\n",
+               u(t.scans_sent), u(t.odometry_sent), u(t.frames_sent));
+  std::fprintf(f, "  \"transport_encode_failed\": %llu,\n  \"transport_bus_full\": %llu,\n", u(t.encode_failed),
+               u(t.bus_full));
+  std::fprintf(f, "  \"transport_faults_frames_dropped\": %llu,\n  \"transport_faults_frames_corrupted\": %llu,\n",
+               u(t.frames_dropped), u(t.frames_corrupted));
+  std::fprintf(f, "  \"decoder_frames\": %llu,\n  \"decoder_scans_ok\": %llu,\n  \"decoder_scans_dropped\": %llu,\n",
+               u(d.frames), u(d.scans_ok), u(d.scans_dropped));
+  std::fprintf(f, "  \"decoder_crc_errors\": %llu,\n  \"decoder_lost_segments\": %llu,\n  \"decoder_malformed\": %llu,\n",
+               u(d.crc_errors), u(d.lost_segments), u(d.malformed));
+  std::fprintf(f, "  \"decoder_orphan_segments\": %llu,\n  \"decoder_unknown_ids\": %llu,\n  \"decoder_invalid_scans\": %llu,\n",
+               u(d.orphan_segments), u(d.unknown_ids), u(d.invalid_scans));
+  std::fprintf(f, "  \"decoder_odometry_ok\": %llu,\n  \"decoder_broken_records\": %llu\n", u(d.odometry_ok),
+               u(d.broken_records));
+}
+
+// One clause of the summary line for a run through a transport with bytes (empty for none).
+static std::string transport_text(const SimSummary& s) {
+  if (s.transport == "none") return {};
+  const TransportStats& t = s.transport_stats;
+  std::string x = fmt("transport %s: %llu frames, %llu dropped + %llu corrupted by fault injection; decoder: %u scans ok, "
+                      "%u dropped (CRC %u, lost segments %u, malformed %u), %u odometry ok, %u broken records",
+                      s.transport.c_str(), static_cast<unsigned long long>(t.frames_sent),
+                      static_cast<unsigned long long>(t.frames_dropped), static_cast<unsigned long long>(t.frames_corrupted),
+                      t.decoder.scans_ok, t.decoder.scans_dropped, t.decoder.crc_errors, t.decoder.lost_segments,
+                      t.decoder.malformed, t.decoder.odometry_ok, t.decoder.broken_records);
+  if (t.encode_failed > 0) x += fmt(", %llu not encodable", static_cast<unsigned long long>(t.encode_failed));
+  if (t.bus_full > 0) x += fmt(", %llu refused by a full bus", static_cast<unsigned long long>(t.bus_full));
+  return x;
+}
+
 bool write_summary_json(const std::string& path, const SimSummary& s, std::string* err) {
   std::FILE* f = std::fopen(path.c_str(), "w");
   if (!f) {
@@ -544,8 +581,10 @@ bool write_summary_json(const std::string& path, const SimSummary& s, std::strin
                static_cast<unsigned long long>(s.ring_drops), static_cast<unsigned long long>(s.odom_rejected));
   std::fprintf(f, "  \"scans_restamped\": %zu,\n  \"deadline_misses\": %llu,\n", s.scans_restamped,
                static_cast<unsigned long long>(s.deadline_misses));
-  std::fprintf(f, "  \"scans_held\": %llu,\n  \"step_errors\": %llu\n}\n", static_cast<unsigned long long>(s.scans_held),
+  std::fprintf(f, "  \"scans_held\": %llu,\n  \"step_errors\": %llu,\n", static_cast<unsigned long long>(s.scans_held),
                static_cast<unsigned long long>(s.step_errors));
+  write_transport_json(f, s);
+  std::fprintf(f, "}\n");
   const bool ok = std::fclose(f) == 0;
   if (!ok) *err = "error writing '" + path + "'";
   return ok;
@@ -726,6 +765,7 @@ std::string summary_line(const SimSummary& s) {
   if (s.kidnap_step >= 0) t += "; " + kidnap_text(s);
   t += fmt("; step p50 %.2f ms, p99 %.2f ms", s.step_ms_p50, s.step_ms_p99);
   t += "; " + final_error_text(s);
+  if (s.transport != "none") t += "; " + transport_text(s);
   return t;
 }
 
@@ -768,6 +808,7 @@ std::string summary_story(const SimSummary& s) {
   if (s.integrity_failures_kidnap > 0) t += fmt(" (%zu before the kidnap was detected)", s.integrity_failures_kidnap);
   t += "; " + pl_text(s) + "\n";
   t += "  " + final_error_text(s) + "\n";
+  if (s.transport != "none") t += "  " + transport_text(s) + "\n";
   return t;
 }
 
@@ -958,6 +999,17 @@ bool run_simulation(const SimConfig& cfg_in, SimResult* out, std::string* err) {
   hal::Hal& hal = sim_hal->hal;
   hal_linux::LinuxClock wall_clock;
   hal_sim::SteppedClock frozen_clock;  // perf clock when timing is off: every duration is 0
+  // --transport can: the loop reads the firmware's CanNode on the hal/sim loopback bus instead of
+  // the rings (sim/devices/sensor_transport.h), on the same stepped clock.
+  auto transport = std::make_unique<SensorTransport>();
+  TransportOptions topt = cfg.transport;
+  topt.seed = cfg.seed;
+  if (!transport->init(topt, clock, err)) return false;
+  if (topt.transport == Transport::kCan) {
+    hal.laser = &transport->laser();
+    hal.odometry = &transport->odometry();
+  }
+  sum.transport = transport_name(topt.transport);
   auto loop = std::make_unique<fw::LocalizationLoop>();
   fw::LocalizationLoopOptions lo;
   lo.perf_clock = cfg.wall_timing ? static_cast<const hal::Clock*>(&wall_clock) : &frozen_clock;
@@ -1089,10 +1141,19 @@ bool run_simulation(const SimConfig& cfg_in, SimResult* out, std::string* err) {
       for (const Box& b : world.unknown_areas) in_unknown |= b.contains(Vec2(frame.truth.x, frame.truth.y));
     }
     info[frame.scan.scan_id] = {frame.t, frame.has_truth, frame.truth, frame.travelled_m, frame.kidnapped, in_unknown};
-    for (const hal::Odometry& o : frame.odometry) {
-      if (!odom->push(o)) ++ring_drops;
+    // The simulated sensors report at the wire's resolution whatever the transport, so the CAN
+    // path and the direct one carry the same values.
+    for (hal::Odometry& o : frame.odometry) to_wire_resolution(&o);
+    to_wire_resolution(&frame.scan);
+    if (topt.transport == Transport::kCan) {
+      for (const hal::Odometry& o : frame.odometry) transport->send_odometry(o);
+      transport->send_scan(frame.scan);
+    } else {
+      for (const hal::Odometry& o : frame.odometry) {
+        if (!odom->push(o)) ++ring_drops;
+      }
+      if (!laser->push(frame.scan)) ++ring_drops;
     }
-    if (!laser->push(frame.scan)) ++ring_drops;
     if (frame.scan.timestamp_ns > clock->now_ns()) clock->set_ns(frame.scan.timestamp_ns);
     tasks->run_once();
     if (!task_ctx.status.is_ok()) ++sum.step_errors;
@@ -1133,6 +1194,7 @@ bool run_simulation(const SimConfig& cfg_in, SimResult* out, std::string* err) {
   sum.odom_rejected = loop->counters().odom_rejected;
   sum.scans_held = loop->counters().scans_held;
   sum.deadline_misses = loop->health().deadline_misses;
+  sum.transport_stats = transport->stats();
   summarize_steps(out->steps, &sum);
   if (cfg.progress) {
     if (sum.first_localized_step < 0) {

@@ -15,6 +15,7 @@
 #include "firmware/base/se2.h"
 #include "hal/msg/pose_estimate.h"
 #include "sim/cli/localizer_factory.h"
+#include "sim/devices/sensor_transport.h"
 #include "sim/io/carmen_log.h"
 #include "sim/world/raster.h"
 #include "sim/world/synthetic_run.h"
@@ -50,6 +51,9 @@ struct SimConfig {
   bool paced = false;          // sleep to the data's real time (× speed)
   double pace_speed = 1.0;
   bool wall_timing = true;     // false: step times are not measured (CSV byte-identical across runs)
+  // How the simulated sensors reach the firmware (--transport, --byte-fault-rate; the fault stream
+  // is seeded by `seed`): sim/devices/sensor_transport.h.
+  TransportOptions transport;
   bool progress = true;        // \r-updated progress line on stderr
   bool pictures = true;
   int threads = 1;             // the mml-sim CLI defaults to 2, as mml-eval (sim_args.cpp)
@@ -131,6 +135,11 @@ struct SimSummary {
   std::uint64_t odom_rejected = 0, scans_held = 0, ring_drops = 0, step_errors = 0;
   std::size_t scans_restamped = 0;
   std::uint64_t deadline_misses = 0;  // log scans whose time stamp stepped back (re-stamped, see sim_runner.cpp)
+  // --transport can: frames through the hal/sim loopback bus, injected byte faults, and what the
+  // firmware's CAN decoder made of them (scans dropped, CRC errors, lost segments, malformed frames,
+  // broken odometry records).
+  std::string transport = "none";
+  TransportStats transport_stats;
 };
 
 struct SimResult {

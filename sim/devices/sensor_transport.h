@@ -1,0 +1,105 @@
+// SensorTransport: how the simulated sensors reach the firmware in mml-sim (ArduPilot SITL style:
+// the simulator feeds the same frames a real sensor would, so the real drivers run under
+// simulation).
+//
+//   none  scans and odometry go straight into the hal/sim rings (SimLaserSource/SimOdometrySource);
+//   can   the device side encodes them with our CAN message set (hal/can codec), sends the frames on
+//         the loopback bus of the simulation backend (hal_sim::SimCanBus), and the loop reads them
+//         from the firmware's CanNode (decoder, rings, clock mapping) exactly as on the robot.
+//
+// Both paths carry the same values: a simulated sensor reports at the wire's resolution (ranges in
+// the range unit, 1 mm; angles in µrad / 0.1 µrad; odometry in mm and µrad; times in µs), which
+// to_wire_resolution() applies with the codec itself (encode, then decode), so with `--timing none`
+// the CAN path gives the same steps.csv as the direct one, byte for byte (sim_transport_test).
+//
+// Faults at the byte level (`--byte-fault-rate P`): every frame on its way to the bus is, with
+// probability P (seeded stream), either dropped or has one bit of one data byte flipped (half each).
+// The decoder drops and counts the affected scan/record (CRC, lost segment, malformed); nothing
+// crashes; TransportStats reports both sides.
+#pragma once
+
+#include <cstdint>
+#include <memory>
+#include <string>
+
+#include "firmware/base/rng.h"
+#include "hal/clock.h"
+#include "hal/msg/laser_scan.h"
+#include "hal/msg/odometry.h"
+#include "hal/sensor_io.h"
+#include "hal_can/can_node.h"
+#include "hal_can/codec.h"
+#include "hal_sim/sim_can_bus.h"
+
+namespace sim {
+
+enum class Transport : std::uint8_t { kNone, kCan };
+const char* transport_name(Transport t);
+// false for an unknown name (expected none or can).
+bool parse_transport(const std::string& name, Transport* out);
+
+struct TransportOptions {
+  Transport transport = Transport::kNone;
+  bool fd = false;                // CAN FD frames instead of classic
+  double byte_fault_rate = 0.0;   // per frame, in [0, 1]: drop it or flip one bit of one data byte
+  std::uint64_t seed = 1;         // fault stream
+  // Test hook: flip one bit of byte 2 (a range byte of a scan segment) of exactly this frame
+  // (0-based count of the frames offered to the bus); -1 = off.
+  std::int64_t fault_frame = -1;
+};
+
+struct TransportStats {
+  // Device side.
+  std::uint64_t scans_sent = 0, odometry_sent = 0, frames_sent = 0;
+  std::uint64_t encode_failed = 0;  // messages the encoder refused (named in last_encode_error)
+  std::uint64_t bus_full = 0;       // frames the loopback bus refused (its queue was full)
+  std::uint64_t frames_dropped = 0, frames_corrupted = 0;  // injected byte-level faults
+  // Firmware side (CanNode's decoder).
+  hal_can::DecoderStats decoder;
+  std::uint32_t node_scans_overflowed = 0, node_odometry_overflowed = 0;
+};
+
+// The value a simulated sensor reports: the message as the wire carries it (encode + decode with
+// the hal/can codec; idempotent). A message the encoder refuses (impossible geometry, no beams) is
+// left as it is (the CAN path counts it in encode_failed and does not send it).
+void to_wire_resolution(hal::LaserScan* scan);
+void to_wire_resolution(hal::Odometry* odom);
+
+class SensorTransport {
+ public:
+  SensorTransport();
+  ~SensorTransport();
+  SensorTransport(const SensorTransport&) = delete;
+  SensorTransport& operator=(const SensorTransport&) = delete;
+
+  // false with *err for a bad option. `clock` is the simulation clock the CanNode reads.
+  bool init(const TransportOptions& options, const hal::Clock* clock, std::string* err);
+  Transport transport() const { return options_.transport; }
+
+  // kCan: encode and send (frames stamped with the message's time on the simulation clock: the
+  // device transmits at the sample time, zero latency). Not used for kNone.
+  void send_odometry(const hal::Odometry& odom);
+  void send_scan(const hal::LaserScan& scan);
+
+  // The sources the localization loop reads for kCan (the CanNode's).
+  hal::LaserScanSource& laser();
+  hal::OdometrySource& odometry();
+
+  TransportStats stats() const;
+  const std::string& last_encode_error() const { return last_encode_error_; }
+
+ private:
+  void transmit(hal::CanFrame* frames, std::size_t n, std::uint64_t t_ns);
+
+  TransportOptions options_;
+  fw::RandomStream faults_{1, 0};
+  std::uint8_t odom_tag_ = 0;
+  std::int64_t frame_index_ = 0;
+  TransportStats stats_;
+  std::string last_encode_error_;
+  // Large (the bus queue, the node's rings, one scan's frames): on the host heap, created once.
+  struct Parts;
+  std::unique_ptr<Parts> parts_;
+};
+
+}  // namespace sim
