@@ -617,6 +617,8 @@ void summarize_steps(const std::vector<StepRecord>& steps, SimSummary* s) {
   s->odom_rejected = keep.odom_rejected;
   s->scans_held = keep.scans_held;
   s->ring_drops = keep.ring_drops;
+  s->transport = keep.transport;
+  s->transport_stats = keep.transport_stats;
   s->step_errors = keep.step_errors;
   s->scans_restamped = keep.scans_restamped;
   s->deadline_misses = keep.deadline_misses;
