@@ -81,7 +81,10 @@ run:
   --timing wall|none      measure step times with the wall clock (default) or not (byte-identical CSV)
   --transport none|can    how scans and odometry reach the firmware: straight into the hal/sim rings
                           (none, default) or through our CAN encoder, the hal/sim loopback bus and the
-                          firmware's CanNode decoder (can); same steps.csv with --timing none
+                          firmware's CanNode decoder (can)
+  --sensor-resolution exact|wire  what the simulated sensors report: exact floats (default with
+                          --transport none) or the wire's mm / µrad / µs (always with can); with wire
+                          and --timing none, none and can give the same steps.csv byte for byte
   --byte-fault-rate P     with --transport can: drop or bit-flip each frame with probability P (seeded
                           by --seed); the decoder drops and counts what it cannot use (summary.json)
   --quiet                 no progress line
@@ -205,6 +208,13 @@ bool parse_sim_args(const std::vector<std::string>& args, SimConfig* cfg, SimArg
         *err = "--transport: '" + v + "' (expected none or can)";
         return false;
       }
+    } else if (a == "--sensor-resolution") {
+      if (!value(&v)) return false;
+      if (v != "exact" && v != "wire") {
+        *err = "--sensor-resolution: '" + v + "' (expected exact or wire)";
+        return false;
+      }
+      cfg->transport.resolution = v == "wire" ? SensorResolution::kWire : SensorResolution::kExact;
     } else if (a == "--byte-fault-rate") {
       if (!value(&v) || !parse_double(a, v, 0, 1, &cfg->transport.byte_fault_rate, err)) return false;
     } else if (a == "--quiet") {

@@ -1143,10 +1143,12 @@ bool run_simulation(const SimConfig& cfg_in, SimResult* out, std::string* err) {
       for (const Box& b : world.unknown_areas) in_unknown |= b.contains(Vec2(frame.truth.x, frame.truth.y));
     }
     info[frame.scan.scan_id] = {frame.t, frame.has_truth, frame.truth, frame.travelled_m, frame.kidnapped, in_unknown};
-    // The simulated sensors report at the wire's resolution whatever the transport, so the CAN
-    // path and the direct one carry the same values.
-    for (hal::Odometry& o : frame.odometry) to_wire_resolution(&o);
-    to_wire_resolution(&frame.scan);
+    // With --transport can (or --sensor-resolution wire) the simulated sensors report what the wire
+    // carries, so the CAN path and the direct one see the same values.
+    if (transport->wire_resolution()) {
+      for (hal::Odometry& o : frame.odometry) to_wire_resolution(&o);
+      to_wire_resolution(&frame.scan);
+    }
     if (topt.transport == Transport::kCan) {
       for (const hal::Odometry& o : frame.odometry) transport->send_odometry(o);
       transport->send_scan(frame.scan);

@@ -1,7 +1,8 @@
 #!/bin/sh
 # Drivers in every simulation (issue 16): mml-sim through the CAN drivers (--transport can: our
 # encoder -> hal/sim loopback bus -> the firmware's CanNode) gives the same steps.csv as the direct
-# path, byte for byte, with --timing none; byte faults are dropped, counted and reported, never a crash.
+# path fed the same sensor values (--sensor-resolution wire: what the wire carries, mm / µrad / µs),
+# byte for byte, with --timing none; byte faults are dropped, counted and reported, never a crash.
 # Usage: transport_test.sh MML_SIM SOURCE-ARGS...   (e.g. --world small-office --steps 150)
 set -eu
 sim=$1
@@ -12,7 +13,7 @@ if [ "$1" = "--dataset" ] && [ ! -d "${MMLFW_DATA_DIR:-/nonexistent}" ]; then
 fi
 t=$(mktemp -d)
 trap 'rm -rf "$t"' EXIT
-"$sim" "$@" --transport none --timing none --quiet --no-pictures --out "$t/none" > "$t/none.txt"
+"$sim" "$@" --transport none --sensor-resolution wire --timing none --quiet --no-pictures --out "$t/none" > "$t/none.txt"
 "$sim" "$@" --transport can --timing none --quiet --no-pictures --out "$t/can" > "$t/can.txt"
 grep -q '"transport": "can"' "$t/can/summary.json"
 grep -q '"decoder_scans_dropped": 0,' "$t/can/summary.json"

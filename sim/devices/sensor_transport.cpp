@@ -107,6 +107,13 @@ bool SensorTransport::init(const TransportOptions& options, const hal::Clock* cl
     return false;
   }
   options_ = options;
+  if (options_.resolution == SensorResolution::kAuto) {
+    options_.resolution = options.transport == Transport::kCan ? SensorResolution::kWire : SensorResolution::kExact;
+  }
+  if (options_.transport == Transport::kCan && options_.resolution != SensorResolution::kWire) {
+    *err = "--sensor-resolution exact: the CAN message set carries mm, µrad and µs (use wire, the default with --transport can)";
+    return false;
+  }
   faults_.reseed(options.seed, kFaultStream);
   parts_->node.init(&parts_->bus, clock, options.fd);
   return true;

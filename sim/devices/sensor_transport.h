@@ -7,10 +7,12 @@
 //         the loopback bus of the simulation backend (hal_sim::SimCanBus), and the loop reads them
 //         from the firmware's CanNode (decoder, rings, clock mapping) exactly as on the robot.
 //
-// Both paths carry the same values: a simulated sensor reports at the wire's resolution (ranges in
-// the range unit, 1 mm; angles in µrad / 0.1 µrad; odometry in mm and µrad; times in µs), which
-// to_wire_resolution() applies with the codec itself (encode, then decode), so with `--timing none`
-// the CAN path gives the same steps.csv as the direct one, byte for byte (sim_transport_test).
+// The wire is lossy (ranges in the range unit, 1 mm; angles in µrad / 0.1 µrad; odometry in mm
+// and µrad; times in µs), so with `can` the simulated sensors report at the wire's resolution:
+// to_wire_resolution() applies it with the codec itself (encode, then decode; idempotent). The
+// direct path keeps the exact floats by default (all figures of earlier runs unchanged) and takes
+// the same resolution with `--sensor-resolution wire`; then, with `--timing none`, the CAN path
+// and the direct one give the same steps.csv byte for byte (sim_transport_*_test).
 //
 // Faults at the byte level (`--byte-fault-rate P`): every frame on its way to the bus is, with
 // probability P (seeded stream), either dropped or has one bit of one data byte flipped (half each).
@@ -34,6 +36,9 @@
 namespace sim {
 
 enum class Transport : std::uint8_t { kNone, kCan };
+// What the simulated sensors report: exact floats, or the values the CAN message set carries.
+// kAuto: kWire with --transport can (the only possible one), kExact with none.
+enum class SensorResolution : std::uint8_t { kAuto, kExact, kWire };
 const char* transport_name(Transport t);
 // false for an unknown name (expected none or can).
 bool parse_transport(const std::string& name, Transport* out);
@@ -41,6 +46,7 @@ bool parse_transport(const std::string& name, Transport* out);
 struct TransportOptions {
   Transport transport = Transport::kNone;
   bool fd = false;                // CAN FD frames instead of classic
+  SensorResolution resolution = SensorResolution::kAuto;
   double byte_fault_rate = 0.0;   // per frame, in [0, 1]: drop it or flip one bit of one data byte
   std::uint64_t seed = 1;         // fault stream
   // Test hook: flip one bit of byte 2 (a range byte of a scan segment) of exactly this frame
@@ -75,6 +81,8 @@ class SensorTransport {
   // false with *err for a bad option. `clock` is the simulation clock the CanNode reads.
   bool init(const TransportOptions& options, const hal::Clock* clock, std::string* err);
   Transport transport() const { return options_.transport; }
+  // Whether the simulated sensors report at the wire's resolution (resolved at init).
+  bool wire_resolution() const { return options_.resolution == SensorResolution::kWire; }
 
   // kCan: encode and send (frames stamped with the message's time on the simulation clock: the
   // device transmits at the sample time, zero latency). Not used for kNone.
