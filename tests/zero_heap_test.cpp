@@ -11,7 +11,6 @@
 #include "firmware/base/ring_buffer.h"
 #include "firmware/base/rng.h"
 #include "firmware/base/se2.h"
-#include "firmware/base/static_vector.h"
 #include "firmware/base/worker_pool.h"
 #include "firmware/map/edt.h"
 #include "firmware/scan/scan_points.h"
@@ -55,7 +54,7 @@ TEST(ZeroHeapTest, BaseScanAndMapSteadyStateAllocateNothing) {
   ASSERT_TRUE(pool.start(opt).is_ok());
   static PoolJob job;
   for (int w = 0; w < 2; ++w) job.streams[w].reseed(5, static_cast<std::uint64_t>(w));
-  static fw::StaticVector<fw::Se2f, 512> poses;
+  static fw::RingBuffer<fw::Se2f, 512> poses;
   static fw::RingBuffer<float, 64> window;
   fw::StartupArena arena;
   ASSERT_TRUE(arena.init_mapped(1 << 20, false, "zero-heap").is_ok());
@@ -87,7 +86,7 @@ TEST(ZeroHeapTest, BaseScanAndMapSteadyStateAllocateNothing) {
     fw::Se2f pose;
     for (int i = 0; i < 500; ++i) {
       pose = pose.compose(fw::Se2f(0.01f, 0.0f, rng.gaussianf(0.0f, 0.01f)));
-      (void)poses.push_back(pose);
+      (void)poses.push(pose);
     }
     window.push_overwrite(pose.x);
     for (std::uint32_t b = 0; b < scan.beam_count; ++b) scan.ranges[b] = 1.0f + rng.uniform01f();

@@ -2,9 +2,7 @@
 
 #include "firmware/base/arena.h"
 #include "firmware/base/fault.h"
-#include "firmware/base/object_pool.h"
 #include "firmware/base/ring_buffer.h"
-#include "firmware/base/static_vector.h"
 
 namespace fw {
 namespace {
@@ -17,29 +15,6 @@ struct FaultCatcher {
   FaultCatcher() : prev(set_fault_handler(&handler)) { count = 0; clear_faults(); }
   ~FaultCatcher() { set_fault_handler(prev); clear_faults(); }
 };
-
-TEST(StaticVectorTest, FullReturnsStatusAndWritesNothing) {
-  StaticVector<int, 3> v;
-  EXPECT_TRUE(v.push_back(1).is_ok());
-  EXPECT_TRUE(v.push_back(2).is_ok());
-  EXPECT_TRUE(v.push_back(3).is_ok());
-  Status s = v.push_back(4);
-  EXPECT_EQ(s.code(), Errc::kCapacityExceeded);
-  EXPECT_EQ(v.size(), 3u);
-  EXPECT_EQ(v[2], 3);
-  v.pop_back();
-  EXPECT_EQ(v.size(), 2u);
-  EXPECT_EQ(v.high_water(), 3u);
-}
-
-TEST(StaticVectorTest, OutOfBoundsIndexRaisesFault) {
-  FaultCatcher catcher;
-  StaticVector<int, 2> v;
-  (void)v.push_back(7);
-  (void)v[1];
-  EXPECT_EQ(FaultCatcher::count, 1);
-  EXPECT_NE(fault_bits() & static_cast<std::uint32_t>(Fault::kIndexOutOfBounds), 0u);
-}
 
 TEST(RingBufferTest, FifoOrderAndOverwrite) {
   RingBuffer<int, 3> r;
@@ -54,32 +29,6 @@ TEST(RingBufferTest, FifoOrderAndOverwrite) {
   EXPECT_EQ(r[0], 3);
   EXPECT_EQ(r.newest(), 4);
   EXPECT_EQ(r.high_water(), 3u);
-}
-
-TEST(ObjectPoolTest, AcquireReleaseExhaust) {
-  ObjectPool<double, 2> pool;
-  auto a = pool.acquire(1.0);
-  auto b = pool.acquire(2.0);
-  ASSERT_TRUE(a && b);
-  auto c = pool.acquire(3.0);
-  EXPECT_EQ(c.status().code(), Errc::kCapacityExceeded);
-  pool.release(*a);
-  auto d = pool.acquire(4.0);
-  ASSERT_TRUE(d);
-  EXPECT_EQ(**d, 4.0);
-  EXPECT_EQ(pool.high_water(), 2u);
-}
-
-TEST(ObjectPoolTest, DoubleReleaseRaisesFault) {
-  FaultCatcher catcher;
-  ObjectPool<int, 2> pool;
-  auto a = pool.acquire(1);
-  pool.release(*a);
-  pool.release(*a);
-  EXPECT_EQ(FaultCatcher::count, 1);
-  int foreign = 0;
-  pool.release(&foreign);
-  EXPECT_EQ(FaultCatcher::count, 2);
 }
 
 TEST(ArenaTest, BumpAllocationThenSealed) {

@@ -6,18 +6,17 @@
 #include <cstring>
 
 #include "firmware/base/ring_buffer.h"
-#include "firmware/base/static_vector.h"
 
 namespace fw {
 namespace {
 
 TEST(MemoryReportTest, ContainersRegisterBytesAndHighWater) {
   MemoryReport::instance().clear();
-  static StaticVector<float, 1000> v;
+  static RingBuffer<float, 1000> v;
   static RingBuffer<int, 16> r;
   ASSERT_TRUE(v.report_as("rbsm", "weights").is_ok());
   ASSERT_TRUE(r.report_as("hal", "scan ring").is_ok());
-  for (int i = 0; i < 10; ++i) (void)v.push_back(1.0f);
+  for (int i = 0; i < 10; ++i) (void)v.push(1.0f);
   EXPECT_EQ(MemoryReport::instance().module_bytes("rbsm"), sizeof(v));
   EXPECT_EQ(MemoryReport::instance().total_bytes(), sizeof(v) + sizeof(r));
   char buf[4096] = {0};

@@ -83,7 +83,6 @@ Status MmlOptions::validate() const {
   FW_RETURN_IF_ERROR(check_range("outside_map_contact", outside_map_contact, 0.0, 1.0));
   FW_RETURN_IF_ERROR(check_positive("contact_distance_m", contact_distance_m));
   FW_RETURN_IF_ERROR(check_range("outside_map_no_match_steps", outside_map_no_match_steps, 0, 100000));
-  FW_RETURN_IF_ERROR(check_range("local_map_fragments", local_map_fragments, 0, 100000));
   FW_RETURN_IF_ERROR(check_range("reduction_min_jump", reduction_min_jump, 0.0, 1e6));
   FW_RETURN_IF_ERROR(check_range("reduction_delta_max", reduction_delta_max, reduction_min_jump, 1e6));
   FW_RETURN_IF_ERROR(check_range("reduction_clusters_max", reduction_clusters_max, 1, kMaxClusters));

@@ -7,7 +7,7 @@
 //         the loopback bus of the simulation backend (hal_sim::SimCanBus), and the loop reads them
 //         from the firmware's CanNode (decoder, rings, clock mapping) exactly as on the robot.
 //
-// The wire is lossy (ranges in the range unit, 1 mm; angles in µrad / 0.1 µrad; odometry in mm
+// The wire is lossy (ranges in the range unit, 1 mm up to 65 m; angles in µrad / 0.1 µrad; odometry in mm
 // and µrad; times in µs), so with `can` the simulated sensors report at the wire's resolution:
 // to_wire_resolution() applies it with the codec itself (encode, then decode; idempotent). The
 // direct path keeps the exact floats by default (all figures of earlier runs unchanged) and takes
