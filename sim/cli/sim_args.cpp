@@ -79,14 +79,16 @@ run:
   --deadline-ms MS        count localizer steps longer than MS as deadline misses (default off)
   --out DIR               output directory (default build/run)
   --timing wall|none      measure step times with the wall clock (default) or not (byte-identical CSV)
-  --transport none|can    how scans and odometry reach the firmware: straight into the hal/sim rings
-                          (none, default) or through our CAN encoder, the hal/sim loopback bus and the
-                          firmware's CanNode decoder (can)
-  --sensor-resolution exact|wire  what the simulated sensors report: exact floats (default with
-                          --transport none) or the wire's mm / µrad / µs (always with can); with wire
-                          and --timing none, none and can give the same steps.csv byte for byte
-  --byte-fault-rate P     with --transport can: drop or bit-flip each frame with probability P (seeded
-                          by --seed); the decoder drops and counts what it cannot use (summary.json)
+  --transport none|can|sick  how scans and odometry reach the firmware: straight into the hal/sim
+                          rings (none, default); through our CAN encoder, the hal/sim loopback bus and
+                          the firmware's CanNode decoder (can); scans as SICK LMS2xx telegrams on the
+                          hal/sim serial port through the firmware's SickLaser driver (sick)
+  --sensor-resolution exact|can|sick  what the simulated sensors report: exact floats (default with
+                          --transport none) or what that wire carries (always with can / sick); with
+                          --timing none, `none --sensor-resolution X` and `X` give the same steps.csv
+  --byte-fault-rate P     with --transport can|sick: drop or bit-flip each frame / telegram with
+                          probability P (seeded by --seed); the firmware's decoder drops and counts
+                          what it cannot use (summary.json, summary line)
   --quiet                 no progress line
   --no-pictures           skip run.svg / run.png
 synthetic world:
@@ -205,16 +207,18 @@ bool parse_sim_args(const std::vector<std::string>& args, SimConfig* cfg, SimArg
     } else if (a == "--transport") {
       if (!value(&v)) return false;
       if (!parse_transport(v, &cfg->transport.transport)) {
-        *err = "--transport: '" + v + "' (expected none or can)";
+        *err = "--transport: '" + v + "' (expected none, can or sick)";
         return false;
       }
     } else if (a == "--sensor-resolution") {
       if (!value(&v)) return false;
-      if (v != "exact" && v != "wire") {
-        *err = "--sensor-resolution: '" + v + "' (expected exact or wire)";
+      if (v != "exact" && v != "can" && v != "sick") {
+        *err = "--sensor-resolution: '" + v + "' (expected exact, can or sick)";
         return false;
       }
-      cfg->transport.resolution = v == "wire" ? SensorResolution::kWire : SensorResolution::kExact;
+      cfg->transport.resolution = v == "can"    ? SensorResolution::kCan
+                                  : v == "sick" ? SensorResolution::kSick
+                                                : SensorResolution::kExact;
     } else if (a == "--byte-fault-rate") {
       if (!value(&v) || !parse_double(a, v, 0, 1, &cfg->transport.byte_fault_rate, err)) return false;
     } else if (a == "--quiet") {

@@ -502,14 +502,28 @@ static void write_transport_json(std::FILE* f, const SimSummary& s) {
                u(d.crc_errors), u(d.lost_segments), u(d.malformed));
   std::fprintf(f, "  \"decoder_orphan_segments\": %llu,\n  \"decoder_unknown_ids\": %llu,\n  \"decoder_invalid_scans\": %llu,\n",
                u(d.orphan_segments), u(d.unknown_ids), u(d.invalid_scans));
-  std::fprintf(f, "  \"decoder_odometry_ok\": %llu,\n  \"decoder_broken_records\": %llu\n", u(d.odometry_ok),
+  std::fprintf(f, "  \"decoder_odometry_ok\": %llu,\n  \"decoder_broken_records\": %llu,\n", u(d.odometry_ok),
                u(d.broken_records));
+  std::fprintf(f, "  \"sick_telegrams_sent\": %llu,\n  \"sick_parser_telegrams\": %llu,\n  \"sick_crc_errors\": %llu,\n",
+               u(t.telegrams_sent), u(t.sick_telegrams), u(t.sick_crc_errors));
+  std::fprintf(f, "  \"sick_bad_length\": %llu,\n  \"sick_garbage_bytes\": %llu,\n  \"sick_scans_ok\": %llu,\n",
+               u(t.sick_bad_length), u(t.sick_garbage_bytes), u(t.sick_scans));
+  std::fprintf(f, "  \"sick_bad_measurements\": %llu,\n  \"sick_scans_dropped\": %llu\n", u(t.sick_bad_measurements),
+               u(t.scans_sent > t.sick_scans ? t.scans_sent - t.sick_scans : 0));
 }
 
 // One clause of the summary line for a run through a transport with bytes (empty for none).
 static std::string transport_text(const SimSummary& s) {
   if (s.transport == "none") return {};
   const TransportStats& t = s.transport_stats;
+  if (s.transport == "sick") {
+    const std::uint64_t lost = t.scans_sent > t.sick_scans ? t.scans_sent - t.sick_scans : 0;
+    return fmt("transport sick: %llu telegrams, %llu dropped + %llu corrupted by fault injection; driver: %u scans ok, "
+               "%llu dropped (CRC %u, bad length %u, garbage bytes %u, bad measurements %u)",
+               static_cast<unsigned long long>(t.telegrams_sent), static_cast<unsigned long long>(t.frames_dropped),
+               static_cast<unsigned long long>(t.frames_corrupted), t.sick_scans, static_cast<unsigned long long>(lost),
+               t.sick_crc_errors, t.sick_bad_length, t.sick_garbage_bytes, t.sick_bad_measurements);
+  }
   std::string x = fmt("transport %s: %llu frames, %llu dropped + %llu corrupted by fault injection; decoder: %u scans ok, "
                       "%u dropped (CRC %u, lost segments %u, malformed %u), %u odometry ok, %u broken records",
                       s.transport.c_str(), static_cast<unsigned long long>(t.frames_sent),
@@ -1007,10 +1021,8 @@ bool run_simulation(const SimConfig& cfg_in, SimResult* out, std::string* err) {
   TransportOptions topt = cfg.transport;
   topt.seed = cfg.seed;
   if (!transport->init(topt, clock, err)) return false;
-  if (topt.transport == Transport::kCan) {
-    hal.laser = &transport->laser();
-    hal.odometry = &transport->odometry();
-  }
+  if (topt.transport != Transport::kNone) hal.laser = &transport->laser();
+  if (transport->carries_odometry()) hal.odometry = &transport->odometry();
   sum.transport = transport_name(topt.transport);
   auto loop = std::make_unique<fw::LocalizationLoop>();
   fw::LocalizationLoopOptions lo;
@@ -1143,20 +1155,21 @@ bool run_simulation(const SimConfig& cfg_in, SimResult* out, std::string* err) {
       for (const Box& b : world.unknown_areas) in_unknown |= b.contains(Vec2(frame.truth.x, frame.truth.y));
     }
     info[frame.scan.scan_id] = {frame.t, frame.has_truth, frame.truth, frame.travelled_m, frame.kidnapped, in_unknown};
-    // With --transport can (or --sensor-resolution wire) the simulated sensors report what the wire
-    // carries, so the CAN path and the direct one see the same values.
-    if (transport->wire_resolution()) {
-      for (hal::Odometry& o : frame.odometry) to_wire_resolution(&o);
-      to_wire_resolution(&frame.scan);
-    }
-    if (topt.transport == Transport::kCan) {
-      for (const hal::Odometry& o : frame.odometry) transport->send_odometry(o);
-      transport->send_scan(frame.scan);
-    } else {
-      for (const hal::Odometry& o : frame.odometry) {
-        if (!odom->push(o)) ++ring_drops;
+    // With --transport can|sick (or --sensor-resolution can|sick) the simulated sensors report what
+    // the wire carries, so the driver path and the direct one see the same values.
+    for (hal::Odometry& o : frame.odometry) transport->to_sensor_resolution(&o);
+    transport->to_sensor_resolution(&frame.scan);
+    for (const hal::Odometry& o : frame.odometry) {
+      if (transport->carries_odometry()) {
+        transport->send_odometry(o);
+      } else if (!odom->push(o)) {
+        ++ring_drops;
       }
-      if (!laser->push(frame.scan)) ++ring_drops;
+    }
+    if (topt.transport != Transport::kNone) {
+      transport->send_scan(frame.scan);
+    } else if (!laser->push(frame.scan)) {
+      ++ring_drops;
     }
     if (frame.scan.timestamp_ns > clock->now_ns()) clock->set_ns(frame.scan.timestamp_ns);
     tasks->run_once();

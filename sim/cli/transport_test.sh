@@ -1,37 +1,44 @@
 #!/bin/sh
-# Drivers in every simulation (issue 16): mml-sim through the CAN drivers (--transport can: our
-# encoder -> hal/sim loopback bus -> the firmware's CanNode) gives the same steps.csv as the direct
-# path fed the same sensor values (--sensor-resolution wire: what the wire carries, mm / µrad / µs),
-# byte for byte, with --timing none; byte faults are dropped, counted and reported, never a crash.
-# Usage: transport_test.sh MML_SIM SOURCE-ARGS...   (e.g. --world small-office --steps 150)
+# Drivers in every simulation (issue 16): mml-sim through the firmware's drivers (--transport can:
+# our CAN encoder -> hal/sim loopback bus -> CanNode; --transport sick: SICK LMS2xx telegrams ->
+# hal/sim serial port -> SickLaser) gives the same steps.csv as the direct path fed the same sensor
+# values (--transport none --sensor-resolution X: what that wire carries), byte for byte, with
+# --timing none; byte faults are dropped, counted and reported, never a crash.
+# Usage: transport_test.sh MML_SIM can|sick SOURCE-ARGS...   (e.g. can --world small-office --steps 150)
 set -eu
 sim=$1
-shift
+tr=$2
+shift 2
 if [ "$1" = "--dataset" ] && [ ! -d "${MMLFW_DATA_DIR:-/nonexistent}" ]; then
   echo "no data dir: skipped"
   exit 0
 fi
+case $tr in
+  can) dropped_key=decoder_scans_dropped; rate=0.01 ;;   # per CAN frame (126 per 361-beam scan)
+  sick) dropped_key=sick_scans_dropped; rate=0.05 ;;     # per telegram (one per scan)
+  *) echo "transport can or sick"; exit 2 ;;
+esac
 t=$(mktemp -d)
 trap 'rm -rf "$t"' EXIT
-"$sim" "$@" --transport none --sensor-resolution wire --timing none --quiet --no-pictures --out "$t/none" > "$t/none.txt"
-"$sim" "$@" --transport can --timing none --quiet --no-pictures --out "$t/can" > "$t/can.txt"
-grep -q '"transport": "can"' "$t/can/summary.json"
-grep -q '"decoder_scans_dropped": 0,' "$t/can/summary.json"
-if ! cmp "$t/none/steps.csv" "$t/can/steps.csv"; then
-  diff "$t/none/steps.csv" "$t/can/steps.csv" | head -20
-  echo "FAIL: --transport can differs from --transport none"
+"$sim" "$@" --transport none --sensor-resolution "$tr" --timing none --quiet --no-pictures --out "$t/none" > "$t/none.txt"
+"$sim" "$@" --transport "$tr" --timing none --quiet --no-pictures --out "$t/drv" > "$t/drv.txt"
+grep -q "\"transport\": \"$tr\"" "$t/drv/summary.json"
+grep -q "\"$dropped_key\": 0[,]*\$" "$t/drv/summary.json"
+if ! cmp "$t/none/steps.csv" "$t/drv/steps.csv"; then
+  diff "$t/none/steps.csv" "$t/drv/steps.csv" | head -20
+  echo "FAIL: --transport $tr differs from --transport none --sensor-resolution $tr"
   exit 1
 fi
 echo "identical: $(wc -l < "$t/none/steps.csv") lines of steps.csv, $(md5sum < "$t/none/steps.csv" | cut -c1-32)"
-grep -o 'transport can:.*' "$t/can.txt"
+grep -o "transport $tr:.*" "$t/drv.txt"
 
-# Byte faults: 1 % of the frames dropped or bit-flipped. The run completes (exit 0), the decoder's
+# Byte faults: 1 % of the CAN frames / 5 % of the SICK telegrams dropped or bit-flipped. The run completes (exit 0), the
 # drops are counted in summary.json and named in the summary line.
-"$sim" "$@" --transport can --byte-fault-rate 0.01 --seed 5 --timing none --quiet --no-pictures --out "$t/faults" > "$t/faults.txt"
-grep -o 'transport can:.*' "$t/faults.txt"
-dropped=$(sed -n 's/.*"decoder_scans_dropped": \([0-9]*\),.*/\1/p' "$t/faults/summary.json")
+"$sim" "$@" --transport "$tr" --byte-fault-rate "$rate" --seed 5 --timing none --quiet --no-pictures --out "$t/faults" > "$t/faults.txt"
+grep -o "transport $tr:.*" "$t/faults.txt"
+dropped=$(sed -n "s/.*\"$dropped_key\": \([0-9]*\).*/\1/p" "$t/faults/summary.json")
 injected=$(sed -n 's/.*"transport_faults_frames_corrupted": \([0-9]*\),.*/\1/p' "$t/faults/summary.json")
 [ "$dropped" -gt 0 ] || { echo "FAIL: faults injected but no scan dropped"; exit 1; }
-[ "$injected" -gt 0 ] || { echo "FAIL: no frame corrupted"; exit 1; }
+[ "$injected" -gt 0 ] || { echo "FAIL: nothing corrupted"; exit 1; }
 grep -q 'dropped (CRC' "$t/faults.txt"
-echo "faults: $injected frames corrupted, $dropped scans dropped by the decoder, run completed"
+echo "faults: $injected corrupted, $dropped scans dropped by the firmware's driver, run completed"

@@ -19,6 +19,8 @@ const char* transport_name(Transport t) {
       return "none";
     case Transport::kCan:
       return "can";
+    case Transport::kSick:
+      return "sick";
   }
   return "?";
 }
@@ -28,6 +30,8 @@ bool parse_transport(const std::string& name, Transport* out) {
     *out = Transport::kNone;
   } else if (name == "can") {
     *out = Transport::kCan;
+  } else if (name == "sick") {
+    *out = Transport::kSick;
   } else {
     return false;
   }
@@ -62,6 +66,89 @@ void to_wire_resolution(hal::Odometry* odom) {
   }
 }
 
+namespace {
+
+// The measured values a SICK LMS2xx sends for a scan: mm while the scan's range fits the 13-bit
+// field (8.191 m), else cm; at/above range_max, not finite or not representable: "no return".
+hal_serial::MeasuredValues sick_values(const hal::LaserScan& scan) {
+  hal_serial::MeasuredValues v;
+  v.count = static_cast<std::uint16_t>(scan.beam_count < hal_serial::kMaxMeasuredValues ? scan.beam_count
+                                                                                     : hal_serial::kMaxMeasuredValues);
+  v.unit_mm = scan.range_max <= static_cast<float>(hal_serial::kSickNoReturn) * 0.001f;
+  const double per_m = v.unit_mm ? 1000.0 : 100.0;
+  for (std::uint16_t b = 0; b < v.count; ++b) {
+    const float r = scan.ranges[b];
+    const double code = std::round(static_cast<double>(r) * per_m);
+    v.values[b] = (!std::isfinite(r) || r < 0.0f || r >= scan.range_max || code >= hal_serial::kSickNoReturn)
+                      ? hal_serial::kSickNoReturn
+                      : static_cast<std::uint16_t>(code);
+  }
+  return v;
+}
+
+// A clock that says what it is told (the sick round trip stamps the scan with its own time).
+class FixedClock final : public hal::Clock {
+ public:
+  std::uint64_t now_ns() const override { return t_ns; }
+  std::uint64_t t_ns = 0;
+};
+
+// Scans the SickLaser delivers carry its own counter; the simulator needs its step index back. The
+// device side notes (sample time, index) per telegram, and a delivered scan (stamped at receipt,
+// which in lockstep is its sample time) takes the index of its time; telegrams lost on the way are
+// skipped. A robot's loop sees the driver's counter.
+class IndexedSickLaser final : public hal::LaserScanSource {
+ public:
+  explicit IndexedSickLaser(hal_serial::SickLaser* inner) : inner_(inner) {}
+  void sent(std::uint64_t t_ns, std::uint32_t id) { (void)sent_.push_overwrite({t_ns, id}); }
+  bool poll(hal::LaserScan* out) override {
+    if (!inner_->poll(out)) return false;
+    Sent s;
+    while (!sent_.empty() && sent_[0].t_ns < out->timestamp_ns) (void)sent_.pop(&s);
+    if (!sent_.empty() && sent_[0].t_ns == out->timestamp_ns) {
+      (void)sent_.pop(&s);
+      out->scan_id = s.id;
+    }
+    return true;
+  }
+  std::uint32_t fault_bits() const override { return inner_->fault_bits(); }
+  std::uint32_t invalid_scans() const override { return inner_->invalid_scans(); }
+  std::uint32_t skipped_scans() const override { return inner_->skipped_scans(); }
+
+ private:
+  struct Sent {
+    std::uint64_t t_ns;
+    std::uint32_t id;
+  };
+  hal_serial::SickLaser* inner_;
+  fw::RingBuffer<Sent, 64> sent_;
+};
+
+}  // namespace
+
+void to_sick_resolution(hal::LaserScan* scan, float fov_rad) {
+  if (scan->beam_count == 0) return;
+  struct RoundTrip {
+    hal_sim::SimSerialPort port;
+    FixedClock clock;
+    hal_serial::SickLaser laser;
+    std::uint8_t bytes[hal_serial::kMaxTelegramData + 16];
+  };
+  thread_local std::unique_ptr<RoundTrip> rt;
+  if (!rt) rt = std::make_unique<RoundTrip>();
+  hal_serial::SickLaserOptions so;
+  so.fov_rad = fov_rad;
+  so.request_continuous = false;
+  rt->laser.init(&rt->port, &rt->clock, so);
+  const std::size_t n = hal_serial::encode_measured_values(sick_values(*scan), rt->bytes, sizeof(rt->bytes));
+  if (n == 0 || !rt->port.device_send(rt->bytes, n)) return;
+  rt->clock.t_ns = scan->timestamp_ns;
+  const std::uint32_t id = scan->scan_id;
+  if (rt->laser.poll(scan)) scan->scan_id = id;
+}
+
+namespace {
+
 // The wire carries 16 bits of the scan id; the simulator finds a step's truth by the full index,
 // so the ids the CanNode delivers are extended (they only grow in a run). A robot's loop sees the
 // 16 bits; nothing else of the scan is touched.
@@ -87,11 +174,17 @@ class UnwrappedLaser final : public hal::LaserScanSource {
   bool have_last_ = false;
 };
 
+}  // namespace
+
 struct SensorTransport::Parts {
   hal_sim::SimCanBus bus;
   hal_can::CanNode node;
   UnwrappedLaser laser{&node.laser()};
   hal::CanFrame frames[hal_can::kMaxScanFrames];
+  hal_sim::SimSerialPort port;
+  hal_serial::SickLaser sick;
+  IndexedSickLaser sick_laser{&sick};
+  std::uint8_t bytes[hal_serial::kMaxTelegramData + 16];
 };
 
 SensorTransport::SensorTransport() : parts_(std::make_unique<Parts>()) {}
@@ -103,17 +196,22 @@ bool SensorTransport::init(const TransportOptions& options, const hal::Clock* cl
     return false;
   }
   if (options.byte_fault_rate > 0.0 && options.transport == Transport::kNone) {
-    *err = "--byte-fault-rate needs a transport with bytes (--transport can)";
+    *err = "--byte-fault-rate needs a transport with bytes (--transport can or sick)";
     return false;
   }
   options_ = options;
-  if (options_.resolution == SensorResolution::kAuto) {
-    options_.resolution = options.transport == Transport::kCan ? SensorResolution::kWire : SensorResolution::kExact;
-  }
-  if (options_.transport == Transport::kCan && options_.resolution != SensorResolution::kWire) {
-    *err = "--sensor-resolution exact: the CAN message set carries mm, µrad and µs (use wire, the default with --transport can)";
+  const SensorResolution own = options.transport == Transport::kCan    ? SensorResolution::kCan
+                               : options.transport == Transport::kSick ? SensorResolution::kSick
+                                                                       : SensorResolution::kExact;
+  if (options_.resolution == SensorResolution::kAuto) options_.resolution = own;
+  if (options_.transport != Transport::kNone && options_.resolution != own) {
+    *err = std::string("--sensor-resolution: --transport ") + transport_name(options.transport) +
+           " carries its own wire's values (leave --sensor-resolution out, or say " + transport_name(options.transport) + ")";
     return false;
   }
+  hal_serial::SickLaserOptions so;
+  so.request_continuous = false;  // the simulated scanner streams from the start
+  parts_->sick.init(&parts_->port, clock, so);
   faults_.reseed(options.seed, kFaultStream);
   parts_->node.init(&parts_->bus, clock, options.fd);
   return true;
@@ -127,14 +225,12 @@ void SensorTransport::transmit(hal::CanFrame* frames, std::size_t n, std::uint64
       f.data[2] ^= 0x01u;
       ++stats_.frames_corrupted;
     }
-    if (options_.byte_fault_rate > 0.0 && faults_.uniform01() < options_.byte_fault_rate) {
-      if ((faults_.next_u32() & 1u) != 0 || f.len == 0) {
-        ++stats_.frames_dropped;
-        continue;
-      }
-      const std::uint32_t byte = faults_.uniform_index(f.len);
-      f.data[byte] ^= static_cast<std::uint8_t>(1u << faults_.uniform_index(8));
-      ++stats_.frames_corrupted;
+    std::uint32_t byte = 0;
+    std::uint8_t mask = 0;
+    bool drop = false;
+    if (fault_draw(f.len, &byte, &mask, &drop)) {
+      if (drop) continue;
+      f.data[byte] ^= mask;
     }
     if (parts_->bus.send(f)) {
       ++stats_.frames_sent;
@@ -142,6 +238,28 @@ void SensorTransport::transmit(hal::CanFrame* frames, std::size_t n, std::uint64
       ++stats_.bus_full;
     }
   }
+}
+
+bool SensorTransport::fault_draw(std::size_t len, std::uint32_t* byte, std::uint8_t* mask, bool* drop) {
+  if (!(options_.byte_fault_rate > 0.0) || faults_.uniform01() >= options_.byte_fault_rate) return false;
+  *drop = (faults_.next_u32() & 1u) != 0 || len == 0;
+  if (*drop) {
+    ++stats_.frames_dropped;
+    return true;
+  }
+  *byte = faults_.uniform_index(static_cast<std::uint32_t>(len));
+  *mask = static_cast<std::uint8_t>(1u << faults_.uniform_index(8));
+  ++stats_.frames_corrupted;
+  return true;
+}
+
+void SensorTransport::to_sensor_resolution(hal::LaserScan* scan) const {
+  if (options_.resolution == SensorResolution::kCan) to_wire_resolution(scan);
+  if (options_.resolution == SensorResolution::kSick) to_sick_resolution(scan, hal_serial::SickLaserOptions{}.fov_rad);
+}
+
+void SensorTransport::to_sensor_resolution(hal::Odometry* odom) const {
+  if (options_.resolution == SensorResolution::kCan) to_wire_resolution(odom);
 }
 
 void SensorTransport::send_odometry(const hal::Odometry& odom) {
@@ -157,6 +275,27 @@ void SensorTransport::send_odometry(const hal::Odometry& odom) {
 }
 
 void SensorTransport::send_scan(const hal::LaserScan& scan) {
+  if (options_.transport == Transport::kSick) {
+    const std::size_t len =
+        hal_serial::encode_measured_values(sick_values(scan), parts_->bytes, sizeof(parts_->bytes));
+    if (len == 0) {
+      ++stats_.encode_failed;
+      last_encode_error_ = "sick telegram: scan " + std::to_string(scan.scan_id) + " has no beams";
+      return;
+    }
+    ++stats_.scans_sent;
+    ++stats_.telegrams_sent;
+    parts_->sick_laser.sent(scan.timestamp_ns, scan.scan_id);
+    std::uint32_t byte = 0;
+    std::uint8_t mask = 0;
+    bool drop = false;
+    if (fault_draw(len, &byte, &mask, &drop)) {
+      if (drop) return;
+      parts_->bytes[byte] ^= mask;
+    }
+    if (!parts_->port.device_send(parts_->bytes, len)) ++stats_.bus_full;
+    return;
+  }
   std::size_t n = 0;
   hal_can::EncodeOptions eo;
   eo.fd = options_.fd;
@@ -170,7 +309,10 @@ void SensorTransport::send_scan(const hal::LaserScan& scan) {
   transmit(parts_->frames, n, scan.timestamp_ns);
 }
 
-hal::LaserScanSource& SensorTransport::laser() { return parts_->laser; }
+hal::LaserScanSource& SensorTransport::laser() {
+  if (options_.transport == Transport::kSick) return parts_->sick_laser;
+  return parts_->laser;
+}
 hal::OdometrySource& SensorTransport::odometry() { return parts_->node.odometry(); }
 
 TransportStats SensorTransport::stats() const {
@@ -178,6 +320,14 @@ TransportStats SensorTransport::stats() const {
   s.decoder = parts_->node.decoder_stats();
   s.node_scans_overflowed = parts_->node.scans_overflowed();
   s.node_odometry_overflowed = parts_->node.odometry_overflowed();
+  const hal_serial::SickParserStats& p = parts_->sick.parser_stats();
+  s.sick_telegrams = p.telegrams;
+  s.sick_crc_errors = p.crc_errors;
+  s.sick_bad_length = p.bad_length;
+  s.sick_garbage_bytes = p.garbage_bytes;
+  s.sick_scans = parts_->sick.stats().scans;
+  s.sick_bad_measurements = parts_->sick.stats().bad_measurements;
+  s.sick_overwritten = parts_->sick.stats().overwritten;
   return s;
 }
 

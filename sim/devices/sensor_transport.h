@@ -6,18 +6,24 @@
 //   can   the device side encodes them with our CAN message set (hal/can codec), sends the frames on
 //         the loopback bus of the simulation backend (hal_sim::SimCanBus), and the loop reads them
 //         from the firmware's CanNode (decoder, rings, clock mapping) exactly as on the robot.
+//   sick  the scans become SICK LMS2xx measured-value telegrams (hal/serial encoder) on the
+//         simulation backend's serial port (hal_sim::SimSerialPort) and the loop reads them from
+//         the firmware's SickLaser driver (telegram parser, CRC-16, geometry, time stamp at
+//         receipt); odometry, which a scanner does not carry, goes straight into its ring.
 //
-// The wire is lossy (ranges in the range unit, 1 mm up to 65 m; angles in µrad / 0.1 µrad; odometry in mm
-// and µrad; times in µs), so with `can` the simulated sensors report at the wire's resolution:
-// to_wire_resolution() applies it with the codec itself (encode, then decode; idempotent). The
-// direct path keeps the exact floats by default (all figures of earlier runs unchanged) and takes
-// the same resolution with `--sensor-resolution wire`; then, with `--timing none`, the CAN path
-// and the direct one give the same steps.csv byte for byte (sim_transport_*_test).
+// The wire is lossy (CAN: ranges in the range unit, 1 mm up to 65 m; angles in µrad / 0.1 µrad;
+// odometry in mm and µrad; times in µs. SICK: ranges in mm up to 8.191 m, else cm; the geometry
+// the driver knows, ±fov/2), so with `can` or `sick` the simulated sensors report at that wire's
+// resolution: to_wire_resolution() / to_sick_resolution() apply it with the codec or driver itself
+// (encode, then decode; idempotent). The direct path keeps the exact floats by default (all
+// figures of earlier runs unchanged) and takes the same resolution with `--sensor-resolution
+// can|sick`; then, with `--timing none`, the driver path and the direct one give the same
+// steps.csv byte for byte (sim_transport_*_test).
 //
 // Faults at the byte level (`--byte-fault-rate P`): every frame on its way to the bus is, with
-// probability P (seeded stream), either dropped or has one bit of one data byte flipped (half each).
-// The decoder drops and counts the affected scan/record (CRC, lost segment, malformed); nothing
-// crashes; TransportStats reports both sides.
+// probability P (seeded stream), either dropped or has one bit of one data byte flipped (half each);
+// for `sick` the unit is one telegram. The decoder / parser drops and counts the affected
+// scan/record (CRC, lost segment, malformed); nothing crashes; TransportStats reports both sides.
 #pragma once
 
 #include <cstdint>
@@ -31,16 +37,18 @@
 #include "hal/sensor_io.h"
 #include "hal_can/can_node.h"
 #include "hal_can/codec.h"
+#include "hal_serial/sick_laser.h"
 #include "hal_sim/sim_can_bus.h"
+#include "hal_sim/sim_serial_port.h"
 
 namespace sim {
 
-enum class Transport : std::uint8_t { kNone, kCan };
-// What the simulated sensors report: exact floats, or the values the CAN message set carries.
-// kAuto: kWire with --transport can (the only possible one), kExact with none.
-enum class SensorResolution : std::uint8_t { kAuto, kExact, kWire };
+enum class Transport : std::uint8_t { kNone, kCan, kSick };
+// What the simulated sensors report: exact floats, or the values a wire carries. kAuto: the
+// transport's own (the only possible one with can / sick), kExact with none.
+enum class SensorResolution : std::uint8_t { kAuto, kExact, kCan, kSick };
 const char* transport_name(Transport t);
-// false for an unknown name (expected none or can).
+// false for an unknown name (expected none, can or sick).
 bool parse_transport(const std::string& name, Transport* out);
 
 struct TransportOptions {
@@ -63,6 +71,10 @@ struct TransportStats {
   // Firmware side (CanNode's decoder).
   hal_can::DecoderStats decoder;
   std::uint32_t node_scans_overflowed = 0, node_odometry_overflowed = 0;
+  // --transport sick: telegrams sent, and the firmware's parser and driver.
+  std::uint64_t telegrams_sent = 0;
+  std::uint32_t sick_telegrams = 0, sick_crc_errors = 0, sick_bad_length = 0, sick_garbage_bytes = 0;
+  std::uint32_t sick_scans = 0, sick_bad_measurements = 0, sick_overwritten = 0;
 };
 
 // The value a simulated sensor reports: the message as the wire carries it (encode + decode with
@@ -70,6 +82,9 @@ struct TransportStats {
 // left as it is (the CAN path counts it in encode_failed and does not send it).
 void to_wire_resolution(hal::LaserScan* scan);
 void to_wire_resolution(hal::Odometry* odom);
+// The scan a SICK LMS2xx with this field of view reports for it, through the telegram encoder and
+// the firmware's SickLaser (time stamp: the scan's own). Odometry is not a scanner's.
+void to_sick_resolution(hal::LaserScan* scan, float fov_rad);
 
 class SensorTransport {
  public:
@@ -81,15 +96,19 @@ class SensorTransport {
   // false with *err for a bad option. `clock` is the simulation clock the CanNode reads.
   bool init(const TransportOptions& options, const hal::Clock* clock, std::string* err);
   Transport transport() const { return options_.transport; }
-  // Whether the simulated sensors report at the wire's resolution (resolved at init).
-  bool wire_resolution() const { return options_.resolution == SensorResolution::kWire; }
+  // The simulated sensors' resolution (resolved at init) applied to a scan / an odometry sample.
+  void to_sensor_resolution(hal::LaserScan* scan) const;
+  void to_sensor_resolution(hal::Odometry* odom) const;
+  // Whether odometry travels on the transport (can) or straight into its ring (none, sick).
+  bool carries_odometry() const { return options_.transport == Transport::kCan; }
 
   // kCan: encode and send (frames stamped with the message's time on the simulation clock: the
-  // device transmits at the sample time, zero latency). Not used for kNone.
+  // device transmits at the sample time, zero latency); kSick: scans only, as telegrams on the
+  // serial port (the driver stamps them at receipt). Not used for kNone.
   void send_odometry(const hal::Odometry& odom);
   void send_scan(const hal::LaserScan& scan);
 
-  // The sources the localization loop reads for kCan (the CanNode's).
+  // The sources the localization loop reads for kCan (the CanNode's) and kSick (the SickLaser's scans).
   hal::LaserScanSource& laser();
   hal::OdometrySource& odometry();
 
@@ -98,6 +117,7 @@ class SensorTransport {
 
  private:
   void transmit(hal::CanFrame* frames, std::size_t n, std::uint64_t t_ns);
+  bool fault_draw(std::size_t len, std::uint32_t* byte, std::uint8_t* mask, bool* drop);
 
   TransportOptions options_;
   fw::RandomStream faults_{1, 0};

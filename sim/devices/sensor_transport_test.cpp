@@ -173,7 +173,8 @@ TEST(SensorTransport, BadOptionsAreRefused) {
   Transport tr;
   EXPECT_TRUE(parse_transport("can", &tr));
   EXPECT_EQ(tr, Transport::kCan);
-  EXPECT_FALSE(parse_transport("sick", &tr));
+  EXPECT_TRUE(parse_transport("sick", &tr));
+  EXPECT_FALSE(parse_transport("serial", &tr));
 }
 
 }  // namespace
