@@ -286,6 +286,10 @@ void SensorTransport::send_scan(const hal::LaserScan& scan) {
     ++stats_.scans_sent;
     ++stats_.telegrams_sent;
     parts_->sick_laser.sent(scan.timestamp_ns, scan.scan_id);
+    if (frame_index_++ == options_.fault_frame && len > 8) {
+      parts_->bytes[8] ^= 0x01u;  // a range byte: only the CRC-16 can notice
+      ++stats_.frames_corrupted;
+    }
     std::uint32_t byte = 0;
     std::uint8_t mask = 0;
     bool drop = false;

@@ -57,8 +57,9 @@ struct TransportOptions {
   SensorResolution resolution = SensorResolution::kAuto;
   double byte_fault_rate = 0.0;   // per frame, in [0, 1]: drop it or flip one bit of one data byte
   std::uint64_t seed = 1;         // fault stream
-  // Test hook: flip one bit of byte 2 (a range byte of a scan segment) of exactly this frame
-  // (0-based count of the frames offered to the bus); -1 = off.
+  // Test hook: flip one bit of byte 2 (a range byte of a scan segment) of exactly this CAN frame,
+  // or of byte 8 (a range byte) of this SICK telegram (0-based count of frames / telegrams sent);
+  // -1 = off.
   std::int64_t fault_frame = -1;
 };
 

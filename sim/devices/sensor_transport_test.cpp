@@ -159,6 +159,42 @@ TEST(SensorTransport, RandomByteFaultsAreCountedAndNeverCrash) {
   EXPECT_LT(delivered, 300u);
 }
 
+// The SICK path (telegram encoder → hal/sim serial port → SickLaser) delivers exactly the scan
+// to_sick_resolution() gives the direct path, with the simulator's index; a telegram with one bit
+// flipped is a CRC-16 error, counted, and the next scan arrives intact.
+TEST(SensorTransport, SickPathDeliversTheSickResolutionScanAndCountsACorruptTelegram) {
+  hal_sim::SteppedClock clock;
+  auto t = std::make_unique<SensorTransport>();
+  std::string err;
+  TransportOptions opt;
+  opt.transport = Transport::kSick;
+  opt.fault_frame = 1;  // the second telegram
+  ASSERT_TRUE(t->init(opt, &clock, &err)) << err;
+  auto got = std::make_unique<hal::LaserScan>();
+  std::uint32_t delivered = 0;
+  for (std::uint32_t k = 0; k < 4; ++k) {
+    const std::uint64_t ts = 1'000'000'000ull * (k + 1);
+    auto s = std::make_unique<hal::LaserScan>(make_scan(100 + k, 361, ts));
+    to_sick_resolution(s.get(), 3.14159265f);
+    EXPECT_EQ(s->scan_id, 100 + k);
+    EXPECT_EQ(s->timestamp_ns, ts);
+    t->send_scan(*s);
+    clock.set_ns(ts);  // the driver stamps at receipt: in lockstep, the sample time
+    if (k == 1) {
+      EXPECT_FALSE(t->laser().poll(got.get()));
+      continue;
+    }
+    ASSERT_TRUE(t->laser().poll(got.get())) << k;
+    EXPECT_TRUE(same_bytes(*got, *s)) << "scan " << k << ": id " << got->scan_id;
+    ++delivered;
+  }
+  EXPECT_EQ(delivered, 3u);
+  const TransportStats st = t->stats();
+  EXPECT_EQ(st.frames_corrupted, 1u);
+  EXPECT_EQ(st.sick_crc_errors, 1u);
+  EXPECT_EQ(st.sick_scans, 3u);
+}
+
 TEST(SensorTransport, BadOptionsAreRefused) {
   hal_sim::SteppedClock clock;
   auto t = std::make_unique<SensorTransport>();
@@ -169,6 +205,10 @@ TEST(SensorTransport, BadOptionsAreRefused) {
   EXPECT_NE(err.find("--transport can"), std::string::npos) << err;
   opt.transport = Transport::kCan;
   opt.byte_fault_rate = 1.5;
+  EXPECT_FALSE(t->init(opt, &clock, &err));
+  opt.byte_fault_rate = 0;
+  opt.resolution = SensorResolution::kCan;  // sick carries its own wire's values
+  opt.transport = Transport::kSick;
   EXPECT_FALSE(t->init(opt, &clock, &err));
   Transport tr;
   EXPECT_TRUE(parse_transport("can", &tr));
