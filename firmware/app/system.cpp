@@ -3,8 +3,8 @@
 #include <cstring>
 #include <new>
 
-#include "firmware/mcl/global_map_view.h"
-#include "firmware/mcl/mcl_presets.h"
+#include "firmware/baselines/mcl/global_map_view.h"
+#include "firmware/baselines/mcl/mcl_presets.h"
 #include "firmware/mml/mml_presets.h"
 
 namespace fw {

@@ -19,7 +19,7 @@
 #include "firmware/base/arena.h"
 #include "firmware/base/worker_pool.h"
 #include "firmware/map/global_map.h"
-#include "firmware/mcl/mcl_localizer.h"
+#include "firmware/baselines/mcl/mcl_localizer.h"
 #include "firmware/mml/handoff_localizer.h"
 #include "firmware/mml/mml_localizer.h"
 #include "firmware/runtime/localizer.h"

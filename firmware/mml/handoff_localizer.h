@@ -8,7 +8,7 @@
 
 #include <cstdint>
 
-#include "firmware/mcl/mcl_localizer.h"
+#include "firmware/baselines/mcl/mcl_localizer.h"
 #include "firmware/mml/mml_localizer.h"
 #include "firmware/runtime/localizer.h"
 

@@ -28,7 +28,7 @@
 #include "firmware/mml/pose_refiner.h"
 #include "firmware/mml/pose_uniqueness.h"
 #include "firmware/pransam/matcher.h"
-#include "firmware/rbsm/local_map.h"
+#include "firmware/local_map/local_map.h"
 #include "firmware/rbsm/rbsm.h"
 #include "firmware/rbsm/scan_matching_odometry.h"
 #include "firmware/runtime/localizer.h"

@@ -107,7 +107,7 @@ struct MmlOptions {
   // start inside the unknown region, where no H_best exists for Eq. 5.37). 0 = off.
   std::uint32_t outside_map_no_match_steps = 10;
 
-  // --- Local map (Sec. 5.4–5.5; the last m fragments kept: LocalMapOptions::keep_last, rbsm/local_map.h).
+  // --- Local map (Sec. 5.4–5.5; the last m fragments kept: LocalMapOptions::keep_last, local_map/local_map.h).
   // Local map reduction (Sec. 5.5.1, Eq. 5.28–5.30, observation_reduction.h): match only the
   // observations (scans) at which the number of clusters f(t) collapsed, plus the two newest.
   bool reduce_observations = false;

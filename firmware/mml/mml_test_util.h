@@ -9,7 +9,7 @@
 
 #include "firmware/base/rng.h"
 #include "firmware/map/global_map.h"
-#include "firmware/mcl/mcl_test_world.h"
+#include "firmware/baselines/mcl/mcl_test_world.h"
 #include "firmware/runtime/localizer.h"
 
 namespace fw {

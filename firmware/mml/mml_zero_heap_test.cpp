@@ -6,7 +6,7 @@
 #include <memory>
 #include <vector>
 
-#include "firmware/mcl/global_map_view.h"
+#include "firmware/baselines/mcl/global_map_view.h"
 #include "firmware/mml/handoff_localizer.h"
 #include "firmware/mml/mml_localizer.h"
 #include "firmware/mml/mml_test_util.h"

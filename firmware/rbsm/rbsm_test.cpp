@@ -9,8 +9,8 @@
 #include <vector>
 
 #include "firmware/base/rng.h"
-#include "firmware/icp/trimmed_icp.h"
-#include "firmware/rbsm/local_map.h"
+#include "firmware/baselines/icp/trimmed_icp.h"
+#include "firmware/local_map/local_map.h"
 #include "firmware/rbsm/scan_matching_odometry.h"
 #include "firmware/rbsm/synthetic_world_test_util.h"
 #include "tests/alloc_counter.h"

@@ -9,7 +9,7 @@
 
 #include "firmware/base/se2.h"
 #include "firmware/base/status.h"
-#include "firmware/rbsm/local_map.h"
+#include "firmware/local_map/local_map.h"
 #include "firmware/rbsm/scan_matcher.h"
 #include "hal/msg/laser_scan.h"
 #include "hal/msg/odometry.h"

@@ -3,7 +3,7 @@
 
 #include <vector>
 
-#include "firmware/mcl/mcl_test_world.h"
+#include "firmware/baselines/mcl/mcl_test_world.h"
 #include "firmware/mml/mml_localizer.h"
 #include "firmware/mml/mml_test_util.h"
 #include "firmware/scan/scan_points.h"

@@ -6,7 +6,7 @@
 #include <cstdlib>
 
 #include "firmware/map/map_image.h"
-#include "firmware/mcl/global_map_view.h"
+#include "firmware/baselines/mcl/global_map_view.h"
 #include "firmware/mml/mml_presets.h"
 #include "sim/localizers/localizer_context.h"  // HypothesisPoint (header only)
 

@@ -13,8 +13,8 @@
 #include "firmware/base/arena.h"
 #include "firmware/base/worker_pool.h"
 #include "firmware/map/global_map.h"
-#include "firmware/mcl/mcl_localizer.h"
-#include "firmware/mcl/mcl_presets.h"
+#include "firmware/baselines/mcl/mcl_localizer.h"
+#include "firmware/baselines/mcl/mcl_presets.h"
 #include "firmware/mml/handoff_localizer.h"
 #include "firmware/mml/mml_localizer.h"
 #include "firmware/runtime/localizer.h"
@@ -36,7 +36,7 @@ namespace sim::mmleval {
 fw::mml::MmlLocalizerConfig mml_config(int config, std::uint64_t seed);
 // The MML part of mml-track (fw::mml::mml_track_preset: pooled cluster support on).
 fw::mml::MmlLocalizerConfig mml_track_config(int config, std::uint64_t seed);
-// MCL presets: firmware/mcl/mcl_presets.h (shared with the firmware).
+// MCL presets: firmware/baselines/mcl/mcl_presets.h (shared with the firmware).
 using fw::mcl::mcl_baseline_options;
 using fw::mcl::mcl_tracking_options;
 

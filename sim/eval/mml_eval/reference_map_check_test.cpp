@@ -7,7 +7,7 @@
 
 #include <cmath>
 
-#include "firmware/mcl/mcl_test_world.h"
+#include "firmware/baselines/mcl/mcl_test_world.h"
 #include "firmware/mml/mml_test_util.h"
 
 namespace sim::mmleval {

@@ -11,8 +11,8 @@
 #include <vector>
 
 #include "firmware/base/worker_pool.h"
-#include "firmware/icp/pl_icp.h"
-#include "firmware/icp/trimmed_icp.h"
+#include "firmware/baselines/icp/pl_icp.h"
+#include "firmware/baselines/icp/trimmed_icp.h"
 #include "firmware/rbsm/rbsm.h"
 #include "firmware/rbsm/scan_matching_odometry.h"
 #include "sim/io/carmen_log.h"

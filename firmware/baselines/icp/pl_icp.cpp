@@ -1,9 +1,9 @@
-#include "firmware/icp/pl_icp.h"
+#include "firmware/baselines/icp/pl_icp.h"
 
 #include <algorithm>
 #include <cmath>
 
-#include "firmware/icp/valid_points.h"
+#include "firmware/baselines/icp/valid_points.h"
 #include "firmware/scan/point_to_line.h"
 
 namespace fw {

@@ -7,7 +7,7 @@
 
 #include "firmware/map/distance_field.h"
 #include "firmware/map/edt.h"
-#include "firmware/mcl/map_view.h"
+#include "firmware/baselines/mcl/map_view.h"
 #include "hal/msg/laser_scan.h"
 
 namespace fw {

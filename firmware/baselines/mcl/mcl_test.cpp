@@ -1,11 +1,11 @@
-#include "firmware/mcl/mcl.h"
+#include "firmware/baselines/mcl/mcl.h"
 
 #include <gtest/gtest.h>
 
 #include <cmath>
 #include <string>
 
-#include "firmware/mcl/mcl_test_world.h"
+#include "firmware/baselines/mcl/mcl_test_world.h"
 
 namespace fw {
 namespace mcl {

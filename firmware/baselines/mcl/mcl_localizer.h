@@ -10,7 +10,7 @@
 
 #include <cstdint>
 
-#include "firmware/mcl/mcl.h"
+#include "firmware/baselines/mcl/mcl.h"
 #include "firmware/runtime/localizer.h"
 
 namespace fw {

@@ -14,8 +14,8 @@
 #include "firmware/base/se2.h"
 #include "firmware/base/status.h"
 #include "firmware/base/worker_pool.h"
-#include "firmware/mcl/map_view.h"
-#include "firmware/mcl/mcl_options.h"
+#include "firmware/baselines/mcl/map_view.h"
+#include "firmware/baselines/mcl/mcl_options.h"
 #include "hal/msg/laser_scan.h"
 
 namespace fw {

@@ -1,7 +1,7 @@
 // MclLocalizer: the AMCL-style update gate (update_min_d / update_min_a) and reset() giving a
 // fresh start (same inputs after reset() ⇒ bit-identical outputs to a freshly initialised object).
-#include "firmware/mcl/mcl_localizer.h"
-#include "firmware/mcl/mcl_presets.h"
+#include "firmware/baselines/mcl/mcl_localizer.h"
+#include "firmware/baselines/mcl/mcl_presets.h"
 
 #include <gtest/gtest.h>
 
@@ -9,7 +9,7 @@
 #include <string>
 #include <vector>
 
-#include "firmware/mcl/mcl_test_world.h"
+#include "firmware/baselines/mcl/mcl_test_world.h"
 
 namespace fw {
 namespace mcl {

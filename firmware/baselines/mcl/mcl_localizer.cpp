@@ -1,4 +1,4 @@
-#include "firmware/mcl/mcl_localizer.h"
+#include "firmware/baselines/mcl/mcl_localizer.h"
 
 #include <cmath>
 

@@ -4,7 +4,7 @@
 
 #include <cstdint>
 
-#include "firmware/mcl/mcl_options.h"
+#include "firmware/baselines/mcl/mcl_options.h"
 
 namespace fw {
 namespace mcl {

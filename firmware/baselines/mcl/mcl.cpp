@@ -1,4 +1,4 @@
-#include "firmware/mcl/mcl.h"
+#include "firmware/baselines/mcl/mcl.h"
 
 #include <cmath>
 

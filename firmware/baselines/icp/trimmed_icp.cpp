@@ -1,9 +1,9 @@
-#include "firmware/icp/trimmed_icp.h"
+#include "firmware/baselines/icp/trimmed_icp.h"
 
 #include <algorithm>
 #include <cmath>
 
-#include "firmware/icp/valid_points.h"
+#include "firmware/baselines/icp/valid_points.h"
 
 namespace fw {
 

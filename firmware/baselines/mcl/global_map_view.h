@@ -3,7 +3,7 @@
 #pragma once
 
 #include "firmware/map/global_map.h"
-#include "firmware/mcl/map_view.h"
+#include "firmware/baselines/mcl/map_view.h"
 
 namespace fw {
 namespace mcl {

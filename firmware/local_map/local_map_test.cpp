@@ -1,4 +1,4 @@
-#include "firmware/rbsm/local_map.h"
+#include "firmware/local_map/local_map.h"
 
 #include <gtest/gtest.h>
 

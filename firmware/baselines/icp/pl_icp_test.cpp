@@ -1,4 +1,4 @@
-#include "firmware/icp/pl_icp.h"
+#include "firmware/baselines/icp/pl_icp.h"
 
 #include <gtest/gtest.h>
 
