@@ -1,9 +1,30 @@
 #include "firmware/antslam/sampled_edge.h"
 
-#include <Eigen/Cholesky>
+#include <Eigen/LU>  // Matrix::inverse (closed form for 3x3)
 #include <cmath>
 
 namespace fw::antslam {
+namespace {
+
+// Cholesky factor of a 3x3 covariance, written out: Eigen::LLT's unblocked path goes through its
+// dynamic-size block products, which reference malloc in unoptimised/sanitizer builds (symbol_check).
+bool cholesky3(const Mat3& a, Mat3* l) {
+  l->setZero();
+  for (int j = 0; j < 3; ++j) {
+    double d = a(j, j);
+    for (int k = 0; k < j; ++k) d -= (*l)(j, k) * (*l)(j, k);
+    if (!(d > 0.0)) return false;
+    (*l)(j, j) = std::sqrt(d);
+    for (int i = j + 1; i < 3; ++i) {
+      double s = a(i, j);
+      for (int k = 0; k < j; ++k) s -= (*l)(i, k) * (*l)(j, k);
+      (*l)(i, j) = s / (*l)(j, j);
+    }
+  }
+  return true;
+}
+
+}  // namespace
 
 Status init_sampled_edge(std::uint32_t from, std::uint32_t to, const Se2d& mean, const Mat3& cov, Se2d* options,
                          double* option_cost, std::uint32_t count, RandomStream& rng, SampledEdge* edge) {
@@ -16,16 +37,15 @@ Status init_sampled_edge(std::uint32_t from, std::uint32_t to, const Se2d& mean,
   if (!cov.allFinite() || (cov - cov.transpose()).cwiseAbs().maxCoeff() > 1e-9 * (1.0 + cov.cwiseAbs().maxCoeff())) {
     return Status::error(Errc::kNumerical, "edge %u->%u: covariance not finite and symmetric", from, to);
   }
-  Eigen::LLT<Mat3> llt(cov);
-  if (llt.info() != Eigen::Success) {
+  Mat3 l;
+  if (!cholesky3(cov, &l)) {
     return Status::error(Errc::kNumerical, "edge %u->%u: covariance not positive definite", from, to);
   }
-  const Mat3 l = llt.matrixL();
   edge->from = from;
   edge->to = to;
   edge->mean = mean;
   edge->cov = cov;
-  edge->info = llt.solve(Mat3::Identity());
+  edge->info = cov.inverse();  // closed form for 3x3; positive definite checked above
   edge->value = mean;
   edge->frozen = false;
   edge->closure = false;
