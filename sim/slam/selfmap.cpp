@@ -111,6 +111,24 @@ bool write_selfmap(const CarmenLog& log, const EvalDataset& d, const std::vector
     *error = out->reference + ": write error";
     return false;
   }
+  // Per-scan residual of the alignment (where the self-built map is distorted).
+  out->residual_csv = dir + "/" + name + ".residual.csv";
+  f = std::fopen(out->residual_csv.c_str(), "w");
+  if (f == nullptr) {
+    *error = out->residual_csv + ": cannot write";
+    return false;
+  }
+  std::fprintf(f, "scan,slam_x,slam_y,slam_theta,ref_x,ref_y,ref_theta,residual_m,residual_deg\n");
+  for (std::size_t i = 0; i < out->alignment.pairs; ++i) {
+    const fw::Se2d r = T.compose(ref[i]);
+    const fw::Se2d& p = poses[i];
+    std::fprintf(f, "%zu,%.4f,%.4f,%.5f,%.4f,%.4f,%.5f,%.4f,%.3f\n", i, p.x, p.y, p.theta, r.x, r.y, r.theta,
+                 std::hypot(r.x - p.x, r.y - p.y), std::fabs(fw::wrap_angle(r.theta - p.theta)) * 57.29577951308232);
+  }
+  if (std::fclose(f) != 0) {
+    *error = out->residual_csv + ": write error";
+    return false;
+  }
   return true;
 }
 

@@ -41,11 +41,12 @@ bool align_rigid_2d(const std::vector<fw::Se2d>& from, const std::vector<fw::Se2
 struct SelfMapFiles {
   std::string map_yaml;   // ROS map of the SLAM poses (as mml-slam --map), the reference map's parameters
   std::string reference;  // "flaser_index ipc logger x y theta" rows: the data set's corrected poses moved by T
+  std::string residual_csv;  // per scan: SLAM pose, aligned reference, |residual| (m, deg)
   RigidAlignment2d alignment;  // reference (all scans) → SLAM trajectory
 };
 
 // Writes <dir>/<name>.yaml/.pgm (map of `poses`, resolution and max range of the data set's global
-// map, sim/map/global_maps.h) and <dir>/<name>.reference.txt: every corrected pose C_k of the data set
+// map, sim/map/global_maps.h), <dir>/<name>.residual.csv and <dir>/<name>.reference.txt: every corrected pose C_k of the data set
 // as T ⊕ C_k, T from align_rigid_2d(reference_at_every_scan(log, C), poses). Chaining odometry is
 // frame-equivariant, so mml-eval's reference from these rows is exactly T ⊕ (the benchmark's
 // reference) at every scan, with the same reference error bounds.
