@@ -4,16 +4,31 @@
 // front end and loops (D_slam_lm_*), RBSM alone (D_rbsm_*) and raw odometry (D_odom_*); mapping
 // time against the log's duration; time in the loop optimisers; and slam_deterministic (an intel
 // prefix twice with the same seed, once with 1 and once with 2 workers: identical poses).
-// Writes the flat JSON of scripts/bench.sh to argv[1]. Budget: see kAcoIterations.
+// Localization in the self-built maps (intel, fr079, aces; D_selfmap_*, D_refmap_*): after the ant
+// colony the map is written (as mml-slam --map) with a reference moved into its frame
+// (sim/slam/selfmap.h: least-squares rigid alignment of the public reference to the AntSLAM
+// trajectory over all scans, residual D_selfmap_frame_rms_m), and the localize benchmark's
+// kidnapped-start first-fix trials (kFixTrials = 20 starts of 200 steps, seed 1; no whole-log runs, no
+// kidnap, no MCL, no unknown area) run in that map and in the data set's reference map, same starts.
+// Files: <dir of OUT.json>/selfmap/ (maps, references, alignment residual per scan, D_localize.json,
+// trial plots and CSVs).
+// Writes the flat JSON of scripts/bench.sh to argv[1]; `bench_slam OUT.json NAME...` runs only
+// the named data sets and skips the determinism check (a quick look). Budget: see kAcoIterations.
+#include <algorithm>
 #include <chrono>
 #include <cmath>
 #include <cstdio>
+#include <fstream>
+#include <map>
 #include <string>
 #include <vector>
 
 #include "sim/common/bench_json.h"
 #include "sim/common/cli_main.h"
+#include "sim/eval/mml_eval/localize_eval.h"
+#include "sim/io/datasets.h"
 #include "sim/io/reference_trajectory.h"
+#include "sim/slam/selfmap.h"
 #include "sim/slam/slam_pipeline.h"
 
 namespace {
@@ -28,13 +43,91 @@ double seconds_since(std::chrono::steady_clock::time_point t0) {
   return std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
 }
 
+// First-fix trials per map, 200 steps each: 20 (twice the localize benchmark's 10, so one trial is
+// 0.05 of the success rate, finer than the 0.1 target margin); ~35 s per data set and map.
+constexpr std::size_t kFixTrials = 20;
+constexpr std::size_t kFixSteps = 200;
+
+// The flat JSON BenchJson writes ("key": value per line) read back as raw value strings.
+std::map<std::string, std::string> read_flat_json(const std::string& path) {
+  std::map<std::string, std::string> out;
+  std::ifstream in(path);
+  std::string line;
+  while (std::getline(in, line)) {
+    const std::size_t q0 = line.find('"');
+    const std::size_t q1 = q0 == std::string::npos ? q0 : line.find('"', q0 + 1);
+    const std::size_t colon = q1 == std::string::npos ? q1 : line.find(':', q1);
+    if (colon == std::string::npos) continue;
+    std::string v = line.substr(colon + 1);
+    while (!v.empty() && (v.back() == ',' || v.back() == ' ')) v.pop_back();
+    while (!v.empty() && v.front() == ' ') v.erase(v.begin());
+    out[line.substr(q0 + 1, q1 - q0 - 1)] = v;
+  }
+  return out;
+}
+
+// Self-built map vs reference map: the same first-fix trials (same starts, seed, localizer) in both.
+bool selfmap_localization(const sim::CarmenLog& log, const sim::EvalDataset& d, const std::vector<fw::Se2d>& poses,
+                          const std::string& key, const std::string& dir, sim::BenchJson* json, std::string* err) {
+  const auto t0 = std::chrono::steady_clock::now();
+  sim::SelfMapFiles files;
+  if (!sim::write_selfmap(log, d, poses, dir, key + "_selfmap", &files, err)) return false;
+  json->add(key + "_selfmap_frame_rms_m", files.alignment.rms_m);
+  json->add(key + "_selfmap_frame_max_m", files.alignment.max_m);
+  sim::mmleval::LocalizePlan plan;
+  plan.datasets = {d.name};
+  sim::mmleval::DatasetFiles f;
+  f.name = key + "-selfmap";  // JSON key prefix <key>_selfmap
+  f.log = d.raw_log;
+  f.map_yaml = files.map_yaml;
+  f.reference = files.reference;
+  const sim::Dataset* known = sim::find_dataset(d.name);
+  if (known != nullptr && known->relations_match_log) f.relations = d.relations;  // the same reference check
+  plan.custom = {f};
+  plan.seed = 1;
+  plan.whole_runs = 0;
+  plan.fix_trials = kFixTrials;
+  plan.fix_steps = kFixSteps;
+  plan.mcl_datasets.clear();
+  plan.kidnap_datasets.clear();
+  plan.run_unknown = false;
+  plan.out_dir = dir + "/" + key + "_localize";
+  sim::BenchJson lj;
+  if (!sim::mmleval::run_localize_evaluation(plan, &lj, err)) return false;
+  const std::string lpath = dir + "/" + key + "_localize.json";
+  if (!lj.write(lpath)) return (*err = lpath + ": cannot write", false);
+  const auto fig = read_flat_json(lpath);
+  bool ok = true;
+  auto copy = [&](const std::string& from, const std::string& to) {
+    const auto it = fig.find(from);
+    if (it == fig.end()) {
+      *err = lpath + ": no " + from;
+      ok = false;
+      return;
+    }
+    json->add_raw(to, it->second);
+  };
+  for (const char* m : {"first_fix_success", "integrity_failures", "integrity_failures_vs_log_reference",
+                        "excluded_map_steps", "localized_steps_checked", "m_to_fix_median", "track_err_m_median",
+                        "track_err_m_p95"}) {
+    copy(key + "_selfmap_" + m, key + "_selfmap_" + m);
+    copy(key + "_" + m, key + "_refmap_" + m);
+  }
+  json->add(key + "_selfmap_localize_s", seconds_since(t0));
+  return ok;
+}
+
 }  // namespace
 
 static int run_main(int argc, char** argv) {
   if (argc < 2) {
-    std::fprintf(stderr, "usage: bench_slam OUT.json\n");
+    std::fprintf(stderr, "usage: bench_slam OUT.json [DATASET...]\n");
     return 2;
   }
+  std::vector<std::string> only(argv + 2, argv + argc);
+  std::string out_dir = argv[1];
+  out_dir = out_dir.find('/') == std::string::npos ? std::string(".") : out_dir.substr(0, out_dir.find_last_of('/'));
+  out_dir += "/selfmap";
   std::setvbuf(stdout, nullptr, _IOLBF, 0);
   const auto t_start = std::chrono::steady_clock::now();
   sim::BenchJson json;
@@ -44,6 +137,7 @@ static int run_main(int argc, char** argv) {
   json.add_int("slam_aco_stall_iterations", kAcoStall);
   json.add_int("slam_aco_ants", sim::SlamConfig{}.slam.aco.ants);
   for (const std::string ds : {"intel", "fr079", "aces", "mit-killian", "fr-clinic"}) {
+    if (!only.empty() && std::find(only.begin(), only.end(), ds) == only.end()) continue;
     std::string key = ds;
     for (char& c : key) if (c == '-') c = '_';
     sim::EvalDataset d;
@@ -97,9 +191,15 @@ static int run_main(int argc, char** argv) {
     json.add_int(key + "_fragments", static_cast<long long>(aco.fragments.size()));
     json.add_int(key + "_loops", aco.stats.loops);
     json.add_int(key + "_loop_candidates", aco.stats.candidates);
+    if (ds == "intel" || ds == "fr079" || ds == "aces") {
+      if (!selfmap_localization(log, d, aco.poses, key, out_dir, &json, &err)) {
+        std::fprintf(stderr, "bench_slam: %s: self-built map localization: %s\n", ds.c_str(), err.c_str());
+        all_ok = false;
+      }
+    }
   }
   // Determinism: same seed → bit-identical poses, also with the work split over 2 workers.
-  {
+  if (only.empty()) {
     sim::EvalDataset d;
     sim::CarmenLog log;
     bool same = false;
