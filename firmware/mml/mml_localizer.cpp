@@ -128,6 +128,13 @@ void MmlLocalizer::reset() {
   last_refine_ = RefineResult();
   last_unique_ = UniquenessResult();
   unique_rejections_ = 0;
+  rivals_.reset();
+  last_rival_ = RivalCheck();
+  rival_rejections_ = 0;
+  pending_ = false;
+  pending_h_ = Se2f();
+  pending_cov_ = Eigen::Matrix3f::Identity();
+  pending_steps_ = pending_isolations_ = 0;
   last_out_ = hal::PoseEstimate();
   perf_match_.reset();
   have_newest_ = false;
@@ -348,7 +355,8 @@ Status MmlLocalizer::step(const hal::LaserScan& scan, const hal::Odometry& odom,
   // x_r of Eq. 5.8 from the wheel odometry (thesis); the RBSM pose can slip in corridors.
   const Se2f odom_delta = have_wheel_ ? prev_wheel_.between(wheel) : Se2f();
   FW_RETURN_IF_ERROR(interpretation_stage(nh, omega_thres, odom_delta));
-  published_pose_stage(odom_delta);
+  if (config_.mml.rival_memory) rivals_.observe(interp_.clusters(), interp_.cluster_count(), local_pose, config_.mml, steps_);
+  published_pose_stage(odom_delta, local_pose);
   prev_wheel_ = wheel;
   have_wheel_ = true;
   if (config_.mml.correct_local_map) correct_local_map(local_pose);
@@ -503,7 +511,7 @@ Status MmlLocalizer::interpretation_stage(std::size_t nh, float omega_thres, con
 // newest scan against the global map, that pose is tracked with the wheel odometry and refined
 // every step; it replaces x_prev of Eq. 5.8, so a cluster that drifts away from it (a slipping
 // local map in a corridor) fails Eq. 5.14 instead of dragging the estimate along.
-void MmlLocalizer::published_pose_stage(const Se2f& odom_delta) {
+void MmlLocalizer::published_pose_stage(const Se2f& odom_delta, const Se2f& local_pose) {
   const MmlOptions& mo = config_.mml;
   if (!mo.refine_pose || num_scan_pts_ == 0) return;
   const std::size_t stride = (num_scan_pts_ + mo.refine_points - 1) / mo.refine_points;
@@ -539,7 +547,15 @@ void MmlLocalizer::published_pose_stage(const Se2f& odom_delta) {
       unique = last_unique_.unique;
       if (!unique) ++unique_rejections_;
     }
+    if (last_refine_.accepted && unique && !isolation_confirmed(local_pose)) {
+      unique = false;
+      pending_ = !last_rival_.candidate_rejected;
+      pending_h_ = last_refine_.pose.compose(local_pose.inverse());
+      pending_cov_ = last_.cov;
+      pending_steps_ = 0;
+    }
     if (last_refine_.accepted && unique) {
+      pending_ = false;
       tracked_valid_ = true;
       tracked_pose_ = last_refine_.pose;
       tracked_bad_steps_ = tracked_unlocalized_steps_ = 0;
@@ -549,12 +565,63 @@ void MmlLocalizer::published_pose_stage(const Se2f& odom_delta) {
       last_.status = hal::LocalizationStatus::kAmbiguous;
       interp_.drop_soft();
     }
+  } else if (!tracked_valid_ && pending_) {
+    recheck_pending(local_pose, refine_pts_, m);
   }
   if (tracked_valid_) {
     interp_.set_previous_pose(tracked_pose_);
     last_.pose = tracked_pose_;
     last_.have_pose = true;
   }
+}
+
+// A pending candidate (held back only by open rivals): the same checks as at isolation, on this
+// step's scan and the grown local map, while MML has nothing better to say (not `localized`, not
+// outside the map). Isolated once every rival is contradicted; dropped when a rival fits better,
+// when the scan no longer fits it, or after tracked_max_unlocalized_steps steps (the local map's
+// drift is bounded only so long).
+void MmlLocalizer::recheck_pending(const Se2f& local_pose, const Point2f* pts, std::size_t m) {
+  const MmlOptions& mo = config_.mml;
+  if (last_.status == hal::LocalizationStatus::kOutsideMap || ++pending_steps_ > mo.tracked_max_unlocalized_steps) {
+    pending_ = false;
+    return;
+  }
+  const RefineOptions ro;
+  last_refine_ = refine_pose(map_, pts, m, pending_h_.compose(local_pose), ro);
+  if (!last_refine_.accepted) {
+    pending_ = false;
+    return;
+  }
+  if (mo.unique_check) {
+    UniquenessOptions uo;
+    uo.clip_m = ro.clip_m;
+    uo.max_shift_m = mo.unique_max_shift_m;
+    uo.shift_step_m = mo.unique_shift_step_m;
+    uo.margin = mo.unique_margin;
+    last_unique_ = check_pose_uniqueness(map_, pts, m, last_refine_.pose, uo);
+    if (!last_unique_.unique) return;  // still pending: a corridor alias may resolve too
+  }
+  if (!isolation_confirmed(local_pose)) {
+    if (last_rival_.candidate_rejected) pending_ = false;
+    return;
+  }
+  pending_ = false;
+  ++pending_isolations_;
+  last_.status = hal::LocalizationStatus::kLocalized;
+  last_.cov = pending_cov_;
+  tracked_valid_ = true;
+  tracked_pose_ = last_refine_.pose;
+  tracked_bad_steps_ = tracked_unlocalized_steps_ = 0;
+}
+
+// Rival memory (rival_memory.h): the refined candidate is isolated only if the local map
+// contradicts every remembered rival, not merely because the rivals left this step's clusters.
+bool MmlLocalizer::isolation_confirmed(const Se2f& local_pose) {
+  if (!config_.mml.rival_memory) return true;
+  const Se2f h_best = last_refine_.pose.compose(local_pose.inverse());
+  last_rival_ = rivals_.check(map_, scene_, num_scene_, h_best, local_pose, config_.mml);
+  if (!last_rival_.resolved) ++rival_rejections_;
+  return last_rival_.resolved;
 }
 
 // (7) The estimate of this step, remembered for a step the front end cannot use.

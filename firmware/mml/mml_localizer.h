@@ -27,6 +27,7 @@
 #include "firmware/mml/observation_reduction.h"
 #include "firmware/mml/pose_refiner.h"
 #include "firmware/mml/pose_uniqueness.h"
+#include "firmware/mml/rival_memory.h"
 #include "firmware/pransam/matcher.h"
 #include "firmware/local_map/local_map.h"
 #include "firmware/rbsm/rbsm.h"
@@ -77,6 +78,13 @@ class MmlLocalizer final : public Localizer {
   // Uniqueness test of the last step that would have entered `localized` (pose_uniqueness.h).
   const UniquenessResult& last_uniqueness() const { return last_unique_; }
   std::uint32_t uniqueness_rejections() const { return unique_rejections_; }
+  // Rival memory (rival_memory.h): the check of the last step that would have entered `localized`,
+  // entries held, and how often a remembered rival kept the status `ambiguous`.
+  const RivalCheck& last_rival_check() const { return last_rival_; }
+  std::size_t rivals_remembered() const { return rivals_.size(); }
+  std::uint32_t rival_rejections() const { return rival_rejections_; }
+  // Candidates isolated later, once the growing local map contradicted the rivals that held them back.
+  std::uint32_t pending_isolations() const { return pending_isolations_; }
   const PerfCounter& match_perf() const { return perf_match_; }
   std::uint32_t front_end_failures() const { return front_end_failures_; }
   bool using_precomputed_table() const { return matcher_.has_precomputed_table(); }
@@ -106,7 +114,9 @@ class MmlLocalizer final : public Localizer {
   Status local_map_stage(const Se2f& rbsm_pose, bool* enough);
   std::size_t global_match_stage(const Se2f& local_pose, std::uint64_t step_begin_ns, float* omega_thres);
   Status interpretation_stage(std::size_t nh, float omega_thres, const Se2f& odom_delta);
-  void published_pose_stage(const Se2f& odom_delta);
+  void published_pose_stage(const Se2f& odom_delta, const Se2f& local_pose);
+  bool isolation_confirmed(const Se2f& local_pose);
+  void recheck_pending(const Se2f& local_pose, const Point2f* pts, std::size_t m);
   void publish(hal::PoseEstimate* out);
   Status gather_local_map();
   Status gather_reduced_map();
@@ -164,6 +174,15 @@ class MmlLocalizer final : public Localizer {
   RefineResult last_refine_;
   UniquenessResult last_unique_;
   std::uint32_t unique_rejections_ = 0;
+  RivalMemory rivals_;
+  RivalCheck last_rival_;
+  std::uint32_t rival_rejections_ = 0;
+  // A candidate held back only by open rivals (map ← local map), re-checked as the local map grows.
+  bool pending_ = false;
+  Se2f pending_h_;
+  Eigen::Matrix3f pending_cov_ = Eigen::Matrix3f::Identity();
+  std::uint32_t pending_steps_ = 0;
+  std::uint32_t pending_isolations_ = 0;
   hal::PoseEstimate last_out_;
   PerfCounter perf_match_{"mml.pransam"};
   const hal::Clock* deadline_clock_ = nullptr;

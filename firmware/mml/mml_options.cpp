@@ -60,6 +60,14 @@ Status MmlOptions::validate() const {
     return Status::error(Errc::kInvalidArgument, "MmlOptions: need 0 < unique_shift_step_m (%g) <= unique_max_shift_m (%g) <= 20",
                          static_cast<double>(unique_shift_step_m), static_cast<double>(unique_max_shift_m));
   }
+  if (!(rival_min_rating_ratio > 0.0f && rival_min_rating_ratio <= 1.0f) || !(rival_separation_m > 0.0f) ||
+      !(rival_separation_rad > 0.0f) || !(rival_clip_m > 0.0f) || !(rival_z > 0.0f) || !(rival_cell_m > 0.0f) ||
+      rival_points < 16 || rival_points > 2048) {
+    return Status::error(Errc::kInvalidArgument,
+                         "MmlOptions: rival memory needs 0 < rival_min_rating_ratio <= 1, positive separations, clip, z "
+                         "and cell, and 16 <= rival_points (%u) <= 2048",
+                         rival_points);
+  }
   if (!(unique_margin >= 0.0f && unique_margin < 1.0f)) {
     return Status::error(Errc::kInvalidArgument, "MmlOptions: unique_margin %g outside [0, 1)", static_cast<double>(unique_margin));
   }

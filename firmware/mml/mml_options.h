@@ -86,6 +86,19 @@ struct MmlOptions {
   float unique_shift_step_m = 0.4f;
   float unique_margin = 0.01f;       // in units of clip² of the truncated scan cost: a near-tie is no proof
 
+  // Extension (rival_memory.h): a cluster that stops appearing is not eliminated. Clusters rated
+  // ≥ rival_min_rating_ratio × the step's best are remembered (as map ← local map transforms);
+  // entering `localized` needs every remembered rival farther than the separation to be explained
+  // significantly worse by the local map (paired test at rival_z over its rival_cell_m cells).
+  bool rival_memory = true;
+  float rival_min_rating_ratio = 0.5f;
+  float rival_separation_m = 1.0f;
+  float rival_separation_rad = 0.35f;  // 20°
+  float rival_clip_m = 0.15f;
+  float rival_z = 3.09f;               // one-sided 1e-3
+  float rival_cell_m = 1.0f;
+  std::uint32_t rival_points = 1024;   // local map points used by the test (≤ kMaxRivalPoints)
+
   // --- Matching threshold adaptation (Sec. 5.3.3, Eq. 5.18–5.21).
   bool bollinger = true;
   float omega_thres0 = 0.7f;

@@ -1,5 +1,5 @@
-// Paired test of two poses on the same scan (extension of the dissertation; used by the tracker's
-// alias check, its heading-fault rule and the confidence extent of the protection level).
+// The confidence extent of the protection level (extension of the dissertation), built on the paired
+// test of two poses on the same scan (firmware/map/paired_fit_test.h).
 #pragma once
 
 #include <cstddef>
@@ -7,16 +7,10 @@
 
 #include "firmware/base/se2.h"
 #include "firmware/map/global_map.h"
+#include "firmware/map/paired_fit_test.h"  // rival_significantly_better
 
 namespace fw {
 namespace track {
-
-// Paired test of the truncated per-point costs (d²/clip², 1 beyond clip or off the map) of the same
-// end-points at `pose` and at `rival`: the rival is better only when the mean difference exceeds z
-// standard errors, with the end-points counted as `independent` observations (the correlation cells
-// of the alignment) — a few cluttered beams or a map drawn a little off in a corridor prove nothing.
-bool rival_significantly_better(const GlobalMap& map, const Point2f* pts, std::size_t n, const Se2f& pose,
-                                const Se2f& rival, float clip_m, std::uint32_t independent, float z);
 
 // How far the scan leaves the pose open: from `fix`, shifts of step_m, 2·step_m, … along both
 // directions of both principal axes of the position information, and turns of step_rad, … in
