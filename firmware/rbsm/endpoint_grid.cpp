@@ -365,4 +365,22 @@ void EndpointGrid::local_scatter(float x, float y, std::int32_t radius, LocalSca
   out->syy = (static_cast<float>(syy) * inv - my * my) * res * res;
 }
 
+std::size_t EndpointGrid::insert_scan(const Point2f* points, std::size_t count, float pose_x, float pose_y,
+                                      float pose_theta, float max_range, Point2f* new_cells, std::size_t capacity) {
+  follow(pose_x, pose_y);
+  const float c = std::cos(pose_theta), s = std::sin(pose_theta);
+  const float max_r2 = max_range > 0.0f ? max_range * max_range : 0.0f;
+  std::size_t n = 0;
+  for (std::size_t i = 0; i < count; ++i) {
+    const float px = points[i](0), py = points[i](1);
+    if (!std::isfinite(px) || !std::isfinite(py)) continue;
+    if (max_r2 > 0.0f && px * px + py * py > max_r2) continue;
+    float cx, cy;
+    if (insert(pose_x + c * px - s * py, pose_y + s * px + c * py, &cx, &cy)) {
+      if (new_cells != nullptr && n < capacity) new_cells[n++] = Point2f(cx, cy);
+    }
+  }
+  return n;
+}
+
 }  // namespace fw

@@ -62,6 +62,11 @@ class EndpointGrid {
   // Sets the cell containing world point (x, y). Returns true if the cell was newly occupied
   // (then *cx, *cy receive its centre); false if already occupied or outside the window.
   bool insert(float x, float y, float* cx = nullptr, float* cy = nullptr);
+  // A scan's end-points (robot frame) placed at `pose` (world): follow(pose), then insert every finite
+  // point within max_range (0 = all); the newly occupied cell centres go to new_cells (up to
+  // capacity), their count to *num_new. The map update of every ScanMatcher built on this grid.
+  std::size_t insert_scan(const Point2f* points, std::size_t count, float pose_x, float pose_y, float pose_theta,
+                          float max_range, Point2f* new_cells, std::size_t capacity);
   bool occupied(float x, float y) const;
   std::size_t occupied_count() const { return occupied_count_; }
 

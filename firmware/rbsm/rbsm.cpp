@@ -515,20 +515,8 @@ Status Rbsm::integrate(const Point2f* points, std::size_t count, const Se2f& pos
   if (!std::isfinite(pose.x) || !std::isfinite(pose.y) || !std::isfinite(pose.theta)) {
     return Status::error(Errc::kInvalidArgument, "rbsm: integrate at non-finite pose");
   }
-  if (num_new) *num_new = 0;
-  grid_.follow(pose.x, pose.y);
-  const float c = std::cos(pose.theta), s = std::sin(pose.theta);
-  const float max_r2 = options_.max_range > 0.0f ? options_.max_range * options_.max_range : 0.0f;
-  std::size_t n = 0;
-  for (std::size_t i = 0; i < count; ++i) {
-    const float px = points[i](0), py = points[i](1);
-    if (!std::isfinite(px) || !std::isfinite(py)) continue;
-    if (max_r2 > 0.0f && px * px + py * py > max_r2) continue;
-    float cx, cy;
-    if (grid_.insert(pose.x + c * px - s * py, pose.y + s * px + c * py, &cx, &cy)) {
-      if (new_cells != nullptr && n < capacity) new_cells[n++] = Point2f(cx, cy);
-    }
-  }
+  const std::size_t n =
+      grid_.insert_scan(points, count, pose.x, pose.y, pose.theta, options_.max_range, new_cells, capacity);
   if (num_new) *num_new = n;
   return Status::ok();
 }
