@@ -9,21 +9,14 @@
 #include <cstdio>
 #include <string_view>
 
+#include "sim/io/text_fields.h"
+
 namespace sim {
 namespace {
 
 constexpr double kRad2Deg = 180.0 / 3.14159265358979323846;
 // A billion scans is 150 days of a 75 Hz laser; a larger index is a corrupt file, not a log.
 constexpr unsigned long long kMaxFlaserIndex = 1000000000ull;
-
-bool parse_double(std::string_view tok, double* v) {
-  const char* b = tok.data();
-  const char* e = b + tok.size();
-  if (b != e && *b == '+') ++b;
-  if (b == e) return false;
-  auto r = std::from_chars(b, e, *v);
-  return r.ec == std::errc() && r.ptr == e && std::isfinite(*v);
-}
 
 fw::Se2d chain(const fw::Se2d& c, const fw::Se2d& o_anchor, const fw::Se2d& o_i) {
   return c.compose(o_anchor.between(o_i));
@@ -66,26 +59,10 @@ bool read_corrected_poses(const std::string& path, std::vector<CorrectedPose>* o
   out->clear();
   std::string data;
   if (!read_file_maybe_gz(path, &data, error)) return false;
-  const char* p = data.data();
-  const char* end = p + data.size();
-  size_t line_no = 0;
+  FieldLines lines(data);
   std::vector<std::string_view> tok;
-  while (p < end) {
-    const char* eol = static_cast<const char*>(memchr(p, '\n', static_cast<size_t>(end - p)));
-    if (!eol) eol = end;
-    ++line_no;
-    const char* q = p;
-    p = eol + 1;
-    tok.clear();
-    while (q < eol && tok.size() <= 6) {
-      while (q < eol && (*q == ' ' || *q == '\t' || *q == '\r')) ++q;
-      if (q == eol) break;
-      const char* b = q;
-      while (q < eol && !(*q == ' ' || *q == '\t' || *q == '\r')) ++q;
-      tok.emplace_back(b, static_cast<size_t>(q - b));
-    }
-    if (tok.empty() || tok[0][0] == '#') continue;
-    const std::string where = path + ":" + std::to_string(line_no) + ": ";
+  while (lines.next(6, &tok)) {
+    const std::string where = path + ":" + std::to_string(lines.line_no()) + ": ";
     if (tok.size() != 6) {
       *error = where + "expected 6 fields (flaser_index ipc_timestamp logger_timestamp x y theta), found " +
                (tok.size() > 6 ? std::string("more") : std::to_string(tok.size()));
@@ -107,7 +84,7 @@ bool read_corrected_poses(const std::string& path, std::vector<CorrectedPose>* o
     double v[5];
     static const char* kNames[5] = {"ipc_timestamp", "logger_timestamp", "x", "y", "theta"};
     for (int i = 0; i < 5; ++i) {
-      if (!parse_double(tok[static_cast<size_t>(i) + 1], &v[i])) {
+      if (!parse_finite_double(tok[static_cast<size_t>(i) + 1], &v[i])) {
         *error = where + kNames[i] + " is not a finite number: '" +
                  std::string(tok[static_cast<size_t>(i) + 1].substr(0, 40)) + "'";
         return false;

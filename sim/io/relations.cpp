@@ -9,18 +9,10 @@
 #include <string_view>
 
 #include "sim/io/carmen_log.h"
+#include "sim/io/text_fields.h"
 
 namespace sim {
 namespace {
-
-bool parse_double(std::string_view tok, double* v) {
-  const char* b = tok.data();
-  const char* e = b + tok.size();
-  if (b != e && *b == '+') ++b;
-  if (b == e) return false;
-  auto r = std::from_chars(b, e, *v);
-  return r.ec == std::errc() && r.ptr == e && std::isfinite(*v);
-}
 
 constexpr double kRad2Deg = 180.0 / 3.14159265358979323846;
 
@@ -82,27 +74,10 @@ bool read_relations(const std::string& path, std::vector<Relation>* out, std::st
   out->clear();
   std::string data;
   if (!read_file_maybe_gz(path, &data, error)) return false;
-  const char* p = data.data();
-  const char* end = p + data.size();
-  size_t line_no = 0;
+  FieldLines lines(data);
   std::vector<std::string_view> tok;
-  while (p < end) {
-    const char* eol = static_cast<const char*>(memchr(p, '\n', static_cast<size_t>(end - p)));
-    if (!eol) eol = end;
-    ++line_no;
-    const char* q = p;
-    p = eol + 1;
-    tok.clear();
-    // At most one token past the 8 expected is kept: a huge line costs no huge token list.
-    while (q < eol && tok.size() <= 8) {
-      while (q < eol && (*q == ' ' || *q == '\t' || *q == '\r')) ++q;
-      if (q == eol) break;
-      const char* b = q;
-      while (q < eol && !(*q == ' ' || *q == '\t' || *q == '\r')) ++q;
-      tok.emplace_back(b, static_cast<size_t>(q - b));
-    }
-    if (tok.empty() || tok[0][0] == '#') continue;
-    const std::string where = path + ":" + std::to_string(line_no) + ": ";
+  while (lines.next(8, &tok)) {
+    const std::string where = path + ":" + std::to_string(lines.line_no()) + ": ";
     if (tok.size() != 8) {
       *error = where + "expected 8 fields (t1 t2 x y z roll pitch yaw), found " +
                (tok.size() > 8 ? std::string("more") : std::to_string(tok.size()));
@@ -111,7 +86,7 @@ bool read_relations(const std::string& path, std::vector<Relation>* out, std::st
     double v[8];
     static const char* kNames[8] = {"t1", "t2", "x", "y", "z", "roll", "pitch", "yaw"};
     for (int i = 0; i < 8; ++i) {
-      if (!parse_double(tok[static_cast<size_t>(i)], &v[i])) {
+      if (!parse_finite_double(tok[static_cast<size_t>(i)], &v[i])) {
         *error = where + "field " + kNames[i] + " is not a finite number: '" +
                  std::string(tok[static_cast<size_t>(i)].substr(0, 40)) + "'";
         return false;
@@ -220,27 +195,10 @@ bool read_trajectory(const std::string& path, Trajectory* out, std::string* erro
   out->clear();
   std::string data;
   if (!read_file_maybe_gz(path, &data, error)) return false;
-  const char* p = data.data();
-  const char* end = p + data.size();
-  size_t line_no = 0;
+  FieldLines lines(data, /*commas=*/true);
   std::vector<std::string_view> tok;
-  auto sep = [](char c) { return c == ' ' || c == '\t' || c == '\r' || c == ','; };
-  while (p < end) {
-    const char* eol = static_cast<const char*>(memchr(p, '\n', static_cast<size_t>(end - p)));
-    if (!eol) eol = end;
-    ++line_no;
-    const char* q = p;
-    p = eol + 1;
-    tok.clear();
-    while (q < eol && tok.size() <= 4) {
-      while (q < eol && sep(*q)) ++q;
-      if (q == eol) break;
-      const char* b = q;
-      while (q < eol && !sep(*q)) ++q;
-      tok.emplace_back(b, static_cast<size_t>(q - b));
-    }
-    if (tok.empty() || tok[0][0] == '#') continue;
-    const std::string where = path + ":" + std::to_string(line_no) + ": ";
+  while (lines.next(4, &tok)) {
+    const std::string where = path + ":" + std::to_string(lines.line_no()) + ": ";
     if (tok.size() != 4) {
       *error = where + "expected 4 fields (t x y theta), found " +
                (tok.size() > 4 ? std::string("more") : std::to_string(tok.size()));
@@ -249,7 +207,7 @@ bool read_trajectory(const std::string& path, Trajectory* out, std::string* erro
     double v[4];
     static const char* kNames[4] = {"t", "x", "y", "theta"};
     for (int i = 0; i < 4; ++i) {
-      if (!parse_double(tok[static_cast<size_t>(i)], &v[i])) {
+      if (!parse_finite_double(tok[static_cast<size_t>(i)], &v[i])) {
         *error = where + kNames[i] + " is not a finite number: '" + std::string(tok[static_cast<size_t>(i)].substr(0, 40)) + "'";
         return false;
       }
