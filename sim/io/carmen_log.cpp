@@ -1,6 +1,7 @@
 #include "sim/io/carmen_log.h"
 
 #include "sim/io/file_io.h"
+#include "sim/io/text_fields.h"
 
 #include <sys/stat.h>
 #include <zlib.h>
@@ -21,16 +22,6 @@ constexpr size_t kMaxBadLineMessages = 100;
 constexpr long kMaxReadings = 100000;
 
 bool is_space(char c) { return c == ' ' || c == '\t' || c == '\r' || c == '\v' || c == '\f'; }
-
-// Parses the whole token as a finite double (strtod syntax minus hex; a leading '+' is accepted).
-bool parse_double(std::string_view tok, double* v) {
-  const char* b = tok.data();
-  const char* e = b + tok.size();
-  if (b != e && *b == '+') ++b;
-  if (b == e) return false;
-  auto r = std::from_chars(b, e, *v);
-  return r.ec == std::errc() && r.ptr == e && std::isfinite(*v);
-}
 
 bool parse_count(std::string_view tok, long* v) {
   const char* b = tok.data();
@@ -62,7 +53,7 @@ class LineParser {
 
   bool num(size_t i, const char* what, double* v) {
     if (i >= tok_.size()) return fail(std::string("missing field ") + what);
-    if (!parse_double(tok_[i], v)) {
+    if (!parse_finite_double(tok_[i], v)) {
       return fail(std::string("field ") + std::to_string(i + 1) + " (" + what + ") is not a finite number: " +
                   show(tok_[i]));
     }
@@ -245,9 +236,9 @@ bool parse_param(const std::vector<std::string_view>& t, std::pair<std::string, 
   // Two layouts occur: "PARAM name value ipc host logger" and (intel, aces) "PARAM name value host logger".
   double d;
   size_t end = t.size();
-  if (t.size() >= 6 && parse_double(t[end - 1], &d) && !parse_double(t[end - 2], &d) && parse_double(t[end - 3], &d)) {
+  if (t.size() >= 6 && parse_finite_double(t[end - 1], &d) && !parse_finite_double(t[end - 2], &d) && parse_finite_double(t[end - 3], &d)) {
     end -= 3;
-  } else if (t.size() >= 5 && parse_double(t[end - 1], &d) && !parse_double(t[end - 2], &d)) {
+  } else if (t.size() >= 5 && parse_finite_double(t[end - 1], &d) && !parse_finite_double(t[end - 2], &d)) {
     end -= 2;
   }
   kv->first = std::string(t[1]);
@@ -258,7 +249,7 @@ bool parse_param(const std::vector<std::string_view>& t, std::pair<std::string, 
   }
   // The laser maxima become the FLASER/RLASER max_range (float): same bounds as a ROBOTLASER1's.
   if ((kv->first == "robot_front_laser_max" || kv->first == "robot_rear_laser_max") &&
-      parse_double(kv->second, &d) && !(d > 0.0 && d <= kMaxLaserRangeM)) {
+      parse_finite_double(kv->second, &d) && !(d > 0.0 && d <= kMaxLaserRangeM)) {
     *why = "PARAM " + kv->first + " " + show(kv->second) + " is not a plausible maximum range (0, 1000] m";
     return false;
   }
@@ -456,7 +447,7 @@ bool parse_carmen_log(const std::string& name, const char* data, size_t size, co
       if (ok) out->params.push_back(kv);
     } else if (head == "NEFF") {
       double v;
-      ok = tok.size() >= 2 && parse_double(tok[1], &v);
+      ok = tok.size() >= 2 && parse_finite_double(tok[1], &v);
       if (ok) {
         ++out->neff_records;
       } else {
@@ -494,7 +485,7 @@ bool parse_carmen_log(const std::string& name, const char* data, size_t size, co
     double maxr = 0.0;
     for (const auto& kvp : out->params) {
       double v;
-      if (kvp.first == param && parse_double(kvp.second, &v) && v > 0.0) maxr = v;
+      if (kvp.first == param && parse_finite_double(kvp.second, &v) && v > 0.0) maxr = v;
     }
     if (maxr == 0.0) {
       float m = 0.0f;
