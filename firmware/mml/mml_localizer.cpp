@@ -538,13 +538,7 @@ void MmlLocalizer::published_pose_stage(const Se2f& odom_delta, const Se2f& loca
     last_refine_ = refine_pose(map_, refine_pts_, m, last_.pose, ro);
     bool unique = true;
     if (last_refine_.accepted && mo.unique_check) {
-      UniquenessOptions uo;
-      uo.clip_m = ro.clip_m;
-      uo.max_shift_m = mo.unique_max_shift_m;
-      uo.shift_step_m = mo.unique_shift_step_m;
-      uo.margin = mo.unique_margin;
-      last_unique_ = check_pose_uniqueness(map_, refine_pts_, m, last_refine_.pose, uo);
-      unique = last_unique_.unique;
+      unique = refined_pose_unique(refine_pts_, m, ro);
       if (!unique) ++unique_rejections_;
     }
     if (last_refine_.accepted && unique && !isolation_confirmed(local_pose)) {
@@ -575,6 +569,18 @@ void MmlLocalizer::published_pose_stage(const Se2f& odom_delta, const Se2f& loca
   }
 }
 
+// pose_uniqueness.h on the refined pose of this step (last_refine_).
+bool MmlLocalizer::refined_pose_unique(const Point2f* pts, std::size_t m, const RefineOptions& ro) {
+  const MmlOptions& mo = config_.mml;
+  UniquenessOptions uo;
+  uo.clip_m = ro.clip_m;
+  uo.max_shift_m = mo.unique_max_shift_m;
+  uo.shift_step_m = mo.unique_shift_step_m;
+  uo.margin = mo.unique_margin;
+  last_unique_ = check_pose_uniqueness(map_, pts, m, last_refine_.pose, uo);
+  return last_unique_.unique;
+}
+
 // A pending candidate (held back only by open rivals): the same checks as at isolation, on this
 // step's scan and the grown local map, while MML has nothing better to say (not `localized`, not
 // outside the map). Isolated once every rival is contradicted; dropped when a rival fits better,
@@ -593,13 +599,7 @@ void MmlLocalizer::recheck_pending(const Se2f& local_pose, const Point2f* pts, s
     return;
   }
   if (mo.unique_check) {
-    UniquenessOptions uo;
-    uo.clip_m = ro.clip_m;
-    uo.max_shift_m = mo.unique_max_shift_m;
-    uo.shift_step_m = mo.unique_shift_step_m;
-    uo.margin = mo.unique_margin;
-    last_unique_ = check_pose_uniqueness(map_, pts, m, last_refine_.pose, uo);
-    if (!last_unique_.unique) return;  // still pending: a corridor alias may resolve too
+    if (!refined_pose_unique(pts, m, ro)) return;  // still pending: a corridor alias may resolve too
   }
   if (!isolation_confirmed(local_pose)) {
     if (last_rival_.candidate_rejected) pending_ = false;

@@ -116,6 +116,7 @@ class MmlLocalizer final : public Localizer {
   Status interpretation_stage(std::size_t nh, float omega_thres, const Se2f& odom_delta);
   void published_pose_stage(const Se2f& odom_delta, const Se2f& local_pose);
   bool isolation_confirmed(const Se2f& local_pose);
+  bool refined_pose_unique(const Point2f* pts, std::size_t m, const RefineOptions& ro);
   void recheck_pending(const Se2f& local_pose, const Point2f* pts, std::size_t m);
   void publish(hal::PoseEstimate* out);
   Status gather_local_map();
