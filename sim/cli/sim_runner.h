@@ -133,8 +133,8 @@ struct SimSummary {
   // excluded: load_s).
   double path_length_m = 0, wall_s = 0, scans_per_s = 0, load_s = 0;
   std::uint64_t odom_rejected = 0, scans_held = 0, ring_drops = 0, step_errors = 0;
-  std::size_t scans_restamped = 0;
-  std::uint64_t deadline_misses = 0;  // log scans whose time stamp stepped back (re-stamped, see sim_runner.cpp)
+  std::size_t scans_restamped = 0;     // log scans whose time stamp stepped back (re-stamped, see log_frames.cpp)
+  std::uint64_t deadline_misses = 0;  // Localizer::step longer than --deadline-ms
   // --transport can: frames through the hal/sim loopback bus, injected byte faults, and what the
   // firmware's CAN decoder made of them (scans dropped, CRC errors, lost segments, malformed frames,
   // broken odometry records).
