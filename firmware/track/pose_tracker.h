@@ -130,7 +130,10 @@ class PoseTracker {
   Eigen::Matrix3f cov_ = Eigen::Matrix3f::Zero();
   Se2f prev_odom_;
   Se2f odom_at_fuse_;      // odometry at the last fused scan (update thresholds)
-  bool fused_once_ = false;
+  Se2f pose_at_fuse_;      // the track's pose after the last fused scan (update thresholds)
+  // The next supported scan is fused whatever the update thresholds say: at the start, and after an
+  // innovation fault widened the covariance (the pose held since the last update is not trusted).
+  bool fuse_next_ = true;
   float bias_xy_m_ = 0.0f, bias_theta_rad_ = 0.0f;  // of the last supported scan
   std::uint32_t unsupported_ = 0, faulty_ = 0, outside_ = 0;
   std::uint32_t consistent_since_fault_ = 0;  // consistent scans since the last contradicting one
