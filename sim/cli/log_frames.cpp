@@ -23,7 +23,8 @@ struct ReplayOrder {
 
 // The whole log is read even with --steps: the reference is chained from corrected poses that may
 // lie beyond the first N scans (aces: the first corrected pose is not at scan 0).
-bool read_log_and_reference(const SimConfig& cfg, CarmenLog* log, std::vector<fw::Se2d>* truth, std::string* err) {
+bool read_log_and_reference(const SimConfig& cfg, CarmenLog* log, std::vector<ReferencePose>* truth,
+                            std::string* err) {
   CarmenReadOptions ro;
   ro.max_bytes = cfg.max_log_bytes;
   if (!read_carmen_log(cfg.log_path, ro, log, err)) return false;
@@ -40,7 +41,7 @@ bool read_log_and_reference(const SimConfig& cfg, CarmenLog* log, std::vector<fw
   if (!cfg.reference_path.empty()) {
     std::vector<CorrectedPose> corrected;
     if (!read_corrected_poses(cfg.reference_path, &corrected, err)) return false;
-    *truth = reference_at_every_scan(*log, corrected);
+    *truth = reference_with_bounds(*log, corrected);
     if (truth->empty()) {
       *err = "reference '" + cfg.reference_path + "' has no pose matching a scan of '" + cfg.log_path + "'";
       return false;
@@ -51,7 +52,7 @@ bool read_log_and_reference(const SimConfig& cfg, CarmenLog* log, std::vector<fw
 
 // --kidnap-at: the scans from --start up to the carry, then from a scan chosen by the seed among
 // those ≥ kLogKidnapMinJumpM away with 50 scans (or a quarter of the log) to run on, to the end.
-bool plan_kidnapped_order(const SimConfig& cfg, const CarmenLog& log, const std::vector<fw::Se2d>& truth,
+bool plan_kidnapped_order(const SimConfig& cfg, const CarmenLog& log, const std::vector<ReferencePose>& truth,
                           ReplayOrder* order, std::string* err) {
   const std::size_t n = log.scans.size();
   const std::size_t last_before = cfg.log_start + cfg.log_kidnap_at - 1;  // last scan before the carry
@@ -60,7 +61,7 @@ bool plan_kidnapped_order(const SimConfig& cfg, const CarmenLog& log, const std:
            std::to_string(n - cfg.log_start) + " scans from --start " + std::to_string(cfg.log_start) + ")";
     return false;
   }
-  auto where = [&](std::size_t i) { return i < truth.size() ? truth[i] : log.scans[i].pose; };
+  auto where = [&](std::size_t i) { return i < truth.size() ? truth[i].pose : log.scans[i].pose; };
   const fw::Se2d here = where(last_before);
   const std::size_t tail = std::min<std::size_t>(50, n / 4);
   std::vector<std::size_t> cand;
@@ -88,7 +89,7 @@ bool plan_kidnapped_order(const SimConfig& cfg, const CarmenLog& log, const std:
   return true;
 }
 
-bool plan_replay_order(const SimConfig& cfg, const CarmenLog& log, const std::vector<fw::Se2d>& truth,
+bool plan_replay_order(const SimConfig& cfg, const CarmenLog& log, const std::vector<ReferencePose>& truth,
                        ReplayOrder* order, std::string* err) {
   if (cfg.log_kidnap_at > 0) {
     if (!plan_kidnapped_order(cfg, log, truth, order, err)) return false;
@@ -103,7 +104,7 @@ bool plan_replay_order(const SimConfig& cfg, const CarmenLog& log, const std::ve
 // A ⊕ (the log's odometry); A changes at the kidnapping only.
 class FrameBuilder {
  public:
-  FrameBuilder(const CarmenLog& log, const std::vector<fw::Se2d>& truth, const ReplayOrder& order)
+  FrameBuilder(const CarmenLog& log, const std::vector<ReferencePose>& truth, const ReplayOrder& order)
       : log_(log), truth_(truth), order_(order) {
     t0_ = log.scans[order.scans.front()].ipc_timestamp;
     last_ts_ = t0_;
@@ -127,7 +128,9 @@ class FrameBuilder {
     f.scan.scan_id = f.index;
     if (i < truth_.size()) {
       f.has_truth = true;
-      f.truth = truth_[i];
+      f.truth = truth_[i].pose;
+      f.truth_bound_m = truth_[i].bound;
+      f.truth_bound_rad = truth_[i].bound_theta;
     }
     const fw::Se2d here = f.has_truth ? f.truth : s.odom;
     if (k > 0 && k != order_.jump_step) travelled_ += std::hypot(here.x - prev_.x, here.y - prev_.y);
@@ -203,7 +206,7 @@ class FrameBuilder {
   }
 
   const CarmenLog& log_;
-  const std::vector<fw::Se2d>& truth_;
+  const std::vector<ReferencePose>& truth_;
   const ReplayOrder& order_;
   double t0_ = 0, last_ts_ = 0, shift_ = 0;
   std::size_t next_odom_ = 0;
@@ -240,7 +243,7 @@ void add_odometry_noise(const SimConfig& cfg, std::vector<Frame>* frames) {
 
 bool load_log_frames(const SimConfig& cfg, std::vector<Frame>* frames, std::size_t* restamped, std::string* err) {
   CarmenLog log;
-  std::vector<fw::Se2d> truth;
+  std::vector<ReferencePose> truth;
   if (!read_log_and_reference(cfg, &log, &truth, err)) return false;
   ReplayOrder order;
   if (!plan_replay_order(cfg, log, truth, &order, err)) return false;

@@ -20,6 +20,9 @@ struct Frame {
   bool kidnapped = false;
   bool has_truth = false;
   fw::Se2d truth;
+  // The reference's own error bound at this scan (sim/io/reference_trajectory.h: 0 where a corrected
+  // pose was given, the closure-residual bound between them, inf beyond the last one).
+  double truth_bound_m = 0, truth_bound_rad = 0;
   double travelled_m = 0;
   std::vector<hal::Odometry> odometry;
   hal::LaserScan scan;

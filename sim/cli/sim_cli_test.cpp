@@ -567,6 +567,28 @@ TEST(SimSummary, FiguresFromSteps) {
                            "kidnap at step 17: detected after 2 steps", "(step 21, localized)"}) {
     EXPECT_NE(line.find(part), std::string::npos) << part << " not in: " << line;
   }
+  // A log reference between corrected poses is itself off by up to its bound (reference_trajectory.h):
+  // an error counts only beyond the limit plus that bound; the rest is counted apart, not judged.
+  std::vector<StepRecord> w;
+  for (std::uint32_t i = 0; i < 4; ++i) {
+    w.push_back(rec(i, S::kLocalized, 0.05, i < 2 ? 7.0 : 2.0));  // 7° > 5°, or 2° > PL 1.15°
+    w.back().estimate.mode = hal::LocalizationMode::kTracking;
+    w.back().estimate.protection_xy_m = 0.2f;
+    w.back().estimate.protection_theta_rad = 0.02f;
+    w.back().truth_bound_deg = i % 2 == 0 ? 3.0 : 0.5;  // 0, 2: within the bound; 1, 3: beyond it
+  }
+  w.push_back(rec(4, S::kLocalized, 0.05, 7.0));
+  w.back().truth_bound_deg = INFINITY;  // extrapolated beyond the last corrected pose: never judged
+  SimSummary b;
+  summarize_steps(w, &b);
+  EXPECT_EQ(b.integrity_failures, 1u);           // step 1
+  EXPECT_EQ(b.integrity_within_truth_bound, 2u);  // steps 0 and 4
+  EXPECT_EQ(b.pl_exceeded, 3u);                  // steps 0 (7° > 1.15° + 3°), 1 and 3
+  EXPECT_EQ(b.pl_within_truth_bound, 1u);         // step 2 (2° < 1.15° + 3°)
+  EXPECT_NE(summary_line(b).find("integrity failures 1 (> 0.5 m or > 5 deg) + 2 within the reference's own error "
+                                 "bound, not judged"),
+            std::string::npos)
+      << summary_line(b);
   // No steps with a pose: nothing to report, and nothing made up.
   SimSummary none;
   summarize_steps({rec(0, S::kSearching, 0), rec(1, S::kSearching, 0)}, &none);

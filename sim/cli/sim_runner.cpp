@@ -37,6 +37,7 @@ struct FrameInfo {
   double t = 0;
   bool has_truth = false;
   fw::Se2d truth;
+  double truth_bound_m = 0, truth_bound_rad = 0;  // the reference's own error bound (log_frames.h)
   double travelled_m = 0;
   bool kidnapped = false;
   bool in_unknown = false;
@@ -392,6 +393,7 @@ class FrameLoop {
     frame_.t = sframe_.t;
     frame_.has_truth = true;
     frame_.truth = sframe_.truth;
+    frame_.truth_bound_m = frame_.truth_bound_rad = 0;  // a simulated world's truth is exact
     frame_.travelled_m = sframe_.travelled_m;
     frame_.kidnapped = sframe_.kidnapped;
     frame_.odometry.swap(sframe_.odometry);
@@ -411,8 +413,8 @@ class FrameLoop {
     if (unknown_known_ && frame_.has_truth) {
       for (const Box& b : src_.world.unknown_areas) in_unknown |= b.contains(Vec2(frame_.truth.x, frame_.truth.y));
     }
-    info_[frame_.scan.scan_id] = {frame_.t,           frame_.has_truth, frame_.truth,
-                                  frame_.travelled_m, frame_.kidnapped, in_unknown};
+    info_[frame_.scan.scan_id] = {frame_.t,           frame_.has_truth, frame_.truth,     frame_.truth_bound_m,
+                                  frame_.truth_bound_rad, frame_.travelled_m, frame_.kidnapped, in_unknown};
   }
 
   // With --transport can|sick (or --sensor-resolution can|sick) the simulated sensors report what
@@ -444,6 +446,8 @@ class FrameLoop {
       r.t = fi.t;
       r.has_truth = fi.has_truth;
       r.truth = fi.truth;
+      r.truth_bound_m = fi.truth_bound_m;
+      r.truth_bound_deg = fi.truth_bound_rad * kRadToDeg;
       r.travelled_m = fi.travelled_m;
       r.kidnapped = fi.kidnapped;
       r.in_unknown = fi.in_unknown;

@@ -82,6 +82,10 @@ struct StepRecord {
   bool has_truth = false;
   bool in_unknown = false;  // the truth lies in the world's unknown area (erased from the map)
   fw::Se2d truth;
+  // The truth's own error bound (a log reference between corrected poses; 0 in a simulated world,
+  // inf where the reference is extrapolated): an error counts against the localizer only beyond a
+  // limit plus this bound, as in mml-eval's whole-log figures.
+  double truth_bound_m = 0, truth_bound_deg = 0;
   double err_m = NAN, err_deg = NAN;  // NaN without truth or without a pose
   double travelled_m = 0;
   bool kidnapped = false;  // the robot was carried away just before this scan
@@ -113,6 +117,9 @@ struct SimSummary {
   // of them, those between a kidnapping and its detection.
   std::size_t integrity_failures = 0, integrity_failures_kidnap = 0;
   long first_integrity_failure_step = -1;
+  // Beyond a limit against the truth, but not beyond the limit plus the truth's own error bound
+  // (StepRecord::truth_bound_m): cannot be judged, counted apart (failures and PL exceedances).
+  std::size_t integrity_within_truth_bound = 0, pl_within_truth_bound = 0;
   // Protection level over `localized` steps that carry one (> 0): exceedances (error beyond the PL
   // in position or heading; scored where the truth is known), median and maximum.
   std::size_t pl_steps = 0, pl_scored = 0, pl_exceeded = 0;

@@ -89,11 +89,14 @@ void count_availability(const StepRecord& r, bool loc, SimSummary* s) {
 // Error of a `localized` step with a pose and a truth: wrong, integrity failure, tracking or global.
 void score_localized_error(const StepRecord& r, long step, bool undetected_kidnap, StepSamples* x, SimSummary* s) {
   x->err_loc.push_back(r.err_m);
-  if (r.err_m >= kWrongM || r.err_deg >= kWrongDeg) ++s->wrong_localized_steps;
-  if (r.err_m > kIntegrityLimitM || r.err_deg > kIntegrityLimitDeg) {
+  const double bm = r.truth_bound_m, bd = r.truth_bound_deg;  // the truth's own error bound
+  if (r.err_m >= kWrongM + bm || r.err_deg >= kWrongDeg + bd) ++s->wrong_localized_steps;
+  if (r.err_m > kIntegrityLimitM + bm || r.err_deg > kIntegrityLimitDeg + bd) {
     ++s->integrity_failures;
     if (undetected_kidnap) ++s->integrity_failures_kidnap;
     if (s->first_integrity_failure_step < 0) s->first_integrity_failure_step = step;
+  } else if (r.err_m > kIntegrityLimitM || r.err_deg > kIntegrityLimitDeg) {
+    ++s->integrity_within_truth_bound;
   }
   if (r.estimate.mode == hal::LocalizationMode::kTracking) {
     x->any_tracking = true;
@@ -123,7 +126,12 @@ void score_localized_step(const StepRecord& r, long step, bool undetected_kidnap
     x->pl_th.push_back(e.protection_theta_rad * kRadToDeg);
     if (scored) {
       ++s->pl_scored;
-      if (r.err_m > e.protection_xy_m || r.err_deg > e.protection_theta_rad * kRadToDeg) ++s->pl_exceeded;
+      const double pl_deg = e.protection_theta_rad * kRadToDeg;
+      if (r.err_m > e.protection_xy_m + r.truth_bound_m || r.err_deg > pl_deg + r.truth_bound_deg) {
+        ++s->pl_exceeded;
+      } else if (r.err_m > e.protection_xy_m || r.err_deg > pl_deg) {
+        ++s->pl_within_truth_bound;
+      }
     }
   }
 }

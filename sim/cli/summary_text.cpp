@@ -39,8 +39,16 @@ std::string pl_text(const SimSummary& s) {
                       s.pl_theta_deg_p50, s.pl_xy_m_max, s.pl_theta_deg_max);
   if (s.pl_scored > 0) {
     t += fmt(", exceeded %zu/%zu (%.2f %%)", s.pl_exceeded, s.pl_scored, 100.0 * s.pl_exceedance_rate);
+    if (s.pl_within_truth_bound > 0) t += fmt(" + %zu within the reference's own bound", s.pl_within_truth_bound);
   }
   return t;
+}
+
+// Steps beyond the integrity limits against a log reference, but not beyond them plus the
+// reference's own error bound between its corrected poses: not judged, said so (empty if none).
+std::string truth_bound_text(const SimSummary& s) {
+  if (s.integrity_within_truth_bound == 0) return "";
+  return fmt(" + %zu within the reference's own error bound, not judged", s.integrity_within_truth_bound);
 }
 
 std::string kidnap_text(const SimSummary& s) {
@@ -84,6 +92,7 @@ std::string summary_line(const SimSummary& s) {
   t += "; " + availability_text(s);
   t += fmt("; integrity failures %zu (> %.1f m or > %.0f deg)", s.integrity_failures, kIntegrityLimitM,
            kIntegrityLimitDeg);
+  t += truth_bound_text(s);
   t += "; " + pl_text(s);
   if (std::isfinite(s.tracking_err_m_p50)) {
     t += fmt("; tracking error median %.3f m, p95 %.3f m", s.tracking_err_m_p50, s.tracking_err_m_p95);
@@ -132,6 +141,7 @@ std::string summary_story(const SimSummary& s) {
   t += fmt("  integrity: %zu of %zu localized steps off by > %.1f m or > %.0f deg", s.integrity_failures,
            s.localized_steps, kIntegrityLimitM, kIntegrityLimitDeg);
   if (s.integrity_failures_kidnap > 0) t += fmt(" (%zu before the kidnap was detected)", s.integrity_failures_kidnap);
+  t += truth_bound_text(s);
   t += "; " + pl_text(s) + "\n";
   t += "  " + final_error_text(s) + "\n";
   if (s.transport != "none") t += "  " + transport_text(s) + "\n";
