@@ -19,20 +19,12 @@
 
 namespace {
 
+using sim::mean;
+using sim::stddev;
+
 constexpr int kSeeds = 3;             // the full tool uses 20 (mml-rbsm-eval odometry --seeds 20)
 constexpr size_t kTimingScans = 800;  // intel prefix used for the particle-count table
 
-double mean(const std::vector<double>& v) {
-  double s = 0;
-  for (double x : v) s += x;
-  return v.empty() ? NAN : s / v.size();
-}
-double stddev(const std::vector<double>& v) {
-  const double m = mean(v);
-  double s = 0;
-  for (double x : v) s += (x - m) * (x - m);
-  return v.empty() ? NAN : std::sqrt(s / v.size());
-}
 
 // A data set of the bench: its raw log and the relations to score on.
 struct BenchCase {

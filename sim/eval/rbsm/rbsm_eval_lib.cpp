@@ -179,6 +179,18 @@ double cpu_ms_per_scan(const OdometryRun& run) {
   return s / static_cast<double>(run.scan_cpu_ms.size());
 }
 
+double mean(const std::vector<double>& v) {
+  double s = 0;
+  for (double x : v) s += x;
+  return v.empty() ? NAN : s / v.size();
+}
+double stddev(const std::vector<double>& v) {
+  const double m = mean(v);
+  double s = 0;
+  for (double x : v) s += (x - m) * (x - m);
+  return v.empty() ? NAN : std::sqrt(s / v.size());
+}
+
 double percentile(std::vector<double> v, double p) {
   if (v.empty()) return std::nan("");
   std::sort(v.begin(), v.end());

@@ -110,5 +110,8 @@ struct EvalDataset {
 bool find_eval_dataset(const std::string& name, EvalDataset* out, std::string* error);
 
 double percentile(std::vector<double> v, double p);
+// Mean and population standard deviation over seeds (NaN when empty).
+double mean(const std::vector<double>& v);
+double stddev(const std::vector<double>& v);
 
 }  // namespace sim

@@ -25,6 +25,9 @@
 
 namespace {
 
+using sim::mean;
+using sim::stddev;
+
 int usage() {
   std::fprintf(stderr,
                "usage: mml-rbsm-eval odometry DATASET [--seeds N] [--scans N] [--particles N] [--workers N] "
@@ -34,17 +37,6 @@ int usage() {
   return 2;
 }
 
-double mean(const std::vector<double>& v) {
-  double s = 0;
-  for (double x : v) s += x;
-  return v.empty() ? NAN : s / v.size();
-}
-double stddev(const std::vector<double>& v) {
-  const double m = mean(v);
-  double s = 0;
-  for (double x : v) s += (x - m) * (x - m);
-  return v.empty() ? NAN : std::sqrt(s / v.size());
-}
 
 bool write_traj(const std::string& path, const sim::CarmenLog& log, const std::vector<fw::Se2d>& poses) {
   std::ofstream f(path);
