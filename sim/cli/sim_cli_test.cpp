@@ -582,11 +582,10 @@ TEST(SimSummary, FiguresFromSteps) {
   SimSummary b;
   summarize_steps(w, &b);
   EXPECT_EQ(b.integrity_failures, 1u);           // step 1
-  EXPECT_EQ(b.integrity_within_truth_bound, 2u);  // steps 0 and 4
+  EXPECT_EQ(b.integrity_not_judged, 2u);  // steps 0 and 4
   EXPECT_EQ(b.pl_exceeded, 3u);                  // steps 0 (7° > 1.15° + 3°), 1 and 3
-  EXPECT_EQ(b.pl_within_truth_bound, 1u);         // step 2 (2° < 1.15° + 3°)
-  EXPECT_NE(summary_line(b).find("integrity failures 1 (> 0.5 m or > 5 deg) + 2 within the reference's own error "
-                                 "bound, not judged"),
+  EXPECT_EQ(b.pl_not_judged, 1u);         // step 2 (2° < 1.15° + 3°)
+  EXPECT_NE(summary_line(b).find("integrity failures 1 (> 0.5 m or > 5 deg) + 2 not judged"),
             std::string::npos)
       << summary_line(b);
   // No steps with a pose: nothing to report, and nothing made up.

@@ -20,6 +20,7 @@
 #include "hal_linux/linux_clock.h"
 #include "hal_sim/sim_hal.h"
 #include "sim/cli/log_frames.h"
+#include "sim/cli/reference_judge.h"
 #include "sim/cli/run_picture.h"
 #include "sim/io/datasets.h"
 #include "sim/map/global_maps.h"
@@ -385,7 +386,7 @@ class FrameLoop {
  private:
   bool next_frame(std::size_t k) {
     if (cfg_.world.empty()) {
-      frame_ = std::move(src_.log_frames[k]);
+      frame_ = src_.log_frames[k];  // a copy: the summary asks the map about these scans afterwards
       return true;
     }
     if (!src_.synthetic.next(&sframe_)) return false;
@@ -636,6 +637,8 @@ bool run_simulation(const SimConfig& cfg_in, SimResult* out, std::string* err) {
   const double wall_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - wall_start).count();
 
   sum.steps = out->steps.size();
+  // A log's reference is judged by the map where a step is beyond a limit against it (reference_judge.h).
+  if (!src.log_frames.empty() && src.have_grid) check_steps_against_map(map.global_map, src.log_frames, &out->steps);
   collect_loop_counters(rig, frames.ring_drops(), wall_s, &sum);
   summarize_steps(out->steps, &sum);
   if (cfg.progress) print_run_report(cfg, rig, sum);

@@ -86,6 +86,11 @@ struct StepRecord {
   // inf where the reference is extrapolated): an error counts against the localizer only beyond a
   // limit plus this bound, as in mml-eval's whole-log figures.
   double truth_bound_m = 0, truth_bound_deg = 0;
+  // The map's own pose for this scan (cli/reference_judge.h), asked only where the step is beyond a
+  // limit against the truth: map_pose_better = it explains the scan clearly better than the truth;
+  // map_err_* = the estimate's error against it.
+  bool map_checked = false, map_pose_better = false;
+  double map_err_m = NAN, map_err_deg = NAN;
   double err_m = NAN, err_deg = NAN;  // NaN without truth or without a pose
   double travelled_m = 0;
   bool kidnapped = false;  // the robot was carried away just before this scan
@@ -118,8 +123,9 @@ struct SimSummary {
   std::size_t integrity_failures = 0, integrity_failures_kidnap = 0;
   long first_integrity_failure_step = -1;
   // Beyond a limit against the truth, but not beyond the limit plus the truth's own error bound
-  // (StepRecord::truth_bound_m): cannot be judged, counted apart (failures and PL exceedances).
-  std::size_t integrity_within_truth_bound = 0, pl_within_truth_bound = 0;
+  // (StepRecord::truth_bound_m), or within it against the map's pose for the scan where the map
+  // explains the scan clearly better (StepRecord::map_*): not judged, counted apart.
+  std::size_t integrity_not_judged = 0, pl_not_judged = 0;
   // Protection level over `localized` steps that carry one (> 0): exceedances (error beyond the PL
   // in position or heading; scored where the truth is known), median and maximum.
   std::size_t pl_steps = 0, pl_scored = 0, pl_exceeded = 0;

@@ -86,17 +86,25 @@ void count_availability(const StepRecord& r, bool loc, SimSummary* s) {
   }
 }
 
+// Beyond (limit_m, limit_deg) as judged against the truth: beyond the limit plus the truth's own
+// error bound, and — where the map explains the scan clearly better at another pose near the truth
+// (reference_judge.h) — beyond the limit against that pose too (mml-eval's rule).
+bool judged_beyond(const StepRecord& r, double limit_m, double limit_deg) {
+  if (!(r.err_m > limit_m + r.truth_bound_m || r.err_deg > limit_deg + r.truth_bound_deg)) return false;
+  if (r.map_checked && r.map_pose_better && !(r.map_err_m > limit_m || r.map_err_deg > limit_deg)) return false;
+  return true;
+}
+
 // Error of a `localized` step with a pose and a truth: wrong, integrity failure, tracking or global.
 void score_localized_error(const StepRecord& r, long step, bool undetected_kidnap, StepSamples* x, SimSummary* s) {
   x->err_loc.push_back(r.err_m);
-  const double bm = r.truth_bound_m, bd = r.truth_bound_deg;  // the truth's own error bound
-  if (r.err_m >= kWrongM + bm || r.err_deg >= kWrongDeg + bd) ++s->wrong_localized_steps;
-  if (r.err_m > kIntegrityLimitM + bm || r.err_deg > kIntegrityLimitDeg + bd) {
+  if (judged_beyond(r, kWrongM, kWrongDeg)) ++s->wrong_localized_steps;
+  if (judged_beyond(r, kIntegrityLimitM, kIntegrityLimitDeg)) {
     ++s->integrity_failures;
     if (undetected_kidnap) ++s->integrity_failures_kidnap;
     if (s->first_integrity_failure_step < 0) s->first_integrity_failure_step = step;
   } else if (r.err_m > kIntegrityLimitM || r.err_deg > kIntegrityLimitDeg) {
-    ++s->integrity_within_truth_bound;
+    ++s->integrity_not_judged;
   }
   if (r.estimate.mode == hal::LocalizationMode::kTracking) {
     x->any_tracking = true;
@@ -127,10 +135,10 @@ void score_localized_step(const StepRecord& r, long step, bool undetected_kidnap
     if (scored) {
       ++s->pl_scored;
       const double pl_deg = e.protection_theta_rad * kRadToDeg;
-      if (r.err_m > e.protection_xy_m + r.truth_bound_m || r.err_deg > pl_deg + r.truth_bound_deg) {
+      if (judged_beyond(r, e.protection_xy_m, pl_deg)) {
         ++s->pl_exceeded;
       } else if (r.err_m > e.protection_xy_m || r.err_deg > pl_deg) {
-        ++s->pl_within_truth_bound;
+        ++s->pl_not_judged;
       }
     }
   }

@@ -39,16 +39,18 @@ std::string pl_text(const SimSummary& s) {
                       s.pl_theta_deg_p50, s.pl_xy_m_max, s.pl_theta_deg_max);
   if (s.pl_scored > 0) {
     t += fmt(", exceeded %zu/%zu (%.2f %%)", s.pl_exceeded, s.pl_scored, 100.0 * s.pl_exceedance_rate);
-    if (s.pl_within_truth_bound > 0) t += fmt(" + %zu within the reference's own bound", s.pl_within_truth_bound);
+    if (s.pl_not_judged > 0) t += fmt(" + %zu not judged", s.pl_not_judged);
   }
   return t;
 }
 
 // Steps beyond the integrity limits against a log reference, but not beyond them plus the
-// reference's own error bound between its corrected poses: not judged, said so (empty if none).
+// reference's own error bound between its corrected poses, or not against the map's pose for the
+// scan where the map explains it clearly better (reference_judge.h): not judged, said so.
 std::string truth_bound_text(const SimSummary& s) {
-  if (s.integrity_within_truth_bound == 0) return "";
-  return fmt(" + %zu within the reference's own error bound, not judged", s.integrity_within_truth_bound);
+  if (s.integrity_not_judged == 0) return "";
+  return fmt(" + %zu not judged (within the reference's own error bound, or cleared by the map's pose)",
+             s.integrity_not_judged);
 }
 
 std::string kidnap_text(const SimSummary& s) {

@@ -15,7 +15,7 @@ std::string final_error_text(const SimSummary& s);
 std::string availability_text(const SimSummary& s);
 std::string pl_text(const SimSummary& s);
 std::string kidnap_text(const SimSummary& s);
-// " + N within the reference's own error bound, not judged" (empty when none).
+// " + N not judged (…)": beyond the integrity limits only against the log reference (empty when none).
 std::string truth_bound_text(const SimSummary& s);
 // One clause for a run through a transport with bytes (empty for none).
 std::string transport_text(const SimSummary& s);

@@ -1,0 +1,51 @@
+#include "sim/cli/reference_judge.h"
+
+#include <cmath>
+
+#include "firmware/base/se2.h"
+#include "sim/eval/mml_eval/reference_map_check.h"
+
+namespace sim {
+
+namespace {
+
+constexpr double kRadToDeg = 180.0 / M_PI;
+
+CarmenScan carmen_scan(const hal::LaserScan& s) {
+  CarmenScan c;
+  c.angle_min = s.angle_min;
+  c.angle_increment = s.angle_increment;
+  c.max_range = s.range_max;
+  c.ranges.assign(s.ranges, s.ranges + s.beam_count);
+  return c;
+}
+
+bool beyond_a_limit(const StepRecord& r) {
+  const hal::PoseEstimate& e = r.estimate;
+  if (r.err_m > kIntegrityLimitM || r.err_deg > kIntegrityLimitDeg) return true;
+  if (e.protection_xy_m <= 0 && e.protection_theta_rad <= 0) return false;
+  return r.err_m > e.protection_xy_m || r.err_deg > e.protection_theta_rad * kRadToDeg;
+}
+
+}  // namespace
+
+std::size_t check_steps_against_map(const fw::GlobalMap& map, const std::vector<Frame>& frames,
+                                    std::vector<StepRecord>* steps) {
+  std::size_t checked = 0;
+  for (StepRecord& r : *steps) {
+    if (!r.has_truth || !r.has_pose || r.estimate.status != hal::LocalizationStatus::kLocalized) continue;
+    if (!std::isfinite(r.err_m) || !std::isfinite(r.err_deg) || !beyond_a_limit(r)) continue;
+    const std::uint32_t k = r.estimate.scan_id;
+    if (k >= frames.size() || frames[k].scan.scan_id != k) continue;
+    const mmleval::ReferenceMapFit f = mmleval::check_reference_against_map(map, carmen_scan(frames[k].scan), r.truth);
+    ++checked;
+    r.map_checked = true;
+    r.map_pose_better = f.improves;
+    const hal::PoseEstimate& e = r.estimate;
+    r.map_err_m = std::hypot(e.x - f.best.x, e.y - f.best.y);
+    r.map_err_deg = std::fabs(fw::wrap_angle(static_cast<double>(e.theta) - f.best.theta)) * kRadToDeg;
+  }
+  return checked;
+}
+
+}  // namespace sim
