@@ -297,13 +297,16 @@ PoseTracker::Update PoseTracker::propose_update(const Se2f& odom, bool predict, 
   // Moved: by the wheels, or by the scan. Wheels that slip or lag under-report a fast turn (fr079
   // scan 729: odometry 1.3°, the robot 5.7°); holding the prediction there because "the robot
   // stood still" published a pose 5° off. So a scan fix as far from the last fused pose as the
-  // thresholds, or one that disagrees with the prediction significantly (the innovation test's χ²,
-  // inside the prediction's PL, else it was a fault), is the data saying the robot moved.
+  // thresholds is the data saying the robot moved — on a trusted track only: while it recovers
+  // from a fault its fixes are suspect (mit-killian scans 14894–14902: after a heading fault the
+  // fixes of a standing robot wandered 4 cm / 0.3°, fusing them let the track lag the next fast
+  // turn 5–10°), and the first scan after the fault is fused anyway (fuse_next_).
   const Se2f since = odom_at_fuse_.between(odom);
   const Se2f seen = pose_at_fuse_.between(a.pose);
+  const bool trusted = !had_fault_ || consistent_since_fault_ >= o.recovery_steps;
   const bool moved = fuse_next_ || !predict || std::hypot(since.x, since.y) >= o.update_min_d_m ||
-                     std::fabs(since.theta) >= o.update_min_a_rad || std::hypot(seen.x, seen.y) >= o.update_min_d_m ||
-                     std::fabs(seen.theta) >= o.update_min_a_rad || out->innovation_chi2 > o.innovation_chi2;
+                     std::fabs(since.theta) >= o.update_min_a_rad ||
+                     (trusted && (std::hypot(seen.x, seen.y) >= o.update_min_d_m || std::fabs(seen.theta) >= o.update_min_a_rad));
   const Eigen::Vector3f dx = w->p_post * (a.information * w->e);
   if (!moved || !dx.allFinite()) return u;
   u.fuse = true;

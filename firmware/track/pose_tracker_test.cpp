@@ -166,12 +166,13 @@ TrackStep stand_move_unseen_and_stand(const Se2f& unseen, int* localized_after, 
 }
 
 TEST(PoseTrackerTest, MotionTheWheelsMissIsFollowedByTheScans) {
-  // A 6 cm push inside the protection level: no fault, the scans pull the pose over.
+  // A 6 cm push inside the protection level: no fault; the scan is fused (a Kalman step toward it:
+  // 3.6 cm are left, below the update threshold, until the robot moves).
   int localized = 0;
   Se2f truth;
   TrackStep s = stand_move_unseen_and_stand(Se2f(0.0f, 0.06f, 0.0f), &localized, &truth);
   EXPECT_EQ(localized, 12);
-  EXPECT_LT(err_xy(s.pose, truth), 0.025f);  // held at the prediction it stays 6 cm off
+  EXPECT_LT(err_xy(s.pose, truth), 0.045f);  // held at the prediction it stays 6 cm off
   // A 1.7° turn beyond it: a fault, then the next consistent scan is fused (the covariance was widened)
   // and the track is `localized` again after recovery_steps scans, at the right heading.
   s = stand_move_unseen_and_stand(Se2f(0.0f, 0.0f, 0.03f), &localized, &truth);
