@@ -22,27 +22,36 @@
 namespace fw {
 
 struct PointToLineSystem {
-  Eigen::Matrix3d h = Eigen::Matrix3d::Zero();  // Σ w J Jᵀ
-  Eigen::Vector3d b = Eigen::Vector3d::Zero();  // Σ w r J
-  double cost = 0.0;                            // Σ w r²
+  // Σ w J Jᵀ (row-major), Σ w r J and Σ w r² as plain doubles: in the callers' per-point loops the
+  // compiler keeps them in registers (Eigen members were re-loaded and stored at every term, the
+  // largest single cost of the tracker's alias check). Each term is summed exactly as
+  // `h += w * (j * jᵀ)` summed it: (w·j_a)·j_e.
+  double h[9] = {0, 0, 0, 0, 0, 0, 0, 0, 0};
+  double b[3] = {0, 0, 0};
+  double cost = 0.0;
   std::uint32_t used = 0;
 
-  void clear() {
-    h.setZero();
-    b.setZero();
-    cost = 0.0;
-    used = 0;
-  }
+  void clear() { *this = PointToLineSystem(); }
 
   // One term: sensor point (px, py), current rotation (c, s) = (cos θ, sin θ), normal (nx, ny)
   // (unit, or the distance-field gradient), residual r, weight w (IRLS weight of a robust loss).
   void add(float px, float py, float c, float s, float nx, float ny, float r, double w) {
-    const Eigen::Vector3d j(nx, ny, nx * (-s * px - c * py) + ny * (c * px - s * py));
-    h += w * (j * j.transpose());
-    b += w * static_cast<double>(r) * j;
-    cost += w * static_cast<double>(r) * r;
+    const double j[3] = {nx, ny, static_cast<double>(nx * (-s * px - c * py) + ny * (c * px - s * py))};
+    const double wj[3] = {w * j[0], w * j[1], w * j[2]};
+    for (int a = 0; a < 3; ++a)
+      for (int e = 0; e < 3; ++e) h[3 * a + e] += wj[a] * j[e];
+    const double wr = w * static_cast<double>(r);
+    for (int a = 0; a < 3; ++a) b[a] += wr * j[a];
+    cost += wr * r;
     ++used;
   }
+
+  Eigen::Matrix3d information() const {
+    Eigen::Matrix3d m;
+    m << h[0], h[1], h[2], h[3], h[4], h[5], h[6], h[7], h[8];
+    return m;
+  }
+  Eigen::Vector3d gradient() const { return Eigen::Vector3d(b[0], b[1], b[2]); }
 
   // Gauss–Newton step dx = −(H + D + λI)⁻¹ (b + D·offset), D = diag(reg_xy, reg_xy, reg_th) and
   // `offset` = current pose − prior (θ wrapped by the caller), λ = damping·(1 + trace(H + D)) (a
@@ -50,8 +59,8 @@ struct PointToLineSystem {
   // False when the step is not finite (a degenerate system).
   bool solve(Eigen::Vector3d* dx, double reg_xy = 0.0, double reg_th = 0.0,
              const Eigen::Vector3d& offset = Eigen::Vector3d::Zero(), double damping = 0.0) const {
-    Eigen::Matrix3d a = h;
-    Eigen::Vector3d g = b;
+    Eigen::Matrix3d a = information();
+    Eigen::Vector3d g = gradient();
     a(0, 0) += reg_xy;
     a(1, 1) += reg_xy;
     a(2, 2) += reg_th;
@@ -70,8 +79,8 @@ struct PointToLineSystem {
   // follows noise. False when degenerate in every direction or not finite.
   bool solve_constrained(Eigen::Vector3d* dx, double length_m, double min_ratio) const {
     const Eigen::Vector3d scale(1.0, 1.0, 1.0 / length_m);
-    const Eigen::Matrix3d hs = scale.asDiagonal() * h * scale.asDiagonal();
-    const Eigen::Vector3d bs = scale.asDiagonal() * b;
+    const Eigen::Matrix3d hs = scale.asDiagonal() * information() * scale.asDiagonal();
+    const Eigen::Vector3d bs = scale.asDiagonal() * gradient();
     Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> es(hs);
     if (es.info() != Eigen::Success) return false;
     const Eigen::Vector3d lambda = es.eigenvalues();  // ascending
