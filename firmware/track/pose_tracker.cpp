@@ -91,6 +91,10 @@ namespace {
 bool outside_bound(const Eigen::Vector3f& e, const ProtectionLevel& pl) {
   return std::hypot(e(0), e(1)) > pl.xy_m || std::fabs(e(2)) > pl.theta_rad;
 }
+// A motion as large as the update thresholds (AMCL's update_min_d / update_min_a).
+bool beyond_update_thresholds(const Se2f& motion, const TrackOptions& o) {
+  return std::hypot(motion.x, motion.y) >= o.update_min_d_m || std::fabs(motion.theta) >= o.update_min_a_rad;
+}
 }  // namespace
 
 // At most kAliasMaxPoints end-points, evenly subsampled into alias_points_ (beam order kept).
@@ -304,9 +308,8 @@ PoseTracker::Update PoseTracker::propose_update(const Se2f& odom, bool predict, 
   const Se2f since = odom_at_fuse_.between(odom);
   const Se2f seen = pose_at_fuse_.between(a.pose);
   const bool trusted = !had_fault_ || consistent_since_fault_ >= o.recovery_steps;
-  const bool moved = fuse_next_ || !predict || std::hypot(since.x, since.y) >= o.update_min_d_m ||
-                     std::fabs(since.theta) >= o.update_min_a_rad ||
-                     (trusted && (std::hypot(seen.x, seen.y) >= o.update_min_d_m || std::fabs(seen.theta) >= o.update_min_a_rad));
+  const bool moved = fuse_next_ || !predict || beyond_update_thresholds(since, o) ||
+                     (trusted && beyond_update_thresholds(seen, o));
   const Eigen::Vector3f dx = w->p_post * (a.information * w->e);
   if (!moved || !dx.allFinite()) return u;
   u.fuse = true;

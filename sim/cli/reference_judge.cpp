@@ -11,15 +11,6 @@ namespace {
 
 constexpr double kRadToDeg = 180.0 / M_PI;
 
-CarmenScan carmen_scan(const hal::LaserScan& s) {
-  CarmenScan c;
-  c.angle_min = s.angle_min;
-  c.angle_increment = s.angle_increment;
-  c.max_range = s.range_max;
-  c.ranges.assign(s.ranges, s.ranges + s.beam_count);
-  return c;
-}
-
 bool beyond_a_limit(const StepRecord& r) {
   const hal::PoseEstimate& e = r.estimate;
   if (r.err_m > kIntegrityLimitM || r.err_deg > kIntegrityLimitDeg) return true;
@@ -37,7 +28,7 @@ std::size_t check_steps_against_map(const fw::GlobalMap& map, const std::vector<
     if (!std::isfinite(r.err_m) || !std::isfinite(r.err_deg) || !beyond_a_limit(r)) continue;
     const std::uint32_t k = r.estimate.scan_id;
     if (k >= frames.size() || frames[k].scan.scan_id != k) continue;
-    const mmleval::ReferenceMapFit f = mmleval::check_reference_against_map(map, carmen_scan(frames[k].scan), r.truth);
+    const mmleval::ReferenceMapFit f = mmleval::check_reference_against_map(map, mmleval::carmen_scan_of(frames[k].scan), r.truth);
     ++checked;
     r.map_checked = true;
     r.map_pose_better = f.improves;

@@ -21,6 +21,15 @@ std::size_t count_inliers(const fw::GlobalMap& map, const std::vector<fw::Point2
 
 }  // namespace
 
+CarmenScan carmen_scan_of(const hal::LaserScan& scan) {
+  CarmenScan c;
+  c.angle_min = scan.angle_min;
+  c.angle_increment = scan.angle_increment;
+  c.max_range = scan.range_max;
+  c.ranges.assign(scan.ranges, scan.ranges + scan.beam_count);
+  return c;
+}
+
 ReferenceMapFit check_reference_against_map(const fw::GlobalMap& map, const CarmenScan& scan, const fw::Se2d& reference,
                                             const ReferenceMapCheckOptions& opt) {
   ReferenceMapFit out;

@@ -22,6 +22,7 @@
 
 #include "firmware/base/se2.h"
 #include "firmware/map/global_map.h"
+#include "hal/msg/laser_scan.h"
 #include "sim/io/carmen_log.h"
 
 namespace sim::mmleval {
@@ -52,5 +53,8 @@ struct ReferenceMapFit {
 
 ReferenceMapFit check_reference_against_map(const fw::GlobalMap& map, const CarmenScan& scan, const fw::Se2d& reference,
                                             const ReferenceMapCheckOptions& opt = {});
+
+// The scan a localizer consumed (hal::LaserScan), as the check reads it.
+CarmenScan carmen_scan_of(const hal::LaserScan& scan);
 
 }  // namespace sim::mmleval

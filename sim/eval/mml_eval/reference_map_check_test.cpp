@@ -29,12 +29,7 @@ GridWorld corridor() {
 CarmenScan scan_at(const GridWorld& g, double x, double y, double th) {
   static hal::LaserScan s;
   fw::mcl::testing::simulate_scan(g.view(), static_cast<float>(x), static_cast<float>(y), static_cast<float>(th), &s);
-  CarmenScan c;
-  c.angle_min = s.angle_min;
-  c.angle_increment = s.angle_increment;
-  c.max_range = s.range_max;
-  c.ranges.assign(s.ranges, s.ranges + s.beam_count);
-  return c;
+  return carmen_scan_of(s);
 }
 
 TEST(ReferenceMapCheck, KeepsAReferenceTheMapAgreesWith) {
