@@ -4,6 +4,7 @@
 #include <vector>
 
 #include "sim/cli/sim_runner.h"
+#include "sim/eval/mml_eval/reference_map_check.h"
 
 namespace sim {
 
@@ -86,13 +87,18 @@ void count_availability(const StepRecord& r, bool loc, SimSummary* s) {
   }
 }
 
-// Beyond (limit_m, limit_deg) as judged against the truth: beyond the limit plus the truth's own
-// error bound, and — where the map explains the scan clearly better at another pose near the truth
-// (reference_judge.h) — beyond the limit against that pose too (mml-eval's rule).
+// Beyond (limit_m, limit_deg) as mml-eval judges it (reference_map_check.h: the truth's own error
+// bound, and the map's pose for the scan where the map explains it clearly better).
 bool judged_beyond(const StepRecord& r, double limit_m, double limit_deg) {
-  if (!(r.err_m > limit_m + r.truth_bound_m || r.err_deg > limit_deg + r.truth_bound_deg)) return false;
-  if (r.map_checked && r.map_pose_better && !(r.map_err_m > limit_m || r.map_err_deg > limit_deg)) return false;
-  return true;
+  mmleval::JudgedError e;
+  e.ref_m = r.err_m;
+  e.ref_ang = r.err_deg;
+  e.bound_m = r.truth_bound_m;
+  e.bound_ang = r.truth_bound_deg;
+  e.map_improves = r.map_checked && r.map_pose_better;
+  e.map_m = r.map_err_m;
+  e.map_ang = r.map_err_deg;
+  return mmleval::judged_beyond(e, limit_m, limit_deg);
 }
 
 // Error of a `localized` step with a pose and a truth: wrong, integrity failure, tracking or global.

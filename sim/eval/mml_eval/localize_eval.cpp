@@ -40,13 +40,12 @@ void describe_failures(const LoadedDataset& ds, const std::string& label, std::s
   for (std::size_t k = 0; k < t.steps.size(); ++k) {
     const StepLog& s = t.steps[k];
     if (s.status != hal::LocalizationStatus::kLocalized || !s.ref_ok || !std::isfinite(s.err_m)) continue;
-    if (s.err_m <= b.bound_m && s.err_rad <= b.bound_rad) continue;
+    if (!integrity_beyond(s, b.bound_m, b.bound_rad)) continue;
     ++total;
     // One line per failure episode (first step of a run of failures), at most 5 per trial.
     const StepLog* p = k > 0 ? &t.steps[k - 1] : nullptr;
     const bool new_episode = p == nullptr || !(p->status == hal::LocalizationStatus::kLocalized && p->ref_ok &&
-                                               std::isfinite(p->err_m) &&
-                                               (p->err_m > b.bound_m || p->err_rad > b.bound_rad));
+                                               std::isfinite(p->err_m) && integrity_beyond(*p, b.bound_m, b.bound_rad));
     if (!new_episode || shown >= 5) continue;
     ++shown;
     std::string hist;

@@ -114,6 +114,24 @@ TEST(LocalizeMetrics, ProtectionLevelExceedance) {
   EXPECT_DOUBLE_EQ(s.pl_exceed_rate, 2.0 / 3.0);
 }
 
+TEST(LocalizeMetrics, EachCriterionCountsOnlyWhereItIsJudgedBeyond) {
+  // Kept steps (the reference checks judged one criterion beyond): a criterion they cleared does not
+  // count, the other does. A failure the map confirms is never dropped because the map clears the PL.
+  TrialResult t = trial({step(L, 0.7, 0.5, 0.80f, 9.0f),   // failure confirmed, PL cleared (PL ≥ limit)
+                         step(L, 0.7, 0.5, 0.30f, 1.0f),   // failure cleared by the map, PL exceedance confirmed
+                         step(L, 0.7, 0.5, 0.30f, 1.0f)}); // both confirmed
+  t.steps[0].pl_cleared = true;
+  t.steps[1].integrity_cleared = true;
+  const TrialMetrics m = trial_metrics(t, MetricBounds());
+  EXPECT_EQ(m.localized_steps, 3u);
+  EXPECT_EQ(m.integrity_failures, 2u);
+  EXPECT_EQ(m.pl_steps, 3u);
+  EXPECT_EQ(m.pl_exceed, 2u);
+  EXPECT_FALSE(m.first_fix_success);
+  t.steps[0].integrity_cleared = true;
+  EXPECT_TRUE(trial_metrics(t, MetricBounds()).first_fix_success);
+}
+
 TEST(LocalizeMetrics, PlaceholderPoseNeverCounted) {
   // A localizer publishing `localized` must have a pose; `searching` steps carry NaN errors and must
   // neither count as failures nor enter the tracking error, even if the (placeholder) pose is 0,0.

@@ -466,13 +466,11 @@ TrialResult run_trial(fw::Localizer& loc, const LoadedDataset& ds, std::size_t s
       // The log reference is itself off by up to its bound (closure residual, reference_trajectory.h):
       // an error counts against the localizer only beyond the limit plus that bound.
       const double rb_m = ds.reference_bound_m(i), rb_rad = ds.reference_bound_rad(i);
-      auto fails = [&](double em, double er, double bm, double br) {
-        return em > ds.success_bound_m + bm || er > bound_rad + br;
+      auto fails = [&](double em, double er) { return em > ds.success_bound_m || er > bound_rad; };
+      auto exceeds = [&](double em, double er) {
+        return (st.pl_xy > 0 && em > st.pl_xy) || (st.pl_theta > 0 && er > st.pl_theta);
       };
-      auto exceeds = [&](double em, double er, double bm, double br) {
-        return (st.pl_xy > 0 && em > st.pl_xy + bm) || (st.pl_theta > 0 && er > st.pl_theta + br);
-      };
-      if (fails(st.err_m, st.err_rad, 0, 0) || exceeds(st.err_m, st.err_rad, 0, 0)) {
+      if (fails(st.err_m, st.err_rad) || exceeds(st.err_m, st.err_rad)) {
         const ReferenceMapFit& f = ds.reference_map_fit(i);
         const double em = std::hypot(est.x - f.best.x, est.y - f.best.y);
         const double er = std::fabs(fw::wrap_angle(static_cast<double>(est.theta) - f.best.theta));
@@ -480,11 +478,27 @@ TrialResult run_trial(fw::Localizer& loc, const LoadedDataset& ds, std::size_t s
         st.map_err_rad = er;
         st.ref_bound_m = rb_m;
         st.ref_bound_rad = rb_rad;
-        if (f.improves && ((fails(st.err_m, st.err_rad, rb_m, rb_rad) && !fails(em, er, 0, 0)) ||
-                           (exceeds(st.err_m, st.err_rad, rb_m, rb_rad) && !exceeds(em, er, 0, 0)))) {
+        // One rule with mml-sim (reference_map_check.h), per criterion: the step is kept while either
+        // (integrity limits, protection level) is judged beyond, and only that one counts — a failure
+        // the map confirms is never dropped because the map clears the other — and excluded, counted,
+        // otherwise.
+        JudgedError je;
+        je.ref_m = st.err_m;
+        je.ref_ang = st.err_rad;
+        je.bound_m = rb_m;
+        je.bound_ang = rb_rad;
+        je.map_improves = f.improves;
+        je.map_m = em;
+        je.map_ang = er;
+        const double pl_m = st.pl_xy, pl_rad = st.pl_theta;
+        st.integrity_cleared = !judged_beyond(je, ds.success_bound_m, bound_rad);
+        st.pl_cleared = !judged_beyond(je, pl_m, pl_rad);
+        const bool judged = !st.integrity_cleared || !st.pl_cleared;
+        const bool beyond_ref = beyond_reference(je, ds.success_bound_m, bound_rad) || beyond_reference(je, pl_m, pl_rad);
+        if (!judged && beyond_ref) {
           st.ref_ok = false;
           st.ref_map_contradicted = true;
-        } else if (!fails(st.err_m, st.err_rad, rb_m, rb_rad) && !exceeds(st.err_m, st.err_rad, rb_m, rb_rad)) {
+        } else if (!beyond_ref) {
           st.ref_ok = false;  // within the reference's own error bound of the limits: cannot be judged
           st.ref_within_bound = true;
         }
@@ -502,7 +516,7 @@ TrialResult run_trial(fw::Localizer& loc, const LoadedDataset& ds, std::size_t s
                   est.rating, est.protection_xy_m, est.protection_theta_rad * 57.2958, st.step_ms);
     }
     if (est.status == hal::LocalizationStatus::kLocalized) {
-      const bool ok = !st.ref_ok || (st.err_m < ds.success_bound_m && st.err_rad < ds.success_bound_rad);
+      const bool ok = !st.ref_ok || st.integrity_cleared || (st.err_m < ds.success_bound_m && st.err_rad < ds.success_bound_rad);
       if (!tr.localized) {
         tr.localized = true;
         tr.steps_to_localize = tr.steps.size();
@@ -545,7 +559,7 @@ TrialMetrics trial_metrics(const TrialResult& t, const MetricBounds& b) {
     m.m_to_fix = t.steps[k].travelled;
     for (std::size_t j = k; j < pre && j < b.fix_within_steps; ++j) {
       if (checkable(t.steps[j])) {
-        m.first_fix_success = !wrong(t.steps[j]);
+        m.first_fix_success = !integrity_beyond(t.steps[j], b.bound_m, b.bound_rad);
         break;
       }
     }
@@ -579,13 +593,13 @@ TrialMetrics trial_metrics(const TrialResult& t, const MetricBounds& b) {
       continue;
     }
     ++m.localized_steps;
-    const bool w = wrong(s);
+    const bool w = integrity_beyond(s, b.bound_m, b.bound_rad);
     m.integrity_failures += w;
     if (k >= kid) m.kidnap_integrity_failures += w;
     if (s.pl_xy > 0.0f || s.pl_theta > 0.0f) {
       ++m.pl_steps;
-      const bool ex_xy = s.pl_xy > 0.0f && s.err_m > s.pl_xy;
-      const bool ex_th = s.pl_theta > 0.0f && s.err_rad > s.pl_theta;
+      const bool ex_xy = pl_xy_beyond(s);
+      const bool ex_th = pl_theta_beyond(s);
       m.pl_exceed += ex_xy || ex_th;
       m.pl_exceed_xy += ex_xy;
       m.pl_exceed_theta += ex_th;
@@ -605,7 +619,7 @@ TrialMetrics trial_metrics(const TrialResult& t, const MetricBounds& b) {
       }
     }
     for (std::size_t k = kid; k < t.steps.size() && k - kid < b.refix_within_steps; ++k) {
-      if (checkable(t.steps[k]) && !wrong(t.steps[k])) {
+      if (checkable(t.steps[k]) && !integrity_beyond(t.steps[k], b.bound_m, b.bound_rad)) {
         m.kidnap_refix = true;
         m.refix_m = t.steps[k].travelled - t.kidnap_travelled;
         break;

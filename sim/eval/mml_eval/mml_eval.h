@@ -135,6 +135,9 @@ struct StepLog {
   bool ref_ok = true;       // reference reliable at this scan (check_reference_against_relations)
   bool ref_map_contradicted = false;  // the map contradicts the reference here (ref_ok false too)
   bool ref_within_bound = false;      // error beyond a limit by less than the reference's own bound (ref_ok false)
+  // Per criterion, on a step kept (ref_ok) because the other criterion is judged beyond: this one is
+  // not (within the reference's bound, or cleared by the map's pose; reference_map_check.h).
+  bool integrity_cleared = false, pl_cleared = false;
   double map_err_m = 0, map_err_rad = 0;  // error against the map's pose (when the map check ran; else NaN)
   double ref_bound_m = 0, ref_bound_rad = 0;  // the reference's own bound at this scan
   float pl_xy = 0, pl_theta = 0;  // published protection level (0 = none)
@@ -146,6 +149,14 @@ struct StepLog {
   bool in_region = false;  // inside the erased region (unknown-area runs)
   std::size_t matched_points = 0;  // MML: local map points handed to pRANSAM (0: not matched / not MML)
 };
+
+// A kept step's judged errors: beyond the integrity bounds / its protection level, unless the
+// reference checks cleared that criterion.
+inline bool integrity_beyond(const StepLog& s, double bound_m, double bound_rad) {
+  return !s.integrity_cleared && (s.err_m > bound_m || s.err_rad > bound_rad);
+}
+inline bool pl_xy_beyond(const StepLog& s) { return !s.pl_cleared && s.pl_xy > 0.0f && s.err_m > s.pl_xy; }
+inline bool pl_theta_beyond(const StepLog& s) { return !s.pl_cleared && s.pl_theta > 0.0f && s.err_rad > s.pl_theta; }
 
 struct TrialResult {
   std::size_t start = 0;

@@ -19,7 +19,20 @@ std::size_t count_inliers(const fw::GlobalMap& map, const std::vector<fw::Point2
   return n;
 }
 
+bool beyond(double err_m, double err_ang, double limit_m, double limit_ang) {
+  return (limit_m > 0 && err_m > limit_m) || (limit_ang > 0 && err_ang > limit_ang);
+}
 }  // namespace
+
+bool beyond_reference(const JudgedError& e, double limit_m, double limit_ang) {
+  // A missing limit stays missing: the bound widens only a limit there is.
+  return beyond(e.ref_m, e.ref_ang, limit_m > 0 ? limit_m + e.bound_m : 0, limit_ang > 0 ? limit_ang + e.bound_ang : 0);
+}
+
+bool judged_beyond(const JudgedError& e, double limit_m, double limit_ang) {
+  if (!beyond_reference(e, limit_m, limit_ang)) return false;
+  return !e.map_improves || beyond(e.map_m, e.map_ang, limit_m, limit_ang);
+}
 
 CarmenScan carmen_scan_of(const hal::LaserScan& scan) {
   CarmenScan c;

@@ -54,6 +54,23 @@ struct ReferenceMapFit {
 ReferenceMapFit check_reference_against_map(const fw::GlobalMap& map, const CarmenScan& scan, const fw::Se2d& reference,
                                             const ReferenceMapCheckOptions& opt = {});
 
+// The judging rule of mml-eval and mml-sim, in one place. An error of a `localized` step counts as
+// beyond a limit (the integrity limits, or the step's protection level) only when it is beyond the
+// limit plus the log reference's own bound (reference_trajectory.h) AND — where the map's pose
+// explains the scan clearly better (`map_improves`, the check above) — beyond the limit against that
+// pose too. Angles in one unit of the caller's choice (mml-eval radians, mml-sim degrees); a limit
+// component ≤ 0 is no limit (a pose published without that bound).
+struct JudgedError {
+  double ref_m = 0, ref_ang = 0;      // error against the log reference
+  double bound_m = 0, bound_ang = 0;  // the reference's own error bound at this scan
+  bool map_improves = false;
+  double map_m = 0, map_ang = 0;      // error against the map's pose (read only when map_improves)
+};
+// Beyond the limit against the log reference plus its bound.
+bool beyond_reference(const JudgedError& e, double limit_m, double limit_ang);
+// Judged beyond: as above, and not cleared by the map's pose.
+bool judged_beyond(const JudgedError& e, double limit_m, double limit_ang);
+
 // The scan a localizer consumed (hal::LaserScan), as the check reads it.
 CarmenScan carmen_scan_of(const hal::LaserScan& scan);
 

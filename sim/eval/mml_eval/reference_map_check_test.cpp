@@ -60,5 +60,38 @@ TEST(ReferenceMapCheck, CorrectsTheHeadingWithoutSlidingAlongTheCorridor) {
   EXPECT_LT(std::fabs(f.best.x - reference.x), 0.03);
 }
 
+TEST(JudgingRule, BeyondTheReferencePlusItsBoundAndNotClearedByTheMap) {
+  JudgedError e;
+  e.ref_m = 0.60;
+  e.ref_ang = 1.0;
+  // Beyond 0.5 m, no bound, no map pose: beyond.
+  EXPECT_TRUE(beyond_reference(e, 0.5, 5.0));
+  EXPECT_TRUE(judged_beyond(e, 0.5, 5.0));
+  // The reference's own bound widens the limit: 0.60 m is within 0.5 + 0.15.
+  e.bound_m = 0.15;
+  EXPECT_FALSE(beyond_reference(e, 0.5, 5.0));
+  EXPECT_FALSE(judged_beyond(e, 0.5, 5.0));
+  e.bound_m = 0.0;
+  // The map's pose explains the scan better and the estimate is within the limit of it: cleared.
+  e.map_improves = true;
+  e.map_m = 0.20;
+  e.map_ang = 0.5;
+  EXPECT_TRUE(beyond_reference(e, 0.5, 5.0));
+  EXPECT_FALSE(judged_beyond(e, 0.5, 5.0));
+  // … beyond it there too: judged beyond. A map pose that does not improve is never read.
+  e.map_m = 0.55;
+  EXPECT_TRUE(judged_beyond(e, 0.5, 5.0));
+  e.map_improves = false;
+  e.map_m = 0.0;
+  EXPECT_TRUE(judged_beyond(e, 0.5, 5.0));
+  // A limit component ≤ 0 is no limit (a pose without a heading bound), and the bound does not
+  // create one.
+  e.ref_m = 0.1;
+  e.ref_ang = 30.0;
+  e.bound_ang = 2.0;
+  EXPECT_FALSE(judged_beyond(e, 0.5, 0.0));
+  EXPECT_TRUE(judged_beyond(e, 0.5, 5.0));
+}
+
 }  // namespace
 }  // namespace sim::mmleval
