@@ -117,7 +117,7 @@ TEST(LocalizeMetrics, ProtectionLevelExceedance) {
 TEST(LocalizeMetrics, EachCriterionCountsOnlyWhereItIsJudgedBeyond) {
   // Kept steps (the reference checks judged one criterion beyond): a criterion they cleared does not
   // count, the other does. A failure the map confirms is never dropped because the map clears the PL.
-  TrialResult t = trial({step(L, 0.7, 0.5, 0.80f, 9.0f),   // failure confirmed, PL cleared (PL ≥ limit)
+  TrialResult t = trial({step(L, 0.7, 0.5, 0.60f, 9.0f),   // failure confirmed, PL cleared (map pose 0.55 m off)
                          step(L, 0.7, 0.5, 0.30f, 1.0f),   // failure cleared by the map, PL exceedance confirmed
                          step(L, 0.7, 0.5, 0.30f, 1.0f)}); // both confirmed
   t.steps[0].pl_cleared = true;
@@ -127,6 +127,9 @@ TEST(LocalizeMetrics, EachCriterionCountsOnlyWhereItIsJudgedBeyond) {
   EXPECT_EQ(m.integrity_failures, 2u);
   EXPECT_EQ(m.pl_steps, 3u);
   EXPECT_EQ(m.pl_exceed, 2u);
+  // Against the log reference alone every one of them is beyond both.
+  EXPECT_EQ(m.integrity_failures_raw, 3u);
+  EXPECT_EQ(m.pl_exceed_raw, 3u);
   EXPECT_FALSE(m.first_fix_success);
   t.steps[0].integrity_cleared = true;
   EXPECT_TRUE(trial_metrics(t, MetricBounds()).first_fix_success);

@@ -576,6 +576,14 @@ TrialMetrics trial_metrics(const TrialResult& t, const MetricBounds& b) {
       m.avail_localized += is_loc(t.steps[k]);
     }
   }
+  // The figures against the log reference alone (`*_vs_log_reference`), beside the judged ones.
+  auto count_raw = [&](const StepLog& s) {
+    m.integrity_failures_raw += wrong(s);
+    if (s.pl_xy > 0.0f || s.pl_theta > 0.0f) {
+      ++m.pl_steps_raw;
+      m.pl_exceed_raw += (s.pl_xy > 0.0f && s.err_m > s.pl_xy) || (s.pl_theta > 0.0f && s.err_rad > s.pl_theta);
+    }
+  };
   for (std::size_t k = 0; k < t.steps.size(); ++k) {
     const StepLog& s = t.steps[k];
     if (!is_loc(s)) continue;
@@ -583,15 +591,10 @@ TrialMetrics trial_metrics(const TrialResult& t, const MetricBounds& b) {
       ++m.excluded_ref_steps;
       m.excluded_map_steps += s.ref_map_contradicted;
       m.excluded_bound_steps += s.ref_within_bound;
-      if ((s.ref_map_contradicted || s.ref_within_bound) && std::isfinite(s.err_m)) {
-        m.integrity_failures_raw += wrong(s);
-        if (s.pl_xy > 0.0f || s.pl_theta > 0.0f) {
-          ++m.pl_steps_raw;
-          m.pl_exceed_raw += (s.pl_xy > 0.0f && s.err_m > s.pl_xy) || (s.pl_theta > 0.0f && s.err_rad > s.pl_theta);
-        }
-      }
+      if ((s.ref_map_contradicted || s.ref_within_bound) && std::isfinite(s.err_m)) count_raw(s);
       continue;
     }
+    count_raw(s);  // a kept step counts against the log reference alone too, whatever the checks cleared
     ++m.localized_steps;
     const bool w = integrity_beyond(s, b.bound_m, b.bound_rad);
     m.integrity_failures += w;
@@ -606,9 +609,6 @@ TrialMetrics trial_metrics(const TrialResult& t, const MetricBounds& b) {
     }
     if (s.mode == hal::LocalizationMode::kTracking) m.track_err.push_back(s.err_m);
   }
-  m.integrity_failures_raw += m.integrity_failures;
-  m.pl_steps_raw += m.pl_steps;
-  m.pl_exceed_raw += m.pl_exceed;
   if (kid != TrialResult::kNone && kid < t.steps.size()) {
     m.kidnapped = true;
     for (std::size_t k = kid; k < t.steps.size(); ++k) {
