@@ -11,11 +11,14 @@ namespace {
 
 constexpr double kRadToDeg = 180.0 / M_PI;
 
+// Beyond the integrity limits or the step's PL against the log reference alone: where the map is asked.
 bool beyond_a_limit(const StepRecord& r) {
+  mmleval::JudgedError raw;
+  raw.ref_m = r.err_m;
+  raw.ref_ang = r.err_deg;
   const hal::PoseEstimate& e = r.estimate;
-  if (r.err_m > kIntegrityLimitM || r.err_deg > kIntegrityLimitDeg) return true;
-  if (e.protection_xy_m <= 0 && e.protection_theta_rad <= 0) return false;
-  return r.err_m > e.protection_xy_m || r.err_deg > e.protection_theta_rad * kRadToDeg;
+  return mmleval::beyond_reference(raw, kIntegrityLimitM, kIntegrityLimitDeg) ||
+         mmleval::beyond_reference(raw, e.protection_xy_m, e.protection_theta_rad * kRadToDeg);
 }
 
 }  // namespace

@@ -466,11 +466,11 @@ TrialResult run_trial(fw::Localizer& loc, const LoadedDataset& ds, std::size_t s
       // The log reference is itself off by up to its bound (closure residual, reference_trajectory.h):
       // an error counts against the localizer only beyond the limit plus that bound.
       const double rb_m = ds.reference_bound_m(i), rb_rad = ds.reference_bound_rad(i);
-      auto fails = [&](double em, double er) { return em > ds.success_bound_m || er > bound_rad; };
-      auto exceeds = [&](double em, double er) {
-        return (st.pl_xy > 0 && em > st.pl_xy) || (st.pl_theta > 0 && er > st.pl_theta);
-      };
-      if (fails(st.err_m, st.err_rad) || exceeds(st.err_m, st.err_rad)) {
+      const double pl_m = st.pl_xy, pl_rad = st.pl_theta;
+      JudgedError je;  // against the log reference alone first: the map is asked only beyond a limit
+      je.ref_m = st.err_m;
+      je.ref_ang = st.err_rad;
+      if (beyond_reference(je, ds.success_bound_m, bound_rad) || beyond_reference(je, pl_m, pl_rad)) {
         const ReferenceMapFit& f = ds.reference_map_fit(i);
         const double em = std::hypot(est.x - f.best.x, est.y - f.best.y);
         const double er = std::fabs(fw::wrap_angle(static_cast<double>(est.theta) - f.best.theta));
@@ -482,15 +482,11 @@ TrialResult run_trial(fw::Localizer& loc, const LoadedDataset& ds, std::size_t s
         // (integrity limits, protection level) is judged beyond, and only that one counts — a failure
         // the map confirms is never dropped because the map clears the other — and excluded, counted,
         // otherwise.
-        JudgedError je;
-        je.ref_m = st.err_m;
-        je.ref_ang = st.err_rad;
         je.bound_m = rb_m;
         je.bound_ang = rb_rad;
         je.map_improves = f.improves;
         je.map_m = em;
         je.map_ang = er;
-        const double pl_m = st.pl_xy, pl_rad = st.pl_theta;
         st.integrity_cleared = !judged_beyond(je, ds.success_bound_m, bound_rad);
         st.pl_cleared = !judged_beyond(je, pl_m, pl_rad);
         const bool judged = !st.integrity_cleared || !st.pl_cleared;
