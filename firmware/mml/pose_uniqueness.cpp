@@ -11,13 +11,14 @@ namespace mml {
 
 float truncated_scan_cost(const GlobalMap& map, const Point2f* points, std::size_t n, const Se2f& pose, float clip_m) {
   if (n == 0) return 1.0f;
+  const DistanceSampler<float> sample(map);
   const float c = std::cos(pose.theta), s = std::sin(pose.theta);
   const double clip2 = static_cast<double>(clip_m) * clip_m;
   double sum = 0.0;
   for (std::size_t i = 0; i < n; ++i) {
     const float px = points[i].x(), py = points[i].y();
     float d, gx, gy;
-    if (!sample_distance<float>(map, pose.x + c * px - s * py, pose.y + s * px + c * py, &d, &gx, &gy) || d > clip_m) {
+    if (!sample(pose.x + c * px - s * py, pose.y + s * px + c * py, &d, &gx, &gy) || d > clip_m) {
       sum += 1.0;
       continue;
     }
@@ -31,13 +32,14 @@ namespace {
 // Principal axes of the translational information Σ ∇D ∇Dᵀ of the inliers at `pose` (columns,
 // weak axis first). Falls back to the map axes when too few points are in contact.
 Eigen::Matrix2f principal_axes(const GlobalMap& map, const Point2f* points, std::size_t n, const Se2f& pose, float clip_m) {
+  const DistanceSampler<float> sample(map);
   const float c = std::cos(pose.theta), s = std::sin(pose.theta);
   Eigen::Matrix2f h = Eigen::Matrix2f::Zero();
   std::size_t inl = 0;
   for (std::size_t i = 0; i < n; ++i) {
     const float px = points[i].x(), py = points[i].y();
     float d, gx, gy;
-    if (!sample_distance<float>(map, pose.x + c * px - s * py, pose.y + s * px + c * py, &d, &gx, &gy) || d > clip_m) continue;
+    if (!sample(pose.x + c * px - s * py, pose.y + s * px + c * py, &d, &gx, &gy) || d > clip_m) continue;
     const Eigen::Vector2f g(gx, gy);
     h += g * g.transpose();
     ++inl;

@@ -25,7 +25,8 @@ struct PointToLineSystem {
   // Σ w J Jᵀ (row-major), Σ w r J and Σ w r² as plain doubles: in the callers' per-point loops the
   // compiler keeps them in registers (Eigen members were re-loaded and stored at every term, the
   // largest single cost of the tracker's alias check). Each term is summed exactly as
-  // `h += w * (j * jᵀ)` summed it: (w·j_a)·j_e.
+  // `h += w * (j * jᵀ)` summed it: (w·j_a)·j_e. Only the lower triangle (e ≤ a) is summed —
+  // the only part LDLT and the self-adjoint eigensolver read — and information() mirrors it.
   double h[9] = {0, 0, 0, 0, 0, 0, 0, 0, 0};
   double b[3] = {0, 0, 0};
   double cost = 0.0;
@@ -39,7 +40,7 @@ struct PointToLineSystem {
     const double j[3] = {nx, ny, static_cast<double>(nx * (-s * px - c * py) + ny * (c * px - s * py))};
     const double wj[3] = {w * j[0], w * j[1], w * j[2]};
     for (int a = 0; a < 3; ++a)
-      for (int e = 0; e < 3; ++e) h[3 * a + e] += wj[a] * j[e];
+      for (int e = 0; e <= a; ++e) h[3 * a + e] += wj[a] * j[e];
     const double wr = w * static_cast<double>(r);
     for (int a = 0; a < 3; ++a) b[a] += wr * j[a];
     cost += wr * r;
@@ -48,7 +49,7 @@ struct PointToLineSystem {
 
   Eigen::Matrix3d information() const {
     Eigen::Matrix3d m;
-    m << h[0], h[1], h[2], h[3], h[4], h[5], h[6], h[7], h[8];
+    m << h[0], h[3], h[6], h[3], h[4], h[7], h[6], h[7], h[8];
     return m;
   }
   Eigen::Vector3d gradient() const { return Eigen::Vector3d(b[0], b[1], b[2]); }

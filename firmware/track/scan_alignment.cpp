@@ -34,6 +34,7 @@ ScanAlignment align_scan(const GlobalMap& map, const Point2f* points, std::size_
   // directions a scan does not see (along a corridor) at the seed instead of letting noise move them.
   const double reg_xy = 1.0 / (1.0 * 1.0), reg_th = 1.0 / (0.5 * 0.5);
   Se2f t = seed;
+  const DistanceSampler<float> sample(map);
   PointToLineSystem sys;  // shared with RBSM's refinement and PL-ICP (firmware/scan/point_to_line.h)
   for (std::uint32_t it = 0; it < o.iterations; ++it) {
     const float outlier = (it < o.iterations / 2) ? 2.0f * o.outlier_m : o.outlier_m;
@@ -43,7 +44,7 @@ ScanAlignment align_scan(const GlobalMap& map, const Point2f* points, std::size_
       const float px = points[i].x(), py = points[i].y();
       const float qx = t.x + c * px - s * py, qy = t.y + s * px + c * py;
       float d = 0.0f, gx = 0.0f, gy = 0.0f;
-      if (!sample_distance<float>(map, qx, qy, &d, &gx, &gy) || d > outlier) continue;
+      if (!sample(qx, qy, &d, &gx, &gy) || d > outlier) continue;
       // On the distance field the residual is d itself and the line normal its gradient.
       const double w = d <= o.huber_m ? 1.0 : static_cast<double>(o.huber_m) / d;  // Huber IRLS weight
       sys.add(px, py, c, s, gx, gy, d, w);
@@ -69,7 +70,7 @@ ScanAlignment align_scan(const GlobalMap& map, const Point2f* points, std::size_
     const float px = points[i].x(), py = points[i].y();
     const float qx = t.x + c * px - s * py, qy = t.y + s * px + c * py;
     float d = 0.0f, gx = 0.0f, gy = 0.0f;
-    const bool ok = sample_distance<float>(map, qx, qy, &d, &gx, &gy);
+    const bool ok = sample(qx, qy, &d, &gx, &gy);
     const PointClass pc = classify(map, qx, qy, ok, d, o.outlier_m);
     if (pc == PointClass::kUnknown) { ++r.unknown; continue; }
     if (pc == PointClass::kContradicting) { ++r.contradicting; continue; }
