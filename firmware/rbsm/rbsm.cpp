@@ -1,6 +1,7 @@
 #include "firmware/rbsm/rbsm.h"
 
 #include "firmware/base/memory_report.h"
+#include "firmware/rbsm/particle_weights.h"
 #include "firmware/scan/point_to_line.h"
 
 #include <cmath>
@@ -160,50 +161,21 @@ std::uint32_t Rbsm::score_pose(const Se2f& pose) {
   return weigh_single(pose.x, pose.y, std::cos(pose.theta), std::sin(pose.theta));
 }
 
-// Weights of sampled particles [begin, end): beams outer, particles inner. Per chunk of particles
-// the window-relative sub-cell coordinates are precomputed; pass 1 (branch-free float/int
-// arithmetic, vectorisable) turns each point into a lookup index (the zero sentinel when outside
-// the window), pass 2 gathers and accumulates. Same values as weigh_single().
+// Weights of sampled particles [begin, end) (particle_weights.h; same values as weigh_single()).
 void Rbsm::weigh_block(std::uint32_t begin, std::uint32_t end) {
   if (options_.mahalanobis) {
     for (std::uint32_t j = begin; j < end; ++j) w_[j] = weigh_mahalanobis(sx_[j], sy_[j], spsi_[j], cos_[j], sin_[j]);
     return;
   }
-  const EndpointGrid::LookupView v = view_;
-  const float lim = v.extent - 1.0f;
-  constexpr std::uint32_t kChunk = 256;
-  alignas(64) float ox[kChunk], oy[kChunk], cs[kChunk], sn[kChunk];
-  alignas(64) std::uint32_t idx[kChunk], acc[kChunk];
-  const std::uint32_t osx = static_cast<std::uint32_t>(v.origin_sx), osy = static_cast<std::uint32_t>(v.origin_sy);
-  const std::uint32_t mask = v.mask, pshift = v.shift - 6, zero = v.zero_index;
-  for (std::uint32_t c0 = begin; c0 < end; c0 += kChunk) {
-    const std::uint32_t n = end - c0 < kChunk ? end - c0 : kChunk;
-    for (std::uint32_t j = 0; j < n; ++j) {
-      ox[j] = (sx_[c0 + j] - v.origin_x) * v.inv_subcell;
-      oy[j] = (sy_[c0 + j] - v.origin_y) * v.inv_subcell;
-      cs[j] = cos_[c0 + j] * v.inv_subcell;
-      sn[j] = sin_[c0 + j] * v.inv_subcell;
-      acc[j] = 0;
-    }
-    for (std::uint32_t i = 0; i < num_points_; ++i) {
-      const float bx = px_[i], by = py_[i];
-      for (std::uint32_t j = 0; j < n; ++j) {
-        float fx = ox[j] + (cs[j] * bx - sn[j] * by);
-        float fy = oy[j] + (sn[j] * bx + cs[j] * by);
-        const bool inside = (fx >= 0.0f) & (fx < v.extent) & (fy >= 0.0f) & (fy < v.extent);
-        fx = fx < 0.0f ? 0.0f : (fx > lim ? lim : fx);
-        fy = fy < 0.0f ? 0.0f : (fy > lim ? lim : fy);
-        const std::uint32_t sx = (static_cast<std::uint32_t>(static_cast<std::int32_t>(fx)) + osx) & mask;
-        const std::uint32_t sy = (static_cast<std::uint32_t>(static_cast<std::int32_t>(fy)) + osy) & mask;
-        const std::uint32_t page = ((sy >> 6) << pshift) | (sx >> 6);
-        const std::uint32_t t =
-            (page << 12) | (((sy >> 3) & 7u) << 9) | (((sx >> 3) & 7u) << 6) | ((sy & 7u) << 3) | (sx & 7u);
-        idx[j] = inside ? t : zero;
-      }
-      for (std::uint32_t j = 0; j < n; ++j) acc[j] += v.values[idx[j]];
-    }
-    for (std::uint32_t j = 0; j < n; ++j) w_[c0 + j] = acc[j];
-  }
+  ParticleBlock b;
+  b.x = sx_;
+  b.y = sy_;
+  b.cos = cos_;
+  b.sin = sin_;
+  b.weights = w_;
+  b.begin = begin;
+  b.end = end;
+  weigh_particles(view_, px_, py_, num_points_, b, options_.wide_simd);
 }
 
 // Alg. 1 l. 12: coordinate hill climbing (±step in x, y, ψ; halve the steps when nothing improves).
