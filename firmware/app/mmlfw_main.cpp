@@ -73,11 +73,11 @@ void trace_step(hal::Hal& hal) {
     const fw::track::TrackStep& t = g_system.tracked()->tracker().last();
     hal.log->log(hal::LogLevel::kDebug,
                  "step scan %u t %llu odom %.4f %.4f %.4f status %s pose %.3f %.3f %.3f track %s inliers %u/%u "
-                 "unknown %u chi2 %.2f pl %.3f m %.4f rad unsupported %u",
+                 "unknown %u chi2 %.2f pl %.3f m %.4f rad unsupported %u reason %s",
                  e.scan_id, static_cast<unsigned long long>(e.timestamp_ns), od.x, od.y, od.theta,
                  hal::status_name(e.status), e.x, e.y, e.theta, fw::track::verdict_name(t.verdict), t.alignment.inliers,
                  t.alignment.inliers + t.alignment.contradicting, t.alignment.unknown, t.innovation_chi2,
-                 e.protection_xy_m, e.protection_theta_rad, e.unsupported_steps);
+                 e.protection_xy_m, e.protection_theta_rad, e.unsupported_steps, hal::reason_name(e.reason));
     return;
   }
   // MML's state belongs to the global thread when it runs there: not read from here.

@@ -46,6 +46,7 @@ void HandoffLocalizer::reset() {
 }
 
 Status HandoffLocalizer::step(const hal::LaserScan& scan, const hal::Odometry& odom, hal::PoseEstimate* out) {
+  const hal::CompleteReasonOnExit reason_on_exit{out};  // every estimate says why it is not `localized`
   if (mml_ == nullptr) return Status::error(Errc::kNotInitialized, "HandoffLocalizer: step() before init()");
   if (!tracking_) {
     FW_RETURN_IF_ERROR(mml_->step(scan, odom, out));

@@ -319,6 +319,7 @@ float MmlLocalizer::unknown_contact(const Se2f& h) const {
 // Eq. 5.37, (3) the local map handed to pRANSAM, (4) pRANSAM collect-all against the global map,
 // (5) interpretation (Eq. 5.8–5.29, unknown regions), (6) the published pose, (7) publication.
 Status MmlLocalizer::step(const hal::LaserScan& scan, const hal::Odometry& odom, hal::PoseEstimate* out) {
+  const hal::CompleteReasonOnExit reason_on_exit{out};  // every estimate says why it is not `localized`
   if (!initialized_) return Status::error(Errc::kNotInitialized, "MmlLocalizer: step() before init()");
   if (out == nullptr) return Status::error(Errc::kInvalidArgument, "MmlLocalizer: null output");
   if (!std::isfinite(odom.x) || !std::isfinite(odom.y) || !std::isfinite(odom.theta)) {

@@ -24,6 +24,7 @@ void OdometryLocalizer::reset() {
 }
 
 Status OdometryLocalizer::step(const hal::LaserScan& scan, const hal::Odometry& odom, hal::PoseEstimate* out) {
+  const hal::CompleteReasonOnExit reason_on_exit{out};  // every estimate says why it is not `localized`
   if (!odometry_is_finite(odom)) {
     return Status::error(Errc::kInvalidArgument, "odom localizer: odometry at t=%llu ns is not finite",
                          static_cast<unsigned long long>(odom.timestamp_ns));

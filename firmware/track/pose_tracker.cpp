@@ -397,13 +397,22 @@ void PoseTracker::publish(const Point2f* points, std::size_t n, const StepWork& 
   out->faulty_steps = faulty_;
   out->outside_steps = outside_;
   const bool within = out->pl.xy_m <= o.alert_limit_m && out->pl.theta_rad <= o.alert_limit_rad;
+  const bool recovered = !had_fault_ || consistent_since_fault_ >= o.recovery_steps;
+  out->status = hal::LocalizationStatus::kAmbiguous;
   if (v == ScanVerdict::kOutsideMap) {
     out->status = hal::LocalizationStatus::kOutsideMap;
-  } else if (v != ScanVerdict::kContradicting && v != ScanVerdict::kAmbiguous && faulty_ == 0 && within &&
-             (!had_fault_ || consistent_since_fault_ >= o.recovery_steps)) {
-    out->status = hal::LocalizationStatus::kLocalized;
+    out->reason = hal::StatusReason::kOutsideMap;
+  } else if (v == ScanVerdict::kContradicting || faulty_ > 0) {
+    out->reason = hal::StatusReason::kTrackFault;
+  } else if (v == ScanVerdict::kAmbiguous) {
+    out->reason = hal::StatusReason::kTrackAlias;
+  } else if (!within) {
+    out->reason = hal::StatusReason::kTrackBeyondAlert;
+  } else if (!recovered) {
+    out->reason = hal::StatusReason::kTrackRecovering;
   } else {
-    out->status = hal::LocalizationStatus::kAmbiguous;
+    out->status = hal::LocalizationStatus::kLocalized;
+    out->reason = hal::StatusReason::kNone;
   }
   out->lost = faulty_ >= o.max_faulty_steps || outside_ >= o.max_outside_steps || !(out->pl.xy_m <= o.lost_limit_m) ||
               !pose_.vector().allFinite();

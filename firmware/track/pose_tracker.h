@@ -50,6 +50,7 @@ struct TrackStep {
   Eigen::Matrix3f cov = Eigen::Matrix3f::Zero();
   ProtectionLevel pl;
   hal::LocalizationStatus status = hal::LocalizationStatus::kSearching;
+  hal::StatusReason reason = hal::StatusReason::kSearching;  // why not `localized` (kNone when it is)
   ScanVerdict verdict = ScanVerdict::kUninformative;
   bool fused = false;
   bool lost = false;            // the track is given up: go back to global localization

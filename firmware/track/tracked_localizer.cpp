@@ -46,6 +46,7 @@ void TrackedLocalizer::publish_track(const TrackStep& ts, hal::PoseEstimate* out
   for (int r = 0; r < 3; ++r)
     for (int c = 0; c < 3; ++c) out->cov[r * 3 + c] = ts.cov(r, c);
   out->status = ts.status;
+  out->reason = ts.reason;
   out->mode = hal::LocalizationMode::kTracking;
   out->hypothesis_count = 1;
   out->cluster_count = 1;
@@ -56,6 +57,7 @@ void TrackedLocalizer::publish_track(const TrackStep& ts, hal::PoseEstimate* out
 }
 
 Status TrackedLocalizer::step(const hal::LaserScan& scan, const hal::Odometry& odom, hal::PoseEstimate* out) {
+  const hal::CompleteReasonOnExit reason_on_exit{out};  // every estimate says why it is not `localized`
   if (mml_ == nullptr) return Status::error(Errc::kNotInitialized, "TrackedLocalizer: step() before init()");
   if (out == nullptr) return Status::error(Errc::kInvalidArgument, "TrackedLocalizer: null output");
   if (!std::isfinite(odom.x) || !std::isfinite(odom.y) || !std::isfinite(odom.theta)) {
@@ -87,6 +89,7 @@ Status TrackedLocalizer::step(const hal::LaserScan& scan, const hal::Odometry& o
       FW_RETURN_IF_ERROR(global_.step(scan, odom, &g));
       out->status = ts.verdict == ScanVerdict::kOutsideMap ? hal::LocalizationStatus::kOutsideMap
                                                            : hal::LocalizationStatus::kSearching;
+      out->reason = hal::reason_of_status(out->status);
       out->mode = hal::LocalizationMode::kGlobal;
       out->protection_xy_m = out->protection_theta_rad = 0.0f;
     }
@@ -95,7 +98,10 @@ Status TrackedLocalizer::step(const hal::LaserScan& scan, const hal::Odometry& o
   FW_RETURN_IF_ERROR(global_.step(scan, odom, out));
   out->mode = hal::LocalizationMode::kGlobal;
   out->protection_xy_m = out->protection_theta_rad = 0.0f;
-  if (out->status != hal::LocalizationStatus::kLocalized) return Status::ok();
+  if (out->status != hal::LocalizationStatus::kLocalized) {
+    out->reason = hal::reason_of_status(out->status);
+    return Status::ok();
+  }
   // MML says the pose is isolated: the tracker must confirm it on this scan before it is published.
   const hal::PoseEstimate g = *out;
   start_from_fix(g, wheel, n, out);
@@ -118,6 +124,7 @@ bool TrackedLocalizer::start_from_fix(const hal::PoseEstimate& g, const Se2f& wh
   ++fix_rejections_;
   tracker_.reset();
   out->status = hal::LocalizationStatus::kAmbiguous;
+  out->reason = hal::StatusReason::kFixRejected;
   out->mode = hal::LocalizationMode::kGlobal;
   out->protection_xy_m = out->protection_theta_rad = 0.0f;
   return false;
@@ -127,7 +134,10 @@ Status TrackedLocalizer::cross_check(const hal::LaserScan& scan, const hal::Odom
                                      std::size_t n, const TrackStep& ts, hal::PoseEstimate* out) {
   const std::uint32_t budget = tracker_.options().cross_check_steps;
   if (budget == 0) return Status::ok();
-  if (unconfirmed_) out->status = hal::LocalizationStatus::kAmbiguous;  // until MML agrees
+  if (unconfirmed_) {  // until MML agrees
+    out->status = hal::LocalizationStatus::kAmbiguous;
+    out->reason = hal::StatusReason::kTrackAwaitingMml;
+  }
   if (ts.status != hal::LocalizationStatus::kLocalized || unconfirmed_) {
     if (cross_check_left_ == 0) global_.reset();  // a fresh local map from this scan on
     cross_check_left_ = budget;                 // runs on for `budget` scans after the last doubt
@@ -145,6 +155,7 @@ Status TrackedLocalizer::cross_check(const hal::LaserScan& scan, const hal::Odom
       unconfirmed_ = false;
       ++confirmations_;
       out->status = ts.status;  // the tracker's own verdict on this scan stands again
+      out->reason = ts.reason;
     }
     return Status::ok();
   }
@@ -163,6 +174,7 @@ Status TrackedLocalizer::cross_check(const hal::LaserScan& scan, const hal::Odom
       ++cross_check_conflicts_;
       unconfirmed_ = true;
       out->status = hal::LocalizationStatus::kAmbiguous;
+      out->reason = hal::StatusReason::kTrackAwaitingMml;
       global_.reset();
       cross_check_left_ = o.cross_check_steps;
       return Status::ok();
@@ -175,6 +187,7 @@ Status TrackedLocalizer::cross_check(const hal::LaserScan& scan, const hal::Odom
   out->timestamp_ns = scan.timestamp_ns;
   out->scan_id = scan.scan_id;
   out->status = hal::LocalizationStatus::kAmbiguous;
+  out->reason = hal::StatusReason::kAmbiguous;
   out->mode = hal::LocalizationMode::kGlobal;
   start_from_fix(g, wheel, n, out);
   return Status::ok();

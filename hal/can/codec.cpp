@@ -249,10 +249,11 @@ Status encode_pose(const hal::PoseEstimate& pose, std::uint8_t tag, bool fd, hal
   put_u48(p + 28, pose.timestamp_ns / 1000);
   p[kPoseLayoutOffset] = kPoseLayout;
   // Part 5 (layout 1): protection level (RAIM-style bound, hal/msg/pose_estimate.h) and the
-  // number of scans since one last confirmed the pose. p[41] is reserved (0).
+  // number of scans since one last confirmed the pose; layout 2: the status reason in p[41].
   put_u16(p + 35, protection_code(pose.protection_xy_m, kProtectionXyPerMetre));
   put_u16(p + 37, protection_code(pose.protection_theta_rad, kProtectionThetaPerRad));
   put_u16(p + 39, pose.unsupported_steps);
+  p[kPoseReasonOffset] = static_cast<std::uint8_t>(pose.reason);
   return emit_record(kPoseId, kPoseParts, tag, p, fd, out, capacity, count, "pose");
 }
 
@@ -539,6 +540,13 @@ Decoded Decoder::feed(const hal::CanFrame& f) {
       pose_.protection_xy_m = protection_value(get_u16(p + 35), kProtectionXyPerMetre);
       pose_.protection_theta_rad = protection_value(get_u16(p + 37), kProtectionThetaPerRad);
       pose_.unsupported_steps = get_u16(p + 39);
+    }
+    if (p[kPoseLayoutOffset] >= 2) {
+      if (p[kPoseReasonOffset] >= hal::kStatusReasonCount) {
+        ++stats_.malformed;
+        return Decoded::kNothing;
+      }
+      pose_.reason = static_cast<hal::StatusReason>(p[kPoseReasonOffset]);
     }
     ++stats_.poses_ok;
     return Decoded::kPose;

@@ -519,6 +519,52 @@ TEST(PoseProtection, DecodesLayoutZeroSenders) {
   }
 }
 
+TEST(PoseReason, RoundTripsOlderLayoutsReadNoneAndAnUnknownReasonIsMalformed) {
+  for (bool fd : {false, true}) {
+    hal::PoseEstimate p = pose_with_protection(0.3f, 0.02f, 4);
+    p.status = hal::LocalizationStatus::kAmbiguous;
+    for (std::uint8_t r = 0; r < hal::kStatusReasonCount; ++r) {
+      p.reason = static_cast<hal::StatusReason>(r);
+      EXPECT_EQ(round_trip(p, fd).reason, p.reason) << "fd=" << fd << " reason " << int(r);
+    }
+    // The reason byte and the layout byte in the frames (payload offsets 41 and 34).
+    auto reason_byte = [fd](hal::CanFrame* f) -> std::uint8_t& {
+      return fd ? f[0].data[1 + kPoseReasonOffset] : f[5].data[1 + (kPoseReasonOffset - 5 * kPartBytes)];
+    };
+    auto layout_byte = [fd](hal::CanFrame* f) -> std::uint8_t& {
+      return fd ? f[0].data[1 + kPoseLayoutOffset] : f[4].data[1 + (kPoseLayoutOffset - 4 * kPartBytes)];
+    };
+    hal::CanFrame f[kMaxParts];
+    std::size_t n = 0;
+    p.reason = hal::StatusReason::kTrackAlias;
+    ASSERT_TRUE(encode_pose(p, 2, fd, f, kMaxParts, &n).is_ok());
+    ASSERT_EQ(reason_byte(f), static_cast<std::uint8_t>(hal::StatusReason::kTrackAlias));
+    ASSERT_EQ(layout_byte(f), kPoseLayout);
+    // A layout-1 sender: byte 41 was reserved (0) and is not read as a reason.
+    layout_byte(f) = 1;
+    reason_byte(f) = 0;
+    {
+      Decoder d;
+      Decoded last = Decoded::kNothing;
+      for (std::size_t i = 0; i < n; ++i) last = d.feed(f[i]);
+      ASSERT_EQ(last, Decoded::kPose);
+      EXPECT_EQ(d.pose().reason, hal::StatusReason::kNone);
+      EXPECT_EQ(d.pose().unsupported_steps, 4);
+    }
+    // Layout 2 with a reason the receiver does not know: malformed, never delivered as something else.
+    layout_byte(f) = kPoseLayout;
+    reason_byte(f) = hal::kStatusReasonCount;
+    {
+      Decoder d;
+      Decoded last = Decoded::kNothing;
+      for (std::size_t i = 0; i < n; ++i) last = d.feed(f[i]);
+      EXPECT_EQ(last, Decoded::kNothing);
+      EXPECT_EQ(d.stats().malformed, 1u);
+      EXPECT_EQ(d.stats().poses_ok, 0u);
+    }
+  }
+}
+
 TEST(PoseProtection, MissingProtectionPartDropsThePose) {
   // Layout 1 announces part 5: without it the pose is not delivered (and never delivered with
   // a made-up bound); the next complete pose is fine again.

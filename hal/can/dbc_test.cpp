@@ -101,6 +101,7 @@ TEST(Dbc, DescribesEveryFrameTheEncoderProduces) {
     p.protection_xy_m = 0.75f;
     p.protection_theta_rad = 0.0523f;
     p.unsupported_steps = 1234;
+    p.reason = hal::StatusReason::kTrackAwaitingMml;
     ASSERT_TRUE(encode_pose(p, 5, fd, f, kMaxParts, &n).is_ok());
     EXPECT_EQ(n, fd ? 1u : kPoseParts);
     for (std::size_t i = 0; i < n; ++i) {
@@ -124,6 +125,7 @@ TEST(Dbc, DescribesEveryFrameTheEncoderProduces) {
     EXPECT_NEAR(sig(dbc, f, n, "ProtectionXY"), 0.75, 1e-9);
     EXPECT_NEAR(sig(dbc, f, n, "ProtectionTheta"), 0.0523, 1e-9);
     EXPECT_EQ(sig(dbc, f, n, "UnsupportedSteps"), 1234);
+    EXPECT_EQ(sig(dbc, f, n, "Reason"), 9);
     // The DBC factors are the codec's: a saturated bound reads as the DBC's maximum.
     p.protection_xy_m = 1e6f;
     p.protection_theta_rad = 100.0f;

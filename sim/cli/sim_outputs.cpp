@@ -51,7 +51,7 @@ bool write_steps_csv(const std::string& path, const std::vector<StepRecord>& ste
   std::fprintf(f,
                "step,t_s,scan_id,status,mode,x,y,theta,truth_x,truth_y,truth_theta,err_m,err_deg,travelled_m,"
                "hypotheses,clusters,rating,odom_x,odom_y,odom_theta,cov_xx,cov_yy,cov_tt,step_ms,kidnapped,"
-               "pl_xy_m,pl_theta_deg,unsupported_steps,in_unknown,truth_bound_m,truth_bound_deg,map_err_m,map_err_deg\n");
+               "pl_xy_m,pl_theta_deg,unsupported_steps,in_unknown,truth_bound_m,truth_bound_deg,map_err_m,map_err_deg,reason\n");
   for (const StepRecord& s : steps) {
     const hal::PoseEstimate& e = s.estimate;
     std::fprintf(f, "%u,%.3f,%u,%s,%s,%.4f,%.4f,%.5f,", s.step, s.t, e.scan_id, hal::status_name(e.status),
@@ -86,10 +86,11 @@ bool write_steps_csv(const std::string& path, const std::vector<StepRecord>& ste
     // The error against the map's pose for the scan, where the map explains it clearly better than
     // the log reference (asked only at steps beyond a limit: reference_judge.h).
     if (s.map_checked && s.map_pose_better) {
-      std::fprintf(f, "%.4f,%.3f\n", s.map_err_m, s.map_err_deg);
+      std::fprintf(f, "%.4f,%.3f,", s.map_err_m, s.map_err_deg);
     } else {
-      std::fprintf(f, ",\n");
+      std::fprintf(f, ",,");
     }
+    std::fprintf(f, "%s\n", hal::reason_name(e.reason));  // why not `localized` (none when it is)
   }
   const bool ok = std::fclose(f) == 0;
   if (!ok) *err = "error writing '" + path + "'";
@@ -118,6 +119,12 @@ bool write_summary_json(const std::string& path, const SimSummary& s, std::strin
   std::fprintf(f, "  \"first_localized_pl_xy_m\": %s,\n", num(s.first_localized_pl_xy_m).c_str());
   std::fprintf(f, "  \"availability\": %s,\n  \"availability_steps\": %zu,\n  \"availability_localized_steps\": %zu,\n",
                num(s.availability).c_str(), s.availability_steps, s.availability_localized);
+  std::fprintf(f, "  \"unavailable_by_reason\": {");
+  for (std::size_t k = 1; k < hal::kStatusReasonCount; ++k) {
+    std::fprintf(f, "%s\"%s\": %zu", k > 1 ? ", " : "", hal::reason_name(static_cast<hal::StatusReason>(k)),
+                 s.unavailable_by_reason[k]);
+  }
+  std::fprintf(f, "},\n");
   std::fprintf(f, "  \"unknown_area_steps_excluded\": %zu,\n", s.unknown_area_steps);
   std::fprintf(f, "  \"integrity_failures\": %zu,\n  \"integrity_failures_before_kidnap_detection\": %zu,\n",
                s.integrity_failures, s.integrity_failures_kidnap);

@@ -118,6 +118,9 @@ struct SimSummary {
   // known (built-in worlds with the unknown area erased); unknown_area_steps counts them.
   std::size_t availability_steps = 0, availability_localized = 0, unknown_area_steps = 0;
   double availability = NAN;
+  // The availability steps that were not `localized`, by the reason published with them
+  // (hal::StatusReason): where the availability went.
+  std::size_t unavailable_by_reason[hal::kStatusReasonCount] = {};
   // Integrity failures: `localized` steps with error > kIntegrityLimitM or > kIntegrityLimitDeg;
   // of them, those between a kidnapping and its detection.
   std::size_t integrity_failures = 0, integrity_failures_kidnap = 0;

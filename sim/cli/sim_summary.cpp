@@ -83,7 +83,12 @@ void count_availability(const StepRecord& r, bool loc, SimSummary* s) {
     ++s->unknown_area_steps;
   } else {
     ++s->availability_steps;
-    if (loc) ++s->availability_localized;
+    if (loc) {
+      ++s->availability_localized;
+    } else {
+      const auto k = static_cast<std::size_t>(r.estimate.reason);
+      if (k < hal::kStatusReasonCount) ++s->unavailable_by_reason[k];
+    }
   }
 }
 

@@ -30,7 +30,24 @@ std::string availability_text(const SimSummary& s) {
   std::string t = fmt("availability %.1f %% (%zu/%zu steps after the fix", 100.0 * s.availability,
                       s.availability_localized, s.availability_steps);
   if (s.unknown_area_steps > 0) t += fmt(", %zu in unknown area left out", s.unknown_area_steps);
-  return t + ")";
+  t += ")";
+  // Where it went, largest share first (the reason published with each step that was not `localized`).
+  std::string why;
+  bool used[hal::kStatusReasonCount] = {};
+  for (;;) {
+    std::size_t best = hal::kStatusReasonCount, n = 0;
+    for (std::size_t k = 0; k < hal::kStatusReasonCount; ++k) {
+      if (!used[k] && s.unavailable_by_reason[k] > n) {
+        n = s.unavailable_by_reason[k];
+        best = k;
+      }
+    }
+    if (best == hal::kStatusReasonCount) break;
+    used[best] = true;
+    why += fmt("%s%s %zu", why.empty() ? "" : ", ", hal::reason_name(static_cast<hal::StatusReason>(best)), n);
+  }
+  if (!why.empty()) t += " [not localized: " + why + "]";
+  return t;
 }
 
 std::string pl_text(const SimSummary& s) {

@@ -47,6 +47,7 @@ void MclLocalizer::publish(const hal::LaserScan& scan, const Se2f& pose, hal::Po
 }
 
 Status MclLocalizer::step(const hal::LaserScan& scan, const hal::Odometry& odom, hal::PoseEstimate* out) {
+  const hal::CompleteReasonOnExit reason_on_exit{out};  // every estimate says why it is not `localized`
   if (out == nullptr) return Status::error(Errc::kInvalidArgument, "MclLocalizer: null output");
   if (!std::isfinite(odom.x) || !std::isfinite(odom.y) || !std::isfinite(odom.theta)) {
     return Status::error(Errc::kInvalidArgument, "MclLocalizer: non-finite odometry at scan %u", scan.scan_id);

@@ -37,10 +37,13 @@ constexpr std::size_t kMaxRecordBytes = kMaxParts * kPartBytes;  // 42
 
 // POSE layout byte (payload offset 34, reserved and 0 before protection levels existed). Layouts
 // only append: layout 0 = the original 5-part record (parts 0x120..0x124), layout 1 adds part 5
-// (0x125) with the protection level and unsupported_steps. Receivers accept both; a layout-0
-// record decodes with protection 0 (= no bound) and unsupported_steps 0.
+// (0x125) with the protection level and unsupported_steps, layout 2 fills part 5's last byte
+// (payload 41, reserved 0 before) with the status reason (hal::StatusReason). Receivers accept
+// all three; a layout-0 record decodes with protection 0 (= no bound) and unsupported_steps 0,
+// a layout < 2 with reason kNone (not stated).
 constexpr std::size_t kPoseLayoutOffset = 34;
-constexpr std::uint8_t kPoseLayout = 1;
+constexpr std::uint8_t kPoseLayout = 2;
+constexpr std::size_t kPoseReasonOffset = 41;
 constexpr std::size_t kPoseLegacyParts = 5;  // layout 0
 
 // Protection level on the wire (POSE part 5): u16, rounded *up* (a bound must not shrink);

@@ -19,6 +19,24 @@ enum class LocalizationMode : std::uint8_t {
   kTracking = 1,  // tracking against the global map after a fix (mml-track: scan-to-map; handoff: MCL)
 };
 
+// Why a pose is not `localized` (the product's silence explained; POSE layout 2 on CAN, the
+// `reason` column of steps.csv). One reason per estimate; where several hold, the first of this
+// order that applies: awaiting MML > fault > alias > beyond the alert limit > recovering.
+enum class StatusReason : std::uint8_t {
+  kNone = 0,             // localized (or not stated: a POSE record of layout < 2)
+  kSearching = 1,        // global: local map too small, or no candidate pose
+  kAmbiguous = 2,        // global: candidate poses, none isolated yet
+  kFixRejected = 3,      // global: MML isolated a pose that the scan, checked on the map, did not confirm
+  kOutsideMap = 4,       // the robot is in space the map does not contain
+  kTrackFault = 5,       // tracked: this scan contradicts the pose (fit, innovation, odometry window)
+  kTrackAlias = 6,       // tracked: the scan fits a rival pose as well (alias check)
+  kTrackBeyondAlert = 7, // tracked: the protection level exceeds an alert limit
+  kTrackRecovering = 8,  // tracked: too few consistent scans since the last fault or alias
+  kTrackAwaitingMml = 9, // tracked: after a large fault (or a conflict), until MML isolates the tracked pose
+  kFault = 10,           // internal fault
+};
+constexpr std::uint8_t kStatusReasonCount = 11;
+
 const char* status_name(LocalizationStatus s);
 
 struct PoseEstimate {
@@ -38,7 +56,56 @@ struct PoseEstimate {
   float protection_theta_rad = 0.0f;
   // Consecutive scans since a scan last confirmed the pose (0 = this scan did).
   std::uint16_t unsupported_steps = 0;
+  StatusReason reason = StatusReason::kNone;  // why not `localized` (kNone when it is)
 };
+
+// The reason a status implies by itself (for localizers that know no more: odometry, MCL, MML alone).
+inline StatusReason reason_of_status(LocalizationStatus s) {
+  switch (s) {
+    case LocalizationStatus::kLocalized: return StatusReason::kNone;
+    case LocalizationStatus::kSearching: return StatusReason::kSearching;
+    case LocalizationStatus::kAmbiguous: return StatusReason::kAmbiguous;
+    case LocalizationStatus::kOutsideMap: return StatusReason::kOutsideMap;
+    case LocalizationStatus::kFault: return StatusReason::kFault;
+  }
+  return StatusReason::kFault;
+}
+
+// Every estimate that is not `localized` says why: the status's own reason unless a more specific one is set;
+// a `localized` estimate has none.
+inline void complete_reason(PoseEstimate* e) {
+  if (e->status == LocalizationStatus::kLocalized) {
+    e->reason = StatusReason::kNone;
+  } else if (e->reason == StatusReason::kNone) {
+    e->reason = reason_of_status(e->status);
+  }
+}
+
+// Declared first in a Localizer's step(): whatever path step() returns by, its estimate says why
+// it is not `localized` (complete_reason).
+struct CompleteReasonOnExit {
+  PoseEstimate* estimate;
+  ~CompleteReasonOnExit() {
+    if (estimate != nullptr) complete_reason(estimate);
+  }
+};
+
+inline const char* reason_name(StatusReason r) {
+  switch (r) {
+    case StatusReason::kNone: return "none";
+    case StatusReason::kSearching: return "searching";
+    case StatusReason::kAmbiguous: return "ambiguous";
+    case StatusReason::kFixRejected: return "fix-rejected";
+    case StatusReason::kOutsideMap: return "outside-map";
+    case StatusReason::kTrackFault: return "track-fault";
+    case StatusReason::kTrackAlias: return "track-alias";
+    case StatusReason::kTrackBeyondAlert: return "track-beyond-alert";
+    case StatusReason::kTrackRecovering: return "track-recovering";
+    case StatusReason::kTrackAwaitingMml: return "track-awaiting-mml";
+    case StatusReason::kFault: return "fault";
+  }
+  return "unknown";
+}
 
 inline const char* status_name(LocalizationStatus s) {
   switch (s) {
