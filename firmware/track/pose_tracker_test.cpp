@@ -106,8 +106,10 @@ TEST(PoseTrackerTest, UninformativeScansGrowProtectionLevelUntilStatusDrops) {
     prev_pl = s.pl.xy_m;
     if (s.status == hal::LocalizationStatus::kLocalized) {
       EXPECT_LT(err_xy(s.pose, truth), s.pl.xy_m) << "step " << i;
+      EXPECT_EQ(s.reason, hal::StatusReason::kNone);
     } else {
       dropped = true;
+      EXPECT_EQ(s.reason, hal::StatusReason::kTrackBeyondAlert) << hal::reason_name(s.reason);
     }
   }
   EXPECT_TRUE(dropped);
@@ -251,6 +253,7 @@ TEST(PoseTrackerTest, OdometryFaultRecoversOnlyAfterConsistentScans) {
   const TrackStep fault = t.step(pts.data(), pts.size(), odom);
   EXPECT_EQ(fault.verdict, ScanVerdict::kContradicting);
   EXPECT_NE(fault.status, hal::LocalizationStatus::kLocalized);
+  EXPECT_EQ(fault.reason, hal::StatusReason::kTrackFault);
   EXPECT_GT(fault.cov(1, 1), 0.25f * 0.25f * 0.5f) << "widened across the motion too";
   for (std::uint32_t i = 0; i < o.recovery_steps + 2; ++i) {
     odom = odom.compose(Se2f(0.0f, 0.0f, 0.06f));  // turn in place so every scan is fused
@@ -260,6 +263,9 @@ TEST(PoseTrackerTest, OdometryFaultRecoversOnlyAfterConsistentScans) {
     EXPECT_EQ(s.verdict, ScanVerdict::kSupported) << i;
     if (i + 1 < o.recovery_steps) {
       EXPECT_NE(s.status, hal::LocalizationStatus::kLocalized) << "too early at " << i;
+      // Still widened by the fault (beyond the alert limit) or counting consistent scans.
+      EXPECT_TRUE(s.reason == hal::StatusReason::kTrackRecovering || s.reason == hal::StatusReason::kTrackBeyondAlert)
+          << i << " " << hal::reason_name(s.reason);
     } else {
       EXPECT_EQ(s.status, hal::LocalizationStatus::kLocalized) << i;
       EXPECT_LT(err_xy(s.pose, tr), s.pl.xy_m) << i;
@@ -372,6 +378,7 @@ TEST(PoseTrackerTest, AliasAlongCorridorIsNeverLocalized) {
       localized += s.status == hal::LocalizationStatus::kLocalized;
       if (check) {
         EXPECT_EQ(s.verdict, ScanVerdict::kAmbiguous) << i;
+        EXPECT_EQ(s.reason, hal::StatusReason::kTrackAlias) << i;
         EXPECT_LT(s.alias_rival_cost, s.alias_cost + o.alias_margin) << i;
       }
     }

@@ -128,6 +128,7 @@ TEST(TrackedLocalizerTest, KidnapIsDetectedAndRefixed) {
 // the track itself unless heading_fault_local_recovery is off: the next test.)
 struct JumpRun {
   int awaiting_steps = 0, awaiting_localized = 0, withheld = 0, localized_after = 0;
+  int awaiting_reason = 0;  // awaiting steps published with the reason track-awaiting-mml
   bool jumped = false;
   std::size_t jump_at = 0;
 };
@@ -160,6 +161,13 @@ void drive_through_heading_jump(Rig& rig, JumpRun* r) {
     hal::PoseEstimate est;
     ASSERT_TRUE(rig.loc->step(scan, od, &est).is_ok());
     const bool loc = est.status == hal::LocalizationStatus::kLocalized;
+    // Every estimate says why it is not `localized`; one that is has no reason.
+    EXPECT_EQ(est.reason == hal::StatusReason::kNone, loc) << i << " " << hal::reason_name(est.reason);
+    if (est.mode == hal::LocalizationMode::kGlobal && !loc) {
+      EXPECT_TRUE(est.reason == hal::StatusReason::kSearching || est.reason == hal::StatusReason::kAmbiguous ||
+                  est.reason == hal::StatusReason::kFixRejected || est.reason == hal::StatusReason::kOutsideMap)
+          << i << " " << hal::reason_name(est.reason);
+    }
     if (loc && fixed_at < 0) fixed_at = static_cast<int>(i);
     if (loc) {
       EXPECT_LT(std::hypot(est.x - path[i].x, est.y - path[i].y), 0.5f) << i;
@@ -167,6 +175,7 @@ void drive_through_heading_jump(Rig& rig, JumpRun* r) {
     }
     if (r->jumped) {
       r->awaiting_steps += rig.loc->awaiting_confirmation();
+      r->awaiting_reason += rig.loc->awaiting_confirmation() && est.reason == hal::StatusReason::kTrackAwaitingMml;
       r->awaiting_localized += rig.loc->awaiting_confirmation() && loc;
       r->withheld += rig.loc->awaiting_confirmation() &&
                      rig.loc->tracker().last().status == hal::LocalizationStatus::kLocalized;
@@ -186,6 +195,7 @@ TEST(TrackedLocalizerTest, LargeFaultWaitsForGlobalConfirmation) {
   ASSERT_TRUE(r.jumped) << "never localized before the jump";
   EXPECT_GT(r.awaiting_steps, 0) << "the 20° jump at step " << r.jump_at << " was not a large fault";
   EXPECT_EQ(r.awaiting_localized, 0);
+  EXPECT_EQ(r.awaiting_reason, r.awaiting_steps) << "the silence while MML confirms is published as such";
   EXPECT_GT(r.withheld, 0) << "the tracker alone would have published `localized` before MML confirmed";
   EXPECT_EQ(rig.loc->tracks_lost(), 0u);
   EXPECT_GE(rig.loc->confirmations(), 1u);

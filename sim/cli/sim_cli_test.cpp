@@ -15,6 +15,7 @@
 #include "sim/cli/localizer_factory.h"
 #include "sim/cli/sim_args.h"
 #include "sim/cli/sim_runner.h"
+#include "sim/cli/summary_text.h"
 #include "sim/viz/picture.h"
 
 namespace sim {
@@ -526,15 +527,23 @@ TEST(SimSummary, FiguresFromSteps) {
   v.push_back(rec(18, S::kLocalized, 40.0));
   v.back().estimate.mode = hal::LocalizationMode::kTracking;
   v.push_back(rec(19, S::kAmbiguous, 40.0));   // detected: 2 steps after the kidnap
+  v.back().estimate.reason = hal::StatusReason::kTrackFault;
   v.push_back(rec(20, S::kSearching, 0));
+  v.back().estimate.reason = hal::StatusReason::kSearching;
   v.push_back(rec(21, S::kLocalized, 0.02));   // re-fix
   v.back().estimate.mode = hal::LocalizationMode::kTracking;
   v.push_back(rec(22, S::kOutsideMap, 0));
   v.back().has_pose = false;  // a placeholder: the final error is step 21's
   v.back().err_m = v.back().err_deg = NAN;
+  v.back().estimate.reason = hal::StatusReason::kOutsideMap;
   SimSummary s;
   s.source = "test";
   summarize_steps(v, &s);
+  // The 3 availability steps not `localized`, by the reason published with them.
+  EXPECT_EQ(s.unavailable_by_reason[static_cast<int>(hal::StatusReason::kTrackFault)], 1u);
+  EXPECT_EQ(s.unavailable_by_reason[static_cast<int>(hal::StatusReason::kSearching)], 1u);
+  EXPECT_EQ(s.unavailable_by_reason[static_cast<int>(hal::StatusReason::kOutsideMap)], 1u);
+  EXPECT_NE(availability_text(s).find("[not localized: "), std::string::npos) << availability_text(s);
   EXPECT_EQ(s.steps, 23u);
   EXPECT_EQ(s.first_localized_step, 5);
   EXPECT_DOUBLE_EQ(s.first_localized_err_m, 0.01);

@@ -133,16 +133,17 @@ void write_plots(const LocalizePlan& plan, const LoadedDataset& ds, const std::s
   {
     std::ofstream csv(base + "_steps.csv");
     csv << "trial,step,scan,segment,status,mode,est_x,est_y,est_theta,ref_x,ref_y,ref_theta,ref_ok,err_m,err_deg,"
-           "pl_xy_m,pl_theta_deg,unsupported\n";
+           "pl_xy_m,pl_theta_deg,unsupported,reason\n";
     for (std::size_t k = 0; k < trials.size(); ++k)
       for (std::size_t i = 0; i < trials[k].steps.size(); ++i) {
         const StepLog& s = trials[k].steps[i];
         char buf[384];
-        std::snprintf(buf, sizeof(buf), "%zu,%zu,%zu,%zu,%s,%s,%.4f,%.4f,%.5f,%.4f,%.4f,%.5f,%d,%.4f,%.3f,%.3f,%.3f,%u\n", k, i,
+        std::snprintf(buf, sizeof(buf), "%zu,%zu,%zu,%zu,%s,%s,%.4f,%.4f,%.5f,%.4f,%.4f,%.5f,%d,%.4f,%.3f,%.3f,%.3f,%u,%s\n", k, i,
                       s.scan, s.segment, hal::status_name(s.status),
                       s.mode == hal::LocalizationMode::kTracking ? "tracking" : "global", s.estimate.x, s.estimate.y,
                       s.estimate.theta, s.truth.x, s.truth.y, s.truth.theta, s.ref_ok ? 1 : 0, s.err_m,
-                      s.err_rad * 57.29578, s.pl_xy, s.pl_theta * 57.29578, s.unsupported_steps);
+                      s.err_rad * 57.29578, s.pl_xy, s.pl_theta * 57.29578, s.unsupported_steps,
+                      hal::reason_name(s.reason));
         csv << buf;
       }
   }
@@ -233,6 +234,14 @@ void add_dataset_figures(BenchJson* json, const std::string& D, const SystemSumm
   json->add(D + "_pl_exceed_xy_rate", s.pl_steps ? static_cast<double>(s.pl_exceed_xy) / s.pl_steps : NAN);
   json->add(D + "_pl_exceed_theta_rate", s.pl_steps ? static_cast<double>(s.pl_exceed_theta) / s.pl_steps : NAN);
   json->add(D + "_availability_steps", static_cast<double>(s.avail_steps));
+  // Where the availability went: share of the availability steps not `localized`, per reason
+  // (hal::StatusReason; names with '-' as '_').
+  for (std::size_t r = 1; r < hal::kStatusReasonCount; ++r) {
+    std::string name = hal::reason_name(static_cast<hal::StatusReason>(r));
+    for (char& c : name) c = c == '-' ? '_' : c;
+    json->add(D + "_unavailable_" + name,
+              s.avail_steps ? static_cast<double>(s.unavailable_by_reason[r]) / static_cast<double>(s.avail_steps) : NAN);
+  }
   json->add(D + "_track_err_m_median", s.track_err_median_m);
   json->add(D + "_track_err_m_p95", s.track_err_p95_m);
   json->add(D + "_step_ms_p50", s.step_ms_p50);
@@ -401,10 +410,37 @@ bool run_unknown_area(LocalizeRun& run, std::string* err) {
   return true;
 }
 
+// Where the availability went, per row: the reason published with each step after the first fix
+// that was not `localized`, as a share of the availability steps, largest first.
+std::string unavailability_text(const std::vector<SystemSummary>& rows) {
+  std::ostringstream t;
+  for (const SystemSummary& s : rows) {
+    if (s.avail_steps == 0) continue;
+    t << "- " << s.dataset << " (" << s.system << ", " << s.avail_steps << " steps):";
+    bool used[hal::kStatusReasonCount] = {};
+    bool any = false;
+    for (;;) {
+      std::size_t best = hal::kStatusReasonCount, n = 0;
+      for (std::size_t r = 0; r < hal::kStatusReasonCount; ++r)
+        if (!used[r] && s.unavailable_by_reason[r] > n) n = s.unavailable_by_reason[r], best = r;
+      if (best == hal::kStatusReasonCount) break;
+      used[best] = true;
+      char buf[96];
+      std::snprintf(buf, sizeof(buf), "%s %s %.3f", any ? "," : "", hal::reason_name(static_cast<hal::StatusReason>(best)),
+                    static_cast<double>(n) / static_cast<double>(s.avail_steps));
+      t << buf;
+      any = true;
+    }
+    t << (any ? "\n" : " always localized\n");
+  }
+  return t.str();
+}
+
 // localize.md: the table, the reference notes and the integrity failures.
 void write_localize_report(LocalizeRun& run) {
   const LocalizePlan& plan = run.plan;
   const std::string table = product_markdown_table(run.rows);
+  const std::string unavailable = unavailability_text(run.rows);
   std::ofstream md(plan.out_dir + "/localize.md");
   md << "# Localizer (mml-track) product evaluation\n\nSeed " << plan.seed << "; per dataset " << plan.whole_runs
      << " whole-log runs (kidnapped start drawn over the first " << plan.whole_start_fraction * 100
@@ -413,10 +449,12 @@ void write_localize_report(LocalizeRun& run) {
      << plan.step_rule.min_move_m << " m or >= " << plan.step_rule.min_turn_rad
      << " rad of odometry motion. Bounds: dataset position bound (0.5 m; 1 m at mit-killian) and 5 deg. "
         "Definitions: sim/eval/mml_eval/README.md.\n\n"
-     << table << "\n## Reference quality\n\n" << run.refnotes.str() << "\n## Integrity failures\n\n"
+     << table << "\n## Where the availability went (share of the steps after the first fix, by the reason published)\n\n"
+     << unavailable << "\n## Reference quality\n\n" << run.refnotes.str() << "\n## Integrity failures\n\n"
      << (run.notes.str().empty() ? std::string("none\n") : run.notes.str());
   if (plan.verbose)
-    std::printf("\n%s\nreference:\n%s\ntotal %.1f s\n", table.c_str(), run.refnotes.str().c_str(), since(run.t_all));
+    std::printf("\n%s\nnot localized after the first fix, by reason:\n%sreference:\n%s\ntotal %.1f s\n", table.c_str(),
+                unavailable.c_str(), run.refnotes.str().c_str(), since(run.t_all));
 }
 
 }  // namespace

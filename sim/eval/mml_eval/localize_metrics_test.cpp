@@ -58,6 +58,25 @@ TEST(LocalizeMetrics, FirstFixAndAvailability) {
   EXPECT_EQ(m.integrity_failures, 0u);
 }
 
+TEST(LocalizeMetrics, UnavailableStepsCountedByTheirReason) {
+  // s L a(alias) a(awaiting) a(alias) L o s: after the fix 6 steps, 1 localized; the 5 others by the
+  // reason published with them (the searching step before the fix is not an availability step).
+  TrialResult t = trial({step(S, 0), step(L, 0.1), step(A, 0.2), step(A, 0.2), step(A, 0.2), step(L, 0.1),
+                         step(O, 0.2), step(S, 0)});
+  t.steps[0].reason = t.steps[7].reason = hal::StatusReason::kSearching;
+  t.steps[2].reason = t.steps[4].reason = hal::StatusReason::kTrackAlias;
+  t.steps[3].reason = hal::StatusReason::kTrackAwaitingMml;
+  t.steps[6].reason = hal::StatusReason::kOutsideMap;
+  const TrialMetrics m = trial_metrics(t, MetricBounds());
+  EXPECT_EQ(m.avail_steps, 6u);
+  EXPECT_EQ(m.avail_localized, 1u);
+  EXPECT_EQ(m.unavailable_by_reason[static_cast<int>(hal::StatusReason::kTrackAlias)], 2u);
+  EXPECT_EQ(m.unavailable_by_reason[static_cast<int>(hal::StatusReason::kTrackAwaitingMml)], 1u);
+  EXPECT_EQ(m.unavailable_by_reason[static_cast<int>(hal::StatusReason::kOutsideMap)], 1u);
+  EXPECT_EQ(m.unavailable_by_reason[static_cast<int>(hal::StatusReason::kSearching)], 1u);
+  EXPECT_EQ(m.unavailable_by_reason[static_cast<int>(hal::StatusReason::kNone)], 0u);
+}
+
 TEST(LocalizeMetrics, AvailabilityExcludesErasedRegion) {
   TrialResult t = trial({step(L, 0.1), step(L, 0.1), step(S, 0), step(S, 0), step(L, 0.1)});
   t.steps[2].in_region = t.steps[3].in_region = true;

@@ -451,6 +451,7 @@ TrialResult run_trial(fw::Localizer& loc, const LoadedDataset& ds, std::size_t s
     st.pl_xy = est.protection_xy_m;
     st.pl_theta = est.protection_theta_rad;
     st.unsupported_steps = est.unsupported_steps;
+    st.reason = est.reason;
     // Searching / fault: the published pose is a placeholder (no pose); never compare it.
     st.has_pose = est.status != hal::LocalizationStatus::kSearching && est.status != hal::LocalizationStatus::kFault;
     if (st.has_pose) {
@@ -569,7 +570,12 @@ TrialMetrics trial_metrics(const TrialResult& t, const MetricBounds& b) {
     for (std::size_t k = first_loc + 1; k < pre; ++k) {
       if (t.steps[k].in_region) continue;
       ++m.avail_steps;
-      m.avail_localized += is_loc(t.steps[k]);
+      if (is_loc(t.steps[k])) {
+        ++m.avail_localized;
+      } else {
+        const auto r = static_cast<std::size_t>(t.steps[k].reason);
+        if (r < hal::kStatusReasonCount) ++m.unavailable_by_reason[r];
+      }
     }
   }
   // The figures against the log reference alone (`*_vs_log_reference`), beside the judged ones.
@@ -699,6 +705,7 @@ SystemSummary summarize(const std::string& dataset, const std::string& system, c
     if (m.first_fix) m_fix.push_back(m.m_to_fix);
     s.avail_steps += m.avail_steps;
     avail_loc += m.avail_localized;
+    for (std::size_t r = 0; r < hal::kStatusReasonCount; ++r) s.unavailable_by_reason[r] += m.unavailable_by_reason[r];
     s.localized_checked += m.localized_steps;
     s.integrity_failures += m.integrity_failures;
     s.excluded_ref_steps += m.excluded_ref_steps;

@@ -142,6 +142,7 @@ struct StepLog {
   double ref_bound_m = 0, ref_bound_rad = 0;  // the reference's own bound at this scan
   float pl_xy = 0, pl_theta = 0;  // published protection level (0 = none)
   std::uint16_t unsupported_steps = 0;
+  hal::StatusReason reason = hal::StatusReason::kNone;  // why not `localized` (published with the pose)
   std::size_t segment = 0;  // 1 after a kidnap
   double step_ms = 0;
   fw::Se2d estimate, truth;
@@ -190,6 +191,7 @@ struct TrialMetrics {
   std::size_t first_fix_index = TrialResult::kNone;  // index in steps
   double m_to_fix = 0;             // NaN when no first fix
   std::size_t avail_steps = 0, avail_localized = 0;  // after the first fix, before a kidnap, outside the erased region
+  std::size_t unavailable_by_reason[hal::kStatusReasonCount] = {};  // avail_steps not `localized`, by reason
   std::size_t localized_steps = 0;      // `localized` with a reliable reference (error-checked)
   std::size_t integrity_failures = 0;   // of those: error beyond the bounds
   std::size_t pl_steps = 0, pl_exceed = 0;
@@ -238,6 +240,7 @@ struct SystemSummary {
   double m_to_fix_median = 0;
   double availability = 0;           // pooled avail_localized / avail_steps
   std::size_t avail_steps = 0;
+  std::size_t unavailable_by_reason[hal::kStatusReasonCount] = {};  // pooled: where the availability went
   std::size_t localized_checked = 0, integrity_failures = 0, excluded_ref_steps = 0, excluded_map_steps = 0,
               excluded_bound_steps = 0, integrity_failures_raw = 0, pl_steps_raw = 0, pl_exceed_raw = 0;
   double integrity_failure_rate = 0;  // per error-checked localized step
