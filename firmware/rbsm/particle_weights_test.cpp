@@ -49,14 +49,7 @@ struct Scene {
   }
   std::vector<std::uint32_t> weigh(bool wide, std::uint32_t begin, std::uint32_t end) {
     std::vector<std::uint32_t> w(x.size(), 0xdeadbeefu);
-    fw::ParticleBlock b;
-    b.x = x.data();
-    b.y = y.data();
-    b.cos = c.data();
-    b.sin = s.data();
-    b.weights = w.data();
-    b.begin = begin;
-    b.end = end;
+    const fw::ParticleBlock b{x.data(), y.data(), c.data(), s.data(), w.data(), begin, end};
     fw::weigh_particles(grid.lookup_view(), px.data(), py.data(), static_cast<std::uint32_t>(px.size()), b, wide);
     return w;
   }

@@ -167,14 +167,7 @@ void Rbsm::weigh_block(std::uint32_t begin, std::uint32_t end) {
     for (std::uint32_t j = begin; j < end; ++j) w_[j] = weigh_mahalanobis(sx_[j], sy_[j], spsi_[j], cos_[j], sin_[j]);
     return;
   }
-  ParticleBlock b;
-  b.x = sx_;
-  b.y = sy_;
-  b.cos = cos_;
-  b.sin = sin_;
-  b.weights = w_;
-  b.begin = begin;
-  b.end = end;
+  const ParticleBlock b{sx_, sy_, cos_, sin_, w_, begin, end};
   weigh_particles(view_, px_, py_, num_points_, b, options_.wide_simd);
 }
 
