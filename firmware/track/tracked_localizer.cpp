@@ -98,10 +98,7 @@ Status TrackedLocalizer::step(const hal::LaserScan& scan, const hal::Odometry& o
   FW_RETURN_IF_ERROR(global_.step(scan, odom, out));
   out->mode = hal::LocalizationMode::kGlobal;
   out->protection_xy_m = out->protection_theta_rad = 0.0f;
-  if (out->status != hal::LocalizationStatus::kLocalized) {
-    out->reason = hal::reason_of_status(out->status);
-    return Status::ok();
-  }
+  if (out->status != hal::LocalizationStatus::kLocalized) return Status::ok();
   // MML says the pose is isolated: the tracker must confirm it on this scan before it is published.
   const hal::PoseEstimate g = *out;
   start_from_fix(g, wheel, n, out);
@@ -187,7 +184,6 @@ Status TrackedLocalizer::cross_check(const hal::LaserScan& scan, const hal::Odom
   out->timestamp_ns = scan.timestamp_ns;
   out->scan_id = scan.scan_id;
   out->status = hal::LocalizationStatus::kAmbiguous;
-  out->reason = hal::StatusReason::kAmbiguous;
   out->mode = hal::LocalizationMode::kGlobal;
   start_from_fix(g, wheel, n, out);
   return Status::ok();

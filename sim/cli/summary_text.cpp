@@ -5,6 +5,8 @@
 #include <cstdarg>
 #include <cstdio>
 
+#include "sim/common/reason_list.h"
+
 namespace sim {
 
 std::string fmt(const char* f, ...) {
@@ -31,21 +33,8 @@ std::string availability_text(const SimSummary& s) {
                       s.availability_localized, s.availability_steps);
   if (s.unknown_area_steps > 0) t += fmt(", %zu in unknown area left out", s.unknown_area_steps);
   t += ")";
-  // Where it went, largest share first (the reason published with each step that was not `localized`).
-  std::string why;
-  bool used[hal::kStatusReasonCount] = {};
-  for (;;) {
-    std::size_t best = hal::kStatusReasonCount, n = 0;
-    for (std::size_t k = 0; k < hal::kStatusReasonCount; ++k) {
-      if (!used[k] && s.unavailable_by_reason[k] > n) {
-        n = s.unavailable_by_reason[k];
-        best = k;
-      }
-    }
-    if (best == hal::kStatusReasonCount) break;
-    used[best] = true;
-    why += fmt("%s%s %zu", why.empty() ? "" : ", ", hal::reason_name(static_cast<hal::StatusReason>(best)), n);
-  }
+  // Where it went (the reason published with each step that was not `localized`).
+  const std::string why = reason_list(s.unavailable_by_reason);
   if (!why.empty()) t += " [not localized: " + why + "]";
   return t;
 }

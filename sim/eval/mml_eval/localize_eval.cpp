@@ -10,6 +10,7 @@
 #include <sstream>
 
 #include "firmware/base/rng.h"
+#include "sim/common/reason_list.h"
 #include "sim/eval/mml_eval/mml_systems.h"
 
 namespace sim::mmleval {
@@ -416,22 +417,9 @@ std::string unavailability_text(const std::vector<SystemSummary>& rows) {
   std::ostringstream t;
   for (const SystemSummary& s : rows) {
     if (s.avail_steps == 0) continue;
-    t << "- " << s.dataset << " (" << s.system << ", " << s.avail_steps << " steps):";
-    bool used[hal::kStatusReasonCount] = {};
-    bool any = false;
-    for (;;) {
-      std::size_t best = hal::kStatusReasonCount, n = 0;
-      for (std::size_t r = 0; r < hal::kStatusReasonCount; ++r)
-        if (!used[r] && s.unavailable_by_reason[r] > n) n = s.unavailable_by_reason[r], best = r;
-      if (best == hal::kStatusReasonCount) break;
-      used[best] = true;
-      char buf[96];
-      std::snprintf(buf, sizeof(buf), "%s %s %.3f", any ? "," : "", hal::reason_name(static_cast<hal::StatusReason>(best)),
-                    static_cast<double>(n) / static_cast<double>(s.avail_steps));
-      t << buf;
-      any = true;
-    }
-    t << (any ? "\n" : " always localized\n");
+    const std::string why = reason_list(s.unavailable_by_reason, s.avail_steps);
+    t << "- " << s.dataset << " (" << s.system << ", " << s.avail_steps << " steps): "
+      << (why.empty() ? "always localized" : why) << "\n";
   }
   return t.str();
 }
