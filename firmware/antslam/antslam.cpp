@@ -33,6 +33,7 @@ Status AntSlamOptions::validate() const {
     return Status::error(Errc::kInvalidArgument, "antslam: loop-closing gates must be > 0");
   }
   FW_RETURN_IF_ERROR(aco.validate());
+  FW_RETURN_IF_ERROR(edge_fit.validate());
   return lm.validate();
 }
 
@@ -123,18 +124,31 @@ Status AntSlam::init(const AntSlamOptions& options, StartupArena& arena, WorkerP
 }
 
 Status AntSlam::add_edge(std::uint32_t from, std::uint32_t to, const Se2d& mean, const Mat3& cov,
-                         std::uint32_t* index) {
+                         const Mat3& predict_cov, std::uint32_t* index) {
   if (num_edges_ >= max_edges_) {
     return Status::error(Errc::kCapacityExceeded, "antslam: more than %u edges", max_edges_);
   }
   const std::size_t off = static_cast<std::size_t>(num_edges_) * options_.samples_per_edge;
   FW_RETURN_IF_ERROR(init_sampled_edge(from, to, mean, cov, edge_options_ + off, edge_option_cost_ + off,
                                        options_.samples_per_edge, edge_rng_, &edges_[num_edges_]));
+  edges_[num_edges_].predict_cov = predict_cov;
   *index = num_edges_++;
   return Status::ok();
 }
 
-Status AntSlam::start_fragment(const Se2d& frontend_pose) {
+bool AntSlam::sensor_model_cov(const Point2f* scene, std::size_t n, const Se2d& pose, Mat3* cov) {
+  EdgeFit fit;
+  if (!fit_edge(matcher_.field(), scene, n, pose, options_.edge_fit, &fit)) {
+    ++stats_.motion_fallbacks;
+    return false;
+  }
+  *cov = fit.cov;
+  cov->diagonal().array() += options_.var_floor;
+  ++stats_.sensor_fits;
+  return true;
+}
+
+Status AntSlam::start_fragment(const Se2d& frontend_pose, const Point2f* points, std::size_t count) {
   if (num_fragments_ >= options_.max_fragments) {
     return Status::error(Errc::kCapacityExceeded, "antslam: more than %u fragments (max_fragments)",
                          options_.max_fragments);
@@ -148,11 +162,21 @@ Status AntSlam::start_fragment(const Se2d& frontend_pose) {
     world_[0] = frontend_pose;
   } else {
     // Adjacent edge T(F_f−1 → F_f) ~ N(μ, Σ) from the tracked pose (Eq. 3.4), sampled (Eq. 3.10).
-    Mat3 cov = rel_cov_;
-    cov.diagonal().array() += options_.var_floor;
-    cov = 0.5 * (cov + cov.transpose());
+    Mat3 motion = rel_cov_;
+    motion.diagonal().array() += options_.var_floor;
+    motion = 0.5 * (motion + motion.transpose());
+    // Eq. 3.9: the scan that opens F_f placed on F_f−1's points around the front end's pose.
+    Mat3 cov = motion;
+    if (options_.edge_model == EdgeModel::kSensorModel) {
+      const bool fitted = points != nullptr && num_points_[f - 1] >= options_.min_fragment_points &&
+                          matcher_.set_model(points_ + static_cast<std::size_t>(f - 1) * options_.max_points_per_fragment,
+                                             num_points_[f - 1], "antslam fragment")
+                              .is_ok() &&
+                          sensor_model_cov(points, count, rel_, &cov);
+      if (!fitted) cov = motion;
+    }
     std::uint32_t e = 0;
-    FW_RETURN_IF_ERROR(add_edge(f - 1, f, rel_, cov, &e));
+    FW_RETURN_IF_ERROR(add_edge(f - 1, f, rel_, cov, motion, &e));
     fragment_length_[f - 1] = travelled_;
     adjacent_edge_[f - 1] = e;
     world_[f] = world_[f - 1].compose(edges_[e].value);
@@ -175,7 +199,7 @@ Status AntSlam::add_scan(const Se2d& pose, const Point2f* points, std::size_t co
   }
   bool closed_fragment = false;
   if (num_fragments_ == 0) {
-    FW_RETURN_IF_ERROR(start_fragment(pose));
+    FW_RETURN_IF_ERROR(start_fragment(pose, points, count));
   } else {
     const Se2d u = last_frontend_.between(pose);
     // Eq. 3.4: x_t = x_{t−1} ⊕ u_t, Σ_t = J_x Σ_{t−1} J_xᵀ + J_u G J_uᵀ.
@@ -189,7 +213,7 @@ Status AntSlam::add_scan(const Se2d& pose, const Point2f* points, std::size_t co
     rel_ = rel_.compose(u);
     travelled_ += d;
     if (travelled_ >= options_.fragment_length_m) {
-      FW_RETURN_IF_ERROR(start_fragment(pose));
+      FW_RETURN_IF_ERROR(start_fragment(pose, points, count));
       closed_fragment = true;
     }
   }
@@ -263,7 +287,7 @@ void AntSlam::compound_path(std::uint32_t n, Se2d* x, Mat3* cov) const {
   for (std::uint32_t i = 0; i < n; ++i) {
     const SampledEdge& e = *steps_[i].edge;
     const Se2d t = step_transform(steps_[i], e.value);
-    Mat3 ct = e.frozen ? Mat3(e.cov * options_.frozen_cov_scale) : e.cov;
+    Mat3 ct = e.frozen ? Mat3(e.predict_cov * options_.frozen_cov_scale) : e.predict_cov;
     if (!steps_[i].forward) {
       const Mat3 ji = e.value.jacobian_inverse();
       ct = ji * ct * ji.transpose();
@@ -398,6 +422,8 @@ Status AntSlam::close_loop(std::uint32_t a) {
     Mat3 cov_h = Mat3::Zero();
     cov_h.diagonal() << options_.closure_sigma_xy * options_.closure_sigma_xy,
         options_.closure_sigma_xy * options_.closure_sigma_xy, options_.closure_sigma_theta * options_.closure_sigma_theta;
+    // Eq. 3.9 for the closing edge: a's points around h on c's field (the matcher's model).
+    if (options_.edge_model == EdgeModel::kSensorModel) sensor_model_cov(scene, num_points_[a], h, &cov_h);
     const Vec3 dh = se2_difference(h, x);
     const double chi2 = dh.dot((cov + cov_h).inverse() * dh);
     if (!(chi2 <= options_.closure_gate_chi2)) {
@@ -443,7 +469,7 @@ Status AntSlam::close_loop(std::uint32_t a) {
       xc = xc.compose(step_transform(steps_[i], e.value));
     }
     std::uint32_t ei = 0;
-    FW_RETURN_IF_ERROR(add_edge(c, a, h, cov_h, &ei));
+    FW_RETURN_IF_ERROR(add_edge(c, a, h, cov_h, cov_h, &ei));
     edges_[ei].closure = true;
     edges_[ei].value = xc;  // consistent with the corrected chain
     edges_[ei].frozen = true;

@@ -7,7 +7,12 @@
 // fragment's frame, so correcting the fragment frames corrects the trajectory. The pose relative
 // to the active fragment is tracked with its covariance (Eq. 3.4: x_t = x_{t−1} ⊕ u_t,
 // Σ_t = J_x Σ J_xᵀ + J_u G J_uᵀ); when the fragment ends, that gives the adjacent edge
-// T(F_i → F_i+1) ~ N(μ, Σ), holding S sampled options (Eq. 3.10, sampled_edge.h).
+// T(F_i → F_i+1) ~ N(μ, Σ), holding S sampled options (Eq. 3.10, sampled_edge.h). Σ of an edge
+// (adjacent or closing) is fitted from poses around it weighted by the sensor model (Eq. 3.9,
+// edge_fit.h; EdgeModel::kSensorModel, the default) or, selectable, the Eq. 3.4 covariance itself
+// (kMotionModel; loop closures then take the fixed closure_sigma_*). Either way the Eq. 3.4
+// covariance is kept beside it for what it is good at: predicting how far a path of edges may
+// have drifted (the loop candidates' Mahalanobis distance and the closure gate).
 //
 // Loop closing, when a fragment a ends: a breadth-first search over the fragment graph (all edge
 // weights 1, so it is Dijkstra's shortest fragment sequence) gives for every older fragment c the
@@ -21,8 +26,7 @@
 //
 // Not implemented (issue 12 item 1): fragment borders, the convex hull and the EXPLORE → TRAVERSAL
 // states (a revisited area gets new fragments, which close loops with the old ones), the
-// covariance of the pose w.r.t. every fragment (only the active one), and edge covariances from
-// K sensor-model-weighted poses (Eq. 3.9): the Eq. 3.4 propagated covariance is used instead.
+// covariance of the pose w.r.t. every fragment (only the active one).
 //
 // Embedded rules: all storage from the StartupArena in init(), sized by AntSlamOptions; errors
 // as Status; deterministic per seed (pRANSAM and the ants own their streams; the optional
@@ -33,6 +37,7 @@
 #include <cstdint>
 
 #include "firmware/antslam/ant_colony.h"
+#include "firmware/antslam/edge_fit.h"
 #include "firmware/antslam/field_fit.h"
 #include "firmware/antslam/loop_lm.h"
 #include "firmware/antslam/sampled_edge.h"
@@ -46,6 +51,8 @@
 namespace fw::antslam {
 
 enum class LoopOptimizer : std::uint8_t { kAntColony, kLevenbergMarquardt };
+// Σ of an edge: Eq. 3.9 (sensor-model-weighted poses, edge_fit.h) or Eq. 3.4 (motion model).
+enum class EdgeModel : std::uint8_t { kSensorModel, kMotionModel };
 
 struct AntSlamOptions {
   // Capacities (arena).
@@ -63,6 +70,8 @@ struct AntSlamOptions {
   double var_theta_per_m = 0.004 * 0.004;
   double var_theta_per_rad = 0.01 * 0.01;
   double var_floor = 1e-8;
+  EdgeModel edge_model = EdgeModel::kSensorModel;
+  EdgeFitOptions edge_fit;
 
   // Points kept for matching: a keyframe every keyframe_step_m or keyframe_turn_rad.
   double keyframe_step_m = 0.3;
@@ -104,6 +113,8 @@ struct AntSlamStats {
   std::uint32_t rejected_quality = 0;  // best hypothesis below min_closure_quality
   std::uint32_t rejected_gate = 0;     // too far from the prediction
   std::uint32_t prediction_kept = 0;   // refined prediction fitted as well as pRANSAM's h
+  std::uint32_t sensor_fits = 0;       // edges whose Σ came from the sensor model (Eq. 3.9)
+  std::uint32_t motion_fallbacks = 0;  // edges that kept the Eq. 3.4 Σ (no fit possible: too few points)
   std::uint32_t loops = 0;             // loops closed and corrected
   std::uint32_t dropped_points = 0;    // points beyond a fragment's capacity
   double aco_initial_cost = 0, aco_final_cost = 0;  // sums over the loops
@@ -155,8 +166,12 @@ class AntSlam {
   const AntSlamStats& stats() const { return stats_; }
 
  private:
-  Status start_fragment(const Se2d& frontend_pose);
-  Status add_edge(std::uint32_t from, std::uint32_t to, const Se2d& mean, const Mat3& cov, std::uint32_t* index);
+  Status start_fragment(const Se2d& frontend_pose, const Point2f* points, std::size_t count);
+  // `predict_cov`: the edge's Eq. 3.4 covariance for path predictions (SampledEdge::predict_cov).
+  Status add_edge(std::uint32_t from, std::uint32_t to, const Se2d& mean, const Mat3& cov, const Mat3& predict_cov,
+                  std::uint32_t* index);
+  // Eq. 3.9 Σ of `scene` placed at `pose` on the matcher's current model; false when no fit is possible.
+  bool sensor_model_cov(const Point2f* scene, std::size_t n, const Se2d& pose, Mat3* cov);
   Status close_loop(std::uint32_t a);
   void shortest_paths(std::uint32_t a);  // BFS from a: parent_edge_, hops_
   // Path c → a as steps (forward/backward) into steps_; returns the number of steps.

@@ -45,6 +45,7 @@ Status init_sampled_edge(std::uint32_t from, std::uint32_t to, const Se2d& mean,
   edge->to = to;
   edge->mean = mean;
   edge->cov = cov;
+  edge->predict_cov = cov;
   edge->info = cov.inverse();  // closed form for 3x3; positive definite checked above
   edge->value = mean;
   edge->frozen = false;

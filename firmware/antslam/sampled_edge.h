@@ -22,6 +22,10 @@ struct SampledEdge {
   Se2d mean;                       // μ_ij
   Mat3 cov = Mat3::Identity();     // Σ_ij
   Mat3 info = Mat3::Identity();    // Σ_ij⁻¹
+  // The motion model's covariance of the edge (Eq. 3.4): how far the front end may have drifted
+  // along it, for predicting a path of edges (AntSLAM's loop candidates and gate). = cov unless
+  // the caller sets it (antslam.h: Σ from the sensor model, Eq. 3.9).
+  Mat3 predict_cov = Mat3::Identity();
   Se2d value;                      // the transform the map currently uses (μ until corrected)
   bool frozen = false;             // corrected by a loop: never changed again
   bool closure = false;            // a loop-closing edge (pRANSAM), not an adjacent pair

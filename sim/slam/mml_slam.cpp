@@ -33,6 +33,8 @@ const char* kHelp =
     "                        between its consecutive GMapping-corrected poses)\n"
     "options:\n"
     "  --optimizer aco|lm    loop optimiser (default aco: the ant colony of Eq. 3.13-3.14)\n"
+    "  --edge-model sensor|motion  edge covariance: from poses weighted by the sensor model (Eq. 3.9, default)\n"
+    "                        or the front end's propagated motion covariance (Eq. 3.4; closures: --closure-sigma)\n"
     "  --ants N              ants per iteration (default 20)\n"
     "  --iterations N        ant-colony iterations per loop (default 5000)\n"
     "  --fragment-length M   metres travelled per fragment (default 5; 10 for long loops)\n"
@@ -122,6 +124,10 @@ int run(int argc, char** argv) {
       if (v == "aco") cfg.slam.optimizer = fw::antslam::LoopOptimizer::kAntColony;
       else if (v == "lm") cfg.slam.optimizer = fw::antslam::LoopOptimizer::kLevenbergMarquardt;
       else return fail("--optimizer: '" + v + "' is not aco or lm");
+    } else if (a == "--edge-model") {
+      if (v == "sensor") cfg.slam.edge_model = fw::antslam::EdgeModel::kSensorModel;
+      else if (v == "motion") cfg.slam.edge_model = fw::antslam::EdgeModel::kMotionModel;
+      else return fail("--edge-model: '" + v + "' is not sensor or motion");
     } else if (a == "--ants") {
       if (!parse_u64(v, 1, 1024, &u)) return fail("--ants: '" + v + "' is not an integer in 1..1024");
       cfg.slam.aco.ants = static_cast<std::uint32_t>(u);
@@ -232,6 +238,10 @@ int run(int argc, char** argv) {
   std::printf("mml-slam: %zu scans, %zu fragments, %u loops closed (%u candidates: %u below quality, %u outside the gate)\n",
               run.poses.size(), run.fragments.size(), run.stats.loops, run.stats.candidates, run.stats.rejected_quality,
               run.stats.rejected_gate);
+  if (cfg.slam.edge_model == fw::antslam::EdgeModel::kSensorModel) {
+    std::printf("mml-slam: edge covariances from the sensor model (Eq. 3.9): %u, fallback (too few points: Eq. 3.4, or closure-sigma for a closure): %u\n",
+                run.stats.sensor_fits, run.stats.motion_fallbacks);
+  }
   std::printf("mml-slam: RBSM %.1f s + AntSLAM %.1f s (pRANSAM %.0f ms, %s %.0f ms) for %.0f s of log\n", run.frontend_s,
               run.backend_s, run.matcher_ms,
               cfg.slam.optimizer == fw::antslam::LoopOptimizer::kAntColony ? "ant colony" : "LM", run.optimizer_ms, log_s);
