@@ -3,6 +3,7 @@
 #include <Eigen/Eigenvalues>
 #include <Eigen/Geometry>
 #include <cmath>
+#include <unordered_map>
 
 namespace sim::pransam_eval {
 
@@ -23,6 +24,33 @@ int count_inliers(const std::vector<Eigen::Vector3f>& scene, const PlaneModel& m
 }
 
 namespace {
+
+// Paired comparison of two poses on the same scene points (McNemar per point or over cells, see the header):
+// z > 0 when `a` explains more of the scene than `b`.
+double paired_z(const std::vector<Eigen::Vector3f>& scene, const PlaneModel& model, const PoseCandidate& a,
+                const PoseCandidate& b, float voxel, double cell) {
+  std::unordered_map<long long, int> d;
+  double only_a = 0.0, only_b = 0.0;
+  for (const auto& p : scene) {
+    const bool ia = model.nearest(a.rotation * p + a.translation, voxel) >= 0;
+    const bool ib = model.nearest(b.rotation * p + b.translation, voxel) >= 0;
+    if (ia == ib) continue;
+    if (!(cell > 0.0)) {  // every point its own unit: McNemar's (b − c) / √(b + c)
+      (ia ? only_a : only_b) += 1.0;
+      continue;
+    }
+    const long long x = static_cast<long long>(std::floor(p.x() / cell)) & 0xFFFFF;
+    const long long y = static_cast<long long>(std::floor(p.y() / cell)) & 0xFFFFF;
+    const long long z = static_cast<long long>(std::floor(p.z() / cell)) & 0xFFFFF;
+    d[(x << 40) | (y << 20) | z] += ia ? 1 : -1;
+  }
+  double sum = only_a - only_b, sum2 = only_a + only_b;
+  for (const auto& [key, v] : d) {
+    sum += v;
+    sum2 += static_cast<double>(v) * v;
+  }
+  return sum2 > 0.0 ? sum / std::sqrt(sum2) : 0.0;  // identical inlier sets: nothing tells them apart
+}
 
 AmbiguityVerdict judge(const std::vector<Eigen::Vector3f>& scene, const PlaneModel& model, float voxel,
                        const PoseCandidate& best, const std::vector<PoseCandidate>& kept,
@@ -128,7 +156,13 @@ AmbiguityVerdict judge(const std::vector<Eigen::Vector3f>& scene, const PlaneMod
     const double trans = ((r.rotation * c_scene + r.translation) - c).norm();
     if (!(rot_deg > options.rot_sep_deg || trans > options.trans_sep_voxels * voxel)) continue;  // same pose
     const double k = count_inliers(scene, model, r.rotation, r.translation, voxel);
-    if (k > v.rival_inliers) {
+    PoseCandidate rp;
+    rp.rotation = r.rotation;
+    rp.translation = r.translation;
+    // The most threatening rival: the lowest paired z (paired) or the most inliers (unpaired).
+    const double z = options.paired ? paired_z(scene, model, best, rp, voxel, options.cell_voxels * voxel) : 0.0;
+    if (options.paired ? (v.rival_inliers < 0 || z < v.rival_z) : k > v.rival_inliers) {
+      v.rival_z = z;
       v.rival_inliers = k;
       v.rival = kind;
       v.rival_rot_deg = rot_deg;
@@ -137,7 +171,8 @@ AmbiguityVerdict judge(const std::vector<Eigen::Vector3f>& scene, const PlaneMod
       v.rival_pose.translation = r.translation;
     }
   }
-  v.ambiguous = v.rival_inliers >= 0 && v.rival_inliers >= v.best_inliers - v.margin;
+  v.ambiguous = v.rival_inliers >= 0 &&
+                (options.paired ? v.rival_z < options.z : v.rival_inliers >= v.best_inliers - v.margin);
   return v;
 }
 
@@ -148,7 +183,11 @@ AmbiguityVerdict check_ambiguity(const std::vector<Eigen::Vector3f>& scene, cons
                                  const AmbiguityOptions& options) {
   AmbiguityVerdict v = judge(scene, model, voxel, best, kept, options);
   int adoptions = 0, refinements = v.refinements;
-  while (adoptions < options.max_adoptions && v.rival_inliers > v.best_inliers + v.margin) {
+  const auto clearly_better = [&](const AmbiguityVerdict& x) {
+    if (x.rival_inliers < 0) return false;
+    return options.paired ? x.rival_z < -options.z : x.rival_inliers > x.best_inliers + x.margin;
+  };
+  while (adoptions < options.max_adoptions && clearly_better(v)) {
     ++adoptions;
     v = judge(scene, model, voxel, v.rival_pose, {}, options);
     refinements += v.refinements;
@@ -156,7 +195,7 @@ AmbiguityVerdict check_ambiguity(const std::vector<Eigen::Vector3f>& scene, cons
   v.adoptions = adoptions;
   v.refinements = refinements;
   // Still a clearly better rival after the last adoption: the answer is not settled.
-  if (v.rival_inliers > v.best_inliers + v.margin) v.ambiguous = true;
+  if (clearly_better(v)) v.ambiguous = true;
   return v;
 }
 

@@ -135,7 +135,7 @@ bool run_pransam3d(const std::vector<CloudDraw>& draws, const Pransam3dConfig& c
         k_truth = t.inlier_fraction * static_cast<double>(d.scene.size());
       }
       std::printf("  %s #%zu |A| %zu |B| %zu ov %.2f: %.1f ms it %llu coll %llu fs-rej %llu Ω %.3f %s  err %.4f m %.2f°  rms %.4f"
-                  "  k %.0f ±%.0f rival %s %.0f (%.1f° %.3f m) k_truth %.0f\n",
+                  "  k %.0f ±%.0f rival %s %.0f z %.2f (%.1f° %.3f m) k_truth %.0f\n",
                   d.cloud.c_str(), d.index, d.scene.size(), d.model.size(), d.overlap, ms,
                   static_cast<unsigned long long>(r.stats.iterations), static_cast<unsigned long long>(r.stats.collisions),
                   static_cast<unsigned long long>(r.stats.free_space_rejected),
@@ -143,7 +143,7 @@ bool run_pransam3d(const std::vector<CloudDraw>& draws, const Pransam3dConfig& c
                   oc.ambiguous ? (oc.correct ? "ambiguous(correct)" : "ambiguous(wrong)")
                   : reported ? (oc.correct || !d.has_truth ? "reported" : "REPORTED-WRONG") : (oc.correct ? "missed(correct)" : "nothing"),
                   oc.trans_err, oc.rot_err_deg, oc.inlier_rms, av.best_inliers, av.margin, rival_kind_name(av.rival),
-                  av.rival_inliers, av.rival_rot_deg, av.rival_trans_m, k_truth);
+                  av.rival_inliers, av.rival_z, av.rival_rot_deg, av.rival_trans_m, k_truth);
     }
     out->outcomes.push_back(oc);
   }

@@ -5,7 +5,7 @@
 //   mml-pransam-eval theorem1 [--dataset intel] [--queries 20]
 //   mml-pransam-eval 3d [--cloud office1|car6|milk|bunny|all|room] [--draws 100] [--threads 2] [--iters 200000]
 //                       [--thres 0.55] [--stop 1] [--extent-voxels 24] [--refine 10] [--refine-min 0.35]
-//                       [--seed 1] [--voxel V] [--no-ambiguity] [--amb-z 3] [--verbose]   (real clouds of ../shared/data/pcl3d, issue 17;
+//                       [--seed 1] [--voxel V] [--no-ambiguity] [--amb-z 3] [--amb-cell 0] [--amb-margin] [--verbose]   (real clouds of ../shared/data/pcl3d, issue 17;
 //                       --cloud room: the synthetic textured room with --trials 10)
 //   mml-pransam-eval build-table [--dataset intel] [--triples 2000000] [--extent 10] --out FILE.mmap
 #include <cstdio>
@@ -46,6 +46,8 @@ Pransam3dConfig config_3d(const std::map<std::string, std::string>& a) {
   c.max_blocked = std::stof(get(a, "max-blocked", std::to_string(c.max_blocked)));
   c.ambiguity = a.count("no-ambiguity") == 0;
   c.ambiguity_options.z = std::stod(get(a, "amb-z", std::to_string(c.ambiguity_options.z)));
+  c.ambiguity_options.paired = a.count("amb-margin") == 0;
+  c.ambiguity_options.cell_voxels = std::stod(get(a, "amb-cell", std::to_string(c.ambiguity_options.cell_voxels)));  // --amb-margin: the unpaired margin rule (ambiguity3d.h)
   return c;
 }
 
