@@ -138,13 +138,9 @@ Status AntSlam::add_edge(std::uint32_t from, std::uint32_t to, const Se2d& mean,
 
 bool AntSlam::sensor_model_cov(const Point2f* scene, std::size_t n, const Se2d& pose, Mat3* cov) {
   EdgeFit fit;
-  if (!fit_edge(matcher_.field(), scene, n, pose, options_.edge_fit, &fit)) {
-    ++stats_.motion_fallbacks;
-    return false;
-  }
+  if (!fit_edge(matcher_.field(), scene, n, pose, options_.edge_fit, &fit)) return false;
   *cov = fit.cov;
   cov->diagonal().array() += options_.var_floor;
-  ++stats_.sensor_fits;
   return true;
 }
 
@@ -161,7 +157,7 @@ Status AntSlam::start_fragment(const Se2d& frontend_pose, const Point2f* points,
   if (f == 0) {
     world_[0] = frontend_pose;
   } else {
-    // Adjacent edge T(F_f−1 → F_f) ~ N(μ, Σ) from the tracked pose (Eq. 3.4), sampled (Eq. 3.10).
+    // Adjacent edge T(F_f−1 → F_f) ~ N(μ, Σ): μ the tracked pose, Σ by Eq. 3.9 (or Eq. 3.4), sampled (Eq. 3.10).
     Mat3 motion = rel_cov_;
     motion.diagonal().array() += options_.var_floor;
     motion = 0.5 * (motion + motion.transpose());
@@ -173,7 +169,7 @@ Status AntSlam::start_fragment(const Se2d& frontend_pose, const Point2f* points,
                                              num_points_[f - 1], "antslam fragment")
                               .is_ok() &&
                           sensor_model_cov(points, count, rel_, &cov);
-      if (!fitted) cov = motion;
+      if (fitted) ++stats_.sensor_fits; else ++stats_.motion_fallbacks;
     }
     std::uint32_t e = 0;
     FW_RETURN_IF_ERROR(add_edge(f - 1, f, rel_, cov, motion, &e));
@@ -423,7 +419,9 @@ Status AntSlam::close_loop(std::uint32_t a) {
     cov_h.diagonal() << options_.closure_sigma_xy * options_.closure_sigma_xy,
         options_.closure_sigma_xy * options_.closure_sigma_xy, options_.closure_sigma_theta * options_.closure_sigma_theta;
     // Eq. 3.9 for the closing edge: a's points around h on c's field (the matcher's model).
-    if (options_.edge_model == EdgeModel::kSensorModel) sensor_model_cov(scene, num_points_[a], h, &cov_h);
+    if (options_.edge_model == EdgeModel::kSensorModel) {
+      if (sensor_model_cov(scene, num_points_[a], h, &cov_h)) ++stats_.sensor_fits; else ++stats_.motion_fallbacks;
+    }
     const Vec3 dh = se2_difference(h, x);
     const double chi2 = dh.dot((cov + cov_h).inverse() * dh);
     if (!(chi2 <= options_.closure_gate_chi2)) {
