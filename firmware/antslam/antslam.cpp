@@ -8,6 +8,50 @@ namespace fw::antslam {
 namespace {
 constexpr std::uint32_t kMaxCandidates = 16;
 constexpr std::uint32_t kNoHops = 0xffffffffu;
+
+// Largest eigenvalue of the 2×2 position covariance (closed form; no Eigen solver, no heap), as a
+// standard deviation.
+double position_sigma(const Mat3& cov) {
+  const double ca = cov(0, 0), cb = cov(0, 1), cc = cov(1, 1);
+  const double lmax = 0.5 * (ca + cc) + std::sqrt(0.25 * (ca - cc) * (ca - cc) + cb * cb);
+  return std::sqrt(lmax > 1e-12 ? lmax : 1e-12);
+}
+
+// Radius of a fragment's keyframes around its frame.
+double frame_radius(const Se2d* k, std::uint32_t n) {
+  double r = 0.0;
+  for (std::uint32_t i = 0; i < n; ++i) r = std::fmax(r, std::hypot(k[i].x, k[i].y));
+  return r;
+}
+
+// Distance of the nearest pair of poses: ka mapped by x against kc.
+double nearest_pose_distance(const Se2d& x, const Se2d* ka, std::uint32_t na, const Se2d* kc, std::uint32_t nc) {
+  double dmin = 1e300;
+  for (std::uint32_t i = 0; i < na; ++i) {
+    const Se2d pa = x.compose(ka[i]);
+    for (std::uint32_t j = 0; j < nc; ++j) {
+      const double d = std::hypot(pa.x - kc[j].x, pa.y - kc[j].y);
+      if (d < dmin) dmin = d;
+    }
+  }
+  return dmin;
+}
+
+// Insert c at distance m into the sorted short list of at most `cap` (ties: older fragment first).
+void insert_candidate(std::uint32_t c, double m, std::uint32_t cap, std::uint32_t* cand, double* cand_m,
+                      std::uint32_t* num_cand) {
+  std::uint32_t pos = *num_cand;
+  while (pos > 0 && cand_m[pos - 1] > m) --pos;
+  if (pos >= cap) return;
+  const std::uint32_t last = *num_cand < cap ? *num_cand : cap - 1;
+  for (std::uint32_t k = last; k > pos; --k) {
+    cand[k] = cand[k - 1];
+    cand_m[k] = cand_m[k - 1];
+  }
+  cand[pos] = c;
+  cand_m[pos] = m;
+  if (*num_cand < cap) ++*num_cand;
+}
 }  // namespace
 
 Status AntSlamOptions::validate() const {
@@ -323,165 +367,194 @@ void AntSlam::recompute_world() {
   }
 }
 
-Status AntSlam::close_loop(std::uint32_t a) {
-  if (num_closures_ >= options_.max_closures || a < options_.min_fragment_gap) return Status::ok();
-  if (num_points_[a] < options_.min_fragment_points) return Status::ok();
-  shortest_paths(a);
-  // Candidates, nearest (Mahalanobis) first.
-  std::uint32_t cand[kMaxCandidates];
+// Older fragments c that may overlap a, nearest (Mahalanobis) first, at most max_candidates of them.
+std::uint32_t AntSlam::find_candidates(std::uint32_t a, std::uint32_t* cand) {
   double cand_m[kMaxCandidates];
   std::uint32_t num_cand = 0;
   for (std::uint32_t c = 0; c + options_.min_fragment_gap <= a; ++c) {
     if (hops_[c] == kNoHops || num_points_[c] < options_.min_fragment_points) continue;
     const std::uint32_t n = build_path(c, a);
     if (n == 0) continue;
-    // Predicted x = F_a in F_c along the path and its covariance (Eq. 3.4 compounding).
-    Se2d x;
-    Mat3 cov = Mat3::Zero();
-    compound_path(n, &x, &cov);
-    // Mahalanobis distance of a's poses to the nearest pose of c (beyond the overlap radius).
-    // Largest eigenvalue of the 2×2 position covariance (closed form; no Eigen solver, no heap).
-    const double ca = cov(0, 0), cb = cov(0, 1), cc = cov(1, 1);
-    const double lmax = 0.5 * (ca + cc) + std::sqrt(0.25 * (ca - cc) * (ca - cc) + cb * cb);
-    const double sigma = std::sqrt(lmax > 1e-12 ? lmax : 1e-12);
-    const Se2d* kc = keyframes_ + static_cast<std::size_t>(c) * options_.max_keyframes_per_fragment;
-    const Se2d* ka = keyframes_ + static_cast<std::size_t>(a) * options_.max_keyframes_per_fragment;
-    // Cheap bound first: fragment radii around their frames.
-    double ra = 0.0, rc = 0.0;
-    for (std::uint32_t i = 0; i < num_keyframes_[a]; ++i) ra = std::fmax(ra, std::hypot(ka[i].x, ka[i].y));
-    for (std::uint32_t j = 0; j < num_keyframes_[c]; ++j) rc = std::fmax(rc, std::hypot(kc[j].x, kc[j].y));
-    const double lower = std::hypot(x.x, x.y) - ra - rc - options_.overlap_radius_m;
-    if (lower > options_.candidate_mahalanobis * sigma) continue;
-    double dmin = 1e300;
-    for (std::uint32_t i = 0; i < num_keyframes_[a]; ++i) {
-      const Se2d pa = x.compose(ka[i]);
-      for (std::uint32_t j = 0; j < num_keyframes_[c]; ++j) {
-        const double d = std::hypot(pa.x - kc[j].x, pa.y - kc[j].y);
-        if (d < dmin) dmin = d;
-      }
-    }
-    const double m = (dmin > options_.overlap_radius_m ? dmin - options_.overlap_radius_m : 0.0) / sigma;
-    if (!(m <= options_.candidate_mahalanobis)) continue;
-    // Insert into the sorted short list (ties: older fragment first).
-    std::uint32_t pos = num_cand;
-    while (pos > 0 && cand_m[pos - 1] > m) --pos;
-    if (pos >= options_.max_candidates) continue;
-    const std::uint32_t last = num_cand < options_.max_candidates ? num_cand : options_.max_candidates - 1;
-    for (std::uint32_t k = last; k > pos; --k) {
-      cand[k] = cand[k - 1];
-      cand_m[k] = cand_m[k - 1];
-    }
-    cand[pos] = c;
-    cand_m[pos] = m;
-    if (num_cand < options_.max_candidates) ++num_cand;
+    double m = 0.0;
+    if (!candidate_distance(c, a, n, &m)) continue;
+    insert_candidate(c, m, options_.max_candidates, cand, cand_m, &num_cand);
   }
+  return num_cand;
+}
+
+// Mahalanobis distance m of a's poses to the nearest pose of c (beyond the overlap radius), a's
+// poses mapped into F_c along the current path of n steps; false when c is beyond the gate.
+bool AntSlam::candidate_distance(std::uint32_t c, std::uint32_t a, std::uint32_t n, double* m) const {
+  // Predicted x = F_a in F_c along the path and its covariance (Eq. 3.4 compounding).
+  Se2d x;
+  Mat3 cov = Mat3::Zero();
+  compound_path(n, &x, &cov);
+  const double sigma = position_sigma(cov);
+  const Se2d* kc = keyframes_ + static_cast<std::size_t>(c) * options_.max_keyframes_per_fragment;
+  const Se2d* ka = keyframes_ + static_cast<std::size_t>(a) * options_.max_keyframes_per_fragment;
+  // Cheap bound first: fragment radii around their frames.
+  const double ra = frame_radius(ka, num_keyframes_[a]), rc = frame_radius(kc, num_keyframes_[c]);
+  const double lower = std::hypot(x.x, x.y) - ra - rc - options_.overlap_radius_m;
+  if (lower > options_.candidate_mahalanobis * sigma) return false;
+  const double dmin = nearest_pose_distance(x, ka, num_keyframes_[a], kc, num_keyframes_[c]);
+  *m = (dmin > options_.overlap_radius_m ? dmin - options_.overlap_radius_m : 0.0) / sigma;
+  return *m <= options_.candidate_mahalanobis;
+}
+
+// pRANSAM: a's points (scene, F_a) against c's (model, F_c) → h = F_a in F_c, refined when asked;
+// false (rejected_quality) when c gives no hypothesis good enough for a closure.
+bool AntSlam::match_closure(std::uint32_t a, std::uint32_t c, const Se2d& x, Se2d* h, float* quality) {
   const Point2f* scene = points_ + static_cast<std::size_t>(a) * options_.max_points_per_fragment;
+  ++stats_.candidates;
+  const std::uint64_t t0 = now();
+  // A fragment pRANSAM cannot take as a model (degenerate, too large for the field) is no candidate.
+  if (!matcher_.set_model(points_ + static_cast<std::size_t>(c) * options_.max_points_per_fragment, num_points_[c],
+                          "antslam fragment")
+           .is_ok()) {
+    ++stats_.rejected_quality;
+    return false;
+  }
+  matcher_.reset();
+  pransam::MatchParams mp = options_.match;
+  mp.seed = options_.seed * 1000003u + a * 4099u + c;
+  pransam::MatchResult<2> res;
+  const Status st = matcher_.match(scene, num_points_[a], mp, &res);
+  stats_.matcher_ns += now() - t0;
+  if (!st.is_ok() || !res.best_valid || res.best.quality < options_.min_closure_quality) {
+    ++stats_.rejected_quality;
+    return false;
+  }
+  *quality = res.best.quality;
+  *h = pransam::to_se2(res.best).cast<double>();
+  if (options_.refine_closure) *h = refine_hypothesis(scene, num_points_[a], *h, x);
+  return true;
+}
+
+// Closure refinement (field_fit.h): h and the prediction x both fitted on c's distance field (the
+// matcher's model); the prediction wins unless h fits better by prefer_prediction_margin.
+Se2d AntSlam::refine_hypothesis(const Point2f* scene, std::uint32_t n, const Se2d& h, const Se2d& x) {
+  const FieldFit fh = fit_on_field(matcher_.field(), scene, n, h, options_.refine_iterations,
+                                   options_.refine_cutoff_start, options_.refine_cutoff_end);
+  const FieldFit fx = fit_on_field(matcher_.field(), scene, n, x, options_.refine_iterations,
+                                   options_.refine_cutoff_start, options_.refine_cutoff_end);
+  if (fx.quality + options_.prefer_prediction_margin >= fh.quality) {
+    ++stats_.prediction_kept;
+    return fx.pose;
+  }
+  return fh.pose;
+}
+
+// Σ_h of the closing edge: the fixed closure sigmas, replaced by the Eq. 3.9 fit where it succeeds.
+Mat3 AntSlam::closure_cov(const Point2f* scene, std::uint32_t n, const Se2d& h) {
+  Mat3 cov_h = Mat3::Zero();
+  cov_h.diagonal() << options_.closure_sigma_xy * options_.closure_sigma_xy,
+      options_.closure_sigma_xy * options_.closure_sigma_xy, options_.closure_sigma_theta * options_.closure_sigma_theta;
+  // Eq. 3.9 for the closing edge: a's points around h on c's field (the matcher's model).
+  if (options_.edge_model == EdgeModel::kSensorModel) {
+    if (sensor_model_cov(scene, n, h, &cov_h)) ++stats_.sensor_fits; else ++stats_.motion_fallbacks;
+  }
+  return cov_h;
+}
+
+// The loop L (c → a, the first n steps_) with the closure h ~ N(μ_h, Σ_h), corrected by the
+// selected optimiser into values_; w0 / w1 its cost W (Eq. 3.13) before / after (0 when all frozen).
+Status AntSlam::optimize_loop(std::uint32_t n, const Se2d& h, const Mat3& cov_h, double* w0, double* w1) {
+  LoopProblem problem;
+  problem.steps = steps_;
+  problem.num_steps = n;
+  problem.closure_mean = h;
+  problem.closure_info = cov_h.inverse();
+  bool any_free = false;
+  for (std::uint32_t i = 0; i < n; ++i) {
+    values_[i] = steps_[i].edge->value;
+    any_free = any_free || !steps_[i].edge->frozen;
+  }
+  const std::uint64_t t1 = now();
+  if (any_free) {
+    if (options_.optimizer == LoopOptimizer::kAntColony) {
+      AntColonyReport rep;
+      FW_RETURN_IF_ERROR(aco_.solve(problem, num_closures_, values_, &rep));
+      *w0 = rep.initial_cost;
+      *w1 = rep.best_cost;
+    } else {
+      LoopLmReport rep;
+      FW_RETURN_IF_ERROR(lm_.solve(problem, values_, &rep));
+      *w0 = rep.initial_cost;
+      *w1 = rep.final_cost;
+    }
+  }
+  stats_.optimizer_ns += now() - t1;
+  stats_.aco_initial_cost += *w0;
+  stats_.aco_final_cost += *w1;
+  return Status::ok();
+}
+
+// Writes the optimised values_ into the loop's free edges and freezes them; returns F_a in F_c along
+// the corrected chain.
+Se2d AntSlam::freeze_loop(std::uint32_t n) {
+  Se2d xc;
+  for (std::uint32_t i = 0; i < n; ++i) {
+    SampledEdge& e = edges_[steps_[i].edge - edges_];
+    if (!e.frozen) {
+      e.value = values_[i];
+      e.frozen = true;  // corrected loops are frozen
+    }
+    xc = xc.compose(step_transform(steps_[i], e.value));
+  }
+  return xc;
+}
+
+// Candidate c for a: match, gate against the prediction, correct and freeze the loop, add the
+// closing edge. `closed` tells whether the loop was closed; errors only from the optimiser / edges.
+Status AntSlam::try_closure(std::uint32_t a, std::uint32_t c, bool* closed) {
+  const Point2f* scene = points_ + static_cast<std::size_t>(a) * options_.max_points_per_fragment;
+  const std::uint32_t n = build_path(c, a);
+  Se2d x;
+  Mat3 cov = Mat3::Zero();
+  compound_path(n, &x, &cov);
+  Se2d h;
+  float quality = 0.0f;
+  if (!match_closure(a, c, x, &h, &quality)) return Status::ok();
+  const Mat3 cov_h = closure_cov(scene, num_points_[a], h);
+  const Vec3 dh = se2_difference(h, x);
+  const double chi2 = dh.dot((cov + cov_h).inverse() * dh);
+  if (!(chi2 <= options_.closure_gate_chi2)) {
+    ++stats_.rejected_gate;
+    return Status::ok();
+  }
+  double w0 = 0, w1 = 0;
+  FW_RETURN_IF_ERROR(optimize_loop(n, h, cov_h, &w0, &w1));
+  const Se2d xc = freeze_loop(n);
+  std::uint32_t ei = 0;
+  FW_RETURN_IF_ERROR(add_edge(c, a, h, cov_h, cov_h, &ei));
+  edges_[ei].closure = true;
+  edges_[ei].value = xc;  // consistent with the corrected chain
+  edges_[ei].frozen = true;
+  closures_[num_closures_++] = ClosureRecord{c,
+                                             a,
+                                             n,
+                                             quality,
+                                             static_cast<float>(chi2),
+                                             static_cast<float>(std::hypot(dh(0), dh(1))),
+                                             static_cast<float>(w0),
+                                             static_cast<float>(w1)};
+  ++stats_.loops;
+  recompute_world();
+  *closed = true;
+  return Status::ok();
+}
+
+Status AntSlam::close_loop(std::uint32_t a) {
+  if (num_closures_ >= options_.max_closures || a < options_.min_fragment_gap) return Status::ok();
+  if (num_points_[a] < options_.min_fragment_points) return Status::ok();
+  shortest_paths(a);
+  // Candidates, nearest (Mahalanobis) first.
+  std::uint32_t cand[kMaxCandidates];
+  const std::uint32_t num_cand = find_candidates(a, cand);
   for (std::uint32_t k = 0; k < num_cand; ++k) {
-    const std::uint32_t c = cand[k];
-    const std::uint32_t n = build_path(c, a);
-    Se2d x;
-    Mat3 cov = Mat3::Zero();
-    compound_path(n, &x, &cov);
-    // pRANSAM: a's points (scene, F_a) against c's (model, F_c) → h = F_a in F_c.
-    ++stats_.candidates;
-    const std::uint64_t t0 = now();
-    // A fragment pRANSAM cannot take as a model (degenerate, too large for the field) is no candidate.
-    if (!matcher_.set_model(points_ + static_cast<std::size_t>(c) * options_.max_points_per_fragment, num_points_[c],
-                            "antslam fragment")
-             .is_ok()) {
-      ++stats_.rejected_quality;
-      continue;
-    }
-    matcher_.reset();
-    pransam::MatchParams mp = options_.match;
-    mp.seed = options_.seed * 1000003u + a * 4099u + c;
-    pransam::MatchResult<2> res;
-    const Status st = matcher_.match(scene, num_points_[a], mp, &res);
-    stats_.matcher_ns += now() - t0;
-    if (!st.is_ok() || !res.best_valid || res.best.quality < options_.min_closure_quality) {
-      ++stats_.rejected_quality;
-      continue;
-    }
-    Se2d h = pransam::to_se2(res.best).cast<double>();
-    if (options_.refine_closure) {
-      const FieldFit fh = fit_on_field(matcher_.field(), scene, num_points_[a], h, options_.refine_iterations,
-                                       options_.refine_cutoff_start, options_.refine_cutoff_end);
-      const FieldFit fx = fit_on_field(matcher_.field(), scene, num_points_[a], x, options_.refine_iterations,
-                                       options_.refine_cutoff_start, options_.refine_cutoff_end);
-      if (fx.quality + options_.prefer_prediction_margin >= fh.quality) {
-        h = fx.pose;
-        ++stats_.prediction_kept;
-      } else {
-        h = fh.pose;
-      }
-    }
-    Mat3 cov_h = Mat3::Zero();
-    cov_h.diagonal() << options_.closure_sigma_xy * options_.closure_sigma_xy,
-        options_.closure_sigma_xy * options_.closure_sigma_xy, options_.closure_sigma_theta * options_.closure_sigma_theta;
-    // Eq. 3.9 for the closing edge: a's points around h on c's field (the matcher's model).
-    if (options_.edge_model == EdgeModel::kSensorModel) {
-      if (sensor_model_cov(scene, num_points_[a], h, &cov_h)) ++stats_.sensor_fits; else ++stats_.motion_fallbacks;
-    }
-    const Vec3 dh = se2_difference(h, x);
-    const double chi2 = dh.dot((cov + cov_h).inverse() * dh);
-    if (!(chi2 <= options_.closure_gate_chi2)) {
-      ++stats_.rejected_gate;
-      continue;
-    }
-    // The loop L (c → a) with the closure h ~ N(μ_h, Σ_h), corrected by the selected optimiser.
-    LoopProblem problem;
-    problem.steps = steps_;
-    problem.num_steps = n;
-    problem.closure_mean = h;
-    problem.closure_info = cov_h.inverse();
-    bool any_free = false;
-    for (std::uint32_t i = 0; i < n; ++i) {
-      values_[i] = steps_[i].edge->value;
-      any_free = any_free || !steps_[i].edge->frozen;
-    }
-    const std::uint64_t t1 = now();
-    double w0 = 0, w1 = 0;
-    if (any_free) {
-      if (options_.optimizer == LoopOptimizer::kAntColony) {
-        AntColonyReport rep;
-        FW_RETURN_IF_ERROR(aco_.solve(problem, num_closures_, values_, &rep));
-        w0 = rep.initial_cost;
-        w1 = rep.best_cost;
-      } else {
-        LoopLmReport rep;
-        FW_RETURN_IF_ERROR(lm_.solve(problem, values_, &rep));
-        w0 = rep.initial_cost;
-        w1 = rep.final_cost;
-      }
-    }
-    stats_.optimizer_ns += now() - t1;
-    stats_.aco_initial_cost += w0;
-    stats_.aco_final_cost += w1;
-    Se2d xc;
-    for (std::uint32_t i = 0; i < n; ++i) {
-      SampledEdge& e = edges_[steps_[i].edge - edges_];
-      if (!e.frozen) {
-        e.value = values_[i];
-        e.frozen = true;  // corrected loops are frozen
-      }
-      xc = xc.compose(step_transform(steps_[i], e.value));
-    }
-    std::uint32_t ei = 0;
-    FW_RETURN_IF_ERROR(add_edge(c, a, h, cov_h, cov_h, &ei));
-    edges_[ei].closure = true;
-    edges_[ei].value = xc;  // consistent with the corrected chain
-    edges_[ei].frozen = true;
-    closures_[num_closures_++] = ClosureRecord{c,
-                                               a,
-                                               n,
-                                               res.best.quality,
-                                               static_cast<float>(chi2),
-                                               static_cast<float>(std::hypot(dh(0), dh(1))),
-                                               static_cast<float>(w0),
-                                               static_cast<float>(w1)};
-    ++stats_.loops;
-    recompute_world();
-    return Status::ok();  // one loop per fragment
+    bool closed = false;
+    FW_RETURN_IF_ERROR(try_closure(a, cand[k], &closed));
+    if (closed) return Status::ok();  // one loop per fragment
   }
   return Status::ok();
 }

@@ -173,6 +173,15 @@ class AntSlam {
   // Eq. 3.9 Σ of `scene` placed at `pose` on the matcher's current model; false when no fit is possible.
   bool sensor_model_cov(const Point2f* scene, std::size_t n, const Se2d& pose, Mat3* cov);
   Status close_loop(std::uint32_t a);
+  // Steps of close_loop() (antslam.cpp).
+  std::uint32_t find_candidates(std::uint32_t a, std::uint32_t* cand);
+  bool candidate_distance(std::uint32_t c, std::uint32_t a, std::uint32_t n, double* m) const;
+  Status try_closure(std::uint32_t a, std::uint32_t c, bool* closed);
+  bool match_closure(std::uint32_t a, std::uint32_t c, const Se2d& x, Se2d* h, float* quality);
+  Se2d refine_hypothesis(const Point2f* scene, std::uint32_t n, const Se2d& h, const Se2d& x);
+  Mat3 closure_cov(const Point2f* scene, std::uint32_t n, const Se2d& h);
+  Status optimize_loop(std::uint32_t n, const Se2d& h, const Mat3& cov_h, double* w0, double* w1);
+  Se2d freeze_loop(std::uint32_t n);
   void shortest_paths(std::uint32_t a);  // BFS from a: parent_edge_, hops_
   // Path c → a as steps (forward/backward) into steps_; returns the number of steps.
   std::uint32_t build_path(std::uint32_t c, std::uint32_t a);

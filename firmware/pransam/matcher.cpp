@@ -24,6 +24,60 @@ bool all_finite(const Point<D>* p, std::size_t n, std::size_t* bad) {
   }
   return true;
 }
+
+// Probes a thinned grid of index triples (about 64 steps per index), stopping at the first keyable one.
+template <int D>
+bool has_keyable_triple(const Point<D>* scene, std::uint32_t n, const TripleFilter& f) {
+  bool any = false;
+  for (std::uint32_t i = 0; i < n && !any; ++i) {
+    for (std::uint32_t j = i + 1; j < n && !any; j += 1 + n / 64) {
+      for (std::uint32_t k = j + 1; k < n && !any; k += 1 + n / 64) {
+        Triple t;
+        t.v[0] = i; t.v[1] = j; t.v[2] = k;
+        std::uint32_t slot;
+        any = key_triple<D>(scene, f, &t, &slot) == KeyResult::kOk;
+      }
+    }
+    if (n > 64) i += n / 64;
+  }
+  return any;
+}
+
+// Random visiting order of A for the extrapolation (Eq. 4.8): Fisher–Yates from the seed.
+void shuffle_scene_order(std::uint32_t* order, std::uint32_t n, std::uint64_t seed) {
+  RandomStream rng(seed, kSceneOrderStream);
+  for (std::uint32_t i = 0; i < n; ++i) order[i] = i;
+  for (std::uint32_t i = n - 1; i > 0; --i) {
+    const std::uint32_t j = rng.uniform_index(i + 1);
+    const std::uint32_t tmp = order[i];
+    order[i] = order[j];
+    order[j] = tmp;
+  }
+}
+
+// Sec. 4.4.3: stop when the next round, at the last round's rate, would end past the deadline.
+bool next_round_misses_deadline(std::uint64_t round_start, std::uint64_t deadline_ns, std::uint64_t last_round_ns,
+                                std::uint64_t last_round_total, std::uint64_t round_total) {
+  const std::uint64_t predicted =
+      last_round_total > 0 ? last_round_ns * round_total / last_round_total : last_round_ns;
+  return round_start >= deadline_ns || deadline_ns - round_start < predicted;
+}
+
+// One worker's counters added to the match's.
+void add_stats(MatchStats* s, const MatchStats& ws) {
+  s->iterations += ws.iterations;
+  s->keyed += ws.keyed;
+  s->rejected_collinear += ws.rejected_collinear;
+  s->rejected_size += ws.rejected_size;
+  s->failed_draws += ws.failed_draws;
+  s->collisions += ws.collisions;
+  s->flipped += ws.flipped;
+  s->evaluated += ws.evaluated;
+  s->extrapolation_cut += ws.extrapolation_cut;
+  s->point_checks += ws.point_checks;
+  s->refined += ws.refined;
+  s->free_space_rejected += ws.free_space_rejected;
+}
 }  // namespace
 
 template <int D>
@@ -227,10 +281,9 @@ void Matcher<D>::reset() {
   round_bound_ = 0.0f;
 }
 
+// Inputs match() cannot work with, in the order they are reported.
 template <int D>
-Status Matcher<D>::match(const Point<D>* scene, std::size_t n, const MatchParams& params, MatchResult<D>* out) {
-  if (out == nullptr) return Status::error(Errc::kInvalidArgument, "pransam match: no result object");
-  *out = MatchResult<D>{};
+Status Matcher<D>::check_match_input(const Point<D>* scene, std::size_t n, const MatchParams& params) const {
   if (!initialized_) return Status::error(Errc::kNotInitialized, "pransam match: matcher not initialised");
   if (model_ == nullptr) return Status::error(Errc::kNotInitialized, "pransam match: no model set (set_model)");
   if ((params.refine_iterations > 0 || params.scene_origin_is_sensor) && !field_.has_distance()) {
@@ -256,17 +309,27 @@ Status Matcher<D>::match(const Point<D>* scene, std::size_t n, const MatchParams
                          "pransam params: omega_thres %g outside [0,1], or max_iterations/first_batch zero",
                          static_cast<double>(params.omega_thres));
   }
-  const int T = options_.num_workers;
-  int tau = params.tau < 0 ? T / 2 : params.tau;
-  if (!precomputed_) {
-    if (!table_b_.valid()) {
-      return Status::error(Errc::kNotInitialized, "pransam match: no precomputed table and R_B not allocated");
-    }
-    if (T < 2 || tau < 1 || tau > T - 1) {
-      return Status::error(Errc::kInvalidArgument,
-                           "pransam params: online matching needs T >= 2 and 1 <= tau <= T-1 (T %d, tau %d)", T, tau);
-    }
+  return Status::ok();
+}
+
+// Online matching fills R_B as it goes and needs workers on both sides of τ (Theorem 1).
+template <int D>
+Status Matcher<D>::check_online_workers(int T, int tau) const {
+  if (precomputed_) return Status::ok();
+  if (!table_b_.valid()) {
+    return Status::error(Errc::kNotInitialized, "pransam match: no precomputed table and R_B not allocated");
   }
+  if (T < 2 || tau < 1 || tau > T - 1) {
+    return Status::error(Errc::kInvalidArgument,
+                         "pransam params: online matching needs T >= 2 and 1 <= tau <= T-1 (T %d, tau %d)", T, tau);
+  }
+  return Status::ok();
+}
+
+// Extent of the relation tables: the precomputed table's, the caller's, or from the sets' diameters.
+template <int D>
+Status Matcher<D>::choose_extent(const Point<D>* scene, std::size_t n, const MatchParams& params,
+                                 float* extent_out) const {
   Point<D> lo = scene[0], hi = scene[0];
   for (std::size_t i = 1; i < n; ++i) {
     lo = lo.cwiseMin(scene[i]);
@@ -286,6 +349,15 @@ Status Matcher<D>::match(const Point<D>* scene, std::size_t n, const MatchParams
     extent *= 1.001f;
   }
   if (!(extent > 0.0f)) return Status::error(Errc::kInvalidArgument, "pransam scene: all points coincide");
+  *extent_out = extent;
+  return Status::ok();
+}
+
+// Per-match state read by the workers, the scene index and, online, empty tables at this extent.
+template <int D>
+Status Matcher<D>::prepare_match(const Point<D>* scene, std::size_t n, const MatchParams& params, int tau,
+                                 float extent) {
+  const int T = options_.num_workers;
   scene_ = scene;
   scene_n_ = static_cast<std::uint32_t>(n);
   params_ = params;
@@ -304,54 +376,32 @@ Status Matcher<D>::match(const Point<D>* scene, std::size_t n, const MatchParams
     }
     model_table_ = &table_b_;
   }
-  // A has to contain at least one keyable triple, otherwise no hypothesis can ever exist.
-  {
-    bool any = false;
-    const TripleFilter& f = filter_;
-    for (std::uint32_t i = 0; i < scene_n_ && !any; ++i) {
-      for (std::uint32_t j = i + 1; j < scene_n_ && !any; j += 1 + scene_n_ / 64) {
-        for (std::uint32_t k = j + 1; k < scene_n_ && !any; k += 1 + scene_n_ / 64) {
-          Triple t;
-          t.v[0] = i; t.v[1] = j; t.v[2] = k;
-          std::uint32_t slot;
-          any = key_triple<D>(scene, f, &t, &slot) == KeyResult::kOk;
-        }
-      }
-      if (scene_n_ > 64) i += scene_n_ / 64;
-    }
-    if (!any) {
-      return Status::error(Errc::kInvalidArgument,
-                           "pransam scene: no usable triple (%zu points all collinear, coincident or wider than the "
-                           "table extent %.2f m)", n, static_cast<double>(extent));
-    }
-  }
-  // Random visiting order of A for the extrapolation (Eq. 4.8): Fisher–Yates from the seed.
-  {
-    RandomStream rng(params.seed, kSceneOrderStream);
-    for (std::uint32_t i = 0; i < scene_n_; ++i) scene_order_[i] = i;
-    for (std::uint32_t i = scene_n_ - 1; i > 0; --i) {
-      const std::uint32_t j = rng.uniform_index(i + 1);
-      const std::uint32_t tmp = scene_order_[i];
-      scene_order_[i] = scene_order_[j];
-      scene_order_[j] = tmp;
-    }
-  }
+  return Status::ok();
+}
+
+// Worker w draws from RandomStream(seed, w): the same seed and T give the same hypotheses.
+template <int D>
+void Matcher<D>::seed_workers(std::uint64_t seed) {
+  const int T = options_.num_workers;
   for (int w = 0; w < T; ++w) {
-    workers_[w].rng.reseed(params.seed, static_cast<std::uint64_t>(w));
+    workers_[w].rng.reseed(seed, static_cast<std::uint64_t>(w));
     workers_[w].stats = MatchStats{};
     workers_[w].dropped = 0;
   }
+}
+
+// Rounds until I_max iterations, a worker reaching Ω_thres, or (deadline mode) the deadline; the
+// batch per worker doubles every round up to max_batch.
+template <int D>
+auto Matcher<D>::run_rounds(const MatchParams& params, MatchResult<D>* out) -> RoundTally {
+  const int T = options_.num_workers;
+  RoundTally tally;
   round_bound_ = 0.0f;
   std::uint64_t done = 0;
   std::uint32_t batch = params.first_batch < options_.max_batch ? params.first_batch : options_.max_batch;
-  std::size_t merged_n = 0;
-  std::size_t dropped = 0;
-  bool reached = false;
-  std::uint32_t rounds = 0;
   const bool deadline_mode = params.clock != nullptr && params.deadline_ns != 0;
-  bool deadline_hit = false;
   std::uint64_t last_round_ns = 0, last_round_total = 0;
-  while (done < params.max_iterations && !reached) {
+  while (done < params.max_iterations && !tally.reached) {
     const std::uint64_t remaining = params.max_iterations - done;
     const std::uint64_t round_total = remaining < static_cast<std::uint64_t>(batch) * static_cast<std::uint64_t>(T)
                                           ? remaining
@@ -359,68 +409,101 @@ Status Matcher<D>::match(const Point<D>* scene, std::size_t n, const MatchParams
     std::uint64_t round_start = 0;
     if (deadline_mode) {
       round_start = params.clock->now_ns();
-      if (rounds > 0) {
-        // Sec. 4.4.3: stop when the next round, at the last round's rate, would end past the deadline.
-        const std::uint64_t predicted =
-            last_round_total > 0 ? last_round_ns * round_total / last_round_total : last_round_ns;
-        if (round_start >= params.deadline_ns || params.deadline_ns - round_start < predicted) {
-          deadline_hit = true;
-          break;
-        }
+      if (tally.rounds > 0 &&
+          next_round_misses_deadline(round_start, params.deadline_ns, last_round_ns, last_round_total, round_total)) {
+        tally.deadline_hit = true;
+        break;
       }
     }
-    for (int w = 0; w < T; ++w) {
-      std::size_t b, e;
-      WorkerPool::partition(static_cast<std::size_t>(round_total), w, T, &b, &e);
-      workers_[w].batch = static_cast<std::uint32_t>(e - b);
-      workers_[w].first_iteration = done + b;
-    }
-    if (pool_ != nullptr && pool_->running()) pool_->run(&Matcher::round_job, this); else round_job(this, 0, 1);
-    if (!precomputed_) {
-      if (pool_ != nullptr && pool_->running()) pool_->run(&Matcher::apply_job, this); else apply_job(this, 0, 1);
-    }
-    // Merge in worker order.
-    for (int w = 0; w < T; ++w) {
-      const WorkerState& st = workers_[w];
-      if (st.best_valid && (!out->best_valid || st.best.quality > out->best.quality)) {
-        out->best = st.best;
-        out->best_valid = true;
-      }
-      for (std::uint32_t i = 0; i < st.num_collected; ++i) {
-        if (merged_n < options_.collect_capacity) merged_[merged_n++] = st.collected[i]; else ++dropped;
-      }
-      reached = reached || st.reached;
-    }
+    plan_round(round_total, done);
+    run_round();
+    merge_round(out, &tally);
     if (out->best_valid) round_bound_ = out->best.quality;
     done += round_total;
-    ++rounds;
+    ++tally.rounds;
     if (deadline_mode) {
       last_round_ns = params.clock->now_ns() - round_start;
       last_round_total = round_total;
     }
     if (batch < options_.max_batch) batch = batch * 2 < options_.max_batch ? batch * 2 : options_.max_batch;
   }
-  MatchStats& s = out->stats;
+  return tally;
+}
+
+// Worker w takes its contiguous share of the round's iteration numbers.
+template <int D>
+void Matcher<D>::plan_round(std::uint64_t round_total, std::uint64_t done) {
+  const int T = options_.num_workers;
   for (int w = 0; w < T; ++w) {
-    const MatchStats& ws = workers_[w].stats;
-    s.iterations += ws.iterations;
-    s.keyed += ws.keyed;
-    s.rejected_collinear += ws.rejected_collinear;
-    s.rejected_size += ws.rejected_size;
-    s.failed_draws += ws.failed_draws;
-    s.collisions += ws.collisions;
-    s.flipped += ws.flipped;
-    s.evaluated += ws.evaluated;
-    s.extrapolation_cut += ws.extrapolation_cut;
-    s.point_checks += ws.point_checks;
-    s.refined += ws.refined;
-    s.free_space_rejected += ws.free_space_rejected;
+    std::size_t b, e;
+    WorkerPool::partition(static_cast<std::size_t>(round_total), w, T, &b, &e);
+    workers_[w].batch = static_cast<std::uint32_t>(e - b);
+    workers_[w].first_iteration = done + b;
+  }
+}
+
+// The workers' batches, then (online) their buffered inserts after the barrier.
+template <int D>
+void Matcher<D>::run_round() {
+  if (pool_ != nullptr && pool_->running()) pool_->run(&Matcher::round_job, this); else round_job(this, 0, 1);
+  if (!precomputed_) {
+    if (pool_ != nullptr && pool_->running()) pool_->run(&Matcher::apply_job, this); else apply_job(this, 0, 1);
+  }
+}
+
+// Merge in worker order.
+template <int D>
+void Matcher<D>::merge_round(MatchResult<D>* out, RoundTally* tally) {
+  const int T = options_.num_workers;
+  for (int w = 0; w < T; ++w) {
+    const WorkerState& st = workers_[w];
+    if (st.best_valid && (!out->best_valid || st.best.quality > out->best.quality)) {
+      out->best = st.best;
+      out->best_valid = true;
+    }
+    for (std::uint32_t i = 0; i < st.num_collected; ++i) {
+      if (tally->merged_n < options_.collect_capacity) {
+        merged_[tally->merged_n++] = st.collected[i];
+      } else {
+        ++tally->dropped;
+      }
+    }
+    tally->reached = tally->reached || st.reached;
+  }
+}
+
+template <int D>
+Status Matcher<D>::match(const Point<D>* scene, std::size_t n, const MatchParams& params, MatchResult<D>* out) {
+  if (out == nullptr) return Status::error(Errc::kInvalidArgument, "pransam match: no result object");
+  *out = MatchResult<D>{};
+  FW_RETURN_IF_ERROR(check_match_input(scene, n, params));
+  const int T = options_.num_workers;
+  const int tau = params.tau < 0 ? T / 2 : params.tau;
+  FW_RETURN_IF_ERROR(check_online_workers(T, tau));
+  float extent = 0.0f;
+  FW_RETURN_IF_ERROR(choose_extent(scene, n, params, &extent));
+  FW_RETURN_IF_ERROR(prepare_match(scene, n, params, tau, extent));
+  // A has to contain at least one keyable triple, otherwise no hypothesis can ever exist.
+  if (!has_keyable_triple<D>(scene, scene_n_, filter_)) {
+    return Status::error(Errc::kInvalidArgument,
+                         "pransam scene: no usable triple (%zu points all collinear, coincident or wider than the "
+                         "table extent %.2f m)", n, static_cast<double>(extent));
+  }
+  shuffle_scene_order(scene_order_, scene_n_, params.seed);
+  seed_workers(params.seed);
+  const RoundTally tally = run_rounds(params, out);
+  MatchStats& s = out->stats;
+  std::size_t dropped = tally.dropped;
+  for (int w = 0; w < T; ++w) {
+    add_stats(&s, workers_[w].stats);
     dropped += workers_[w].dropped;
   }
-  s.rounds = rounds;
-  s.stop = reached ? StopReason::kThreshold : deadline_hit ? StopReason::kDeadline : StopReason::kMaxIterations;
+  s.rounds = tally.rounds;
+  s.stop = tally.reached        ? StopReason::kThreshold
+           : tally.deadline_hit ? StopReason::kDeadline
+                                : StopReason::kMaxIterations;
   out->hypotheses = merged_;
-  out->num_hypotheses = merged_n;
+  out->num_hypotheses = tally.merged_n;
   out->dropped = dropped;
   out->found = out->best_valid && out->best.quality >= params.omega_thres;
   return Status::ok();

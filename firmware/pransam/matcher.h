@@ -210,6 +210,25 @@ class Matcher {
     std::uint64_t first_iteration = 0;
     MatchStats stats;
   };
+  // What match()'s rounds leave for the result.
+  struct RoundTally {
+    std::size_t merged_n = 0;   // hypotheses in merged_
+    std::size_t dropped = 0;    // collect-all hypotheses lost to merged_'s capacity
+    std::uint32_t rounds = 0;
+    bool reached = false;       // a worker reached Ω_thres (stop mode)
+    bool deadline_hit = false;  // deadline mode stopped before I_max
+  };
+
+  // Steps of match() (matcher.cpp).
+  Status check_match_input(const Point<D>* scene, std::size_t n, const MatchParams& params) const;
+  Status check_online_workers(int T, int tau) const;
+  Status choose_extent(const Point<D>* scene, std::size_t n, const MatchParams& params, float* extent_out) const;
+  Status prepare_match(const Point<D>* scene, std::size_t n, const MatchParams& params, int tau, float extent);
+  void seed_workers(std::uint64_t seed);
+  RoundTally run_rounds(const MatchParams& params, MatchResult<D>* out);
+  void plan_round(std::uint64_t round_total, std::uint64_t done);
+  void run_round();
+  void merge_round(MatchResult<D>* out, RoundTally* tally);
 
   static void round_job(void* ctx, int pool_index, int pool_size);
   static void apply_job(void* ctx, int pool_index, int pool_size);
