@@ -47,6 +47,306 @@ bool parse_u64(const std::string& flag, const std::string& v, unsigned long long
   return true;
 }
 
+// Walks the arguments; an option that takes a value consumes the one after it.
+struct ArgCursor {
+  const std::vector<std::string>& args;
+  size_t i = 0;
+  std::string* err;
+
+  const std::string& flag() const { return args[i]; }
+  // The value after the flag, or false: a following "--x" is taken for a forgotten value, not for
+  // the value itself.
+  bool value(std::string* v) {
+    const std::string& a = flag();
+    if (i + 1 >= args.size() || (args[i + 1].rfind("--", 0) == 0 && args[i + 1].size() > 2)) {
+      *err = a + " needs a value";
+      return false;
+    }
+    *v = args[++i];
+    return true;
+  }
+  bool u64_value(unsigned long long hi, unsigned long long* n) {
+    const std::string& a = flag();
+    std::string v;
+    return value(&v) && parse_u64(a, v, hi, n, err);
+  }
+  bool double_value(double lo, double hi, double* d) {
+    const std::string& a = flag();
+    std::string v;
+    return value(&v) && parse_double(a, v, lo, hi, d, err);
+  }
+};
+
+// What the checks after the loop need beyond the config itself.
+struct GivenOptions {
+  std::vector<std::string> world_only;  // options of synthetic worlds that were given
+  bool start = false, odom_noise = false;
+};
+
+// An option group's verdict on the current argument.
+enum class Parsed { kNotMine, kOk, kError };
+
+Parsed ok_if(bool ok) { return ok ? Parsed::kOk : Parsed::kError; }
+
+Parsed fail_with(std::string* err, const std::string& msg) {
+  *err = msg;
+  return Parsed::kError;
+}
+
+// --help, --list: what to do instead of a run.
+Parsed parse_action_option(const std::string& a, SimArgsAction* action) {
+  if (a == "--help" || a == "-h") {
+    *action = SimArgsAction::kHelp;
+  } else if (a == "--list") {
+    *action = SimArgsAction::kList;
+  } else {
+    return Parsed::kNotMine;
+  }
+  return Parsed::kOk;
+}
+
+// --world, --dataset, --log and what a log replay takes beside it.
+Parsed parse_source_option(ArgCursor* cur, SimConfig* cfg, GivenOptions* given) {
+  const std::string& a = cur->flag();
+  unsigned long long n = 0;
+  if (a == "--world") return ok_if(cur->value(&cfg->world));
+  if (a == "--dataset") return ok_if(cur->value(&cfg->dataset));
+  if (a == "--log") return ok_if(cur->value(&cfg->log_path));
+  if (a == "--reference") return ok_if(cur->value(&cfg->reference_path));
+  if (a == "--map") return ok_if(cur->value(&cfg->map_yaml));
+  if (a == "--start") {
+    if (!cur->u64_value(100000000ull, &n)) return Parsed::kError;
+    cfg->log_start = static_cast<size_t>(n);
+    given->start = true;
+    return Parsed::kOk;
+  }
+  if (a == "--max-log-mib") {
+    if (!cur->u64_value(1ull << 20, &n)) return Parsed::kError;
+    if (n == 0) return fail_with(cur->err, "--max-log-mib: must be at least 1");
+    cfg->max_log_bytes = static_cast<std::uint64_t>(n) << 20;
+    return Parsed::kOk;
+  }
+  return Parsed::kNotMine;
+}
+
+// The run options of the help text but the transport ones.
+Parsed parse_run_option(ArgCursor* cur, SimConfig* cfg) {
+  const std::string& a = cur->flag();
+  std::string v;
+  unsigned long long n = 0;
+  if (a == "--localizer") return ok_if(cur->value(&cfg->localizer));
+  if (a == "--opt") {
+    if (!cur->value(&v)) return Parsed::kError;
+    const size_t eq = v.find('=');
+    if (eq == std::string::npos || eq == 0) return fail_with(cur->err, "--opt: '" + v + "' is not KEY=VALUE");
+    cfg->localizer_options[v.substr(0, eq)] = v.substr(eq + 1);
+    return Parsed::kOk;
+  }
+  if (a == "--seed") {
+    if (!cur->u64_value(~0ull, &n)) return Parsed::kError;
+    cfg->seed = n;
+    return Parsed::kOk;
+  }
+  if (a == "--steps") {
+    if (!cur->u64_value(100000000ull, &n)) return Parsed::kError;
+    cfg->steps = static_cast<size_t>(n);
+    return Parsed::kOk;
+  }
+  if (a == "--paced") {
+    cfg->paced = true;
+    return Parsed::kOk;
+  }
+  if (a == "--speed") return ok_if(cur->double_value(0.01, 1000, &cfg->pace_speed));
+  if (a == "--threads") {
+    if (!cur->u64_value(64, &n)) return Parsed::kError;
+    if (n == 0) return fail_with(cur->err, "--threads: must be at least 1");
+    cfg->threads = static_cast<int>(n);
+    return Parsed::kOk;
+  }
+  if (a == "--deadline-ms") return ok_if(cur->double_value(0, 100000, &cfg->deadline_ms));
+  if (a == "--out") return ok_if(cur->value(&cfg->out_dir));
+  if (a == "--timing") {
+    if (!cur->value(&v)) return Parsed::kError;
+    if (v != "wall" && v != "none") return fail_with(cur->err, "--timing: '" + v + "' (expected wall or none)");
+    cfg->wall_timing = v == "wall";
+    return Parsed::kOk;
+  }
+  if (a == "--quiet") {
+    cfg->progress = false;
+    return Parsed::kOk;
+  }
+  if (a == "--no-pictures") {
+    cfg->pictures = false;
+    return Parsed::kOk;
+  }
+  return Parsed::kNotMine;
+}
+
+// --transport, --sensor-resolution, --byte-fault-rate: the wire between the sensors and the firmware.
+Parsed parse_transport_option(ArgCursor* cur, SimConfig* cfg) {
+  const std::string& a = cur->flag();
+  std::string v;
+  if (a == "--transport") {
+    if (!cur->value(&v)) return Parsed::kError;
+    if (!parse_transport(v, &cfg->transport.transport)) {
+      return fail_with(cur->err, "--transport: '" + v + "' (expected none, can or sick)");
+    }
+    return Parsed::kOk;
+  }
+  if (a == "--sensor-resolution") {
+    if (!cur->value(&v)) return Parsed::kError;
+    if (v != "exact" && v != "can" && v != "sick") {
+      return fail_with(cur->err, "--sensor-resolution: '" + v + "' (expected exact, can or sick)");
+    }
+    cfg->transport.resolution = v == "can"    ? SensorResolution::kCan
+                                : v == "sick" ? SensorResolution::kSick
+                                              : SensorResolution::kExact;
+    return Parsed::kOk;
+  }
+  if (a == "--byte-fault-rate") return ok_if(cur->double_value(0, 1, &cfg->transport.byte_fault_rate));
+  return Parsed::kNotMine;
+}
+
+// Options of synthetic worlds alone: a log brings its own laser, route and map.
+Parsed parse_world_only_option(ArgCursor* cur, SimConfig* cfg) {
+  const std::string& a = cur->flag();
+  unsigned long long n = 0;
+  double d = 0;
+  if (a == "--people") {
+    if (!cur->u64_value(200, &n)) return Parsed::kError;
+    cfg->synthetic.people = static_cast<int>(n);
+    return Parsed::kOk;
+  }
+  if (a == "--beams") {
+    if (!cur->u64_value(hal::LaserScan::kMaxBeams, &n)) return Parsed::kError;
+    if (n < 2) return fail_with(cur->err, "--beams: need at least 2");
+    cfg->synthetic.laser.beams = static_cast<int>(n);
+    return Parsed::kOk;
+  }
+  if (a == "--max-range") return ok_if(cur->double_value(0.5, 200, &cfg->synthetic.laser.max_range));
+  if (a == "--range-noise") return ok_if(cur->double_value(0, 1, &cfg->synthetic.laser.sigma_range));
+  if (a == "--dropout") return ok_if(cur->double_value(0, 1, &cfg->synthetic.laser.dropout_rate));
+  if (a == "--scan-period") return ok_if(cur->double_value(0.01, 10, &cfg->synthetic.scan_period_s));
+  if (a == "--route-length") return ok_if(cur->double_value(1, 100000, &cfg->synthetic.route.length_m));
+  if (a == "--start-node") {
+    if (!cur->u64_value(1000000, &n)) return Parsed::kError;
+    cfg->synthetic.route.start_node = static_cast<int>(n);
+    return Parsed::kOk;
+  }
+  if (a == "--via-unknown") {
+    cfg->synthetic.route.via_unknown = true;
+    return Parsed::kOk;
+  }
+  if (a == "--enter-unknown") {
+    cfg->synthetic.route.avoid_unknown = false;
+    return Parsed::kOk;
+  }
+  if (a == "--map-unknown") {
+    cfg->raster.erase_unknown_areas = false;
+    return Parsed::kOk;
+  }
+  if (a == "--resolution") {
+    if (!cur->double_value(0.01, 1, &d)) return Parsed::kError;
+    cfg->raster.resolution = d;
+    return Parsed::kOk;
+  }
+  return Parsed::kNotMine;
+}
+
+// --odom-noise T,R: the synthetic odometry's noise, or extra noise on a log's odometry.
+Parsed parse_odom_noise(ArgCursor* cur, SimConfig* cfg, GivenOptions* given) {
+  const std::string& a = cur->flag();
+  std::string v;
+  if (!cur->value(&v)) return Parsed::kError;
+  const size_t comma = v.find(',');
+  if (comma == std::string::npos) {
+    return fail_with(cur->err, "--odom-noise: '" + v + "' is not T,R (metres,degrees per scan step)");
+  }
+  if (!parse_double(a, v.substr(0, comma), 0, 10, &cfg->synthetic.odometry.sigma_trans, cur->err) ||
+      !parse_double(a, v.substr(comma + 1), 0, 180, &cfg->synthetic.odometry.sigma_rot_deg, cur->err)) {
+    return Parsed::kError;
+  }
+  cfg->log_odom_sigma_m = cfg->synthetic.odometry.sigma_trans;
+  cfg->log_odom_sigma_deg = cfg->synthetic.odometry.sigma_rot_deg;
+  given->odom_noise = true;
+  return Parsed::kOk;
+}
+
+// --kidnap-at N: set for both kinds of source; check_source_kind keeps the one that applies.
+Parsed parse_kidnap_at(ArgCursor* cur, SimConfig* cfg) {
+  unsigned long long n = 0;
+  if (!cur->u64_value(100000000ull, &n)) return Parsed::kError;
+  if (n == 0) return fail_with(cur->err, "--kidnap-at: the scan index must be at least 1");
+  cfg->synthetic.kidnap_at_scan = static_cast<size_t>(n);
+  cfg->log_kidnap_at = static_cast<size_t>(n);
+  return Parsed::kOk;
+}
+
+// The "synthetic world" options of the help text.
+Parsed parse_world_option(ArgCursor* cur, SimConfig* cfg, GivenOptions* given) {
+  const std::string& a = cur->flag();
+  if (a == "--odom-noise") return parse_odom_noise(cur, cfg, given);
+  if (a == "--kidnap-at") return parse_kidnap_at(cur, cfg);
+  const Parsed p = parse_world_only_option(cur, cfg);
+  if (p != Parsed::kNotMine) given->world_only.push_back(a);
+  return p;
+}
+
+// Hands the current argument to each option group in turn; one that none takes is an error.
+bool parse_one_option(ArgCursor* cur, SimConfig* cfg, SimArgsAction* action, GivenOptions* given) {
+  Parsed p = parse_action_option(cur->flag(), action);
+  if (p == Parsed::kNotMine) p = parse_source_option(cur, cfg, given);
+  if (p == Parsed::kNotMine) p = parse_run_option(cur, cfg);
+  if (p == Parsed::kNotMine) p = parse_transport_option(cur, cfg);
+  if (p == Parsed::kNotMine) p = parse_world_option(cur, cfg, given);
+  if (p == Parsed::kNotMine) *cur->err = "unknown argument '" + cur->flag() + "' (see --help)";
+  return p == Parsed::kOk;
+}
+
+// Exactly one source, and the log-only options only with a log.
+bool check_source_choice(const SimConfig& cfg, std::string* err) {
+  const int sources = !cfg.world.empty() + !cfg.log_path.empty() + !cfg.dataset.empty();
+  if (sources == 0) {
+    *err = "no input: give --world NAME, --dataset NAME or --log FILE (see --help)";
+    return false;
+  }
+  if (sources > 1) {
+    *err = "--world, --dataset and --log exclude each other";
+    return false;
+  }
+  if (!cfg.reference_path.empty() && cfg.log_path.empty() && cfg.dataset.empty()) {
+    *err = "--reference needs --log";
+    return false;
+  }
+  if (!cfg.map_yaml.empty() && cfg.log_path.empty() && cfg.dataset.empty()) {
+    *err = "--map is for --log replays (worlds bring their own map)";
+    return false;
+  }
+  return true;
+}
+
+// Options that mean different things for a world and a log: refuse the ones of the other kind and
+// switch off what the other kind would have used.
+bool check_source_kind(const GivenOptions& given, SimConfig* cfg, std::string* err) {
+  const bool log_source = cfg->world.empty();
+  if (log_source) {
+    if (!given.world_only.empty()) {
+      *err = given.world_only.front() + " is an option of synthetic worlds (--world); a log (--log, --dataset) brings " +
+             "its own laser, route and map";
+      return false;
+    }
+    cfg->log_odom_noise = given.odom_noise;
+    cfg->synthetic.kidnap_at_scan = 0;
+  } else {
+    if (given.start) {
+      *err = "--start is for --log / --dataset replays (a world's route: --start-node)";
+      return false;
+    }
+    cfg->log_kidnap_at = 0;
+  }
+  return true;
+}
+
 }  // namespace
 
 std::string sim_usage() {
@@ -126,211 +426,13 @@ bool parse_sim_args(const std::vector<std::string>& args, SimConfig* cfg, SimArg
   *action = SimArgsAction::kRun;
   cfg->out_dir = "build/run";
   cfg->threads = 2;  // as mml-eval (SimConfig's own default stays 1 for the library's tests)
-  std::vector<std::string> world_only;  // options of synthetic worlds that were given
-  bool start_given = false, odom_noise_given = false;
-  for (size_t i = 0; i < args.size(); ++i) {
-    const std::string& a = args[i];
-    auto value = [&](std::string* v) {
-      if (i + 1 >= args.size() || (args[i + 1].rfind("--", 0) == 0 && args[i + 1].size() > 2)) {
-        *err = a + " needs a value";
-        return false;
-      }
-      *v = args[++i];
-      return true;
-    };
-    std::string v;
-    double d = 0;
-    unsigned long long n = 0;
-    if (a == "--help" || a == "-h") {
-      *action = SimArgsAction::kHelp;
-    } else if (a == "--list") {
-      *action = SimArgsAction::kList;
-    } else if (a == "--world") {
-      if (!value(&cfg->world)) return false;
-    } else if (a == "--dataset") {
-      if (!value(&cfg->dataset)) return false;
-    } else if (a == "--log") {
-      if (!value(&cfg->log_path)) return false;
-    } else if (a == "--reference") {
-      if (!value(&cfg->reference_path)) return false;
-    } else if (a == "--map") {
-      if (!value(&cfg->map_yaml)) return false;
-    } else if (a == "--start") {
-      if (!value(&v) || !parse_u64(a, v, 100000000ull, &n, err)) return false;
-      cfg->log_start = static_cast<size_t>(n);
-      start_given = true;
-    } else if (a == "--max-log-mib") {
-      if (!value(&v) || !parse_u64(a, v, 1ull << 20, &n, err)) return false;
-      if (n == 0) {
-        *err = "--max-log-mib: must be at least 1";
-        return false;
-      }
-      cfg->max_log_bytes = static_cast<std::uint64_t>(n) << 20;
-    } else if (a == "--localizer") {
-      if (!value(&cfg->localizer)) return false;
-    } else if (a == "--opt") {
-      if (!value(&v)) return false;
-      const size_t eq = v.find('=');
-      if (eq == std::string::npos || eq == 0) {
-        *err = "--opt: '" + v + "' is not KEY=VALUE";
-        return false;
-      }
-      cfg->localizer_options[v.substr(0, eq)] = v.substr(eq + 1);
-    } else if (a == "--seed") {
-      if (!value(&v) || !parse_u64(a, v, ~0ull, &n, err)) return false;
-      cfg->seed = n;
-    } else if (a == "--steps") {
-      if (!value(&v) || !parse_u64(a, v, 100000000ull, &n, err)) return false;
-      cfg->steps = static_cast<size_t>(n);
-    } else if (a == "--paced") {
-      cfg->paced = true;
-    } else if (a == "--speed") {
-      if (!value(&v) || !parse_double(a, v, 0.01, 1000, &cfg->pace_speed, err)) return false;
-    } else if (a == "--threads") {
-      if (!value(&v) || !parse_u64(a, v, 64, &n, err)) return false;
-      if (n == 0) {
-        *err = "--threads: must be at least 1";
-        return false;
-      }
-      cfg->threads = static_cast<int>(n);
-    } else if (a == "--deadline-ms") {
-      if (!value(&v) || !parse_double(a, v, 0, 100000, &cfg->deadline_ms, err)) return false;
-    } else if (a == "--out") {
-      if (!value(&cfg->out_dir)) return false;
-    } else if (a == "--timing") {
-      if (!value(&v)) return false;
-      if (v != "wall" && v != "none") {
-        *err = "--timing: '" + v + "' (expected wall or none)";
-        return false;
-      }
-      cfg->wall_timing = v == "wall";
-    } else if (a == "--transport") {
-      if (!value(&v)) return false;
-      if (!parse_transport(v, &cfg->transport.transport)) {
-        *err = "--transport: '" + v + "' (expected none, can or sick)";
-        return false;
-      }
-    } else if (a == "--sensor-resolution") {
-      if (!value(&v)) return false;
-      if (v != "exact" && v != "can" && v != "sick") {
-        *err = "--sensor-resolution: '" + v + "' (expected exact, can or sick)";
-        return false;
-      }
-      cfg->transport.resolution = v == "can"    ? SensorResolution::kCan
-                                  : v == "sick" ? SensorResolution::kSick
-                                                : SensorResolution::kExact;
-    } else if (a == "--byte-fault-rate") {
-      if (!value(&v) || !parse_double(a, v, 0, 1, &cfg->transport.byte_fault_rate, err)) return false;
-    } else if (a == "--quiet") {
-      cfg->progress = false;
-    } else if (a == "--no-pictures") {
-      cfg->pictures = false;
-    } else if (a == "--people") {
-      world_only.push_back(a);
-      if (!value(&v) || !parse_u64(a, v, 200, &n, err)) return false;
-      cfg->synthetic.people = static_cast<int>(n);
-    } else if (a == "--beams") {
-      world_only.push_back(a);
-      if (!value(&v) || !parse_u64(a, v, hal::LaserScan::kMaxBeams, &n, err)) return false;
-      if (n < 2) {
-        *err = "--beams: need at least 2";
-        return false;
-      }
-      cfg->synthetic.laser.beams = static_cast<int>(n);
-    } else if (a == "--max-range") {
-      world_only.push_back(a);
-      if (!value(&v) || !parse_double(a, v, 0.5, 200, &cfg->synthetic.laser.max_range, err)) return false;
-    } else if (a == "--range-noise") {
-      world_only.push_back(a);
-      if (!value(&v) || !parse_double(a, v, 0, 1, &cfg->synthetic.laser.sigma_range, err)) return false;
-    } else if (a == "--dropout") {
-      world_only.push_back(a);
-      if (!value(&v) || !parse_double(a, v, 0, 1, &cfg->synthetic.laser.dropout_rate, err)) return false;
-    } else if (a == "--odom-noise") {
-      if (!value(&v)) return false;
-      const size_t comma = v.find(',');
-      if (comma == std::string::npos) {
-        *err = "--odom-noise: '" + v + "' is not T,R (metres,degrees per scan step)";
-        return false;
-      }
-      if (!parse_double(a, v.substr(0, comma), 0, 10, &cfg->synthetic.odometry.sigma_trans, err) ||
-          !parse_double(a, v.substr(comma + 1), 0, 180, &cfg->synthetic.odometry.sigma_rot_deg, err)) {
-        return false;
-      }
-      cfg->log_odom_sigma_m = cfg->synthetic.odometry.sigma_trans;
-      cfg->log_odom_sigma_deg = cfg->synthetic.odometry.sigma_rot_deg;
-      odom_noise_given = true;
-    } else if (a == "--scan-period") {
-      world_only.push_back(a);
-      if (!value(&v) || !parse_double(a, v, 0.01, 10, &cfg->synthetic.scan_period_s, err)) return false;
-    } else if (a == "--route-length") {
-      world_only.push_back(a);
-      if (!value(&v) || !parse_double(a, v, 1, 100000, &cfg->synthetic.route.length_m, err)) return false;
-    } else if (a == "--start-node") {
-      world_only.push_back(a);
-      if (!value(&v) || !parse_u64(a, v, 1000000, &n, err)) return false;
-      cfg->synthetic.route.start_node = static_cast<int>(n);
-    } else if (a == "--via-unknown") {
-      world_only.push_back(a);
-      cfg->synthetic.route.via_unknown = true;
-    } else if (a == "--kidnap-at") {
-      if (!value(&v) || !parse_u64(a, v, 100000000ull, &n, err)) return false;
-      if (n == 0) {
-        *err = "--kidnap-at: the scan index must be at least 1";
-        return false;
-      }
-      cfg->synthetic.kidnap_at_scan = static_cast<size_t>(n);
-      cfg->log_kidnap_at = static_cast<size_t>(n);
-    } else if (a == "--enter-unknown") {
-      world_only.push_back(a);
-      cfg->synthetic.route.avoid_unknown = false;
-    } else if (a == "--map-unknown") {
-      world_only.push_back(a);
-      cfg->raster.erase_unknown_areas = false;
-    } else if (a == "--resolution") {
-      world_only.push_back(a);
-      if (!value(&v) || !parse_double(a, v, 0.01, 1, &d, err)) return false;
-      cfg->raster.resolution = d;
-    } else {
-      *err = "unknown argument '" + a + "' (see --help)";
-      return false;
-    }
+  ArgCursor cur{args, 0, err};
+  GivenOptions given;
+  for (; cur.i < args.size(); ++cur.i) {
+    if (!parse_one_option(&cur, cfg, action, &given)) return false;
   }
   if (*action != SimArgsAction::kRun) return true;
-  const int sources = !cfg->world.empty() + !cfg->log_path.empty() + !cfg->dataset.empty();
-  if (sources == 0) {
-    *err = "no input: give --world NAME, --dataset NAME or --log FILE (see --help)";
-    return false;
-  }
-  if (sources > 1) {
-    *err = "--world, --dataset and --log exclude each other";
-    return false;
-  }
-  if (!cfg->reference_path.empty() && cfg->log_path.empty() && cfg->dataset.empty()) {
-    *err = "--reference needs --log";
-    return false;
-  }
-  if (!cfg->map_yaml.empty() && cfg->log_path.empty() && cfg->dataset.empty()) {
-    *err = "--map is for --log replays (worlds bring their own map)";
-    return false;
-  }
-  const bool log_source = cfg->world.empty();
-  if (log_source) {
-    if (!world_only.empty()) {
-      *err = world_only.front() + " is an option of synthetic worlds (--world); a log (--log, --dataset) brings " +
-             "its own laser, route and map";
-      return false;
-    }
-    cfg->log_odom_noise = odom_noise_given;
-    cfg->synthetic.kidnap_at_scan = 0;
-  } else {
-    if (start_given) {
-      *err = "--start is for --log / --dataset replays (a world's route: --start-node)";
-      return false;
-    }
-    cfg->log_kidnap_at = 0;
-  }
-  return true;
+  return check_source_choice(*cfg, err) && check_source_kind(given, cfg, err);
 }
 
 }  // namespace sim

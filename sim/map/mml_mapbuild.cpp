@@ -16,6 +16,7 @@
 #include <cstdlib>
 #include <cstring>
 #include <filesystem>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -79,11 +80,30 @@ void print_stats(const std::string& name, const sim::RosMap& m, const sim::Occup
               s.free, s.unknown, secs);
 }
 
-}  // namespace
-
-static int run_main(int argc, char** argv) {
+// The command line: a built-in dataset (or all), or a log with known poses and the map's name.
+struct MapBuildArgs {
   std::string dataset, log_path, name, out = sim::map_cache_dir();
-  double resolution = 0.0, max_range = 0.0, laser_max = 0.0;
+  double resolution = 0.0, max_range = 0.0, laser_max = 0.0;  // 0: not given
+};
+
+// Options given together that do not go together. Set: the exit code of the error reported.
+std::optional<int> check_combination(const MapBuildArgs& o) {
+  if (!o.dataset.empty() && !o.log_path.empty()) return usage_error("--dataset and --log exclude each other");
+  if (o.dataset.empty() && o.log_path.empty()) return usage_error("nothing to build: give --dataset NAME or --log FILE --name NAME");
+  if (!o.log_path.empty() && o.name.empty()) {
+    return usage_error("--log needs --name NAME (the map's file name: DIR/NAME.yaml, .pgm, .png, .mmap)");
+  }
+  if (!o.dataset.empty() && !o.name.empty()) return usage_error("--name is for --log (a dataset's map is named after it)");
+  if (!o.dataset.empty() && (o.max_range > 0.0 || o.laser_max > 0.0)) {
+    return usage_error(std::string(o.max_range > 0.0 ? "--max-range" : "--laser-max-range") +
+                       " is for --log (the built-in maps use their own: 25 m, 40 m for mit-killian and fr-campus)");
+  }
+  return std::nullopt;
+}
+
+// Reads the command line into *o. Set: the run ends here with that exit code (--help, or an error
+// already reported).
+std::optional<int> parse_args(int argc, char** argv, MapBuildArgs* o) {
   std::string err;
   for (int i = 1; i < argc; ++i) {
     const std::string a = argv[i];
@@ -97,149 +117,184 @@ static int run_main(int argc, char** argv) {
     if (i + 1 >= argc) return usage_error(a + " needs a value");
     const char* v = argv[++i];
     if (a == "--dataset") {
-      dataset = v;
+      o->dataset = v;
     } else if (a == "--resolution") {
-      if (!parse_positive(a, v, &resolution, &err)) return usage_error(err);
+      if (!parse_positive(a, v, &o->resolution, &err)) return usage_error(err);
     } else if (a == "--out") {
-      out = v;
+      o->out = v;
     } else if (a == "--log") {
-      log_path = v;
+      o->log_path = v;
     } else if (a == "--name") {
-      name = v;
-      if (name.empty() || name.find('/') != std::string::npos) {
-        return usage_error("--name: '" + name + "' is not a file name (no '/'; the directory is --out)");
+      o->name = v;
+      if (o->name.empty() || o->name.find('/') != std::string::npos) {
+        return usage_error("--name: '" + o->name + "' is not a file name (no '/'; the directory is --out)");
       }
     } else if (a == "--max-range") {
-      if (!parse_positive(a, v, &max_range, &err)) return usage_error(err);
+      if (!parse_positive(a, v, &o->max_range, &err)) return usage_error(err);
     } else if (a == "--laser-max-range") {
-      if (!parse_positive(a, v, &laser_max, &err)) return usage_error(err);
+      if (!parse_positive(a, v, &o->laser_max, &err)) return usage_error(err);
     }
   }
-  if (!dataset.empty() && !log_path.empty()) return usage_error("--dataset and --log exclude each other");
-  if (dataset.empty() && log_path.empty()) return usage_error("nothing to build: give --dataset NAME or --log FILE --name NAME");
-  if (!log_path.empty() && name.empty()) {
-    return usage_error("--log needs --name NAME (the map's file name: DIR/NAME.yaml, .pgm, .png, .mmap)");
+  return check_combination(*o);
+}
+
+// Where the laser's maximum range comes from, for the messages.
+std::string laser_max_source(const sim::CarmenLog& log, double laser_max) {
+  std::string max_src = "--laser-max-range";
+  if (laser_max <= 0.0) {
+    max_src = "the largest reading of the log (no PARAM robot_front_laser_max / robot_rear_laser_max)";
+    for (const auto& kv : log.params) {
+      if (kv.first == "robot_front_laser_max" || kv.first == "robot_rear_laser_max") max_src = "PARAM " + kv.first;
+    }
   }
-  if (!dataset.empty() && !name.empty()) return usage_error("--name is for --log (a dataset's map is named after it)");
-  if (!dataset.empty() && (max_range > 0.0 || laser_max > 0.0)) {
-    return usage_error(std::string(max_range > 0.0 ? "--max-range" : "--laser-max-range") +
-                       " is for --log (the built-in maps use their own: 25 m, 40 m for mit-killian and fr-campus)");
+  return max_src;
+}
+
+// How the beams stand to the laser's maximum range.
+struct BeamCensus {
+  std::size_t beams = 0, at_max = 0, beyond = 0;
+  // Beyond the maximum but below the largest reading: real measurements (the largest reading
+  // itself is often the laser's no-echo code, 81.91 m for a SICK LMS).
+  std::size_t beyond_below_largest = 0;
+  float max_seen = 0.0f;  // the largest reading
+};
+
+BeamCensus count_beams(const sim::CarmenLog& log) {
+  BeamCensus c;
+  for (const sim::CarmenScan& s : log.scans) {
+    for (float r : s.ranges) {
+      ++c.beams;
+      if (std::isfinite(r)) c.max_seen = std::max(c.max_seen, r);
+      if (s.max_range > 0.0f && r >= s.max_range - 0.01f) ++(r > s.max_range + 0.01f ? c.beyond : c.at_max);
+    }
   }
-  std::error_code ec;
-  std::filesystem::create_directories(out, ec);
-  if (ec) {
-    std::fprintf(stderr, "mml-mapbuild: %s: %s\n", out.c_str(), ec.message().c_str());
+  for (const sim::CarmenScan& s : log.scans) {
+    for (float r : s.ranges) {
+      if (s.max_range > 0.0f && r > s.max_range + 0.01f && r < c.max_seen - 0.01f) ++c.beyond_below_largest;
+    }
+  }
+  return c;
+}
+
+// Says how many beams the laser's maximum range leaves out, with a warning when that may lose real
+// measurements.
+void report_beam_census(const MapBuildArgs& o, double lmax, const std::string& max_src, const BeamCensus& c) {
+  const double pct = 100.0 / static_cast<double>(std::max<std::size_t>(c.beams, 1));
+  std::printf("%s: laser maximum range %.2f m (from %s): of %zu beams, %zu (%.1f %%) read the maximum (no echo) and "
+              "%zu (%.1f %%) beyond it; both are 'no return' and not drawn; largest reading %.2f m\n",
+              o.name.c_str(), lmax, max_src.c_str(), c.beams, c.at_max, pct * static_cast<double>(c.at_max), c.beyond,
+              pct * static_cast<double>(c.beyond), static_cast<double>(c.max_seen));
+  if (c.beyond > 0 && c.beyond_below_largest * 100 <= c.beyond) {
+    std::printf("%s: %zu of the %zu beams beyond it read %.2f m, the laser's no-echo value: next to nothing is lost\n",
+                o.name.c_str(), c.beyond - c.beyond_below_largest, c.beyond, static_cast<double>(c.max_seen));
+  } else if (c.beyond > 0) {
+    std::fprintf(stderr,
+                 "mml-mapbuild: warning: %s: %zu of %zu beams (%.1f %%) read beyond the laser maximum range %.2f m "
+                 "(%s), up to %.2f m, and are left out of the map; if the laser measures that far, give "
+                 "--laser-max-range %.2f\n",
+                 o.log_path.c_str(), c.beyond, c.beams, pct * static_cast<double>(c.beyond), lmax, max_src.c_str(),
+                 static_cast<double>(c.max_seen), std::ceil((static_cast<double>(c.max_seen) + 0.02) * 100.0) / 100.0);
+  } else if (pct * static_cast<double>(c.at_max) > 5.0) {
+    std::fprintf(stderr,
+                 "mml-mapbuild: warning: %s: %zu of %zu beams (%.1f %%) read the laser maximum range %.2f m (%s) and "
+                 "are left out of the map as 'no echo'; if that is not the laser's no-echo value, give "
+                 "--laser-max-range M\n",
+                 o.log_path.c_str(), c.at_max, c.beams, pct * static_cast<double>(c.at_max), lmax, max_src.c_str());
+  }
+}
+
+// The occupancy grid of the log's scans at their poses, written as NAME.{yaml,pgm,png,mmap}: 0, or
+// the exit code of the failure reported.
+int build_and_write(const MapBuildArgs& o, const sim::CarmenLog& log, std::chrono::steady_clock::time_point t0) {
+  std::string err;
+  std::vector<sim::PosedScan> scans;
+  for (const sim::CarmenScan& s : log.scans) {
+    scans.push_back({s.pose, s.angle_min, s.angle_increment, s.max_range, s.ranges.data(), s.ranges.size()});
+  }
+  // Default options of the built-in maps (sim/map/global_maps.cpp: 25 m indoors).
+  sim::OccupancyBuildOptions opt = sim::global_map_options("", o.resolution > 0.0 ? o.resolution : 0.05);
+  if (o.max_range > 0.0) opt.max_usable_range = o.max_range;
+  std::printf("%s: resolution %.3g m, readings used up to %.1f m%s\n", o.name.c_str(), opt.resolution,
+              opt.max_usable_range, o.max_range > 0.0 ? " (--max-range)" : " (default, as the built-in indoor maps)");
+  sim::OccupancyGrid grid;
+  sim::OccupancyBuildStats stats;
+  if (!sim::build_occupancy_grid(scans, opt, &grid, &stats, &err)) {
+    std::fprintf(stderr, "mml-mapbuild: %s: %s\n", o.log_path.c_str(), err.c_str());
     return 1;
   }
-  if (!log_path.empty()) {
-    const auto t0 = std::chrono::steady_clock::now();
-    sim::CarmenLog log;
-    if (!sim::read_carmen_log(log_path, sim::CarmenReadOptions{}, &log, &err)) {
-      std::fprintf(stderr, "mml-mapbuild: %s\n", err.c_str());
-      return 1;
-    }
-    if (log.scans.empty()) {
-      std::fprintf(stderr, "mml-mapbuild: %s: no laser scans in the log\n", log_path.c_str());
-      return 1;
-    }
-    // The laser's maximum: readings at or beyond it are "no return" (occupancy_builder.h) and are
-    // not drawn. Say where it comes from and how many beams it leaves out.
-    std::string max_src = "--laser-max-range";
-    if (laser_max <= 0.0) {
-      max_src = "the largest reading of the log (no PARAM robot_front_laser_max / robot_rear_laser_max)";
-      for (const auto& kv : log.params) {
-        if (kv.first == "robot_front_laser_max" || kv.first == "robot_rear_laser_max") max_src = "PARAM " + kv.first;
-      }
-    }
-    std::size_t beams = 0, at_max = 0, beyond = 0;
-    float max_seen = 0.0f;
-    for (sim::CarmenScan& s : log.scans) {
-      if (laser_max > 0.0) s.max_range = static_cast<float>(laser_max);
-      for (float r : s.ranges) {
-        ++beams;
-        if (std::isfinite(r)) max_seen = std::max(max_seen, r);
-        if (s.max_range > 0.0f && r >= s.max_range - 0.01f) ++(r > s.max_range + 0.01f ? beyond : at_max);
-      }
-    }
-    // Beyond the maximum but below the largest reading: real measurements (the largest reading
-    // itself is often the laser's no-echo code, 81.91 m for a SICK LMS).
-    std::size_t beyond_below_largest = 0;
-    for (const sim::CarmenScan& s : log.scans) {
-      for (float r : s.ranges) {
-        if (s.max_range > 0.0f && r > s.max_range + 0.01f && r < max_seen - 0.01f) ++beyond_below_largest;
-      }
-    }
-    const double lmax = log.scans.front().max_range;
-    const double pct = 100.0 / static_cast<double>(std::max<std::size_t>(beams, 1));
-    std::printf("%s: laser maximum range %.2f m (from %s): of %zu beams, %zu (%.1f %%) read the maximum (no echo) and "
-                "%zu (%.1f %%) beyond it; both are 'no return' and not drawn; largest reading %.2f m\n",
-                name.c_str(), lmax, max_src.c_str(), beams, at_max, pct * static_cast<double>(at_max), beyond,
-                pct * static_cast<double>(beyond), static_cast<double>(max_seen));
-    if (beyond > 0 && beyond_below_largest * 100 <= beyond) {
-      std::printf("%s: %zu of the %zu beams beyond it read %.2f m, the laser's no-echo value: next to nothing is lost\n",
-                  name.c_str(), beyond - beyond_below_largest, beyond, static_cast<double>(max_seen));
-    } else if (beyond > 0) {
-      std::fprintf(stderr,
-                   "mml-mapbuild: warning: %s: %zu of %zu beams (%.1f %%) read beyond the laser maximum range %.2f m "
-                   "(%s), up to %.2f m, and are left out of the map; if the laser measures that far, give "
-                   "--laser-max-range %.2f\n",
-                   log_path.c_str(), beyond, beams, pct * static_cast<double>(beyond), lmax, max_src.c_str(),
-                   static_cast<double>(max_seen), std::ceil((static_cast<double>(max_seen) + 0.02) * 100.0) / 100.0);
-    } else if (pct * static_cast<double>(at_max) > 5.0) {
-      std::fprintf(stderr,
-                   "mml-mapbuild: warning: %s: %zu of %zu beams (%.1f %%) read the laser maximum range %.2f m (%s) and "
-                   "are left out of the map as 'no echo'; if that is not the laser's no-echo value, give "
-                   "--laser-max-range M\n",
-                   log_path.c_str(), at_max, beams, pct * static_cast<double>(at_max), lmax, max_src.c_str());
-    }
-    std::vector<sim::PosedScan> scans;
-    for (const sim::CarmenScan& s : log.scans) {
-      scans.push_back({s.pose, s.angle_min, s.angle_increment, s.max_range, s.ranges.data(), s.ranges.size()});
-    }
-    // Default options of the built-in maps (sim/map/global_maps.cpp: 25 m indoors).
-    sim::OccupancyBuildOptions o = sim::global_map_options("", resolution > 0.0 ? resolution : 0.05);
-    if (max_range > 0.0) o.max_usable_range = max_range;
-    std::printf("%s: resolution %.3g m, readings used up to %.1f m%s\n", name.c_str(), o.resolution, o.max_usable_range,
-                max_range > 0.0 ? " (--max-range)" : " (default, as the built-in indoor maps)");
-    sim::OccupancyGrid grid;
-    sim::OccupancyBuildStats stats;
-    if (!sim::build_occupancy_grid(scans, o, &grid, &stats, &err)) {
-      std::fprintf(stderr, "mml-mapbuild: %s: %s\n", log_path.c_str(), err.c_str());
-      return 1;
-    }
-    const sim::RosMap map = sim::grid_to_ros_map(grid, name + ".pgm");
-    if (!write_all(out, name, map, &err)) {
-      std::fprintf(stderr, "mml-mapbuild: %s\n", err.c_str());
-      return 1;
-    }
-    print_stats(name, map, stats, std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count());
-    std::printf("  wrote %s/%s.{yaml,pgm,png,mmap}\n", out.c_str(), name.c_str());
-    return 0;
+  const sim::RosMap map = sim::grid_to_ros_map(grid, o.name + ".pgm");
+  if (!write_all(o.out, o.name, map, &err)) {
+    std::fprintf(stderr, "mml-mapbuild: %s\n", err.c_str());
+    return 1;
   }
+  print_stats(o.name, map, stats, std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count());
+  std::printf("  wrote %s/%s.{yaml,pgm,png,mmap}\n", o.out.c_str(), o.name.c_str());
+  return 0;
+}
+
+// --log: the map of a log whose scan poses are correct.
+int build_from_log(const MapBuildArgs& o) {
+  const auto t0 = std::chrono::steady_clock::now();
+  std::string err;
+  sim::CarmenLog log;
+  if (!sim::read_carmen_log(o.log_path, sim::CarmenReadOptions{}, &log, &err)) {
+    std::fprintf(stderr, "mml-mapbuild: %s\n", err.c_str());
+    return 1;
+  }
+  if (log.scans.empty()) {
+    std::fprintf(stderr, "mml-mapbuild: %s: no laser scans in the log\n", o.log_path.c_str());
+    return 1;
+  }
+  // The laser's maximum: readings at or beyond it are "no return" (occupancy_builder.h) and are
+  // not drawn. Say where it comes from and how many beams it leaves out.
+  const std::string max_src = laser_max_source(log, o.laser_max);
+  if (o.laser_max > 0.0) {
+    for (sim::CarmenScan& s : log.scans) s.max_range = static_cast<float>(o.laser_max);
+  }
+  report_beam_census(o, log.scans.front().max_range, max_src, count_beams(log));
+  return build_and_write(o, log, t0);
+}
+
+// --dataset: the built-in maps; one that fails does not stop the others.
+int build_datasets(const MapBuildArgs& o) {
   std::vector<std::string> list;
-  if (dataset == "all") {
+  if (o.dataset == "all") {
     list = sim::global_map_datasets();
   } else {
-    list = {dataset};
+    list = {o.dataset};
   }
   int rc = 0;
   for (const std::string& ds : list) {
     const auto t0 = std::chrono::steady_clock::now();
-    const double r = resolution > 0.0 ? resolution : sim::default_map_resolution(ds);
+    const double r = o.resolution > 0.0 ? o.resolution : sim::default_map_resolution(ds);
     sim::RosMap map;
     sim::OccupancyBuildStats stats;
-    std::string report;
-    if (!sim::write_global_map(ds, r, out, &map, &err, &stats, &report)) {
+    std::string err, report;
+    if (!sim::write_global_map(ds, r, o.out, &map, &err, &stats, &report)) {
       std::fprintf(stderr, "mml-mapbuild: %s: %s\n", ds.c_str(), err.c_str());
       rc = 1;
       continue;
     }
     print_stats(ds, map, stats, std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count());
     if (!report.empty()) std::printf("  %s\n", report.c_str());
-    std::printf("  source: %s\n  wrote %s/%s.{yaml,pgm,png,mmap}\n", sim::global_map_source(ds).c_str(), out.c_str(),
+    std::printf("  source: %s\n  wrote %s/%s.{yaml,pgm,png,mmap}\n", sim::global_map_source(ds).c_str(), o.out.c_str(),
                 ds.c_str());
   }
   return rc;
+}
+
+}  // namespace
+
+static int run_main(int argc, char** argv) {
+  MapBuildArgs o;
+  if (const std::optional<int> exit_code = parse_args(argc, argv, &o)) return *exit_code;
+  std::error_code ec;
+  std::filesystem::create_directories(o.out, ec);
+  if (ec) {
+    std::fprintf(stderr, "mml-mapbuild: %s: %s\n", o.out.c_str(), ec.message().c_str());
+    return 1;
+  }
+  return o.log_path.empty() ? build_datasets(o) : build_from_log(o);
 }
 
 int main(int argc, char** argv) {

@@ -5,6 +5,7 @@
 #include <cstdio>
 #include <cstdlib>
 #include <filesystem>
+#include <optional>
 #include <utility>
 #include <string>
 
@@ -79,13 +80,134 @@ bool parse_pos(const std::string& s, double lo, double hi, double* out) {
   return true;
 }
 
-int run(int argc, char** argv) {
-  std::string rbsm_traj_path;
-  std::string log_path, dataset, traj_path, map_path, svg_path, rel_path;
+// The command line: what to read, what to write and how to map.
+struct SlamArgs {
+  std::string log_path, dataset;
+  std::string traj_path, rbsm_traj_path, map_path, svg_path, rel_path;
   sim::SlamConfig cfg;
-  cfg.workers = 2;
   double resolution = 0.05, max_range = 25.0;
   bool quiet = false, verbose = false;
+};
+
+// An option group's verdict on one option and its value.
+enum class Parsed { kNotMine, kOk, kFailed };
+
+Parsed failed(const std::string& msg) {
+  fail(msg);
+  return Parsed::kFailed;
+}
+
+// The input and the output files.
+Parsed parse_file_option(const std::string& a, const std::string& v, SlamArgs* o) {
+  if (a == "--log") {
+    o->log_path = v;
+  } else if (a == "--dataset") {
+    o->dataset = v;
+  } else if (a == "--trajectory") {
+    o->traj_path = v;
+  } else if (a == "--rbsm-trajectory") {
+    o->rbsm_traj_path = v;
+  } else if (a == "--map") {
+    if (v.size() < 6 || v.substr(v.size() - 5) != ".yaml") return failed("--map: '" + v + "' must end in .yaml");
+    o->map_path = v;
+  } else if (a == "--svg") {
+    o->svg_path = v;
+  } else if (a == "--relations") {
+    o->rel_path = v;
+  } else {
+    return Parsed::kNotMine;
+  }
+  return Parsed::kOk;
+}
+
+// The "options" of the help text: optimiser, colony size, fragments, seed, threads, map raster.
+Parsed parse_run_option(const std::string& a, const std::string& v, SlamArgs* o) {
+  sim::SlamConfig& cfg = o->cfg;
+  unsigned long long u = 0;
+  double d = 0;
+  if (a == "--optimizer") {
+    if (v == "aco") cfg.slam.optimizer = fw::antslam::LoopOptimizer::kAntColony;
+    else if (v == "lm") cfg.slam.optimizer = fw::antslam::LoopOptimizer::kLevenbergMarquardt;
+    else return failed("--optimizer: '" + v + "' is not aco or lm");
+  } else if (a == "--edge-model") {
+    if (v == "sensor") cfg.slam.edge_model = fw::antslam::EdgeModel::kSensorModel;
+    else if (v == "motion") cfg.slam.edge_model = fw::antslam::EdgeModel::kMotionModel;
+    else return failed("--edge-model: '" + v + "' is not sensor or motion");
+  } else if (a == "--ants") {
+    if (!parse_u64(v, 1, 1024, &u)) return failed("--ants: '" + v + "' is not an integer in 1..1024");
+    cfg.slam.aco.ants = static_cast<std::uint32_t>(u);
+  } else if (a == "--iterations") {
+    if (!parse_u64(v, 1, 1000000, &u)) return failed("--iterations: '" + v + "' is not an integer in 1..1000000");
+    cfg.slam.aco.iterations = static_cast<std::uint32_t>(u);
+  } else if (a == "--fragment-length") {
+    if (!parse_pos(v, 0.5, 100.0, &d)) return failed("--fragment-length: '" + v + "' is not a number of metres in 0.5..100");
+    cfg.slam.fragment_length_m = d;
+  } else if (a == "--seed") {
+    if (!parse_u64(v, 0, ~0ull, &u)) return failed("--seed: '" + v + "' is not a non-negative integer");
+    cfg.slam.seed = u;
+    cfg.slam.aco.seed = u;
+    cfg.front.rbsm.seed = u;
+  } else if (a == "--workers") {
+    if (!parse_u64(v, 1, 16, &u)) return failed("--workers: '" + v + "' is not an integer in 1..16");
+    cfg.workers = static_cast<int>(u);
+  } else if (a == "--max-scans") {
+    if (!parse_u64(v, 1, 10000000, &u)) return failed("--max-scans: '" + v + "' is not a positive integer");
+    cfg.max_scans = u;
+  } else if (a == "--resolution") {
+    if (!parse_pos(v, 0.01, 1.0, &o->resolution)) return failed("--resolution: '" + v + "' is not a cell size in 0.01..1 m");
+  } else if (a == "--max-range") {
+    if (!parse_pos(v, 1.0, 100.0, &o->max_range)) return failed("--max-range: '" + v + "' is not a range in 1..100 m");
+  } else {
+    return Parsed::kNotMine;
+  }
+  return Parsed::kOk;
+}
+
+// The "tuning" of the help text: drift, loop-closure gate and acceptance.
+Parsed parse_tuning_option(const std::string& a, const std::string& v, fw::antslam::AntSlamOptions* slam) {
+  unsigned long long u = 0;
+  double d = 0;
+  if (a == "--sigma-xy") {
+    if (!parse_pos(v, 1e-4, 10.0, &d)) return failed("--sigma-xy: '" + v + "' is not a number in 1e-4..10");
+    slam->var_xy_per_m = d * d;
+  } else if (a == "--sigma-theta") {
+    if (!parse_pos(v, 1e-5, 1.0, &d)) return failed("--sigma-theta: '" + v + "' is not a number in 1e-5..1");
+    slam->var_theta_per_m = d * d;
+  } else if (a == "--gate") {
+    if (!parse_pos(v, 0.1, 1e6, &d)) return failed("--gate: '" + v + "' is not a number in 0.1..1e6");
+    slam->closure_gate_chi2 = d;
+  } else if (a == "--closure-sigma") {
+    if (!parse_pos(v, 1e-3, 10.0, &d)) return failed("--closure-sigma: '" + v + "' is not a number of metres in 0.001..10");
+    slam->closure_sigma_xy = d;
+    slam->closure_sigma_theta = d * 0.349;  // 5 cm ↔ 1°
+  } else if (a == "--closure-refine") {
+    if (v == "none") {
+      slam->refine_closure = false;
+    } else if (v == "pransam") {
+      slam->refine_closure = true;
+      slam->prefer_prediction_margin = -1.0f;
+    } else if (v == "both") {
+      slam->refine_closure = true;
+      slam->prefer_prediction_margin = 0.02f;
+    } else {
+      return failed("--closure-refine: '" + v + "' is not none, pransam or both");
+    }
+  } else if (a == "--min-gap") {
+    if (!parse_u64(v, 1, 100000, &u)) return failed("--min-gap: '" + v + "' is not a positive integer");
+    slam->min_fragment_gap = static_cast<std::uint32_t>(u);
+  } else if (a == "--min-quality") {
+    if (!parse_pos(v, 0.0, 1.0, &d)) return failed("--min-quality: '" + v + "' is not a number in 0..1");
+    slam->min_closure_quality = static_cast<float>(d);
+  } else {
+    return Parsed::kNotMine;
+  }
+  return Parsed::kOk;
+}
+
+// Reads the command line into *o. Set: the run ends here with that exit code (--help, or an error
+// already reported).
+std::optional<int> parse_args(int argc, char** argv, SlamArgs* o) {
+  o->cfg.workers = 2;
   for (int i = 1; i < argc; ++i) {
     const std::string a = argv[i];
     if (a == "--help" || a == "-h") {
@@ -93,147 +215,70 @@ int run(int argc, char** argv) {
       return 0;
     }
     if (a == "--quiet") {
-      quiet = true;
+      o->quiet = true;
       continue;
     }
     if (a == "--verbose") {
-      verbose = true;
+      o->verbose = true;
       continue;
     }
     if (a.rfind("--", 0) != 0) return fail("unexpected argument '" + a + "' (see --help)");
     if (i + 1 >= argc) return fail(a + ": missing value (see --help)");
     const std::string v = argv[++i];
-    unsigned long long u = 0;
-    double d = 0;
-    if (a == "--log") {
-      log_path = v;
-    } else if (a == "--dataset") {
-      dataset = v;
-    } else if (a == "--trajectory") {
-      traj_path = v;
-    } else if (a == "--rbsm-trajectory") {
-      rbsm_traj_path = v;
-    } else if (a == "--map") {
-      if (v.size() < 6 || v.substr(v.size() - 5) != ".yaml") return fail("--map: '" + v + "' must end in .yaml");
-      map_path = v;
-    } else if (a == "--svg") {
-      svg_path = v;
-    } else if (a == "--relations") {
-      rel_path = v;
-    } else if (a == "--optimizer") {
-      if (v == "aco") cfg.slam.optimizer = fw::antslam::LoopOptimizer::kAntColony;
-      else if (v == "lm") cfg.slam.optimizer = fw::antslam::LoopOptimizer::kLevenbergMarquardt;
-      else return fail("--optimizer: '" + v + "' is not aco or lm");
-    } else if (a == "--edge-model") {
-      if (v == "sensor") cfg.slam.edge_model = fw::antslam::EdgeModel::kSensorModel;
-      else if (v == "motion") cfg.slam.edge_model = fw::antslam::EdgeModel::kMotionModel;
-      else return fail("--edge-model: '" + v + "' is not sensor or motion");
-    } else if (a == "--ants") {
-      if (!parse_u64(v, 1, 1024, &u)) return fail("--ants: '" + v + "' is not an integer in 1..1024");
-      cfg.slam.aco.ants = static_cast<std::uint32_t>(u);
-    } else if (a == "--iterations") {
-      if (!parse_u64(v, 1, 1000000, &u)) return fail("--iterations: '" + v + "' is not an integer in 1..1000000");
-      cfg.slam.aco.iterations = static_cast<std::uint32_t>(u);
-    } else if (a == "--fragment-length") {
-      if (!parse_pos(v, 0.5, 100.0, &d)) return fail("--fragment-length: '" + v + "' is not a number of metres in 0.5..100");
-      cfg.slam.fragment_length_m = d;
-    } else if (a == "--seed") {
-      if (!parse_u64(v, 0, ~0ull, &u)) return fail("--seed: '" + v + "' is not a non-negative integer");
-      cfg.slam.seed = u;
-      cfg.slam.aco.seed = u;
-      cfg.front.rbsm.seed = u;
-    } else if (a == "--workers") {
-      if (!parse_u64(v, 1, 16, &u)) return fail("--workers: '" + v + "' is not an integer in 1..16");
-      cfg.workers = static_cast<int>(u);
-    } else if (a == "--max-scans") {
-      if (!parse_u64(v, 1, 10000000, &u)) return fail("--max-scans: '" + v + "' is not a positive integer");
-      cfg.max_scans = u;
-    } else if (a == "--resolution") {
-      if (!parse_pos(v, 0.01, 1.0, &resolution)) return fail("--resolution: '" + v + "' is not a cell size in 0.01..1 m");
-    } else if (a == "--max-range") {
-      if (!parse_pos(v, 1.0, 100.0, &max_range)) return fail("--max-range: '" + v + "' is not a range in 1..100 m");
-    } else if (a == "--sigma-xy") {
-      if (!parse_pos(v, 1e-4, 10.0, &d)) return fail("--sigma-xy: '" + v + "' is not a number in 1e-4..10");
-      cfg.slam.var_xy_per_m = d * d;
-    } else if (a == "--sigma-theta") {
-      if (!parse_pos(v, 1e-5, 1.0, &d)) return fail("--sigma-theta: '" + v + "' is not a number in 1e-5..1");
-      cfg.slam.var_theta_per_m = d * d;
-    } else if (a == "--gate") {
-      if (!parse_pos(v, 0.1, 1e6, &d)) return fail("--gate: '" + v + "' is not a number in 0.1..1e6");
-      cfg.slam.closure_gate_chi2 = d;
-    } else if (a == "--closure-sigma") {
-      if (!parse_pos(v, 1e-3, 10.0, &d)) return fail("--closure-sigma: '" + v + "' is not a number of metres in 0.001..10");
-      cfg.slam.closure_sigma_xy = d;
-      cfg.slam.closure_sigma_theta = d * 0.349;  // 5 cm ↔ 1°
-    } else if (a == "--closure-refine") {
-      if (v == "none") {
-        cfg.slam.refine_closure = false;
-      } else if (v == "pransam") {
-        cfg.slam.refine_closure = true;
-        cfg.slam.prefer_prediction_margin = -1.0f;
-      } else if (v == "both") {
-        cfg.slam.refine_closure = true;
-        cfg.slam.prefer_prediction_margin = 0.02f;
-      } else {
-        return fail("--closure-refine: '" + v + "' is not none, pransam or both");
-      }
-    } else if (a == "--min-gap") {
-      if (!parse_u64(v, 1, 100000, &u)) return fail("--min-gap: '" + v + "' is not a positive integer");
-      cfg.slam.min_fragment_gap = static_cast<std::uint32_t>(u);
-    } else if (a == "--min-quality") {
-      if (!parse_pos(v, 0.0, 1.0, &d)) return fail("--min-quality: '" + v + "' is not a number in 0..1");
-      cfg.slam.min_closure_quality = static_cast<float>(d);
-    } else {
-      return fail("unknown option '" + a + "' (see --help)");
-    }
+    Parsed p = parse_file_option(a, v, o);
+    if (p == Parsed::kNotMine) p = parse_run_option(a, v, o);
+    if (p == Parsed::kNotMine) p = parse_tuning_option(a, v, &o->cfg.slam);
+    if (p == Parsed::kFailed) return 2;
+    if (p == Parsed::kNotMine) return fail("unknown option '" + a + "' (see --help)");
   }
-  if (log_path.empty() == dataset.empty()) return fail("give exactly one of --log FILE or --dataset NAME (see --help)");
-  std::string err;
-  sim::EvalDataset ds;
-  std::string ds_relations;
-  if (!dataset.empty()) {
-    if (!sim::find_eval_dataset(dataset, &ds, &err)) {
-      return fail("--dataset: " + err + " (names: intel, fr079, aces, mit-killian, fr-clinic; data under MMLFW_DATA_DIR)");
-    }
-    log_path = ds.raw_log;
-    if (rel_path.empty()) rel_path = ds_relations = ds.relations;
+  if (o->log_path.empty() == o->dataset.empty()) {
+    return fail("give exactly one of --log FILE or --dataset NAME (see --help)");
   }
-  // Outputs go into existing directories: say so now, not after minutes of mapping.
-  for (const auto& [opt, path] : {std::pair<const char*, const std::string*>{"--trajectory", &traj_path},
-                                  {"--rbsm-trajectory", &rbsm_traj_path},
-                                  {"--map", &map_path},
-                                  {"--svg", &svg_path}}) {
+  return std::nullopt;
+}
+
+// Outputs go into existing directories: say so now, not after minutes of mapping. Empty: all exist.
+std::string missing_output_dir(const SlamArgs& o) {
+  for (const auto& [opt, path] : {std::pair<const char*, const std::string*>{"--trajectory", &o.traj_path},
+                                  {"--rbsm-trajectory", &o.rbsm_traj_path},
+                                  {"--map", &o.map_path},
+                                  {"--svg", &o.svg_path}}) {
     if (path->empty()) continue;
     const std::filesystem::path dir = std::filesystem::path(*path).parent_path();
     std::error_code ec;
     if (!dir.empty() && !std::filesystem::is_directory(dir, ec)) {
-      return fail(std::string(opt) + ": directory '" + dir.string() + "' does not exist");
+      return std::string(opt) + ": directory '" + dir.string() + "' does not exist";
     }
   }
-  sim::CarmenLog log;
-  if (!sim::read_carmen_log(log_path, sim::CarmenReadOptions{}, &log, &err)) return fail(err);
-  std::vector<sim::Relation> rel;
-  if (!dataset.empty() && rel_path == ds_relations) {
-    if (!sim::slam_dataset_relations(log, ds, &rel, &err)) return fail("--dataset: " + err);
-  } else if (!rel_path.empty() && !sim::read_relations(rel_path, &rel, &err)) {
+  return "";
+}
+
+// The log and the relations to score against. Set: the exit code of a failure already reported.
+std::optional<int> load_inputs(SlamArgs* o, sim::CarmenLog* log, std::vector<sim::Relation>* rel) {
+  std::string err;
+  sim::EvalDataset ds;
+  std::string ds_relations;
+  if (!o->dataset.empty()) {
+    if (!sim::find_eval_dataset(o->dataset, &ds, &err)) {
+      return fail("--dataset: " + err + " (names: intel, fr079, aces, mit-killian, fr-clinic; data under MMLFW_DATA_DIR)");
+    }
+    o->log_path = ds.raw_log;
+    if (o->rel_path.empty()) o->rel_path = ds_relations = ds.relations;
+  }
+  const std::string missing_dir = missing_output_dir(*o);
+  if (!missing_dir.empty()) return fail(missing_dir);
+  if (!sim::read_carmen_log(o->log_path, sim::CarmenReadOptions{}, log, &err)) return fail(err);
+  if (!o->dataset.empty() && o->rel_path == ds_relations) {
+    if (!sim::slam_dataset_relations(*log, ds, rel, &err)) return fail("--dataset: " + err);
+  } else if (!o->rel_path.empty() && !sim::read_relations(o->rel_path, rel, &err)) {
     return fail("--relations: " + err);
   }
-  if (log.scans.empty()) return fail(log_path + ": no laser scans in the log");
-  const auto t0 = std::chrono::steady_clock::now();
-  if (!quiet) {
-    cfg.progress = [t0](std::size_t done, std::size_t total, const char* phase) {
-      const double s = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
-      std::fprintf(stderr, "\rmml-slam: %s %zu/%zu scans, %.0f s   ", phase, done, total, s);
-      std::fflush(stderr);
-    };
-  }
-  sim::SlamRun run;
-  if (!sim::run_slam(log, cfg, &run, &err)) {
-    if (!quiet) std::fputc('\n', stderr);
-    std::fprintf(stderr, "mml-slam: %s\n", err.c_str());
-    return 1;
-  }
-  if (!quiet) std::fputc('\n', stderr);
+  if (log->scans.empty()) return fail(o->log_path + ": no laser scans in the log");
+  return std::nullopt;
+}
+
+// The summary lines on stdout: loops, edge covariances, time, and with --verbose every closed loop.
+void print_summary(const sim::CarmenLog& log, const sim::SlamConfig& cfg, const sim::SlamRun& run, bool verbose) {
   const double log_s = log.scans.size() > 1 ? log.scans[run.poses.size() - 1].ipc_timestamp - log.scans[0].ipc_timestamp : 0;
   std::printf("mml-slam: %zu scans, %zu fragments, %u loops closed (%u candidates: %u below quality, %u outside the gate)\n",
               run.poses.size(), run.fragments.size(), run.stats.loops, run.stats.candidates, run.stats.rejected_quality,
@@ -251,26 +296,57 @@ int run(int argc, char** argv) {
                   c.path_edges, c.quality, c.gate_chi2, c.shift_m, c.cost_before, c.cost_after);
     }
   }
+}
+
+// The files asked for: 0, or the exit code of the failure reported.
+int write_outputs(const SlamArgs& o, const sim::CarmenLog& log, const sim::SlamRun& run) {
+  std::string err;
+  if (!o.traj_path.empty() && !sim::write_trajectory(o.traj_path, sim::make_trajectory(log, run.poses), &err)) {
+    return fail("--trajectory: " + err);
+  }
+  if (!o.rbsm_traj_path.empty() &&
+      !sim::write_trajectory(o.rbsm_traj_path, sim::make_trajectory(log, run.frontend), &err)) {
+    return fail("--rbsm-trajectory: " + err);
+  }
+  if (!o.map_path.empty() && !sim::write_slam_map(log, run.poses, o.resolution, o.max_range, o.map_path, &err)) {
+    return fail("--map: " + err);
+  }
+  if (!o.svg_path.empty() && !sim::write_slam_svg(run, "AntSLAM: " + o.log_path, o.svg_path, &err)) {
+    return fail("--svg: " + err);
+  }
+  return 0;
+}
+
+int run(int argc, char** argv) {
+  SlamArgs o;
+  if (const std::optional<int> exit_code = parse_args(argc, argv, &o)) return *exit_code;
+  sim::CarmenLog log;
+  std::vector<sim::Relation> rel;
+  if (const std::optional<int> exit_code = load_inputs(&o, &log, &rel)) return *exit_code;
+  const auto t0 = std::chrono::steady_clock::now();
+  if (!o.quiet) {
+    o.cfg.progress = [t0](std::size_t done, std::size_t total, const char* phase) {
+      const double s = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+      std::fprintf(stderr, "\rmml-slam: %s %zu/%zu scans, %.0f s   ", phase, done, total, s);
+      std::fflush(stderr);
+    };
+  }
+  sim::SlamRun run;
+  std::string err;
+  if (!sim::run_slam(log, o.cfg, &run, &err)) {
+    if (!o.quiet) std::fputc('\n', stderr);
+    std::fprintf(stderr, "mml-slam: %s\n", err.c_str());
+    return 1;
+  }
+  if (!o.quiet) std::fputc('\n', stderr);
+  print_summary(log, o.cfg, run, o.verbose);
   if (!rel.empty()) {
     const auto mf = sim::evaluate_relations(rel, sim::make_trajectory(log, run.frontend));
     const auto ms = sim::evaluate_relations(rel, sim::make_trajectory(log, run.poses));
     std::printf("relations, RBSM alone: %s\nrelations, AntSLAM:    %s\n", sim::to_string(mf).c_str(),
                 sim::to_string(ms).c_str());
   }
-  if (!traj_path.empty() && !sim::write_trajectory(traj_path, sim::make_trajectory(log, run.poses), &err)) {
-    return fail("--trajectory: " + err);
-  }
-  if (!rbsm_traj_path.empty() &&
-      !sim::write_trajectory(rbsm_traj_path, sim::make_trajectory(log, run.frontend), &err)) {
-    return fail("--rbsm-trajectory: " + err);
-  }
-  if (!map_path.empty() && !sim::write_slam_map(log, run.poses, resolution, max_range, map_path, &err)) {
-    return fail("--map: " + err);
-  }
-  if (!svg_path.empty() && !sim::write_slam_svg(run, "AntSLAM: " + log_path, svg_path, &err)) {
-    return fail("--svg: " + err);
-  }
-  return 0;
+  return write_outputs(o, log, run);
 }
 
 }  // namespace
