@@ -7,13 +7,18 @@
 // until M_eff = 1/Σ w_j² ≥ Δ·M (l. 7, 20) or the iteration cap; Σ ← δ·Σ each round (l. 21). The
 // best particle over all rounds is x̂_t (Eq. 2.7); integrate() adds its points to the map (Eq. 2.5–2.6).
 //
-// Extension of Alg. 1 (issue 15, `refine`, on by default; refine = false is pure Alg. 1): x̂_t is
-// polished by a few Gauss–Newton steps of a point-to-line cost against the end-point map: each
-// scan point is paired with the line fitted to the occupied cells around it (their centroid and
-// principal axis), residual = distance from that line. The particles stop at the M_eff rule on a
-// binary grid (their spread is a few cells, the best particle is the best of a cloud); the
-// continuous step removes that quantisation. Guard rails: refinement that moves farther than
-// refine_max_shift_* (another basin) or finds too few surfaces is discarded (x̂_t of Alg. 1 stays).
+// Extension of Alg. 1 (issue 15, `refine`, on by default; refine = motion_prior = false is pure
+// Alg. 1): x̂_t is polished by a few Gauss–Newton steps of a point-to-line cost against the
+// end-point map: each scan point is paired with the line fitted to the occupied cells around it
+// (their centroid and principal axis), residual = distance from that line. The particles stop at
+// the M_eff rule on a binary grid (their spread is a few cells, the best particle is the best of a
+// cloud); the continuous step removes that quantisation. Guard rails: refinement that moves farther
+// than refine_max_shift_* (another basin) or finds too few surfaces is discarded (x̂_t of Alg. 1
+// stays).
+// Second extension (issue 15, `motion_prior`, off by default: firmware/rbsm/README.md says why):
+// Eq. 2.8 is flat along a featureless corridor, so the set diffuses metres along it and x̂_t jumps
+// inside it; in the first round of each match the weights are multiplied by a wide Gaussian prior
+// on the position around the odometry guess (σ = 0.5 m + 0.2·|u|), pruning what the wheels rule out.
 //
 // Fast without changing what is computed: the bounded NN likelihood is a lookup (EndpointGrid),
 // particles are structure-of-arrays, sin/cos are per particle, the weighting loop runs beams outer
@@ -80,6 +85,13 @@ struct RbsmOptions {
   float refine_max_shift_deg = 2.0f;       // … or turning more than this
   float refine_min_eigen_ratio = 0.05f;    // directions weaker than this × the strongest stay put
   float refine_max_score_loss = 1.0f;      // reject when Σδ (Eq. 2.8) drops by more than this share
+  // Extension of Alg. 1: odometry motion prior on the position (see the header comment). In the
+  // first round of each match every sampled particle's weight is multiplied by
+  // exp(−½ d²/σ²), d its distance from the initial guess (last estimate ⊕ odometry) and
+  // σ = prior_sigma_xy_m + prior_sigma_xy_per_m·|u| (u the odometry motion since the last match).
+  bool motion_prior = false;
+  float prior_sigma_xy_m = 0.5f;
+  float prior_sigma_xy_per_m = 0.2f;
   // Weigh the particles with the AVX2 build of the same loop where the CPU has it (x86-64;
   // particle_weights.h): same weights bit for bit, ~40 % less CPU. false = the portable build.
   bool wide_simd = true;
@@ -123,9 +135,12 @@ class Rbsm final : public ScanMatcher {
   std::uint32_t weigh_mahalanobis(float x, float y, float psi, float c, float s) const;
   void hill_climb(std::uint32_t j, float step_xy, float step_psi);
   void resample(std::uint64_t total);
+  void move_particles(const Se2f& guess);  // Alg. 1 l. 2–4 (and this match's motion prior)
   // Extension of Alg. 1: point-to-line Gauss–Newton from `start`; false (and *out = start) when
   // discarded. *used: points paired with a surface at the last step.
   bool refine(const Se2f& start, Se2f* out, std::uint32_t* used) const;
+  // Extension of Alg. 1: w_j ← w_j · exp(−½ d_j²/σ²) over [begin, end) (motion_prior).
+  void apply_motion_prior(std::uint32_t begin, std::uint32_t end);
 
   RbsmOptions options_;
   EndpointGrid grid_;
@@ -149,6 +164,9 @@ class Rbsm final : public ScanMatcher {
   float py_[RbsmOptions::kMaxPoints] = {};
   float pcov_[RbsmOptions::kMaxPoints][3] = {};  // P_p (xx, xy, yy) in the sensor frame
   EndpointGrid::LookupView view_{};
+  std::uint32_t round_ = 0;                    // resampling round of the current match (1-based)
+  Se2f prior_center_;                          // the match's initial guess
+  float prior_inv_var_xy_ = 0.0f;              // 1/σ² of the motion prior; 0 = none this match
   float cur_sig_xy_ = 0.0f, cur_sig_psi_ = 0.0f;  // current Σ (m, rad) for Eq. 2.14's P_B
 
   RandomStream streams_[RbsmOptions::kPartitions];

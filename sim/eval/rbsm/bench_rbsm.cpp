@@ -162,17 +162,33 @@ void add_rbsm_figures(const std::string& ds, const RbsmSeedFigures& f, const sim
   json->add("rbsm_cpu_ms_per_scan_" + ds, mean(f.scan_cpu));
 }
 
-// Pure Alg. 1 (refine = false, the extension off), one seed: what the refinement changes.
+// Pure Alg. 1 (refine = false, motion_prior = false: both extensions off), one seed: what they change.
 bool add_pure_alg1(const BenchCase& c, const sim::MatcherConfig& cfg, sim::BenchJson* json, std::string* err) {
   sim::MatcherConfig pure = cfg;
   pure.rbsm.refine = false;
+  pure.rbsm.motion_prior = false;
   pure.rbsm.seed = 1;
   sim::OdometryRun run;
   if (!run_odometry(c.log, sim::MatcherKind::kRbsm, pure, 0, &run, err)) return false;
   const auto m = score(c, run.poses);
-  std::printf("%s rbsm pure Alg. 1 (no refinement), seed 1:\n%s\n", c.ds.c_str(), sim::to_string(m).c_str());
+  std::printf("%s rbsm pure Alg. 1 (no refinement, no motion prior), seed 1:\n%s\n", c.ds.c_str(), sim::to_string(m).c_str());
   add_split(c.ds, "rbsm_alg1", m, json);
   json->add("rbsm_alg1_cpu_ms_per_scan_" + c.ds, sim::cpu_ms_per_scan(run));
+  return true;
+}
+
+// The odometry motion prior (extension, RbsmOptions::motion_prior, off by default): the same
+// kSeeds seeds with it on, so its effect on the short relations is read against the default.
+bool add_motion_prior(const BenchCase& c, const sim::MatcherConfig& cfg, sim::BenchJson* json, std::string* err) {
+  sim::MatcherConfig with = cfg;
+  with.rbsm.motion_prior = true;
+  RbsmSeedFigures f;
+  if (!run_rbsm_seeds(c, &with, &f, err)) return false;
+  json->add(c.ds + "_trans_err_rbsm_prior", mean(f.tm));
+  json->add(c.ds + "_short_trans_err_rbsm_prior", mean(f.st));
+  json->add(c.ds + "_short_rot_err_rbsm_prior", mean(f.sr));
+  json->add(c.ds + "_long_trans_err_rbsm_prior", mean(f.lt));
+  json->add("rbsm_prior_cpu_ms_per_scan_" + c.ds, mean(f.scan_cpu));
   return true;
 }
 
@@ -223,6 +239,7 @@ bool bench_case(const BenchCase& c, sim::BenchJson* json, std::string* err) {
   if (!run_rbsm_seeds(c, &cfg, &f, err)) return false;
   add_rbsm_figures(c.ds, f, mi, mo, json);
   if (!add_pure_alg1(c, cfg, json, err)) return false;
+  if (!add_motion_prior(c, cfg, json, err)) return false;
   // intel and fr079 only, as before: the bench has a time budget.
   if (c.ds != "aces" && !add_stop_rule_alone(c, cfg, json, err)) return false;
   add_pairwise(c, cfg, json, err);

@@ -8,7 +8,7 @@
 //   mml-rbsm-eval pairwise DATASET [--pairs N] [--seeds N] [--particles N]
 //   --set KEY=VALUE overrides the matcher configuration (max_range, resolution, size_log2, subcell_log2,
 //     shrink, accept_ratio, min_iterations, max_iterations, sigma_xy2, sigma_psi2, hill_climbing, mahalanobis,
-//     min_translation, min_rotation_deg, icp_max_corr, refine (0: pure Alg. 1), refine_radius, refine_iterations,
+//     min_translation, min_rotation_deg, icp_max_corr, refine (0: pure Alg. 1 with prior=0), prior (odometry motion prior, 0/1), prior_xy (its σ in m), refine_radius, refine_iterations,
 //     refine_gate, refine_eigen, refine_score_loss, chain_refined, plicp_max_corr, plicp_kf_dist, plicp_kf_deg, plicp_trim); --no-maps skips the PNGs.
 //     consecutive corrected-scan pairs, guess perturbed by N(0, 10 cm, 6°): mean/p95/max errors.
 #include <algorithm>
@@ -160,6 +160,9 @@ bool apply_rbsm_setting(const std::string& key, double v, fw::RbsmOptions* rbsm)
   else if (key == "hill_climbing") rbsm->hill_climbing = v != 0;
   else if (key == "mahalanobis") rbsm->mahalanobis = v != 0;
   else if (key == "refine") rbsm->refine = v != 0;
+  else if (key == "prior") rbsm->motion_prior = v != 0;
+  else if (key == "prior_xy") rbsm->prior_sigma_xy_m = static_cast<float>(v);
+
   else if (key == "refine_radius") rbsm->refine_radius_cells = static_cast<uint32_t>(v);
   else if (key == "refine_iterations") rbsm->refine_iterations = static_cast<uint32_t>(v);
   else if (key == "refine_score_loss") rbsm->refine_max_score_loss = static_cast<float>(v);
