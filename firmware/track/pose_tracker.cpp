@@ -284,6 +284,8 @@ void PoseTracker::check_aliases(const Point2f* points, std::size_t n, StepWork* 
                        std::fabs(wrap_angle(u.rival.theta - a.pose.theta)) > o.alert_limit_rad;
   } else if (!u.unique) {
     w->v = ScanVerdict::kAmbiguous;  // fused (odometry keeps the mode), never `localized`
+    out->alias_beyond_alert = std::hypot(u.rival.x - a.pose.x, u.rival.y - a.pose.y) > o.alert_limit_m ||
+                              std::fabs(wrap_angle(u.rival.theta - a.pose.theta)) > o.alert_limit_rad;
   }
 }
 

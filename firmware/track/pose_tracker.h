@@ -60,6 +60,10 @@ struct TrackStep {
   bool large_fault = false;
   // A fault in heading only, recovered by the track (TrackOptions::heading_fault_local_recovery).
   bool heading_fault = false;
+  // The alias check found a rival that fits this scan as well as the fix and lies beyond the alert
+  // limits: the track may already follow the wrong one of two look-alikes (a kidnap into a place
+  // that fits near the old pose), which no later local test can tell (tracked_localizer.h).
+  bool alias_beyond_alert = false;
   // Confidence extent of the scan fix (fit_comparison.h; 0 when not computed).
   float confidence_xy_m = 0.0f, confidence_theta_rad = 0.0f;
   std::uint32_t unsupported_steps = 0, faulty_steps = 0, outside_steps = 0;

@@ -380,6 +380,9 @@ TEST(PoseTrackerTest, AliasAlongCorridorIsNeverLocalized) {
         EXPECT_EQ(s.verdict, ScanVerdict::kAmbiguous) << i;
         EXPECT_EQ(s.reason, hal::StatusReason::kTrackAlias) << i;
         EXPECT_LT(s.alias_rival_cost, s.alias_cost + o.alias_margin) << i;
+        // The rival lies one period (2 m) away, beyond the 0.5 m alert limit: the track may follow
+        // the wrong look-alike from here on, so the localizer must wait for MML (tracked_localizer.h).
+        EXPECT_TRUE(s.alias_beyond_alert) << i;
       }
     }
     if (check) EXPECT_EQ(localized, 0);
