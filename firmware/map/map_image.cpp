@@ -267,18 +267,32 @@ Status verify_map_image(const std::uint8_t* bytes, std::size_t size, const char*
   return check_padding(bytes, size, map_section_count(bytes, size), name);
 }
 
-Status load_map_image(const std::uint8_t* bytes, std::size_t size, StartupArena& arena, GlobalMap* out,
-                      const char* name, const MapLoadOptions& options) {
-  if (out == nullptr) return Status::error(Errc::kInvalidArgument, "%s: no output map", name);
-  FW_RETURN_IF_ERROR(verify_except_padding(bytes, size, name));
-  const std::size_t count = map_section_count(bytes, size);
+namespace {
 
+// The four sections every map image carries (required_section: exactly one of each, version 1).
+struct MapSections {
   MapSectionInfo geo, occ, dist, pts;
-  FW_RETURN_IF_ERROR(required_section(bytes, count, MapSectionType::kGeometry, name, &geo));
-  FW_RETURN_IF_ERROR(required_section(bytes, count, MapSectionType::kOccupancy, name, &occ));
-  FW_RETURN_IF_ERROR(required_section(bytes, count, MapSectionType::kDistanceField, name, &dist));
-  FW_RETURN_IF_ERROR(required_section(bytes, count, MapSectionType::kOccupiedPoints, name, &pts));
+};
 
+Status find_map_sections(const std::uint8_t* bytes, std::size_t count, const char* name, MapSections* out) {
+  FW_RETURN_IF_ERROR(required_section(bytes, count, MapSectionType::kGeometry, name, &out->geo));
+  FW_RETURN_IF_ERROR(required_section(bytes, count, MapSectionType::kOccupancy, name, &out->occ));
+  FW_RETURN_IF_ERROR(required_section(bytes, count, MapSectionType::kDistanceField, name, &out->dist));
+  FW_RETURN_IF_ERROR(required_section(bytes, count, MapSectionType::kOccupiedPoints, name, &out->pts));
+  return Status::ok();
+}
+
+// The geometry section's contents; everything else in the image is checked against them.
+struct MapGeometry {
+  GridGeometry grid;
+  std::uint32_t num_points = 0;
+  float max_distance = 0.0f;
+  std::uint64_t cells() const { return static_cast<std::uint64_t>(grid.width) * grid.height; }
+};
+
+// Parses the geometry section and checks each field on its own (plausible, representable extent);
+// the cross-checks against the other sections come after.
+Status read_geometry(const std::uint8_t* bytes, const MapSectionInfo& geo, const char* name, MapGeometry* out) {
   if (geo.size != kMapGeometryBytes) {
     return Status::error(Errc::kCorruptData, "%s: geometry section is %llu bytes, expected %zu", name,
                          static_cast<unsigned long long>(geo.size), kMapGeometryBytes);
@@ -317,27 +331,41 @@ Status load_map_image(const std::uint8_t* bytes, std::size_t size, StartupArena&
                          static_cast<double>(geometry.origin_x), static_cast<double>(geometry.origin_y),
                          geometry.width, geometry.height);
   }
-  const std::uint64_t cells = static_cast<std::uint64_t>(geometry.width) * geometry.height;
-  if (occ.size != cells) {
+  out->grid = geometry;
+  out->num_points = num_points;
+  out->max_distance = max_distance;
+  return Status::ok();
+}
+
+// The data sections must be exactly as large as the geometry says: check_cells and check_points
+// index them by the geometry alone.
+Status check_section_sizes(const MapSections& sections, const MapGeometry& map_geometry, const char* name) {
+  const GridGeometry& geometry = map_geometry.grid;
+  const std::uint64_t cells = map_geometry.cells();
+  const std::uint32_t num_points = map_geometry.num_points;
+  if (sections.occ.size != cells) {
     return Status::error(Errc::kCorruptData, "%s: occupancy section is %llu bytes, geometry %ux%u needs %llu", name,
-                         static_cast<unsigned long long>(occ.size), geometry.width, geometry.height,
+                         static_cast<unsigned long long>(sections.occ.size), geometry.width, geometry.height,
                          static_cast<unsigned long long>(cells));
   }
-  if (dist.size != cells * 4u) {
+  if (sections.dist.size != cells * 4u) {
     return Status::error(Errc::kCorruptData, "%s: distance field section is %llu bytes, geometry %ux%u needs %llu",
-                         name, static_cast<unsigned long long>(dist.size), geometry.width, geometry.height,
+                         name, static_cast<unsigned long long>(sections.dist.size), geometry.width, geometry.height,
                          static_cast<unsigned long long>(cells * 4u));
   }
-  if (pts.size != static_cast<std::uint64_t>(num_points) * 8u) {
+  if (sections.pts.size != static_cast<std::uint64_t>(num_points) * 8u) {
     return Status::error(Errc::kCorruptData, "%s: occupied points section is %llu bytes, %u points need %llu", name,
-                         static_cast<unsigned long long>(pts.size), num_points,
+                         static_cast<unsigned long long>(sections.pts.size), num_points,
                          static_cast<unsigned long long>(num_points) * 8u);
   }
-  FW_RETURN_IF_ERROR(check_padding(bytes, size, count, name));
+  return Status::ok();
+}
 
-  // Contents: occupancy codes, distance 0 exactly on occupied cells, finite non-negative elsewhere.
-  const std::uint8_t* occ_bytes = bytes + occ.offset;
-  const std::uint8_t* dist_bytes = bytes + dist.offset;
+// Contents: occupancy codes, distance 0 exactly on occupied cells, finite non-negative elsewhere; the
+// occupied cells and the largest distance must agree with the geometry section.
+Status check_cells(const MapGeometry& map_geometry, const std::uint8_t* occ_bytes, const std::uint8_t* dist_bytes,
+                   const char* name) {
+  const std::uint64_t cells = map_geometry.cells();
   std::uint64_t occupied = 0;
   float max_seen = 0.0f;
   for (std::uint64_t i = 0; i < cells; ++i) {
@@ -362,20 +390,24 @@ Status load_map_image(const std::uint8_t* bytes, std::size_t size, StartupArena&
   if (occupied == 0) {
     return Status::error(Errc::kCorruptData, "%s: the map has no occupied cells (nothing to localize against)", name);
   }
-  if (occupied != num_points) {
+  if (occupied != map_geometry.num_points) {
     return Status::error(Errc::kCorruptData, "%s: geometry says %u occupied points, occupancy has %llu", name,
-                         num_points, static_cast<unsigned long long>(occupied));
+                         map_geometry.num_points, static_cast<unsigned long long>(occupied));
   }
-  if (max_seen != max_distance) {
+  if (max_seen != map_geometry.max_distance) {
     return Status::error(Errc::kCorruptData, "%s: geometry max distance %g, distance field max %g", name,
-                         static_cast<double>(max_distance), static_cast<double>(max_seen));
+                         static_cast<double>(map_geometry.max_distance), static_cast<double>(max_seen));
   }
-  // Points: one per occupied cell, at its centre, in row-major order. Strictly increasing cell indices
-  // plus the count check above make that a one-to-one map onto the occupied cells (a duplicated point
-  // would weigh its wall twice in every match and leave another cell without one). "At the centre"
-  // allows a quarter cell: the writer's float arithmetic may differ from ours in the last bit (fused
-  // multiply-add on another CPU), and the extent check bounds that bit to 1/16 of a cell.
-  const std::uint8_t* pts_bytes = bytes + pts.offset;
+  return Status::ok();
+}
+
+// Points: one per occupied cell, at its centre, in row-major order. Strictly increasing cell indices
+// plus the count check (check_cells) make that a one-to-one map onto the occupied cells (a duplicated
+// point would weigh its wall twice in every match and leave another cell without one). "At the centre"
+// allows a quarter cell: the writer's float arithmetic may differ from ours in the last bit (fused
+// multiply-add on another CPU), and the extent check bounds that bit to 1/16 of a cell.
+Status check_points(const GridGeometry& geometry, std::uint32_t num_points, const std::uint8_t* occ_bytes,
+                    const std::uint8_t* pts_bytes, const char* name) {
   std::size_t previous_cell = 0;
   const float centre_tolerance = 0.25f * geometry.resolution;
   for (std::uint32_t i = 0; i < num_points; ++i) {
@@ -406,16 +438,24 @@ Status load_map_image(const std::uint8_t* bytes, std::size_t size, StartupArena&
     }
     previous_cell = cell;
   }
+  return Status::ok();
+}
 
-  // Copy into the start-up arena (the image buffer may be unmapped afterwards). Everything is released
-  // again (rewind) if the distance field turns out wrong: nothing stays allocated for a bad image.
-  // The distance field is kept truncated and tiled (distance_field.h); the dense float array the
-  // check recomputes is scratch above everything kept, released before returning.
-  DistanceFieldLayout layout;
-  FW_RETURN_IF_ERROR(plan_distance_field(dist_bytes, geometry.width, geometry.height, geometry.resolution,
-                                         options.distance_truncation_m, &layout));
-  OccupancyTilesLayout occ_layout;
-  FW_RETURN_IF_ERROR(plan_occupancy_tiles(occ_bytes, geometry.width, geometry.height, &occ_layout));
+// The arena arrays the loaded map keeps (GlobalMap is a view of them).
+struct MapArrays {
+  std::uint32_t* occ_slots = nullptr;
+  std::uint8_t* occ_cells = nullptr;
+  std::uint32_t* dist_slots = nullptr;
+  std::uint16_t* dist_tiles = nullptr;
+  float* dist_table = nullptr;
+  Point2f* points = nullptr;
+};
+
+// Carves the kept arrays: occupancy tiles, distance tiles, points, in that order (below the distance
+// check's scratch, which must stay on top to be released). On failure everything taken here is
+// released again.
+Status allocate_map_arrays(const OccupancyTilesLayout& occ_layout, const DistanceFieldLayout& layout,
+                           std::uint32_t num_points, StartupArena& arena, MapArrays* out) {
   const std::size_t arena_mark = arena.mark();
   Result<std::uint32_t*> occ_slots =
       arena.allocate_array<std::uint32_t>(occ_layout.slot_count(), "map occupancy tiles");
@@ -441,37 +481,98 @@ Status load_map_image(const std::uint8_t* bytes, std::size_t size, StartupArena&
     arena.rewind(arena_mark);
     return pts_mem.status();
   }
-  Point2f* points = *pts_mem;
-  const std::size_t scratch_mark = arena.mark();
-  Result<float*> dist_mem = arena.allocate_array<float>(static_cast<std::size_t>(cells), "map distance check");
-  if (!dist_mem) {
-    arena.rewind(arena_mark);
-    return dist_mem.status();
-  }
-  const Status field = recompute_distance_field(geometry, occ_bytes, dist_bytes, arena, *dist_mem, name);
-  arena.rewind(scratch_mark);
-  if (!field) {
-    arena.rewind(arena_mark);
-    return field;
-  }
-  const DistanceField distance = fill_distance_field(layout, dist_bytes, *slot_mem, *tile_mem, *table_mem);
-  const OccupancyTiles occupancy = fill_occupancy_tiles(occ_layout, occ_bytes, *occ_slots, *occ_mem);
-  for (std::uint32_t i = 0; i < num_points; ++i) {
-    points[i] = Point2f(rd_f32(pts_bytes + 8u * i), rd_f32(pts_bytes + 8u * i + 4));
-  }
+  out->occ_slots = *occ_slots;
+  out->occ_cells = *occ_mem;
+  out->dist_slots = *slot_mem;
+  out->dist_tiles = *tile_mem;
+  out->dist_table = *table_mem;
+  out->points = *pts_mem;
+  return Status::ok();
+}
 
+// recompute_distance_field on a dense float field taken from the arena as scratch and released
+// before returning (also when the field is wrong; a failed allocation leaves nothing to release).
+Status check_distance_field(const MapGeometry& map_geometry, const std::uint8_t* occ_bytes,
+                            const std::uint8_t* dist_bytes, StartupArena& arena, const char* name) {
+  const std::size_t scratch_mark = arena.mark();
+  Result<float*> dist_mem =
+      arena.allocate_array<float>(static_cast<std::size_t>(map_geometry.cells()), "map distance check");
+  if (!dist_mem) return dist_mem.status();
+  const Status field = recompute_distance_field(map_geometry.grid, occ_bytes, dist_bytes, arena, *dist_mem, name);
+  arena.rewind(scratch_mark);
+  return field;
+}
+
+// The kept arrays in the memory report (module "map").
+Status register_map_memory(const OccupancyTilesLayout& occ_layout, const DistanceFieldLayout& layout,
+                           std::uint32_t num_points) {
   MemoryReport& report = MemoryReport::instance();
   FW_RETURN_IF_ERROR(report.add({"map", "occupancy (tiles)", occ_layout.bytes(), occ_layout.stored_tiles, nullptr}));
   FW_RETURN_IF_ERROR(report.add({"map", "distance field (tiles)", layout.bytes(), layout.stored_tiles, nullptr}));
   FW_RETURN_IF_ERROR(report.add({"map", "occupied points", num_points * sizeof(Point2f), num_points, nullptr}));
+  return Status::ok();
+}
+
+// Copy into the start-up arena (the image buffer may be unmapped afterwards). Everything is released
+// again (rewind) if the distance field turns out wrong: nothing stays allocated for a bad image.
+// The distance field is kept truncated and tiled (distance_field.h); the dense float array the
+// check recomputes is scratch above everything kept, released before returning.
+Status copy_map_to_arena(const MapGeometry& map_geometry, const std::uint8_t* occ_bytes,
+                         const std::uint8_t* dist_bytes, const std::uint8_t* pts_bytes, StartupArena& arena,
+                         const MapLoadOptions& options, const char* name, GlobalMap* out) {
+  const GridGeometry& geometry = map_geometry.grid;
+  const std::uint32_t num_points = map_geometry.num_points;
+  DistanceFieldLayout layout;
+  FW_RETURN_IF_ERROR(plan_distance_field(dist_bytes, geometry.width, geometry.height, geometry.resolution,
+                                         options.distance_truncation_m, &layout));
+  OccupancyTilesLayout occ_layout;
+  FW_RETURN_IF_ERROR(plan_occupancy_tiles(occ_bytes, geometry.width, geometry.height, &occ_layout));
+  const std::size_t arena_mark = arena.mark();
+  MapArrays arrays;
+  FW_RETURN_IF_ERROR(allocate_map_arrays(occ_layout, layout, num_points, arena, &arrays));
+  const Status field = check_distance_field(map_geometry, occ_bytes, dist_bytes, arena, name);
+  if (!field) {
+    arena.rewind(arena_mark);
+    return field;
+  }
+  const DistanceField distance =
+      fill_distance_field(layout, dist_bytes, arrays.dist_slots, arrays.dist_tiles, arrays.dist_table);
+  const OccupancyTiles occupancy = fill_occupancy_tiles(occ_layout, occ_bytes, arrays.occ_slots, arrays.occ_cells);
+  for (std::uint32_t i = 0; i < num_points; ++i) {
+    arrays.points[i] = Point2f(rd_f32(pts_bytes + 8u * i), rd_f32(pts_bytes + 8u * i + 4));
+  }
+  FW_RETURN_IF_ERROR(register_map_memory(occ_layout, layout, num_points));
 
   out->geometry = geometry;
   out->occupancy = occupancy;
   out->distance = distance;
-  out->points = points;
+  out->points = arrays.points;
   out->num_points = num_points;
-  out->max_distance_m = max_distance;
+  out->max_distance_m = map_geometry.max_distance;
   return Status::ok();
+}
+
+}  // namespace
+
+Status load_map_image(const std::uint8_t* bytes, std::size_t size, StartupArena& arena, GlobalMap* out,
+                      const char* name, const MapLoadOptions& options) {
+  if (out == nullptr) return Status::error(Errc::kInvalidArgument, "%s: no output map", name);
+  FW_RETURN_IF_ERROR(verify_except_padding(bytes, size, name));
+  const std::size_t count = map_section_count(bytes, size);
+
+  MapSections sections;
+  FW_RETURN_IF_ERROR(find_map_sections(bytes, count, name, &sections));
+  MapGeometry map_geometry;
+  FW_RETURN_IF_ERROR(read_geometry(bytes, sections.geo, name, &map_geometry));
+  FW_RETURN_IF_ERROR(check_section_sizes(sections, map_geometry, name));
+  FW_RETURN_IF_ERROR(check_padding(bytes, size, count, name));
+
+  const std::uint8_t* occ_bytes = bytes + sections.occ.offset;
+  const std::uint8_t* dist_bytes = bytes + sections.dist.offset;
+  const std::uint8_t* pts_bytes = bytes + sections.pts.offset;
+  FW_RETURN_IF_ERROR(check_cells(map_geometry, occ_bytes, dist_bytes, name));
+  FW_RETURN_IF_ERROR(check_points(map_geometry.grid, map_geometry.num_points, occ_bytes, pts_bytes, name));
+  return copy_map_to_arena(map_geometry, occ_bytes, dist_bytes, pts_bytes, arena, options, name, out);
 }
 
 std::size_t map_image_arena_bytes(const std::uint8_t* bytes, std::size_t size, const MapLoadOptions& options) {
