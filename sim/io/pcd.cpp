@@ -96,277 +96,368 @@ bool lzf_decompress(const std::uint8_t* in, std::size_t in_size, std::uint8_t* o
   return op == out_size;
 }
 
-bool parse_pcd(const std::string& name, const std::string& bytes, const PcdReadOptions& options, PcdCloud* out,
-               std::string* error) {
-  *out = PcdCloud();
-  out->path = name;
-  std::vector<Field> fields;
-  bool seen[9] = {};
-  const char* keys[9] = {"VERSION", "FIELDS", "SIZE", "TYPE", "COUNT", "WIDTH", "HEIGHT", "VIEWPOINT", "POINTS"};
-  std::vector<std::uint64_t> sizes, counts;
-  std::vector<char> types;
-  std::uint64_t width = 0, height = 0, points = 0;
+namespace {
+
+// The file read line by line: `pos` is the byte after the last line read (one past the end when
+// the file does not end in '\n'; the binary readers start at `pos`), `line` its 1-based number.
+struct LineCursor {
   std::size_t pos = 0, line = 0;
-  std::size_t fields_line = 0;
-  bool have_data = false;
-  std::size_t data_line = 0;
-  while (pos < bytes.size() && !have_data) {
+  // The next line without its '\n'; only while pos < bytes.size().
+  std::string_view next(const std::string& bytes) {
     std::size_t eol = bytes.find('\n', pos);
     if (eol == std::string::npos) eol = bytes.size();
     std::string_view l(bytes.data() + pos, eol - pos);
     pos = eol + 1;
     ++line;
-    if (l.size() > 4096) {
-      *error = at(name, line) + "header line longer than 4096 bytes (not a PCD file?)";
-      return false;
-    }
+    return l;
+  }
+};
+
+// Header keywords other than DATA, in the order of `seen`.
+const char* const kKeys[9] = {"VERSION", "FIELDS", "SIZE", "TYPE", "COUNT", "WIDTH", "HEIGHT", "VIEWPOINT", "POINTS"};
+constexpr int kWidthKey = 5, kHeightKey = 6, kPointsKey = 8;
+
+// The header as declared, before its lines are checked against one another.
+struct PcdHeader {
+  std::vector<Field> fields;
+  bool seen[9] = {};
+  std::vector<std::uint64_t> sizes, counts;
+  std::vector<char> types;
+  std::uint64_t width = 0, height = 0, points = 0;
+  std::size_t fields_line = 0;  // a field listed twice or a missing x/y/z is reported here
+  std::size_t data_line = 0;    // every other whole-header problem is reported here
+};
+
+using Tokens = std::vector<std::string_view>;
+
+bool fail_at(const std::string& name, std::size_t line, const std::string& problem, std::string* error) {
+  *error = at(name, line) + problem;
+  return false;
+}
+
+bool parse_field_names(const std::string& name, std::size_t line, const Tokens& t, PcdHeader* h, std::string* error) {
+  if (t.size() == 1) return fail_at(name, line, "FIELDS lists no field", error);
+  for (std::size_t i = 1; i < t.size(); ++i) {
+    Field f;
+    f.name = std::string(t[i]);
+    h->fields.push_back(f);
+  }
+  h->fields_line = line;
+  return true;
+}
+
+// SIZE or COUNT: one integer in [1, 1024] per field.
+bool parse_field_integers(const std::string& name, std::size_t line, const std::string& key, const Tokens& t,
+                          std::vector<std::uint64_t>* v, std::string* error) {
+  for (std::size_t i = 1; i < t.size(); ++i) {
+    std::uint64_t x;
+    if (!to_u64(t[i], &x) || x == 0 || x > 1024)
+      return fail_at(name, line, key + " value '" + std::string(t[i]) + "' is not an integer in [1, 1024]", error);
+    v->push_back(x);
+  }
+  return true;
+}
+
+bool parse_field_types(const std::string& name, std::size_t line, const Tokens& t, PcdHeader* h, std::string* error) {
+  for (std::size_t i = 1; i < t.size(); ++i) {
+    if (t[i].size() != 1 || (t[i][0] != 'F' && t[i][0] != 'I' && t[i][0] != 'U'))
+      return fail_at(name, line, "TYPE value '" + std::string(t[i]) + "' is not F, I or U", error);
+    h->types.push_back(t[i][0]);
+  }
+  return true;
+}
+
+// VIEWPOINT is checked but not kept: the points are returned as stored, the viewpoint is not applied.
+bool check_viewpoint(const std::string& name, std::size_t line, const Tokens& t, std::string* error) {
+  double d;
+  for (std::size_t i = 1; i < t.size(); ++i) {
+    if (!to_double(t[i], &d) || !std::isfinite(d))
+      return fail_at(name, line, "VIEWPOINT value '" + std::string(t[i]) + "' is not a finite number", error);
+  }
+  if (t.size() - 1 != 7) return fail_at(name, line, "VIEWPOINT needs 7 values (tx ty tz qw qx qy qz)", error);
+  return true;
+}
+
+// The values of one header line whose keyword is known and not repeated.
+bool parse_header_values(const std::string& name, std::size_t line, const std::string& key, const Tokens& t,
+                         PcdHeader* h, std::string* error) {
+  if (key == "VERSION") return true;
+  if (key == "FIELDS") return parse_field_names(name, line, t, h, error);
+  if (key == "SIZE" || key == "COUNT")
+    return parse_field_integers(name, line, key, t, key == "SIZE" ? &h->sizes : &h->counts, error);
+  if (key == "TYPE") return parse_field_types(name, line, t, h, error);
+  if (key == "VIEWPOINT") return check_viewpoint(name, line, t, error);
+  // WIDTH, HEIGHT, POINTS: one integer each.
+  std::uint64_t x;
+  if (t.size() - 1 != 1 || !to_u64(t[1], &x))
+    return fail_at(name, line, key + " needs one non-negative integer", error);
+  (key == "WIDTH" ? h->width : key == "HEIGHT" ? h->height : h->points) = x;
+  return true;
+}
+
+// Header lines up to and including DATA (its kind goes to out->data); the cursor is left on the
+// first byte of the data.
+bool read_header(const std::string& name, const std::string& bytes, LineCursor* c, PcdHeader* h, PcdCloud* out,
+                 std::string* error) {
+  while (c->pos < bytes.size()) {
+    const std::string_view l = c->next(bytes);
+    const std::size_t line = c->line;
+    if (l.size() > 4096) return fail_at(name, line, "header line longer than 4096 bytes (not a PCD file?)", error);
     const auto t = split(l);
     if (t.empty() || t[0][0] == '#') continue;
     const std::string key(t[0]);
     if (key == "DATA") {
-      if (t.size() != 2 || (t[1] != "ascii" && t[1] != "binary" && t[1] != "binary_compressed")) {
-        *error = at(name, line) + "DATA must be one of ascii, binary, binary_compressed";
-        return false;
-      }
+      if (t.size() != 2 || (t[1] != "ascii" && t[1] != "binary" && t[1] != "binary_compressed"))
+        return fail_at(name, line, "DATA must be one of ascii, binary, binary_compressed", error);
       out->data = std::string(t[1]);
-      have_data = true;
-      data_line = line;
-      break;
+      h->data_line = line;
+      return true;
     }
     int k = -1;
-    for (int i = 0; i < 9; ++i) if (key == keys[i]) k = i;
-    if (k < 0) {
-      *error = at(name, line) + "unknown header keyword '" + key + "'";
-      return false;
-    }
-    if (seen[k]) {
-      *error = at(name, line) + "repeated header keyword " + key;
-      return false;
-    }
-    seen[k] = true;
-    const std::size_t nv = t.size() - 1;
-    if (key == "VERSION") continue;
-    if (key == "FIELDS") {
-      if (nv == 0) { *error = at(name, line) + "FIELDS lists no field"; return false; }
-      for (std::size_t i = 1; i < t.size(); ++i) {
-        Field f;
-        f.name = std::string(t[i]);
-        fields.push_back(f);
-      }
-      fields_line = line;
-      continue;
-    }
-    if (key == "SIZE" || key == "COUNT") {
-      auto& v = key == "SIZE" ? sizes : counts;
-      for (std::size_t i = 1; i < t.size(); ++i) {
-        std::uint64_t x;
-        if (!to_u64(t[i], &x) || x == 0 || x > 1024) {
-          *error = at(name, line) + key + " value '" + std::string(t[i]) + "' is not an integer in [1, 1024]";
-          return false;
-        }
-        v.push_back(x);
-      }
-      continue;
-    }
-    if (key == "TYPE") {
-      for (std::size_t i = 1; i < t.size(); ++i) {
-        if (t[i].size() != 1 || (t[i][0] != 'F' && t[i][0] != 'I' && t[i][0] != 'U')) {
-          *error = at(name, line) + "TYPE value '" + std::string(t[i]) + "' is not F, I or U";
-          return false;
-        }
-        types.push_back(t[i][0]);
-      }
-      continue;
-    }
-    if (key == "VIEWPOINT") {
-      double d;
-      for (std::size_t i = 1; i < t.size(); ++i) {
-        if (!to_double(t[i], &d) || !std::isfinite(d)) {
-          *error = at(name, line) + "VIEWPOINT value '" + std::string(t[i]) + "' is not a finite number";
-          return false;
-        }
-      }
-      if (nv != 7) { *error = at(name, line) + "VIEWPOINT needs 7 values (tx ty tz qw qx qy qz)"; return false; }
-      continue;
-    }
-    // WIDTH, HEIGHT, POINTS: one integer each.
-    std::uint64_t x;
-    if (nv != 1 || !to_u64(t[1], &x)) {
-      *error = at(name, line) + key + " needs one non-negative integer";
-      return false;
-    }
-    (key == "WIDTH" ? width : key == "HEIGHT" ? height : points) = x;
+    for (int i = 0; i < 9; ++i) if (key == kKeys[i]) k = i;
+    if (k < 0) return fail_at(name, line, "unknown header keyword '" + key + "'", error);
+    if (h->seen[k]) return fail_at(name, line, "repeated header keyword " + key, error);
+    h->seen[k] = true;
+    if (!parse_header_values(name, line, key, t, h, error)) return false;
   }
-  if (!have_data) {
-    *error = at(name, line) + "header ends without a DATA line (not a PCD file, or truncated)";
-    return false;
+  return fail_at(name, c->line, "header ends without a DATA line (not a PCD file, or truncated)", error);
+}
+
+// The header's lines agree with one another and the point count is within the cap.
+bool check_header(const std::string& name, const PcdHeader& h, const PcdReadOptions& options, std::string* error) {
+  const std::size_t hl = h.data_line;
+  if (h.fields.empty()) return fail_at(name, hl, "no FIELDS before DATA", error);
+  if (h.sizes.size() != h.fields.size() || h.types.size() != h.fields.size()) {
+    return fail_at(name, hl,
+                   "FIELDS lists " + std::to_string(h.fields.size()) + " fields but SIZE has " +
+                       std::to_string(h.sizes.size()) + " and TYPE " + std::to_string(h.types.size()) + " values",
+                   error);
   }
-  const std::size_t hl = data_line;
-  if (fields.empty()) { *error = at(name, hl) + "no FIELDS before DATA"; return false; }
-  if (sizes.size() != fields.size() || types.size() != fields.size()) {
-    *error = at(name, hl) + "FIELDS lists " + std::to_string(fields.size()) + " fields but SIZE has " +
-             std::to_string(sizes.size()) + " and TYPE " + std::to_string(types.size()) + " values";
-    return false;
+  if (!h.counts.empty() && h.counts.size() != h.fields.size()) {
+    return fail_at(name, hl,
+                   "FIELDS lists " + std::to_string(h.fields.size()) + " fields but COUNT has " +
+                       std::to_string(h.counts.size()) + " values",
+                   error);
   }
-  if (!counts.empty() && counts.size() != fields.size()) {
-    *error = at(name, hl) + "FIELDS lists " + std::to_string(fields.size()) + " fields but COUNT has " +
-             std::to_string(counts.size()) + " values";
-    return false;
+  if (!h.seen[kWidthKey] || !h.seen[kHeightKey]) return fail_at(name, hl, "WIDTH and HEIGHT are required", error);
+  if (h.width == 0 || h.height == 0) return fail_at(name, hl, "WIDTH and HEIGHT must be positive", error);
+  if (h.width > options.max_points || h.height > options.max_points || h.width * h.height > options.max_points) {
+    return fail_at(name, hl,
+                   "WIDTH x HEIGHT = " + std::to_string(h.width) + " x " + std::to_string(h.height) +
+                       " exceeds the cap of " + std::to_string(options.max_points) + " points",
+                   error);
   }
-  if (!seen[5] || !seen[6]) { *error = at(name, hl) + "WIDTH and HEIGHT are required"; return false; }
-  if (width == 0 || height == 0) { *error = at(name, hl) + "WIDTH and HEIGHT must be positive"; return false; }
-  if (width > options.max_points || height > options.max_points || width * height > options.max_points) {
-    *error = at(name, hl) + "WIDTH x HEIGHT = " + std::to_string(width) + " x " + std::to_string(height) +
-             " exceeds the cap of " + std::to_string(options.max_points) + " points";
-    return false;
+  if (h.seen[kPointsKey] && h.points != h.width * h.height) {
+    return fail_at(name, hl,
+                   "POINTS " + std::to_string(h.points) + " != WIDTH x HEIGHT " + std::to_string(h.width * h.height),
+                   error);
   }
-  if (seen[8] && points != width * height) {
-    *error = at(name, hl) + "POINTS " + std::to_string(points) + " != WIDTH x HEIGHT " + std::to_string(width * height);
-    return false;
-  }
-  const std::size_t n = static_cast<std::size_t>(width * height);
+  return true;
+}
+
+// Where x, y and z are, and how big one point is.
+struct PointLayout {
   int ix = -1, iy = -1, iz = -1;
-  std::size_t step = 0, values = 0;
-  for (std::size_t i = 0; i < fields.size(); ++i) {
-    Field& f = fields[i];
-    f.size = static_cast<std::uint32_t>(sizes[i]);
-    f.type = types[i];
-    f.count = counts.empty() ? 1 : static_cast<std::uint32_t>(counts[i]);
+  std::size_t step = 0;    // bytes per point (binary)
+  std::size_t values = 0;  // numbers per point (ascii)
+};
+
+// Gives every field its size, type, count and offsets (sizes must fit their type) and finds x, y
+// and z (each once, of TYPE F).
+bool lay_out_fields(const std::string& name, PcdHeader* h, PointLayout* lay, std::string* error) {
+  const std::size_t hl = h->data_line;
+  for (std::size_t i = 0; i < h->fields.size(); ++i) {
+    Field& f = h->fields[i];
+    f.size = static_cast<std::uint32_t>(h->sizes[i]);
+    f.type = h->types[i];
+    f.count = h->counts.empty() ? 1 : static_cast<std::uint32_t>(h->counts[i]);
     const bool ok = f.type == 'F' ? (f.size == 4 || f.size == 8)
                                   : (f.size == 1 || f.size == 2 || f.size == 4 || f.size == 8);
     if (!ok) {
-      *error = at(name, hl) + "field '" + f.name + "' has TYPE " + f.type + " with SIZE " + std::to_string(f.size) +
-               " (F: 4 or 8; I/U: 1, 2, 4 or 8)";
-      return false;
+      return fail_at(name, hl,
+                     "field '" + f.name + "' has TYPE " + f.type + " with SIZE " + std::to_string(f.size) +
+                         " (F: 4 or 8; I/U: 1, 2, 4 or 8)",
+                     error);
     }
-    f.offset = step;
-    f.value_offset = values;
-    step += static_cast<std::size_t>(f.size) * f.count;
-    values += f.count;
-    int* slot = f.name == "x" ? &ix : f.name == "y" ? &iy : f.name == "z" ? &iz : nullptr;
+    f.offset = lay->step;
+    f.value_offset = lay->values;
+    lay->step += static_cast<std::size_t>(f.size) * f.count;
+    lay->values += f.count;
+    int* slot = f.name == "x" ? &lay->ix : f.name == "y" ? &lay->iy : f.name == "z" ? &lay->iz : nullptr;
     if (slot != nullptr) {
-      if (*slot >= 0) { *error = at(name, fields_line) + "field '" + f.name + "' listed twice"; return false; }
+      if (*slot >= 0) return fail_at(name, h->fields_line, "field '" + f.name + "' listed twice", error);
       *slot = static_cast<int>(i);
     }
   }
-  if (ix < 0 || iy < 0 || iz < 0) {
-    *error = at(name, fields_line) + "FIELDS must include x, y and z";
-    return false;
+  if (lay->ix < 0 || lay->iy < 0 || lay->iz < 0)
+    return fail_at(name, h->fields_line, "FIELDS must include x, y and z", error);
+  for (int i : {lay->ix, lay->iy, lay->iz}) {
+    if (h->fields[i].type != 'F')
+      return fail_at(name, hl, "field '" + h->fields[i].name + "' must be of TYPE F (float coordinates)", error);
   }
-  for (int i : {ix, iy, iz}) {
-    if (fields[i].type != 'F') {
-      *error = at(name, hl) + "field '" + fields[i].name + "' must be of TYPE F (float coordinates)";
-      return false;
-    }
-  }
-  for (const Field& f : fields) out->fields.push_back(f.name);
-  out->width = static_cast<std::uint32_t>(width);
-  out->height = static_cast<std::uint32_t>(height);
-  out->declared_points = n;
-  const Field& fx = fields[ix];
-  const Field& fy = fields[iy];
-  const Field& fz = fields[iz];
-  auto keep = [&](double x, double y, double z, std::size_t i) {
-    if (!(std::isfinite(x) && std::isfinite(y) && std::isfinite(z))) {
-      ++out->dropped_nonfinite;
-      return;
-    }
-    out->points.emplace_back(static_cast<float>(x), static_cast<float>(y), static_cast<float>(z));
-    out->index.push_back(static_cast<std::uint32_t>(i));
-  };
+  return true;
+}
 
-  if (out->data == "ascii") {
-    // Every point is one line of `values` numbers; the vectors grow with the lines actually present.
-    std::size_t i = 0;
-    std::vector<std::string_view> t;
-    while (pos < bytes.size()) {
-      std::size_t eol = bytes.find('\n', pos);
-      if (eol == std::string::npos) eol = bytes.size();
-      std::string_view l(bytes.data() + pos, eol - pos);
-      pos = eol + 1;
-      ++line;
-      t = split(l);
-      if (t.empty()) continue;
-      if (i >= n) {
-        *error = at(name, line) + "more data lines than the " + std::to_string(n) + " points declared";
-        return false;
-      }
-      if (t.size() != values) {
-        *error = at(name, line) + std::to_string(t.size()) + " values, expected " + std::to_string(values);
-        return false;
-      }
-      double xyz[3] = {0, 0, 0};
-      for (std::size_t k = 0; k < t.size(); ++k) {
-        double v;
-        if (!to_double(t[k], &v)) {
-          *error = at(name, line) + "value " + std::to_string(k + 1) + " '" + std::string(t[k]) + "' is not a number";
-          return false;
-        }
-        if (k == fx.value_offset) xyz[0] = v;
-        if (k == fy.value_offset) xyz[1] = v;
-        if (k == fz.value_offset) xyz[2] = v;
-      }
-      keep(xyz[0], xyz[1], xyz[2], i);
-      ++i;
-    }
-    if (i != n) {
-      *error = at(name, line) + "file ends after " + std::to_string(i) + " of " + std::to_string(n) + " points";
-      return false;
-    }
-    return true;
-  }
+// What the data readers need of the checked header.
+struct PointShape {
+  const Field& fx;
+  const Field& fy;
+  const Field& fz;
+  std::size_t n;            // points declared (WIDTH · HEIGHT)
+  std::size_t step;         // bytes per point
+  std::size_t values;       // numbers per ascii line
+  std::size_t header_line;  // the DATA line, named by the binary problems
+};
 
-  const std::size_t need = n * step;
-  const std::size_t have = pos <= bytes.size() ? bytes.size() - pos : 0;
-  const auto* base = reinterpret_cast<const std::uint8_t*>(bytes.data()) + (pos <= bytes.size() ? pos : bytes.size());
-  if (out->data == "binary") {
-    if (have != need) {
-      *error = at(name, hl) + "binary data of " + std::to_string(have) + " bytes after the header (byte " +
-               std::to_string(pos) + "), expected " + std::to_string(n) + " points x " + std::to_string(step) +
-               " bytes = " + std::to_string(need);
-      return false;
-    }
-    out->points.reserve(n);
-    out->index.reserve(n);
-    for (std::size_t i = 0; i < n; ++i) {
-      const std::uint8_t* p = base + i * step;
-      keep(load_value(fx, p + fx.offset), load_value(fy, p + fy.offset), load_value(fz, p + fz.offset), i);
-    }
-    return true;
+// Point i of the file: kept when x, y and z are all finite, counted as dropped otherwise.
+void keep_point(double x, double y, double z, std::size_t i, PcdCloud* out) {
+  if (!(std::isfinite(x) && std::isfinite(y) && std::isfinite(z))) {
+    ++out->dropped_nonfinite;
+    return;
   }
-  // binary_compressed: uint32 compressed size, uint32 uncompressed size, LZF block; inflated, the
-  // fields follow one another (all x, then all y, …: PCL's column layout compresses better).
-  if (have < 8) {
-    *error = at(name, hl) + "binary_compressed block truncated: " + std::to_string(have) + " bytes after the header";
-    return false;
+  out->points.emplace_back(static_cast<float>(x), static_cast<float>(y), static_cast<float>(z));
+  out->index.push_back(static_cast<std::uint32_t>(i));
+}
+
+// DATA ascii: every point is one line of `values` numbers; the vectors grow with the lines actually
+// present (nothing is reserved for a count the file may not hold).
+bool read_ascii(const std::string& name, const std::string& bytes, LineCursor c, const PointShape& s, PcdCloud* out,
+                std::string* error) {
+  std::size_t i = 0;
+  std::vector<std::string_view> t;
+  while (c.pos < bytes.size()) {
+    t = split(c.next(bytes));
+    if (t.empty()) continue;
+    if (i >= s.n)
+      return fail_at(name, c.line, "more data lines than the " + std::to_string(s.n) + " points declared", error);
+    if (t.size() != s.values)
+      return fail_at(name, c.line, std::to_string(t.size()) + " values, expected " + std::to_string(s.values), error);
+    double xyz[3] = {0, 0, 0};
+    for (std::size_t k = 0; k < t.size(); ++k) {
+      double v;
+      if (!to_double(t[k], &v)) {
+        return fail_at(name, c.line,
+                       "value " + std::to_string(k + 1) + " '" + std::string(t[k]) + "' is not a number", error);
+      }
+      if (k == s.fx.value_offset) xyz[0] = v;
+      if (k == s.fy.value_offset) xyz[1] = v;
+      if (k == s.fz.value_offset) xyz[2] = v;
+    }
+    keep_point(xyz[0], xyz[1], xyz[2], i, out);
+    ++i;
+  }
+  if (i != s.n)
+    return fail_at(name, c.line, "file ends after " + std::to_string(i) + " of " + std::to_string(s.n) + " points",
+                   error);
+  return true;
+}
+
+// The bytes after the header: `have` of them from `base`; `pos` is the header's end (may be one
+// past the end of the file).
+struct DataBlock {
+  const std::uint8_t* base;
+  std::size_t have;
+  std::size_t pos;
+};
+
+// DATA binary: exactly n points of `step` bytes, fields interleaved.
+bool read_binary(const std::string& name, const DataBlock& d, const PointShape& s, PcdCloud* out, std::string* error) {
+  const std::size_t need = s.n * s.step;
+  if (d.have != need) {
+    return fail_at(name, s.header_line,
+                   "binary data of " + std::to_string(d.have) + " bytes after the header (byte " +
+                       std::to_string(d.pos) + "), expected " + std::to_string(s.n) + " points x " +
+                       std::to_string(s.step) + " bytes = " + std::to_string(need),
+                   error);
+  }
+  out->points.reserve(s.n);
+  out->index.reserve(s.n);
+  for (std::size_t i = 0; i < s.n; ++i) {
+    const std::uint8_t* p = d.base + i * s.step;
+    keep_point(load_value(s.fx, p + s.fx.offset), load_value(s.fy, p + s.fy.offset),
+               load_value(s.fz, p + s.fz.offset), i, out);
+  }
+  return true;
+}
+
+// The binary_compressed block's two sizes agree with the header and with the bytes present.
+bool check_compressed_block(const std::string& name, const DataBlock& d, const PointShape& s, std::uint32_t csize,
+                            std::uint32_t usize, std::string* error) {
+  const std::size_t need = s.n * s.step;
+  if (usize != need) {
+    return fail_at(name, s.header_line,
+                   "binary_compressed block inflates to " + std::to_string(usize) + " bytes, expected " +
+                       std::to_string(need) + " (" + std::to_string(s.n) + " points x " + std::to_string(s.step) +
+                       " bytes)",
+                   error);
+  }
+  if (static_cast<std::size_t>(csize) + 8 != d.have) {
+    return fail_at(name, s.header_line,
+                   std::string("binary_compressed block ") +
+                       (csize + std::size_t(8) > d.have ? "truncated" : "followed by garbage") + ": " +
+                       std::to_string(csize) + " compressed bytes declared, " + std::to_string(d.have - 8) +
+                       " present",
+                   error);
+  }
+  return true;
+}
+
+// DATA binary_compressed: uint32 compressed size, uint32 uncompressed size, LZF block; inflated, the
+// fields follow one another (all x, then all y, …: PCL's column layout compresses better).
+bool read_binary_compressed(const std::string& name, const DataBlock& d, const PointShape& s, PcdCloud* out,
+                            std::string* error) {
+  if (d.have < 8) {
+    return fail_at(name, s.header_line,
+                   "binary_compressed block truncated: " + std::to_string(d.have) + " bytes after the header", error);
   }
   std::uint32_t csize, usize;
-  std::memcpy(&csize, base, 4);
-  std::memcpy(&usize, base + 4, 4);
-  if (usize != need) {
-    *error = at(name, hl) + "binary_compressed block inflates to " + std::to_string(usize) + " bytes, expected " +
-             std::to_string(need) + " (" + std::to_string(n) + " points x " + std::to_string(step) + " bytes)";
-    return false;
-  }
-  if (static_cast<std::size_t>(csize) + 8 != have) {
-    *error = at(name, hl) + "binary_compressed block " + (csize + std::size_t(8) > have ? "truncated" : "followed by garbage") +
-             ": " + std::to_string(csize) + " compressed bytes declared, " + std::to_string(have - 8) + " present";
-    return false;
-  }
+  std::memcpy(&csize, d.base, 4);
+  std::memcpy(&usize, d.base + 4, 4);
+  if (!check_compressed_block(name, d, s, csize, usize, error)) return false;
+  const std::size_t n = s.n, need = n * s.step;
   std::vector<std::uint8_t> raw(need);
-  if (need > 0 && !lzf_decompress(base + 8, csize, raw.data(), raw.size())) {
-    *error = at(name, hl) + "binary_compressed block is corrupt (LZF stream at byte " + std::to_string(pos + 8) +
-             " does not inflate to " + std::to_string(need) + " bytes)";
-    return false;
+  if (need > 0 && !lzf_decompress(d.base + 8, csize, raw.data(), raw.size())) {
+    return fail_at(name, s.header_line,
+                   "binary_compressed block is corrupt (LZF stream at byte " + std::to_string(d.pos + 8) +
+                       " does not inflate to " + std::to_string(need) + " bytes)",
+                   error);
   }
   out->points.reserve(n);
   out->index.reserve(n);
   // Column layout: field f's values start at n · (its byte offset in a point).
   for (std::size_t i = 0; i < n; ++i) {
     auto col = [&](const Field& f) { return load_value(f, raw.data() + n * f.offset + i * f.size * f.count); };
-    keep(col(fx), col(fy), col(fz), i);
+    keep_point(col(s.fx), col(s.fy), col(s.fz), i, out);
   }
   return true;
+}
+
+}  // namespace
+
+bool parse_pcd(const std::string& name, const std::string& bytes, const PcdReadOptions& options, PcdCloud* out,
+               std::string* error) {
+  *out = PcdCloud();
+  out->path = name;
+  PcdHeader h;
+  LineCursor c;
+  PointLayout lay;
+  if (!read_header(name, bytes, &c, &h, out, error) || !check_header(name, h, options, error) ||
+      !lay_out_fields(name, &h, &lay, error))
+    return false;
+  const std::size_t n = static_cast<std::size_t>(h.width * h.height);
+  for (const Field& f : h.fields) out->fields.push_back(f.name);
+  out->width = static_cast<std::uint32_t>(h.width);
+  out->height = static_cast<std::uint32_t>(h.height);
+  out->declared_points = n;
+  const PointShape s{h.fields[lay.ix], h.fields[lay.iy], h.fields[lay.iz], n, lay.step, lay.values, h.data_line};
+  if (out->data == "ascii") return read_ascii(name, bytes, c, s, out, error);
+  const std::size_t pos = c.pos;
+  DataBlock d;
+  d.have = pos <= bytes.size() ? bytes.size() - pos : 0;
+  d.base = reinterpret_cast<const std::uint8_t*>(bytes.data()) + (pos <= bytes.size() ? pos : bytes.size());
+  d.pos = pos;
+  if (out->data == "binary") return read_binary(name, d, s, out, error);
+  return read_binary_compressed(name, d, s, out, error);
 }
 
 bool read_pcd(const std::string& path, const PcdReadOptions& options, PcdCloud* out, std::string* error) {

@@ -369,168 +369,225 @@ const ReferenceMapFit& LoadedDataset::reference_map_fit(std::size_t scan) const 
   return ref_map_checks.emplace(scan, check_reference_against_map(map, log.scans[scan], reference[scan])).first->second;
 }
 
+namespace {
+
+// The odometry fed to the localizer along one trial: shift ⊕ log odometry, where the shift changes
+// only at a kidnap (continuity: the wheels do not see the carrying).
+struct OdometryFeed {
+  fw::Se2d last_used;  // last odometry fed (after the kidnap shift)
+  bool have_last = false;
+  fw::Se2d shift = fw::Se2d(0, 0, 0);
+  std::size_t segment = 0, seg_steps = 0;  // segment 1: after the kidnap
+  double travelled_base = 0;               // travelled = travelled_base + ds.travelled[i]
+};
+
+// Running count of the localized steps: the current unbroken run and the error sum for the mean.
+struct LocalizedTally {
+  std::size_t run = 0;
+  double err_sum = 0;
+  std::size_t err_n = 0;
+};
+
+// A kidnap happens once, in the first segment: at step `kidnap_at_step`, or `kidnap_after_fix_steps`
+// steps after the first fix.
+bool kidnap_due(const TrialResult& tr, const OdometryFeed& feed, const TrialOptions& opt) {
+  return feed.segment == 0 && ((opt.kidnap_at_step > 0 && tr.steps.size() == opt.kidnap_at_step) ||
+                               (opt.kidnap_after_fix_steps > 0 && tr.localized &&
+                                tr.steps.size() == tr.steps_to_localize + opt.kidnap_after_fix_steps));
+}
+
+// Kidnap: carry the robot from scan `from` to scan j, another part of the log. The new segment's
+// odometry is shifted so that its first scan sits exactly at the last fed odometry pose: zero
+// odometry delta at the jump.
+void kidnap(const LoadedDataset& ds, std::size_t from, std::size_t j, OdometryFeed* feed, TrialResult* tr) {
+  tr->kidnap_scan_from = from;
+  tr->kidnap_travelled = tr->steps.empty() ? 0.0 : tr->steps.back().travelled;
+  feed->shift = (feed->have_last ? feed->last_used : ds.odometry[j]).compose(ds.odometry[j].inverse());
+  feed->travelled_base = tr->kidnap_travelled - ds.travelled[j];
+  feed->segment = 1;
+  feed->seg_steps = 0;
+  tr->kidnap_step = tr->steps.size();
+}
+
+// A scan is a step once the fed odometry moved or turned enough since the last one (the same rule
+// for every system).
+bool moved_enough(const OdometryFeed& feed, const fw::Se2d& od, const TrialOptions& opt) {
+  if (!feed.have_last) return true;
+  const double dm = std::hypot(od.x - feed.last_used.x, od.y - feed.last_used.y);
+  const double dt = std::fabs(fw::wrap_angle(od.theta - feed.last_used.theta));
+  return !(dm < opt.min_move_m && dt < opt.min_turn_rad);
+}
+
+// One localizer step on scan i with the fed odometry od; *step_ms is its wall time.
+fw::Status step_localizer(fw::Localizer& loc, const LoadedDataset& ds, std::size_t i, const fw::Se2d& od,
+                          hal::PoseEstimate* est, double* step_ms) {
+  static hal::LaserScan scan;
+  const std::uint64_t ts = static_cast<std::uint64_t>(std::llround(ds.log.scans[i].ipc_timestamp * 1e9));
+  scan = to_laser_scan(ds.log.scans[i], ts);
+  scan.scan_id = static_cast<std::uint32_t>(i);
+  hal::Odometry o;
+  o.timestamp_ns = ts;
+  o.x = static_cast<float>(od.x);
+  o.y = static_cast<float>(od.y);
+  o.theta = static_cast<float>(od.theta);
+  const auto t0 = std::chrono::steady_clock::now();
+  const fw::Status s = loc.step(scan, o, est);
+  const auto t1 = std::chrono::steady_clock::now();
+  *step_ms = std::chrono::duration<double, std::milli>(t1 - t0).count();
+  return s;
+}
+
+// The step as published, with its error against the log reference.
+StepLog make_step_log(const LoadedDataset& ds, std::size_t i, const hal::PoseEstimate& est, const fw::Se2d& od,
+                      std::size_t segment, double travelled, double step_ms,
+                      const std::function<std::size_t()>& matched_points) {
+  StepLog st;
+  st.scan = i;
+  st.map_err_m = st.map_err_rad = std::numeric_limits<double>::quiet_NaN();
+  st.segment = segment;
+  st.odom = od;
+  if (matched_points) st.matched_points = matched_points();
+  st.travelled = travelled;
+  st.status = est.status;
+  st.mode = est.mode;
+  st.step_ms = step_ms;
+  st.estimate = fw::Se2d(est.x, est.y, est.theta);
+  st.truth = ds.reference[i];
+  st.ref_ok = !ds.reference_unreliable(i);
+  st.pl_xy = est.protection_xy_m;
+  st.pl_theta = est.protection_theta_rad;
+  st.unsupported_steps = est.unsupported_steps;
+  st.reason = est.reason;
+  // Searching / fault: the published pose is a placeholder (no pose); never compare it.
+  st.has_pose = est.status != hal::LocalizationStatus::kSearching && est.status != hal::LocalizationStatus::kFault;
+  if (st.has_pose) {
+    st.err_m = std::hypot(est.x - st.truth.x, est.y - st.truth.y);
+    st.err_rad = std::fabs(fw::wrap_angle(static_cast<double>(est.theta) - st.truth.theta));
+  } else {
+    st.err_m = st.err_rad = std::numeric_limits<double>::quiet_NaN();
+  }
+  return st;
+}
+
+// A failure or PL exceedance must hold against the log reference AND the map's pose for this scan
+// (reference_map_check.h); a step where the map clears the estimate is excluded and counted.
+void judge_against_map(const LoadedDataset& ds, std::size_t i, const hal::PoseEstimate& est, StepLog* st) {
+  if (!(st->has_pose && st->ref_ok && est.status == hal::LocalizationStatus::kLocalized)) return;
+  const double bound_rad = 5.0 * 3.14159265358979 / 180.0;
+  // The log reference is itself off by up to its bound (closure residual, reference_trajectory.h):
+  // an error counts against the localizer only beyond the limit plus that bound.
+  const double rb_m = ds.reference_bound_m(i), rb_rad = ds.reference_bound_rad(i);
+  const double pl_m = st->pl_xy, pl_rad = st->pl_theta;
+  JudgedError je;  // against the log reference alone first: the map is asked only beyond a limit
+  je.ref_m = st->err_m;
+  je.ref_ang = st->err_rad;
+  if (!(beyond_reference(je, ds.success_bound_m, bound_rad) || beyond_reference(je, pl_m, pl_rad))) return;
+  const ReferenceMapFit& f = ds.reference_map_fit(i);
+  const double em = std::hypot(est.x - f.best.x, est.y - f.best.y);
+  const double er = std::fabs(fw::wrap_angle(static_cast<double>(est.theta) - f.best.theta));
+  st->map_err_m = em;
+  st->map_err_rad = er;
+  st->ref_bound_m = rb_m;
+  st->ref_bound_rad = rb_rad;
+  // One rule with mml-sim (reference_map_check.h), per criterion: the step is kept while either
+  // (integrity limits, protection level) is judged beyond, and only that one counts — a failure
+  // the map confirms is never dropped because the map clears the other — and excluded, counted,
+  // otherwise.
+  je.bound_m = rb_m;
+  je.bound_ang = rb_rad;
+  je.map_improves = f.improves;
+  je.map_m = em;
+  je.map_ang = er;
+  st->integrity_cleared = !judged_beyond(je, ds.success_bound_m, bound_rad);
+  st->pl_cleared = !judged_beyond(je, pl_m, pl_rad);
+  const bool judged = !st->integrity_cleared || !st->pl_cleared;
+  const bool beyond_ref = beyond_reference(je, ds.success_bound_m, bound_rad) || beyond_reference(je, pl_m, pl_rad);
+  if (!judged && beyond_ref) {
+    st->ref_ok = false;
+    st->ref_map_contradicted = true;
+  } else if (!beyond_ref) {
+    st->ref_ok = false;  // within the reference's own error bound of the limits: cannot be judged
+    st->ref_within_bound = true;
+  }
+}
+
+// MML_EVAL_TRACE: one line per step (n: steps so far).
+void trace_step(std::size_t n, std::size_t i, const hal::PoseEstimate& est, const StepLog& st) {
+  std::printf("    step %3zu scan %5zu %-11s %s est (%.2f %.2f %.2f) ref (%.2f %.2f %.2f) err %.2f m %.1f deg  hyp %u cl %u r %.2f PL %.2f m %.1f deg %.1f ms\n",
+              n, i, hal::status_name(est.status),
+              est.mode == hal::LocalizationMode::kTracking ? "T" : "G", est.x, est.y, est.theta, st.truth.x,
+              st.truth.y, st.truth.theta, st.err_m, st.err_rad * 57.2958, est.hypothesis_count, est.cluster_count,
+              est.rating, est.protection_xy_m, est.protection_theta_rad * 57.2958, st.step_ms);
+}
+
+// Counts a recorded step: the first fix (steps, metres, right or wrong), a wrong fix before the
+// kidnap as a failure, the error for the mean. True when the trial is settled and stops here.
+bool tally_step(const StepLog& st, const LoadedDataset& ds, const TrialOptions& opt, LocalizedTally* tally,
+                TrialResult* tr) {
+  if (st.status != hal::LocalizationStatus::kLocalized) {
+    tally->run = 0;
+    return false;
+  }
+  const bool ok = !st.ref_ok || st.integrity_cleared || (st.err_m < ds.success_bound_m && st.err_rad < ds.success_bound_rad);
+  if (!tr->localized) {
+    tr->localized = true;
+    tr->steps_to_localize = tr->steps.size();
+    tr->metres_to_localize = st.travelled;
+    tr->success = ok;
+  }
+  if (!ok && st.segment == 0) tr->failure = true;
+  tally->err_sum += st.err_m;
+  ++tally->err_n;
+  ++tally->run;
+  return opt.stop_after_localized && tally->run >= opt.settle_steps;
+}
+
+}  // namespace
+
 TrialResult run_trial(fw::Localizer& loc, const LoadedDataset& ds, std::size_t start, const TrialOptions& opt,
                       const double* region, const std::function<std::size_t()>& matched_points) {
   TrialResult tr;
   tr.start = start;
   loc.reset();
-  static hal::LaserScan scan;
-  fw::Se2d last_used;  // last odometry fed (after the kidnap shift)
-  bool have_last = false;
-  std::size_t localized_run = 0;
-  double err_sum = 0;
-  std::size_t err_n = 0;
-  // Odometry fed = shift ⊕ log odometry; the shift changes only at a kidnap (continuity).
-  fw::Se2d shift(0, 0, 0);
-  std::size_t segment = 0, seg_steps = 0;
-  double travelled_base = -ds.travelled[start];  // travelled = travelled_base + ds.travelled[i]
+  OdometryFeed feed;
+  feed.travelled_base = -ds.travelled[start];
+  LocalizedTally tally;
   const std::size_t cap = opt.max_steps == 0 ? static_cast<std::size_t>(-1) : opt.max_steps;
   for (std::size_t i = start; i < ds.log.scans.size() && tr.steps.size() < cap; ++i) {
-    const bool kidnap_now =
-        segment == 0 && ((opt.kidnap_at_step > 0 && tr.steps.size() == opt.kidnap_at_step) ||
-                         (opt.kidnap_after_fix_steps > 0 && tr.localized &&
-                          tr.steps.size() == tr.steps_to_localize + opt.kidnap_after_fix_steps));
-    const std::size_t target =
-        kidnap_now ? (opt.kidnap_target ? opt.kidnap_target(tr.steps.empty() ? start : tr.steps.back().scan)
-                                        : opt.kidnap_to_scan)
-                   : 0;
-    if (kidnap_now && target < ds.log.scans.size()) {
-      // Kidnap: carry the robot to another part of the log. The new segment's odometry is shifted so
-      // that its first scan sits exactly at the last fed odometry pose: zero odometry delta at the jump.
-      const std::size_t j = target;
-      tr.kidnap_scan_from = tr.steps.empty() ? start : tr.steps.back().scan;
-      tr.kidnap_travelled = tr.steps.empty() ? 0.0 : tr.steps.back().travelled;
-      shift = (have_last ? last_used : ds.odometry[j]).compose(ds.odometry[j].inverse());
-      travelled_base = tr.kidnap_travelled - ds.travelled[j];
-      segment = 1;
-      seg_steps = 0;
-      i = j;
-      tr.kidnap_step = tr.steps.size();
+    if (kidnap_due(tr, feed, opt)) {
+      const std::size_t from = tr.steps.empty() ? start : tr.steps.back().scan;
+      const std::size_t target = opt.kidnap_target ? opt.kidnap_target(from) : opt.kidnap_to_scan;
+      if (target < ds.log.scans.size()) {
+        kidnap(ds, from, target, &feed, &tr);
+        i = target;
+      }
     }
-    if (segment == 1 && opt.kidnap_steps_after > 0 && seg_steps >= opt.kidnap_steps_after) break;
-    const fw::Se2d od = shift.compose(ds.odometry[i]);
-    if (have_last) {
-      const double dm = std::hypot(od.x - last_used.x, od.y - last_used.y);
-      const double dt = std::fabs(fw::wrap_angle(od.theta - last_used.theta));
-      if (dm < opt.min_move_m && dt < opt.min_turn_rad) continue;
-    }
-    const double travelled = travelled_base + ds.travelled[i];
+    if (feed.segment == 1 && opt.kidnap_steps_after > 0 && feed.seg_steps >= opt.kidnap_steps_after) break;
+    const fw::Se2d od = feed.shift.compose(ds.odometry[i]);
+    if (!moved_enough(feed, od, opt)) continue;
+    const double travelled = feed.travelled_base + ds.travelled[i];
     if (travelled > opt.max_metres) break;
-    last_used = od;
-    have_last = true;
-    const std::uint64_t ts = static_cast<std::uint64_t>(std::llround(ds.log.scans[i].ipc_timestamp * 1e9));
-    scan = to_laser_scan(ds.log.scans[i], ts);
-    scan.scan_id = static_cast<std::uint32_t>(i);
-    hal::Odometry o;
-    o.timestamp_ns = ts;
-    o.x = static_cast<float>(od.x);
-    o.y = static_cast<float>(od.y);
-    o.theta = static_cast<float>(od.theta);
+    feed.last_used = od;
+    feed.have_last = true;
     hal::PoseEstimate est;
-    const auto t0 = std::chrono::steady_clock::now();
-    const fw::Status s = loc.step(scan, o, &est);
-    const auto t1 = std::chrono::steady_clock::now();
+    double step_ms = 0;
+    const fw::Status s = step_localizer(loc, ds, i, od, &est, &step_ms);
     if (!s.is_ok()) {
       tr.error = std::string("scan ") + std::to_string(i) + ": " + s.message();
       break;
     }
-    ++seg_steps;
-    StepLog st;
-    st.scan = i;
-    st.map_err_m = st.map_err_rad = std::numeric_limits<double>::quiet_NaN();
-    st.segment = segment;
-    st.odom = od;
-    if (matched_points) st.matched_points = matched_points();
-    st.travelled = travelled;
-    st.status = est.status;
-    st.mode = est.mode;
-    st.step_ms = std::chrono::duration<double, std::milli>(t1 - t0).count();
-    st.estimate = fw::Se2d(est.x, est.y, est.theta);
-    st.truth = ds.reference[i];
-    st.ref_ok = !ds.reference_unreliable(i);
-    st.pl_xy = est.protection_xy_m;
-    st.pl_theta = est.protection_theta_rad;
-    st.unsupported_steps = est.unsupported_steps;
-    st.reason = est.reason;
-    // Searching / fault: the published pose is a placeholder (no pose); never compare it.
-    st.has_pose = est.status != hal::LocalizationStatus::kSearching && est.status != hal::LocalizationStatus::kFault;
-    if (st.has_pose) {
-      st.err_m = std::hypot(est.x - st.truth.x, est.y - st.truth.y);
-      st.err_rad = std::fabs(fw::wrap_angle(static_cast<double>(est.theta) - st.truth.theta));
-    } else {
-      st.err_m = st.err_rad = std::numeric_limits<double>::quiet_NaN();
-    }
-    // A failure or PL exceedance must hold against the log reference AND the map's pose for this scan
-    // (reference_map_check.h); a step where the map clears the estimate is excluded and counted.
-    if (st.has_pose && st.ref_ok && est.status == hal::LocalizationStatus::kLocalized) {
-      const double bound_rad = 5.0 * 3.14159265358979 / 180.0;
-      // The log reference is itself off by up to its bound (closure residual, reference_trajectory.h):
-      // an error counts against the localizer only beyond the limit plus that bound.
-      const double rb_m = ds.reference_bound_m(i), rb_rad = ds.reference_bound_rad(i);
-      const double pl_m = st.pl_xy, pl_rad = st.pl_theta;
-      JudgedError je;  // against the log reference alone first: the map is asked only beyond a limit
-      je.ref_m = st.err_m;
-      je.ref_ang = st.err_rad;
-      if (beyond_reference(je, ds.success_bound_m, bound_rad) || beyond_reference(je, pl_m, pl_rad)) {
-        const ReferenceMapFit& f = ds.reference_map_fit(i);
-        const double em = std::hypot(est.x - f.best.x, est.y - f.best.y);
-        const double er = std::fabs(fw::wrap_angle(static_cast<double>(est.theta) - f.best.theta));
-        st.map_err_m = em;
-        st.map_err_rad = er;
-        st.ref_bound_m = rb_m;
-        st.ref_bound_rad = rb_rad;
-        // One rule with mml-sim (reference_map_check.h), per criterion: the step is kept while either
-        // (integrity limits, protection level) is judged beyond, and only that one counts — a failure
-        // the map confirms is never dropped because the map clears the other — and excluded, counted,
-        // otherwise.
-        je.bound_m = rb_m;
-        je.bound_ang = rb_rad;
-        je.map_improves = f.improves;
-        je.map_m = em;
-        je.map_ang = er;
-        st.integrity_cleared = !judged_beyond(je, ds.success_bound_m, bound_rad);
-        st.pl_cleared = !judged_beyond(je, pl_m, pl_rad);
-        const bool judged = !st.integrity_cleared || !st.pl_cleared;
-        const bool beyond_ref = beyond_reference(je, ds.success_bound_m, bound_rad) || beyond_reference(je, pl_m, pl_rad);
-        if (!judged && beyond_ref) {
-          st.ref_ok = false;
-          st.ref_map_contradicted = true;
-        } else if (!beyond_ref) {
-          st.ref_ok = false;  // within the reference's own error bound of the limits: cannot be judged
-          st.ref_within_bound = true;
-        }
-      }
-    }
+    ++feed.seg_steps;
+    StepLog st = make_step_log(ds, i, est, od, feed.segment, travelled, step_ms, matched_points);
+    judge_against_map(ds, i, est, &st);
     if (region) {
       st.in_region = st.truth.x >= region[0] && st.truth.x <= region[2] && st.truth.y >= region[1] && st.truth.y <= region[3];
     }
     tr.steps.push_back(st);
-    if (std::getenv("MML_EVAL_TRACE")) {
-      std::printf("    step %3zu scan %5zu %-11s %s est (%.2f %.2f %.2f) ref (%.2f %.2f %.2f) err %.2f m %.1f deg  hyp %u cl %u r %.2f PL %.2f m %.1f deg %.1f ms\n",
-                  tr.steps.size(), i, hal::status_name(est.status),
-                  est.mode == hal::LocalizationMode::kTracking ? "T" : "G", est.x, est.y, est.theta, st.truth.x,
-                  st.truth.y, st.truth.theta, st.err_m, st.err_rad * 57.2958, est.hypothesis_count, est.cluster_count,
-                  est.rating, est.protection_xy_m, est.protection_theta_rad * 57.2958, st.step_ms);
-    }
-    if (est.status == hal::LocalizationStatus::kLocalized) {
-      const bool ok = !st.ref_ok || st.integrity_cleared || (st.err_m < ds.success_bound_m && st.err_rad < ds.success_bound_rad);
-      if (!tr.localized) {
-        tr.localized = true;
-        tr.steps_to_localize = tr.steps.size();
-        tr.metres_to_localize = travelled;
-        tr.success = ok;
-      }
-      if (!ok && segment == 0) tr.failure = true;
-      err_sum += st.err_m;
-      ++err_n;
-      ++localized_run;
-      if (opt.stop_after_localized && localized_run >= opt.settle_steps) break;
-    } else {
-      localized_run = 0;
-    }
+    if (std::getenv("MML_EVAL_TRACE")) trace_step(tr.steps.size(), i, est, st);
+    if (tally_step(st, ds, opt, &tally, &tr)) break;
   }
   if (tr.failure) tr.success = false;
-  tr.mean_err_localized = err_n ? err_sum / err_n : std::numeric_limits<double>::quiet_NaN();
+  tr.mean_err_localized = tally.err_n ? tally.err_sum / tally.err_n : std::numeric_limits<double>::quiet_NaN();
   return tr;
 }
 
