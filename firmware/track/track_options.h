@@ -135,6 +135,12 @@ struct TrackOptions {
   // background from a fresh local map for at most this many scans; if it isolates a pose outside the
   // track's protection level, the track was in a look-alike and MML's fix replaces it. 0 = off.
   std::uint32_t cross_check_steps = 300;
+  // An alias whose equally good rival lies beyond the alert limits (TrackStep::alias_beyond_alert)
+  // asks for MML's confirmation like a large fault. Off: it closes the hole an experiment found
+  // (tracked_localizer.h) but costs availability where look-alikes are common and MML needs many
+  // metres to isolate (scripts/bench.sh localize: large office 0.78 → 0.19, mit-killian 0.88 → 0.65,
+  // intel 0.94 → 0.93; no integrity failure either way on the bench).
+  bool confirm_alias_beyond_alert = false;
   // Protection level (protection_level.h): integrity risk per `localized` step and alert limits.
   float integrity_risk = 1e-3f;
   float alert_limit_m = 0.5f;             // PL beyond → not `localized` (the product's 0.5 m bound)

@@ -79,13 +79,14 @@ Status TrackedLocalizer::step(const hal::LaserScan& scan, const hal::Odometry& o
       global_.reset();
       cross_check_left_ = tracker_.options().cross_check_steps;
     }
-    if (ts.alias_beyond_alert && !ts.large_fault && !ts.lost && !unconfirmed_ &&
-        tracker_.options().cross_check_steps > 0) {
+    if (tracker_.options().confirm_alias_beyond_alert && ts.alias_beyond_alert && !ts.large_fault && !ts.lost &&
+        !unconfirmed_ && tracker_.options().cross_check_steps > 0) {
       // Two look-alikes farther apart than the alert limits fit this scan equally: once the track
       // has passed through such a scan, which of them it follows is beyond every local test (intel
       // kidnap 6737 → 7812: the scans of the new place fit 11 m away from it, the track went
       // alias → recovering → `localized` 10.8 m off before the background search had isolated
-      // anything). Like a large fault, only MML's word makes it `localized` again; its local map
+      // anything; seen with RBSM's motion prior on, track_options.h says why this is optional).
+      // Like a large fault, only MML's word makes it `localized` again; its local map
       // starts here, so it holds no scan from before the doubt. Once per episode: resetting it on
       // every such scan of a long corridor would keep MML from ever isolating anything.
       unconfirmed_ = true;
