@@ -56,6 +56,14 @@ void TrackedLocalizer::publish_track(const TrackStep& ts, hal::PoseEstimate* out
   out->unsupported_steps = static_cast<std::uint16_t>(ts.unsupported_steps > 65535 ? 65535 : ts.unsupported_steps);
 }
 
+// The track stays, but it is `localized` again only on MML's word, from a local map that starts
+// now (so it holds no scan from before the doubt), checked over cross_check_steps scans.
+void TrackedLocalizer::await_mml_confirmation() {
+  unconfirmed_ = true;
+  global_.reset();
+  cross_check_left_ = tracker_.options().cross_check_steps;
+}
+
 Status TrackedLocalizer::step(const hal::LaserScan& scan, const hal::Odometry& odom, hal::PoseEstimate* out) {
   const hal::CompleteReasonOnExit reason_on_exit{out};  // every estimate says why it is not `localized`
   if (mml_ == nullptr) return Status::error(Errc::kNotInitialized, "TrackedLocalizer: step() before init()");
@@ -75,9 +83,7 @@ Status TrackedLocalizer::step(const hal::LaserScan& scan, const hal::Odometry& o
     if (ts.large_fault && !ts.lost && tracker_.options().cross_check_steps > 0) {
       // The robot may have been carried anywhere (a kidnap into a twin corridor fits every local
       // test): the pose needs MML's word again, from a local map that starts after the fault.
-      unconfirmed_ = true;
-      global_.reset();
-      cross_check_left_ = tracker_.options().cross_check_steps;
+      await_mml_confirmation();
     }
     if (tracker_.options().confirm_alias_beyond_alert && ts.alias_beyond_alert && !ts.large_fault && !ts.lost &&
         !unconfirmed_ && tracker_.options().cross_check_steps > 0) {
@@ -89,9 +95,7 @@ Status TrackedLocalizer::step(const hal::LaserScan& scan, const hal::Odometry& o
       // Like a large fault, only MML's word makes it `localized` again; its local map
       // starts here, so it holds no scan from before the doubt. Once per episode: resetting it on
       // every such scan of a long corridor would keep MML from ever isolating anything.
-      unconfirmed_ = true;
-      global_.reset();
-      cross_check_left_ = tracker_.options().cross_check_steps;
+      await_mml_confirmation();
     }
     if (!ts.lost) return cross_check(scan, odom, wheel, n, ts, out);
     {

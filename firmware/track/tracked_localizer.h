@@ -64,6 +64,7 @@ class TrackedLocalizer final : public Localizer {
  private:
   std::size_t scan_points(const hal::LaserScan& scan);
   void publish_track(const TrackStep& ts, hal::PoseEstimate* out) const;
+  void await_mml_confirmation();
   // MML's fix in `g` → tracker started and confirmed on this scan; false (tracker reset) if not.
   bool start_from_fix(const hal::PoseEstimate& g, const Se2f& wheel, std::size_t n, hal::PoseEstimate* out);
   Status cross_check(const hal::LaserScan& scan, const hal::Odometry& odom, const Se2f& wheel, std::size_t n,
