@@ -316,8 +316,10 @@ Status Interpreter::interpret(const InterpretInput& in, InterpretResult* out) {
       return Status::ok();
     }
     soft_active_ = false;
-    consistent_streak_ = 0;
-    pooled_support_ = 0;
+    if (!options_.keep_support_across_empty_steps) {
+      consistent_streak_ = 0;
+      pooled_support_ = 0;
+    }
     if (can_predict) {  // keep x_prev moving with the robot so the next d² is meaningful
       prev_pose_ = pred.pose;
       prev_cov_ = pred.cov;

@@ -191,6 +191,52 @@ TEST(InterpreterTest, PooledSupportLocalizesASparseButConsistentCluster) {
   }
 }
 
+// keep_support_across_empty_steps: steps without any hypothesis (the adaptive threshold above
+// everything) between consistent steps of one cluster keep its pooled support — the cluster
+// localizes with the option and never without it. A gap is no free pass for a jump: twins that
+// alternate across empty steps still fail d² (x_prev is carried by the odometry through the gap).
+TEST(InterpreterTest, EmptyStepsKeepTheSupportOnlyWithTheOption) {
+  for (const bool keep : {true, false}) {
+    static Interpreter it;
+    MmlOptions o;
+    o.pool_cluster_support = true;
+    o.keep_support_across_empty_steps = keep;
+    ASSERT_TRUE(it.init(o).is_ok());
+    RandomStream rng(17, 0);
+    Se2f truth(2, 3, 0.3f);
+    const Se2f step(0.3f, 0.0f, 0.05f);
+    int localized = 0;
+    for (int t = 0; t < 30; ++t) {
+      const auto h = t % 2 ? std::vector<PoseHypothesis>() : blob(truth.x, truth.y, truth.theta, 2, 0.02f, 0.9f, &rng);
+      const InterpretResult r = run(&it, h, step, t > 0);
+      if (r.status == hal::LocalizationStatus::kLocalized && !r.soft) {
+        ++localized;
+        EXPECT_TRUE(keep);
+        EXPECT_NEAR(r.pose.x, truth.x, 0.05f);
+      }
+      truth = truth.compose(step);
+    }
+    if (keep) EXPECT_GT(localized, 3); else EXPECT_EQ(localized, 0);
+  }
+  static Interpreter twins;
+  MmlOptions o;
+  o.pool_cluster_support = true;
+  o.keep_support_across_empty_steps = true;
+  ASSERT_TRUE(twins.init(o).is_ok());
+  RandomStream rng(18, 0);
+  Se2f a(2, 3, 0.0f), b(12, 3, 3.14159f);
+  const Se2f step(0.3f, 0.0f, 0.0f);
+  for (int t = 0; t < 40; ++t) {
+    const Se2f& p = (t / 4) % 2 ? b : a;  // twin a, empty, twin a, empty, then b the same way
+    const auto h = t % 2 ? std::vector<PoseHypothesis>() : blob(p.x, p.y, p.theta, 2, 0.02f, 0.9f, &rng);
+    const InterpretResult r = run(&twins, h, step, t > 0);
+    EXPECT_NE(r.status, hal::LocalizationStatus::kLocalized) << t;
+    EXPECT_LT(r.pooled_support, 5u) << t;
+    a = a.compose(step);
+    b = b.compose(step);
+  }
+}
+
 // A single cluster that jumps (inconsistent with odometry) fails the Mahalanobis test.
 TEST(InterpreterTest, JumpingClusterFailsMahalanobis) {
   static Interpreter it;

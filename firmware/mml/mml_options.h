@@ -49,6 +49,12 @@ struct MmlOptions {
   // (Eq. 5.22) unchecked — with pooling it localized earlier on intel's unknown-area run and then
   // stayed `localized` 1.1 m behind as the robot drove into the erased box (bench mml, trial 1).
   bool pool_cluster_support = false;
+  // Extension: a step in which pRANSAM returns no hypothesis above Ω_thres (`searching`) neither
+  // supports nor contradicts the best cluster, so it keeps the pool and the consistency streak (x_prev
+  // is carried by the odometry through it, so the next d² still spans the gap). Off: such a step
+  // starts both again (the adaptive threshold alternates full and empty steps while the robot is
+  // still; intel fix trial 3 stayed `ambiguous`/`searching` for 200 steps at 0.0–0.2 m error).
+  bool keep_support_across_empty_steps = false;
   float xi_r2 = 8.0f;           // d²(r_h, R_h) < ξ_r² (χ² quantile, 3 dof)
   float xi_med = 10.0f;         // σ_med < ξ_med
   std::uint32_t tau_m = 10;     // window of d² values for the median test (Eq. 5.15–5.16)

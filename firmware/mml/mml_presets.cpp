@@ -20,6 +20,7 @@ MmlLocalizerConfig mml_preset(int preset, std::uint64_t seed) {
 MmlLocalizerConfig mml_track_preset(int preset, std::uint64_t seed) {
   MmlLocalizerConfig c = mml_preset(preset, seed);
   c.mml.pool_cluster_support = true;
+  c.mml.keep_support_across_empty_steps = true;
   return c;
 }
 

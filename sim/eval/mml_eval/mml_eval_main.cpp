@@ -129,6 +129,8 @@ static int run_main(int argc, char** argv) {
     else if (a == "--synthetic-odometry") files.synthetic_odometry = true;
     else if (a == "--pool") lp.pool_cluster_support = true;
     else if (a == "--no-pool") lp.pool_cluster_support = false;
+    else if (a == "--keep-support") lp.keep_support_across_empty_steps = true;
+    else if (a == "--no-keep-support") lp.keep_support_across_empty_steps = false;
     else if (a == "--global") {
       const std::string m = str();
       if (m == "ref") sim::mmleval::set_eval_global_mode(sim::mmleval::EvalGlobalMode::kReference);
