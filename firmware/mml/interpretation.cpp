@@ -376,6 +376,9 @@ Status Interpreter::interpret(const InterpretInput& in, InterpretResult* out) {
   // pool again. Off: the members of one step must reach the minimum alone.
   if (options_.pool_cluster_support && rating_alone && out->c_mahalanobis && out->c_median) {
     pooled_support_ += static_cast<std::uint32_t>(cb.size());
+  } else if (options_.pool_cluster_support && options_.keep_support_across_contested_steps && out->c_mahalanobis &&
+             out->c_median) {
+    // Contested but consistent: the step adds nothing and takes nothing (MmlOptions).
   } else {
     pooled_support_ = 0;
   }

@@ -237,6 +237,61 @@ TEST(InterpreterTest, EmptyStepsKeepTheSupportOnlyWithTheOption) {
   }
 }
 
+// keep_support_across_contested_steps: the true cluster consistent at every step, alone in every
+// other one and joined by a one-off rival elsewhere (rated as high) in the others: the pool survives
+// the contested steps only with the option, and `localized` comes only on a step where the cluster
+// is alone. A twin that takes the lead in a contested step breaks d², which empties the pool.
+TEST(InterpreterTest, ContestedStepsKeepTheSupportOnlyWithTheOption) {
+  for (const bool keep : {true, false}) {
+    static Interpreter it;
+    MmlOptions o;
+    o.pool_cluster_support = true;
+    o.keep_support_across_contested_steps = keep;
+    ASSERT_TRUE(it.init(o).is_ok());
+    RandomStream rng(19, 0);
+    Se2f truth(2, 3, 0.3f);
+    const Se2f step(0.3f, 0.0f, 0.05f);
+    int localized = 0;
+    for (int t = 0; t < 30; ++t) {
+      auto h = blob(truth.x, truth.y, truth.theta, 2, 0.02f, 0.9f, &rng);
+      const bool contested = t % 2 == 1;
+      if (contested) {  // one rival hypothesis at a new random place each time
+        const auto r = blob(20.0f + 3.0f * static_cast<float>(t), -5.0f, 1.0f, 1, 0.0f, 0.9f, &rng);
+        h.insert(h.end(), r.begin(), r.end());
+      }
+      const InterpretResult r = run(&it, h, step, t > 0);
+      if (r.status == hal::LocalizationStatus::kLocalized && !r.soft) {
+        ++localized;
+        EXPECT_TRUE(keep);
+        EXPECT_FALSE(contested) << t;
+        EXPECT_NEAR(r.pose.x, truth.x, 0.05f);
+      }
+      truth = truth.compose(step);
+    }
+    if (keep) EXPECT_GT(localized, 3); else EXPECT_EQ(localized, 0);
+  }
+  static Interpreter twins;
+  MmlOptions o;
+  o.pool_cluster_support = true;
+  o.keep_support_across_contested_steps = true;
+  ASSERT_TRUE(twins.init(o).is_ok());
+  RandomStream rng(20, 0);
+  Se2f a(2, 3, 0.0f), b(12, 3, 3.14159f);
+  const Se2f step(0.3f, 0.0f, 0.0f);
+  for (int t = 0; t < 40; ++t) {
+    // a alone, a with b (b ahead every other time), a alone, …: the lead changes, d² fails.
+    std::vector<PoseHypothesis> h = blob(a.x, a.y, a.theta, 2, 0.02f, 0.9f, &rng);
+    if (t % 2 == 1) {
+      const auto r = blob(b.x, b.y, b.theta, (t / 2) % 2 ? 3 : 1, 0.02f, 0.9f, &rng);
+      h.insert(h.end(), r.begin(), r.end());
+    }
+    const InterpretResult r = run(&twins, h, step, t > 0);
+    EXPECT_LT(r.pooled_support, 5u) << t;
+    a = a.compose(step);
+    b = b.compose(step);
+  }
+}
+
 // A single cluster that jumps (inconsistent with odometry) fails the Mahalanobis test.
 TEST(InterpreterTest, JumpingClusterFailsMahalanobis) {
   static Interpreter it;

@@ -55,6 +55,11 @@ struct MmlOptions {
   // starts both again (the adaptive threshold alternates full and empty steps while the robot is
   // still; intel fix trial 3 stayed `ambiguous`/`searching` for 200 steps at 0.0–0.2 m error).
   bool keep_support_across_empty_steps = false;
+  // Extension: a step in which the best cluster is consistent (d², σ_med) but not alone above δ_r
+  // (a rival cluster holds more than 1 − δ_r of the rating) adds no member and keeps the pool; an
+  // inconsistent step still empties it, and `localized` still needs a step in which the cluster is
+  // alone. Off: such a step empties the pool.
+  bool keep_support_across_contested_steps = false;
   float xi_r2 = 8.0f;           // d²(r_h, R_h) < ξ_r² (χ² quantile, 3 dof)
   float xi_med = 10.0f;         // σ_med < ξ_med
   std::uint32_t tau_m = 10;     // window of d² values for the median test (Eq. 5.15–5.16)

@@ -452,6 +452,7 @@ bool run_localize_evaluation(const LocalizePlan& plan, BenchJson* json, std::str
                   mml_track_config(plan.mml_config, plan.seed)};
   run.mml_cfg.mml.pool_cluster_support = plan.pool_cluster_support;
   run.mml_cfg.mml.keep_support_across_empty_steps = plan.keep_support_across_empty_steps;
+  run.mml_cfg.mml.keep_support_across_contested_steps = plan.keep_support_across_contested_steps;
   std::filesystem::create_directories(plan.out_dir);
   json->add_int("seed", static_cast<long long>(plan.seed));
   json->add_int("whole_runs_per_dataset", static_cast<long long>(plan.whole_runs));
