@@ -21,6 +21,7 @@ MmlLocalizerConfig mml_track_preset(int preset, std::uint64_t seed) {
   MmlLocalizerConfig c = mml_preset(preset, seed);
   c.mml.pool_cluster_support = true;
   c.mml.keep_support_across_empty_steps = true;
+  c.mml.keep_support_across_contested_steps = true;
   return c;
 }
 

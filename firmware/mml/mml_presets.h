@@ -22,7 +22,8 @@ constexpr int kDefaultMmlPreset = 3;
 MmlLocalizerConfig mml_preset(int preset, std::uint64_t seed);
 
 // The MML part of mml-track: C`preset` with the pooled cluster support (MmlOptions::
-// pool_cluster_support), which the tracker's confirmation of every fix makes safe to use.
+// pool_cluster_support, kept across empty and contested steps), which the tracker's confirmation
+// of every fix makes safe to use.
 MmlLocalizerConfig mml_track_preset(int preset, std::uint64_t seed);
 
 // pRANSAM's contact field must cover the whole global map: its cell follows the map's resolution

@@ -136,11 +136,12 @@ struct TrackOptions {
   // track's protection level, the track was in a look-alike and MML's fix replaces it. 0 = off.
   std::uint32_t cross_check_steps = 300;
   // An alias whose equally good rival lies beyond the alert limits (TrackStep::alias_beyond_alert)
-  // asks for MML's confirmation like a large fault. Off: it closes the hole an experiment found
-  // (tracked_localizer.h) but costs availability where look-alikes are common and MML needs many
-  // metres to isolate (scripts/bench.sh localize: large office 0.78 → 0.19, mit-killian 0.88 → 0.65,
-  // intel 0.94 → 0.93; no integrity failure either way on the bench).
-  bool confirm_alias_beyond_alert = false;
+  // asks for MML's confirmation like a large fault: the track may already follow the wrong one of
+  // two look-alikes, and no local test can tell (intel kidnap 6735 → 7812: `localized` 10.8 m off
+  // four scans after such an alias whenever MML's background search lost the race). It costs
+  // availability where look-alikes are common and MML needs metres to isolate (README: large office
+  // 0.78 → 0.65, mit-killian 0.88 → 0.72 with MML's faster isolation). false = the old race.
+  bool confirm_alias_beyond_alert = true;
   // Protection level (protection_level.h): integrity risk per `localized` step and alert limits.
   float integrity_risk = 1e-3f;
   float alert_limit_m = 0.5f;             // PL beyond → not `localized` (the product's 0.5 m bound)

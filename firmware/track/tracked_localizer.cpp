@@ -91,7 +91,7 @@ Status TrackedLocalizer::step(const hal::LaserScan& scan, const hal::Odometry& o
       // has passed through such a scan, which of them it follows is beyond every local test (intel
       // kidnap 6737 → 7812: the scans of the new place fit 11 m away from it, the track went
       // alias → recovering → `localized` 10.8 m off before the background search had isolated
-      // anything; seen with RBSM's motion prior on, track_options.h says why this is optional).
+      // anything; first with RBSM's motion prior on, then in the default chain, track_options.h).
       // Like a large fault, only MML's word makes it `localized` again; its local map
       // starts here, so it holds no scan from before the doubt. Once per episode: resetting it on
       // every such scan of a long corridor would keep MML from ever isolating anything.

@@ -14,7 +14,7 @@
 // may have been carried; see TrackStep::large_fault) restarts that search from a fresh local map and
 // withholds `localized` until MML isolates the tracked pose (or replaces it): the tracker's tests are
 // local and cannot see that a look-alike 35 m away fits as well as the place it came from. With
-// TrackOptions::confirm_alias_beyond_alert (off by default: its cost in availability is measured
+// TrackOptions::confirm_alias_beyond_alert (on by default; its cost in availability is measured
 // there) an alias whose equally good rival lies beyond the alert limits is treated the same way, once
 // per episode: the track may already follow the wrong one of two look-alikes.
 // PoseEstimate.mode says which one is active; protection_xy_m / protection_theta_rad are set on

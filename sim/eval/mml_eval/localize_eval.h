@@ -20,7 +20,7 @@ struct LocalizePlan {
   std::uint64_t seed = 1;
   int threads = 2;
   int mml_config = 3;
-  bool keep_support_across_contested_steps = false;  // --keep-contested
+  bool keep_support_across_contested_steps = true;  // --no-keep-contested: off (MmlOptions)
   bool keep_support_across_empty_steps = true;  // --no-keep-support: off (MmlOptions::keep_support_across_empty_steps)
   bool pool_cluster_support = true;  // --no-pool: mml-track's MML without the pooled support (mml_track_preset)
   TrialOptions step_rule;            // min_move_m / min_turn_rad (the suite's step rule)

@@ -513,8 +513,8 @@ void judge_against_map(const LoadedDataset& ds, std::size_t i, const hal::PoseEs
 
 // MML_EVAL_TRACE: one line per step (n: steps so far).
 void trace_step(std::size_t n, std::size_t i, const hal::PoseEstimate& est, const StepLog& st) {
-  std::printf("    step %3zu scan %5zu %-11s %s est (%.2f %.2f %.2f) ref (%.2f %.2f %.2f) err %.2f m %.1f deg  hyp %u cl %u r %.2f PL %.2f m %.1f deg %.1f ms\n",
-              n, i, hal::status_name(est.status),
+  std::printf("    step %3zu scan %5zu %-11s %-18s %s est (%.2f %.2f %.2f) ref (%.2f %.2f %.2f) err %.2f m %.1f deg  hyp %u cl %u r %.2f PL %.2f m %.1f deg %.1f ms\n",
+              n, i, hal::status_name(est.status), hal::reason_name(est.reason),
               est.mode == hal::LocalizationMode::kTracking ? "T" : "G", est.x, est.y, est.theta, st.truth.x,
               st.truth.y, st.truth.theta, st.err_m, st.err_rad * 57.2958, est.hypothesis_count, est.cluster_count,
               est.rating, est.protection_xy_m, est.protection_theta_rad * 57.2958, st.step_ms);

@@ -132,6 +132,7 @@ static int run_main(int argc, char** argv) {
     else if (a == "--keep-support") lp.keep_support_across_empty_steps = true;
     else if (a == "--no-keep-support") lp.keep_support_across_empty_steps = false;
     else if (a == "--keep-contested") lp.keep_support_across_contested_steps = true;
+    else if (a == "--no-keep-contested") lp.keep_support_across_contested_steps = false;
     else if (a == "--global") {
       const std::string m = str();
       if (m == "ref") sim::mmleval::set_eval_global_mode(sim::mmleval::EvalGlobalMode::kReference);

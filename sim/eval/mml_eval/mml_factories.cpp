@@ -40,23 +40,27 @@ bool parse_int(const std::map<std::string, std::string>& o, const std::string& k
 
 // correct=0|1 / reduce=0|1: local map correction (Eq. 5.23–5.27) / reduction (Eq. 5.28–5.30);
 // pool=0|1: best-cluster support pooled over consistent steps (interpretation.cpp); keep=0|1: the
-// pool and streak kept across steps without hypotheses; rivals=0|1:
+// pool and streak kept across steps without hypotheses; contested=0|1: the pool kept across
+// consistent steps with a rival cluster; rivals=0|1:
 // the rival memory (rival_memory.h; 0 only to measure what it does).
 bool apply_local_map_options(const std::map<std::string, std::string>& o, const std::string& who,
                              fw::mml::MmlLocalizerConfig* cfg, std::string* err) {
   long correct = cfg->mml.correct_local_map ? 1 : 0, reduce = cfg->mml.reduce_observations ? 1 : 0;
   long pool = cfg->mml.pool_cluster_support ? 1 : 0, rivals = cfg->mml.rival_memory ? 1 : 0;
   long keep = cfg->mml.keep_support_across_empty_steps ? 1 : 0;
+  long contested = cfg->mml.keep_support_across_contested_steps ? 1 : 0;
   if (!parse_int(o, "correct", 0, 1, &correct, who, err)) return false;
   if (!parse_int(o, "rivals", 0, 1, &rivals, who, err)) return false;
   if (!parse_int(o, "reduce", 0, 1, &reduce, who, err)) return false;
   if (!parse_int(o, "pool", 0, 1, &pool, who, err)) return false;
   if (!parse_int(o, "keep", 0, 1, &keep, who, err)) return false;
+  if (!parse_int(o, "contested", 0, 1, &contested, who, err)) return false;
   cfg->mml.correct_local_map = correct != 0;
   cfg->mml.reduce_observations = reduce != 0;
   cfg->mml.pool_cluster_support = pool != 0;  // MmlOptions::pool_cluster_support (on in mml-track)
   cfg->mml.rival_memory = rivals != 0;
   cfg->mml.keep_support_across_empty_steps = keep != 0;  // MmlOptions::keep_support_across_empty_steps (on in mml-track)
+  cfg->mml.keep_support_across_contested_steps = contested != 0;  // ..._contested_steps (on in mml-track)
   return true;
 }
 
@@ -71,7 +75,7 @@ std::unique_ptr<fw::Localizer> wrap_hooks(std::unique_ptr<OwnedLocalizer> o, con
 }  // namespace
 
 std::unique_ptr<fw::Localizer> make_mml_localizer(const LocalizerContext& ctx, std::string* err) {
-  const std::string bad = check_keys("mml", ctx.options, {"config", "iterations", "correct", "reduce", "pool", "keep", "rivals"});
+  const std::string bad = check_keys("mml", ctx.options, {"config", "iterations", "correct", "reduce", "pool", "keep", "contested", "rivals"});
   if (!bad.empty()) { *err = bad; return nullptr; }
   if (ctx.global_map == nullptr) { *err = "localizer mml: needs a global map"; return nullptr; }
   long config = 3, iters = 0;
@@ -111,7 +115,7 @@ std::unique_ptr<fw::Localizer> make_mcl_localizer(const LocalizerContext& ctx, s
 }
 
 std::unique_ptr<fw::Localizer> make_handoff_localizer(const LocalizerContext& ctx, std::string* err) {
-  const std::string bad = check_keys("handoff", ctx.options, {"config", "correct", "reduce", "pool", "keep", "rivals"});
+  const std::string bad = check_keys("handoff", ctx.options, {"config", "correct", "reduce", "pool", "keep", "contested", "rivals"});
   if (!bad.empty()) { *err = bad; return nullptr; }
   if (ctx.global_map == nullptr) { *err = "localizer handoff: needs a global map"; return nullptr; }
   long config = 3;
@@ -130,9 +134,9 @@ std::unique_ptr<fw::Localizer> make_handoff_localizer(const LocalizerContext& ct
 namespace sim::mmleval {
 
 // The product's system (firmware default): MML fix confirmed and tracked with a protection level.
-// Options: config=1..4, correct=0|1, reduce=0|1, pool=0|1, rivals=0|1 (MML part); alert=M (alert limit, metres).
+// Options: config=1..4, correct=0|1, reduce=0|1, pool=0|1, keep=0|1, contested=0|1, rivals=0|1 (MML part); alert=M (alert limit, metres).
 std::unique_ptr<fw::Localizer> make_track_localizer(const LocalizerContext& ctx, std::string* err) {
-  const std::string bad = check_keys("mml-track", ctx.options, {"config", "correct", "reduce", "pool", "keep", "rivals", "alert"});
+  const std::string bad = check_keys("mml-track", ctx.options, {"config", "correct", "reduce", "pool", "keep", "contested", "rivals", "alert"});
   if (!bad.empty()) { *err = bad; return nullptr; }
   if (ctx.global_map == nullptr) { *err = "localizer mml-track: needs a global map"; return nullptr; }
   long config = 3;
