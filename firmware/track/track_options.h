@@ -139,8 +139,8 @@ struct TrackOptions {
   // asks for MML's confirmation like a large fault: the track may already follow the wrong one of
   // two look-alikes, and no local test can tell (intel kidnap 6735 → 7812: `localized` 10.8 m off
   // four scans after such an alias whenever MML's background search lost the race). It costs
-  // availability where look-alikes are common and MML needs metres to isolate (README: large office
-  // 0.78 → 0.65, mit-killian 0.88 → 0.72 with MML's faster isolation). false = the old race.
+  // availability where look-alikes are common and MML needs long to isolate again (README: large
+  // office 0.78 → 0.19, mit-killian 0.88 → 0.72). false = the old race.
   bool confirm_alias_beyond_alert = true;
   // Protection level (protection_level.h): integrity risk per `localized` step and alert limits.
   float integrity_risk = 1e-3f;
