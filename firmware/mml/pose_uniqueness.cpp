@@ -27,6 +27,24 @@ float truncated_scan_cost(const GlobalMap& map, const Point2f* points, std::size
   return static_cast<float>(sum / static_cast<double>(n));
 }
 
+bool in_same_cost_valley(const GlobalMap& map, const Point2f* points, std::size_t n, const Se2f& pose,
+                         const Se2f& rival, float clip_m, float step_m, float margin) {
+  const float cost_pose = truncated_scan_cost(map, points, n, pose, clip_m);
+  const float cost_rival = truncated_scan_cost(map, points, n, rival, clip_m);
+  if (std::fabs(cost_pose - cost_rival) > margin) return false;  // one end fits worse: not one valley
+  const float ceiling = std::fmax(cost_pose, cost_rival) + margin;
+  const float dx = rival.x - pose.x, dy = rival.y - pose.y, dth = wrap_angle(rival.theta - pose.theta);
+  const float d = std::hypot(dx, dy);
+  // At most 1000 samples (75 m at the default step): the rivals of the alias check lie within 3 m.
+  const int samples = step_m > 0.0f ? static_cast<int>(std::fmin(std::ceil(d / step_m), 1000.0f)) : 1;
+  for (int k = 1; k < samples; ++k) {
+    const float f = static_cast<float>(k) / static_cast<float>(samples);
+    const Se2f on_path(pose.x + f * dx, pose.y + f * dy, wrap_angle(pose.theta + f * dth));
+    if (truncated_scan_cost(map, points, n, on_path, clip_m) > ceiling) return false;
+  }
+  return true;
+}
+
 namespace {
 
 // Principal axes of the translational information Σ ∇D ∇Dᵀ of the inliers at `pose` (columns,

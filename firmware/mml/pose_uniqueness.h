@@ -43,6 +43,15 @@ struct UniquenessResult {
 // count as outliers. Never allocates.
 float truncated_scan_cost(const GlobalMap& map, const Point2f* points, std::size_t n, const Se2f& pose, float clip_m);
 
+// Whether `rival` lies in the same valley of the truncated cost as `pose`: both fit alike (costs
+// within `margin`) and on the straight path between them (position and heading interpolated, samples at most step_m apart in position) no pose
+// fits worse than the worse of the two ends by more than `margin`. A rival reached along such a path
+// is the scan's own indeterminacy along its weak axis (a corridor whose walls fit wherever the robot
+// stands along it): one mode with `pose`. One behind a barrier (a pillar, a door frame that only one
+// of them explains) is a separate look-alike. Never allocates.
+bool in_same_cost_valley(const GlobalMap& map, const Point2f* points, std::size_t n, const Se2f& pose,
+                         const Se2f& rival, float clip_m, float step_m, float margin);
+
 UniquenessResult check_pose_uniqueness(const GlobalMap& map, const Point2f* points, std::size_t n, const Se2f& pose,
                                        const UniquenessOptions& options);
 

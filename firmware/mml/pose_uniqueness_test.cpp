@@ -110,6 +110,38 @@ TEST(PoseUniquenessTest, PeriodicCorridorIsNotUnique) {
   }
 }
 
+// The periodic corridor's rival one period away is a separate look-alike: between the two, the
+// pillars fit nowhere (a barrier). Along a corridor without pillars the walls fit all the way: one
+// valley. In the unique room a pose 1 m off is neither (its cost is far above the true pose's).
+TEST(PoseUniquenessTest, SameCostValleyOnlyAlongAFeaturelessAxis) {
+  static GridWorld periodic = periodic_corridor();
+  static testing::OwnedGlobalMap pm(periodic);
+  static GridWorld plain;
+  plain.w = 800; plain.h = 60;
+  plain.occ.assign(plain.w * plain.h, 0);
+  plain.box(0.5f, 0.5f, 39.5f, 2.5f);
+  plain.finish();
+  static testing::OwnedGlobalMap fm(plain);
+  static GridWorld room = mcl::testing::unique_room();
+  static testing::OwnedGlobalMap rm(room);
+  static Point2f pts[1081];
+  const Se2f at(18.1f, 1.5f, 0.0f);
+  std::size_t n = scan_points_at(periodic, at, pts);
+  const UniquenessResult r = check_pose_uniqueness(pm.map, pts, n, at, UniquenessOptions());
+  ASSERT_FALSE(r.unique);
+  EXPECT_FALSE(in_same_cost_valley(pm.map, pts, n, at, r.rival, 0.15f, 0.075f, 0.01f));
+  EXPECT_TRUE(in_same_cost_valley(pm.map, pts, n, at, Se2f(at.x + 0.05f, at.y, at.theta), 0.15f, 0.075f, 0.01f))
+      << "a neighbour closer than one sample is its own valley";
+  n = scan_points_at(plain, at, pts);  // 8 m laser: the ends of the 39 m corridor are out of range
+  EXPECT_TRUE(in_same_cost_valley(fm.map, pts, n, at, Se2f(at.x + 2.5f, at.y, at.theta), 0.15f, 0.075f, 0.01f));
+  EXPECT_TRUE(in_same_cost_valley(fm.map, pts, n, at, Se2f(at.x - 2.5f, at.y, at.theta), 0.15f, 0.075f, 0.01f));
+  EXPECT_FALSE(in_same_cost_valley(fm.map, pts, n, at, Se2f(at.x + 2.5f, at.y + 0.5f, at.theta), 0.15f, 0.075f, 0.01f))
+      << "across the corridor the walls do not fit";
+  const Se2f room_pose(4.0f, 3.0f, 0.3f);
+  n = scan_points_at(room, room_pose, pts);
+  EXPECT_FALSE(in_same_cost_valley(rm.map, pts, n, room_pose, Se2f(5.0f, 3.0f, 0.3f), 0.15f, 0.075f, 0.01f));
+}
+
 TEST(PoseUniquenessTest, EmptyInputIsHandled) {
   static GridWorld g = mcl::testing::unique_room();
   static testing::OwnedGlobalMap gm(g);

@@ -70,6 +70,10 @@ struct TrackStep {
   float innovation_chi2 = 0.0f;
   float odometry_chi2 = 0.0f;   // odometry consistency over the window (0 = not tested)
   float alias_cost = 0.0f, alias_rival_cost = 1.0f;  // alias check (1 = not run)
+  Se2f alias_rival;               // the alias check's best rival (when alias_rival_cost < 1)
+  // The rival of an ambiguous scan is a place the robot could be: turned, or at the fix's heading
+  // inside the prediction's protection level and behind a barrier (not in the fix's cost valley).
+  bool alias_rival_credible = false;
   std::uint32_t search_candidates = 0;  // correlative pre-search (0 = not run: prediction tight)
   bool search_moved = false;            // the alignment started from the search's best pose
   ScanAlignment alignment;
@@ -143,6 +147,9 @@ class PoseTracker {
   std::uint32_t unsupported_ = 0, faulty_ = 0, outside_ = 0;
   std::uint32_t consistent_since_fault_ = 0;  // consistent scans since the last contradicting one
   bool had_fault_ = false;
+  // A contradicting scan since the last recovery_steps unique consistent scans (ambiguous scans do
+  // not count either way): the track may be wrong, so no alias rival is ruled out (check_aliases).
+  bool contradicted_ = false;
   TrackStep last_;
 };
 
