@@ -140,16 +140,19 @@ struct TrackOptions {
   // two look-alikes, and no local test can tell (intel kidnap 6735 → 7812: `localized` 10.8 m off
   // four scans after such an alias whenever MML's background search lost the race). It costs
   // availability where look-alikes are common and MML needs long to isolate again (README: large
-  // office 0.78 → 0.19, mit-killian 0.88 → 0.72). false = the old race.
+  // office 0.78 → 0.19, mit-killian 0.88 → 0.72 before the rule below; 0.57 and 0.88 with it).
+  // false = the old race.
   bool confirm_alias_beyond_alert = true;
   // ... and only when the rival is a place the robot could be (TrackStep::alias_rival_credible): a
   // rival at the fix's heading in the fix's own cost valley (a featureless corridor: one mode, its
   // axis left to the odometry) or outside the prediction's protection level (beyond where a track
   // that was right at the last scan reaches, the bound the innovation test trusts) is not. The large
   // office waited for MML after nearly every alias of its 80 m corridors: rivals 0.5–2.8 m along
-  // the axis, the prediction's σ 6–14 cm. The scan is still `ambiguous` and `recovery_steps` unique
-  // scans are still needed. Turned rivals always count (intel kidnap: rivals 5–10° turned).
-  // false = every alias beyond the alert limits waits.
+  // the axis, the prediction's σ 6–14 cm. Both exemptions assume a track that was right, so they
+  // hold only while no scan has contradicted it since the last `recovery_steps` unique scans
+  // (pose_tracker.cpp, check_aliases: a kidnap along a mit-killian corridor seen as a heading fault).
+  // The scan is still `ambiguous` and `recovery_steps` unique scans are still needed. Turned rivals
+  // always count (intel kidnap: rivals 5–10° turned). false = every alias beyond the alert limits waits.
   bool alias_rival_must_be_credible = true;
   // Protection level (protection_level.h): integrity risk per `localized` step and alert limits.
   float integrity_risk = 1e-3f;

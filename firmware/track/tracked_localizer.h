@@ -16,7 +16,8 @@
 // local and cannot see that a look-alike 35 m away fits as well as the place it came from. With
 // TrackOptions::confirm_alias_beyond_alert (on by default; its cost in availability is measured
 // there) an alias whose equally good rival lies beyond the alert limits is treated the same way, once
-// per episode: the track may already follow the wrong one of two look-alikes.
+// per episode: the track may already follow the wrong one of two look-alikes — when that rival is a
+// place the robot could be (TrackOptions::alias_rival_must_be_credible).
 // PoseEstimate.mode says which one is active; protection_xy_m / protection_theta_rad are set on
 // every `localized` pose. Never allocates in step(); both parts live in static storage.
 #pragma once
