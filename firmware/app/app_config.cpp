@@ -64,7 +64,7 @@ bool parse_baud(const char* v, unsigned long* out) {
 constexpr const char* kKeys[] = {"laser",     "odometry",  "output",  "can_fd",           "localizer",
                                  "mml_preset", "map",       "workers", "cores",            "realtime",
                                  "arena_mib", "step_deadline_ms", "health_period_ms", "laser_timeout_ms", "seed",
-                                 "log_level", "global_context", "global_period_scans"};
+                                 "log_level", "global_context", "global_period_scans", "odom_noise"};
 constexpr int kNumKeys = static_cast<int>(sizeof(kKeys) / sizeof(kKeys[0]));
 
 // The config path as shown in messages: at most kShownPath characters, the end kept (the file
@@ -107,6 +107,27 @@ Status check_backend_arg(const char* name, int line, const char* key, const char
       unsigned long baud = 0;
       if (!parse_baud(at + 1, &baud)) return CFG_ERR("baud '%s' is not one of %s", at + 1, kBaudList);
     }
+  }
+  return Status::ok();
+}
+
+// "TT, TR, RR, RT": the tracker's odometry noise model (track_options.h), four numbers in 0..10.
+Status parse_odom_noise(const char* name, int line, const char* key, char* v, float out[4]) {
+  int commas = 0;
+  for (const char* c = v; *c; ++c) commas += *c == ',';
+  if (commas != 3) return CFG_ERR("'%s' is not four numbers TT, TR, RR, RT", v);
+  char* tok = v;
+  for (int i = 0; i < 4; ++i) {
+    char* comma = std::strchr(tok, ',');
+    if (comma != nullptr) *comma = '\0';
+    char* pe = nullptr;
+    const double d = std::strtod(tok, &pe);
+    while (pe != nullptr && (*pe == ' ' || *pe == '\t')) ++pe;
+    if (pe == tok || *pe || !std::isfinite(d) || d < 0.0 || d > 10.0) {
+      return CFG_ERR("number %d '%s' is not in 0..10 (TT, TR, RR, RT)", i + 1, tok);
+    }
+    out[i] = static_cast<float>(d);
+    tok = comma != nullptr ? comma + 1 : nullptr;
   }
   return Status::ok();
 }
@@ -237,6 +258,8 @@ Status parse_app_config(const char* path, const char* text, std::size_t len, App
     } else if (!std::strcmp(key, "seed")) {
       if (!parse_int(v, 0, 0x7FFFFFFF, &x)) return CFG_ERR("'%s' is not a non-negative integer", v);
       out->seed = static_cast<std::uint64_t>(x);
+    } else if (!std::strcmp(key, "odom_noise")) {
+      FW_RETURN_IF_ERROR(parse_odom_noise(name, line, key, v, out->odom_noise));
     } else if (!std::strcmp(key, "log_level")) {
       static const char* const kLevels[] = {"debug", "info", "warning", "error"};
       int lvl = -1;

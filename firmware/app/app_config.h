@@ -58,6 +58,11 @@ struct AppConfig {
   std::uint32_t laser_timeout_ms = 500;
   std::uint64_t seed = 1;
   int log_level = 1;         // hal::LogLevel
+  // The tracker's odometry noise model (TrackOptions::odom_trans_per_m, _trans_per_rad, _rot_per_rad,
+  // _rot_per_m; AMCL's α, same defaults): σ_trans = TT·|Δs| + TR·|Δθ|, σ_rot = RR·|Δθ| + RT·|Δs|
+  // per scan interval. Set it from your robot: a model tighter than the wheels makes right tracks
+  // fail the innovation and odometry-consistency tests (availability).
+  float odom_noise[4] = {0.2f, 0.2f, 0.2f, 0.2f};
 };
 
 // Parses `text` (len bytes); `path` is used in messages (abbreviated to its last 96 characters).

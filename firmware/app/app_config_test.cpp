@@ -153,6 +153,36 @@ TEST(AppConfig, LaserTimeoutKey) {
   EXPECT_NE(std::strstr(s.message(), "line 3: key 'laser_timeout_ms'"), nullptr) << s.message();
 }
 
+// odom_noise: the tracker's odometry noise model, AMCL's four α (defaults 0.2); malformed values name
+// the line, the key and which of the four numbers is wrong.
+TEST(AppConfig, OdomNoiseKey) {
+  AppConfig c;
+  ASSERT_TRUE(parse("laser = socketcan:vcan0\nlocalizer = odom\n", &c).is_ok());
+  for (const float a : c.odom_noise) EXPECT_FLOAT_EQ(a, 0.2f);
+  ASSERT_TRUE(parse("laser = socketcan:vcan0\nlocalizer = odom\nodom_noise = 0.1, 0.05,0.3 , 0.25\n", &c).is_ok());
+  EXPECT_FLOAT_EQ(c.odom_noise[0], 0.1f);
+  EXPECT_FLOAT_EQ(c.odom_noise[1], 0.05f);
+  EXPECT_FLOAT_EQ(c.odom_noise[2], 0.3f);
+  EXPECT_FLOAT_EQ(c.odom_noise[3], 0.25f);
+  struct Case {
+    const char* value;
+    const char* must_contain;
+  } cases[] = {
+      {"0.1, 0.2, 0.3", "line 3: key 'odom_noise': '0.1, 0.2, 0.3' is not four numbers"},
+      {"0.1,0.2,0.3,0.4,0.5", "is not four numbers"},
+      {"0.1,x,0.3,0.4", "number 2 'x' is not in 0..10"},
+      {"-1,0,0,0", "number 1 '-1' is not in 0..10"},
+      {"0.1,0.2,0.3,11", "number 4 '11' is not in 0..10"},
+      {"0.1,0.2,0.3,nan", "number 4 'nan'"},
+  };
+  for (const Case& k : cases) {
+    const std::string text = std::string("laser = socketcan:vcan0\nlocalizer = odom\nodom_noise = ") + k.value + "\n";
+    const Status s = parse(text, &c);
+    ASSERT_FALSE(s.is_ok()) << k.value;
+    EXPECT_NE(std::strstr(s.message(), k.must_contain), nullptr) << s.message();
+  }
+}
+
 // global_context (issue 14): thread by default, inline selectable, anything else named.
 TEST(AppConfig, GlobalContextKey) {
   AppConfig c;

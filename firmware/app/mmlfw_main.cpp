@@ -122,6 +122,7 @@ struct Startup {
   bool global_thread = false;
   fw::track::GlobalScheduleOptions live;
   fw::ExecutionContext global_ctx;
+  fw::track::TrackOptions track;  // the shipped options but the config's odometry noise model
 };
 Startup g_startup;  // static storage, as every big object (the map image handle, the map view)
 
@@ -239,6 +240,11 @@ int build_localizer(const Args& a, Startup* su) {
   sys.localizer = c.localizer;
   sys.mml_preset = c.mml_preset;
   sys.seed = c.seed;
+  su->track.odom_trans_per_m = c.odom_noise[0];
+  su->track.odom_trans_per_rad = c.odom_noise[1];
+  su->track.odom_rot_per_rad = c.odom_noise[2];
+  su->track.odom_rot_per_m = c.odom_noise[3];
+  sys.track = &su->track;
   su->live = fw::track::live_global_schedule(c.global_period_scans);
   su->global_ctx = fw::track::global_context_for(c.global_period_scans);
   su->global_thread = c.global_threaded && !std::strcmp(c.localizer, "mml-track") && !a.memory_report;

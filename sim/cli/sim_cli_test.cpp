@@ -226,6 +226,11 @@ TEST(SimRunner, BadInputsAreClearErrors) {
   EXPECT_FALSE(run_simulation(cfg, &r, &err));
   EXPECT_NE(err.find("anchor='moon'"), std::string::npos) << err;
   cfg = small_run("", 1);
+  cfg.localizer = "mml-track";
+  cfg.localizer_options["odom_noise"] = "0.2,0.2";
+  EXPECT_FALSE(run_simulation(cfg, &r, &err));
+  EXPECT_NE(err.find("odom_noise='0.2,0.2' (expected four numbers TT,TR,RR,RT in 0..10)"), std::string::npos) << err;
+  cfg = small_run("", 1);
   cfg.world = "atlantis";
   EXPECT_FALSE(run_simulation(cfg, &r, &err));
   EXPECT_NE(err.find("atlantis"), std::string::npos);

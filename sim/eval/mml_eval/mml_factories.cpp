@@ -133,10 +133,36 @@ std::unique_ptr<fw::Localizer> make_handoff_localizer(const LocalizerContext& ct
 
 namespace sim::mmleval {
 
+// odom_noise=TT,TR,RR,RT → the tracker's odometry noise model (four numbers in 0..10).
+static bool parse_odom_noise(const std::map<std::string, std::string>& options, fw::track::TrackOptions* to,
+                             std::string* err) {
+  const auto it = options.find("odom_noise");
+  if (it == options.end()) return true;
+  float v[4];
+  const char* p = it->second.c_str();
+  for (int i = 0; i < 4; ++i) {
+    char* end = nullptr;
+    const double d = std::strtod(p, &end);
+    const char want = i < 3 ? ',' : '\0';
+    if (end == p || *end != want || !(d >= 0.0 && d <= 10.0)) {
+      *err = "localizer mml-track: option odom_noise='" + it->second + "' (expected four numbers TT,TR,RR,RT in 0..10)";
+      return false;
+    }
+    v[i] = static_cast<float>(d);
+    p = end + 1;
+  }
+  to->odom_trans_per_m = v[0];
+  to->odom_trans_per_rad = v[1];
+  to->odom_rot_per_rad = v[2];
+  to->odom_rot_per_m = v[3];
+  return true;
+}
+
 // The product's system (firmware default): MML fix confirmed and tracked with a protection level.
-// Options: config=1..4, correct=0|1, reduce=0|1, pool=0|1, keep=0|1, contested=0|1, rivals=0|1 (MML part); alert=M (alert limit, metres).
+// Options: config=1..4, correct=0|1, reduce=0|1, pool=0|1, keep=0|1, contested=0|1, rivals=0|1 (MML part); alert=M (alert limit, metres);
+// odom_noise=TT,TR,RR,RT (the tracker's odometry noise model, as mmlfw's config key odom_noise).
 std::unique_ptr<fw::Localizer> make_track_localizer(const LocalizerContext& ctx, std::string* err) {
-  const std::string bad = check_keys("mml-track", ctx.options, {"config", "correct", "reduce", "pool", "keep", "contested", "rivals", "alert"});
+  const std::string bad = check_keys("mml-track", ctx.options, {"config", "correct", "reduce", "pool", "keep", "contested", "rivals", "alert", "odom_noise"});
   if (!bad.empty()) { *err = bad; return nullptr; }
   if (ctx.global_map == nullptr) { *err = "localizer mml-track: needs a global map"; return nullptr; }
   long config = 3;
@@ -155,6 +181,7 @@ std::unique_ptr<fw::Localizer> make_track_localizer(const LocalizerContext& ctx,
     to.alert_limit_m = static_cast<float>(v);
     if (to.lost_limit_m < to.alert_limit_m) to.lost_limit_m = to.alert_limit_m;
   }
+  if (!parse_odom_noise(ctx.options, &to, err)) return nullptr;
   static const std::vector<std::uint8_t> kEmpty;
   return wrap_hooks(OwnedLocalizer::make_track(*ctx.global_map, ctx.map_image ? *ctx.map_image : kEmpty, cfg, to,
                                                ctx.threads, err),
