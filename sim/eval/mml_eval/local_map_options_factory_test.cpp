@@ -86,4 +86,32 @@ TEST(LocalMapOptionsFactory, BadValuesAreRefused) {
   EXPECT_NE(err.find("correct, reduce"), std::string::npos) << err;
 }
 
+// odom_noise (mml-sim --opt, mml-eval --odom-noise, mmlfw's config key): the four numbers reach the
+// tracker of mml-track; malformed values are refused naming the option.
+TEST(LocalMapOptionsFactory, OdomNoiseReachesTheTracker) {
+  SmallOffice so;
+  ASSERT_TRUE(so.load()) << so.err;
+  sim::LocalizerContext ctx;
+  ctx.global_map = &so.map;
+  ctx.map_image = &so.image;
+  ctx.options = {{"odom_noise", "0.1,0.05,0.3,0.25"}};
+  std::string err;
+  auto loc = sim::mmleval::make_track_localizer(ctx, &err);
+  ASSERT_NE(loc, nullptr) << err;
+  const fw::track::TrackOptions& o =
+      static_cast<sim::mmleval::OwnedLocalizer*>(loc.get())->tracked()->tracker().options();
+  EXPECT_FLOAT_EQ(o.odom_trans_per_m, 0.1f);
+  EXPECT_FLOAT_EQ(o.odom_trans_per_rad, 0.05f);
+  EXPECT_FLOAT_EQ(o.odom_rot_per_rad, 0.3f);
+  EXPECT_FLOAT_EQ(o.odom_rot_per_m, 0.25f);
+  for (const char* bad : {"0.1,0.2,0.3", "0.1,0.2,0.3,0.4,", "a,b,c,d", "0.1,0.2,0.3,-1", "0.1,0.2,0.3,10.5"}) {
+    ctx.options = {{"odom_noise", bad}};
+    EXPECT_EQ(sim::mmleval::make_track_localizer(ctx, &err), nullptr) << bad;
+    EXPECT_NE(err.find(std::string("odom_noise='") + bad + "'"), std::string::npos) << err;
+    fw::track::TrackOptions untouched;
+    EXPECT_FALSE(sim::mmleval::set_odom_noise(bad, &untouched)) << bad;
+    EXPECT_FLOAT_EQ(untouched.odom_rot_per_m, 0.2f) << bad;
+  }
+}
+
 }  // namespace

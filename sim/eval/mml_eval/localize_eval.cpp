@@ -331,7 +331,7 @@ bool evaluate_dataset(LocalizeRun& run, const std::string& name, const DatasetFi
   json->add_int(ds.key + "_ref_excluded_scans", static_cast<long long>(ds.ref_excluded_scans));
   const MetricBounds b = bounds_for(ds);
   std::string e;
-  auto loc = OwnedLocalizer::make_track(ds.map, ds.image, run.mml_cfg, fw::track::TrackOptions(), plan.threads, &e);
+  auto loc = OwnedLocalizer::make_track(ds.map, ds.image, run.mml_cfg, plan.track, plan.threads, &e);
   if (!loc) return (*err = ds.name + ": mml-track: " + e, false);
 
   std::vector<TrialResult> all;  // every mml-track trial on this dataset (whole + fix)
@@ -374,7 +374,7 @@ bool run_unknown_area(LocalizeRun& run, std::string* err) {
   if (!prepare_unknown_area(plan.unknown_dataset, plan.seed, plan.unknown_trials, &ds, region, &starts, err))
     return false;
   std::string e;
-  auto loc = OwnedLocalizer::make_track(ds.map, ds.image, run.mml_cfg, fw::track::TrackOptions(), plan.threads, &e);
+  auto loc = OwnedLocalizer::make_track(ds.map, ds.image, run.mml_cfg, plan.track, plan.threads, &e);
   if (!loc) return (*err = "unknown area: mml-track: " + e, false);
   TrialOptions uo = plan.step_rule;
   uo.max_steps = plan.unknown_steps;

@@ -9,12 +9,14 @@
 #include <string>
 #include <vector>
 
+#include "firmware/track/track_options.h"
 #include "sim/common/bench_json.h"
 #include "sim/eval/mml_eval/mml_eval.h"
 
 namespace sim::mmleval {
 
 struct LocalizePlan {
+  fw::track::TrackOptions track;  // the shipped options; --odom-noise sets the odometry noise model
   std::vector<std::string> datasets = {"intel", "fr079", "aces", "fr-clinic", "mit-killian", "fr101", "fr-campus"};
   std::vector<DatasetFiles> custom;  // buildings given by path (evaluated after `datasets`)
   std::uint64_t seed = 1;

@@ -49,7 +49,7 @@ const char kUsage[] =
     "       mml-eval --localize [--datasets intel,fr101] [--whole-runs 3] [--steps 0] [--fix-trials 10]\n"
     "                [--fix-steps 200] [--mcl-trials 3] [--mcl-datasets intel,fr079] [--kidnap-runs 2]\n"
     "                [--kidnap-datasets intel,fr079,aces] [--no-unknown] [--seed 1] [--threads 2] [--out DIR]\n"
-    "                [--no-pool] [--global ref|live|live-deadline]\n"
+    "                [--no-pool] [--global ref|live|live-deadline] [--odom-noise TT,TR,RR,RT]\n"
     "       mml-eval --log LOG.clf[.gz] --map MAP.yaml|MAP.mmap --reference POSES.txt|CORRECTED.log[.gz]\n"
     "                [--relations R] [--name NAME] [--synthetic-odometry]   (any building by path)\n"
     "Datasets (--datasets, --mcl-datasets, --kidnap-datasets): intel, fr079, aces, mit-killian, fr-clinic,\n"
@@ -58,7 +58,8 @@ const char kUsage[] =
     "(default 0 = to the end of the log). --threads: worker threads (default 2, as mml-sim).\n"
     "Your own building: --log RAW.clf --map MAP.yaml or MAP.mmap (a compiled image: its relation table is\n"
     "used) --reference REF (REF: 'mml-carmen reference' rows or a CARMEN log with one pose per scan of\n"
-    "RAW). Definitions of every figure: sim/eval/mml_eval/README.md.\n";
+    "RAW). --odom-noise: the tracker's odometry noise model (mmlfw's config key odom_noise; default\n"
+    "0.2,0.2,0.2,0.2). Definitions of every figure: sim/eval/mml_eval/README.md.\n";
 int usage(const char* msg) {
   std::fprintf(stderr, "mml-eval: %s\n%s", msg, kUsage);
   return 2;
@@ -133,6 +134,13 @@ static int run_main(int argc, char** argv) {
     else if (a == "--no-keep-support") lp.keep_support_across_empty_steps = false;
     else if (a == "--keep-contested") lp.keep_support_across_contested_steps = true;
     else if (a == "--no-keep-contested") lp.keep_support_across_contested_steps = false;
+    else if (a == "--odom-noise") {
+      const std::string v = str();
+      if (!sim::mmleval::set_odom_noise(v, &lp.track)) {
+        return usage(("--odom-noise: '" + v + "' is not four numbers TT,TR,RR,RT in 0..10").c_str());
+      }
+      localize = true;
+    }
     else if (a == "--global") {
       const std::string m = str();
       if (m == "ref") sim::mmleval::set_eval_global_mode(sim::mmleval::EvalGlobalMode::kReference);

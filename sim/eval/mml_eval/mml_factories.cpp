@@ -133,21 +133,14 @@ std::unique_ptr<fw::Localizer> make_handoff_localizer(const LocalizerContext& ct
 
 namespace sim::mmleval {
 
-// odom_noise=TT,TR,RR,RT → the tracker's odometry noise model (four numbers in 0..10).
-static bool parse_odom_noise(const std::map<std::string, std::string>& options, fw::track::TrackOptions* to,
-                             std::string* err) {
-  const auto it = options.find("odom_noise");
-  if (it == options.end()) return true;
+bool set_odom_noise(const std::string& value, fw::track::TrackOptions* to) {
   float v[4];
-  const char* p = it->second.c_str();
+  const char* p = value.c_str();
   for (int i = 0; i < 4; ++i) {
     char* end = nullptr;
     const double d = std::strtod(p, &end);
     const char want = i < 3 ? ',' : '\0';
-    if (end == p || *end != want || !(d >= 0.0 && d <= 10.0)) {
-      *err = "localizer mml-track: option odom_noise='" + it->second + "' (expected four numbers TT,TR,RR,RT in 0..10)";
-      return false;
-    }
+    if (end == p || *end != want || !(d >= 0.0 && d <= 10.0)) return false;
     v[i] = static_cast<float>(d);
     p = end + 1;
   }
@@ -156,6 +149,15 @@ static bool parse_odom_noise(const std::map<std::string, std::string>& options, 
   to->odom_rot_per_rad = v[2];
   to->odom_rot_per_m = v[3];
   return true;
+}
+
+// odom_noise=TT,TR,RR,RT → the tracker's odometry noise model.
+static bool parse_odom_noise(const std::map<std::string, std::string>& options, fw::track::TrackOptions* to,
+                             std::string* err) {
+  const auto it = options.find("odom_noise");
+  if (it == options.end() || set_odom_noise(it->second, to)) return true;
+  *err = "localizer mml-track: option odom_noise='" + it->second + "' (expected four numbers TT,TR,RR,RT in 0..10)";
+  return false;
 }
 
 // The product's system (firmware default): MML fix confirmed and tracked with a protection level.

@@ -102,6 +102,9 @@ class OwnedLocalizer : public fw::Localizer {
 // model=beam|field, kld=0|1, inject=0|1; handoff: config=1..4, correct=0|1, reduce=0|1.
 std::unique_ptr<fw::Localizer> make_mml_localizer(const LocalizerContext& ctx, std::string* err);
 std::unique_ptr<fw::Localizer> make_track_localizer(const LocalizerContext& ctx, std::string* err);
+// "TT,TR,RR,RT" (each in 0..10) → the tracker's odometry noise model (as mmlfw's config key
+// odom_noise); false, `to` unchanged, when malformed.
+bool set_odom_noise(const std::string& value, fw::track::TrackOptions* to);
 std::unique_ptr<fw::Localizer> make_mcl_localizer(const LocalizerContext& ctx, std::string* err);
 std::unique_ptr<fw::Localizer> make_handoff_localizer(const LocalizerContext& ctx, std::string* err);
 
