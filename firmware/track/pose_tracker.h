@@ -58,6 +58,8 @@ struct TrackStep {
   // beyond them, the odometry disagreeing over the window): the robot may have been carried
   // anywhere, so local evidence alone can no longer make the pose `localized` (tracked_localizer.h).
   bool large_fault = false;
+  // The map explains fewer than TrackOptions::min_explained_fraction of the scan's end-points.
+  bool unexplained = false;
   // A fault in heading only, recovered by the track (TrackOptions::heading_fault_local_recovery).
   bool heading_fault = false;
   // The alias check found a rival that fits this scan as well as the fix and lies beyond the alert

@@ -220,6 +220,42 @@ TEST(PoseTrackerTest, UnmappedSpaceIsOutsideMap) {
   EXPECT_TRUE(lost);
 }
 
+// A scan the map explains less than half of — 40 % on walls, 45 % in unknown space, 15 % on free
+// cells — passes the outside-map test (unknown ≤ half) and the inlier test (73 % of the mapped
+// end-points fit) but is never `localized`: what a robot carried elsewhere sees (aces kidnap 1628 →
+// 2472). A large fault, so only MML's word makes the pose `localized` again.
+TEST(PoseTrackerTest, ScanTheMapCannotExplainIsALargeFault) {
+  RandomStream rng(21, 0);
+  const Se2f a(4.5f, 6.0f, -0.4f);
+  auto pts = testing::scan_at(room(), a, &rng);
+  ASSERT_GT(pts.size(), 100u);
+  for (std::size_t i = 0; i < pts.size(); ++i) {
+    const std::size_t k = i % 20;
+    if (k >= 8 && k < 17) pts[i] = Point2f(pts[i].x() + 100.0f, pts[i].y());  // off the map: unknown
+    if (k >= 17) pts[i] = Point2f(0.3f, 0.0f);                                 // free space ahead
+  }
+  for (const float min_explained : {0.5f, 0.0f}) {
+    PoseTracker t;
+    TrackOptions o;
+    o.min_explained_fraction = min_explained;
+    ASSERT_TRUE(t.init(o, room_map().map).is_ok());
+    t.start(a, small_cov(), Se2f());
+    const TrackStep s = t.step(pts.data(), pts.size(), Se2f(), false);
+    EXPECT_LE(s.alignment.unknown_fraction(), o.outside_map_fraction);
+    EXPECT_GE(s.alignment.inlier_fraction(), o.min_inlier_fraction);
+    EXPECT_LT(static_cast<float>(s.alignment.inliers), 0.5f * static_cast<float>(s.alignment.points));
+    if (min_explained > 0.0f) {
+      EXPECT_EQ(s.verdict, ScanVerdict::kContradicting);
+      EXPECT_TRUE(s.unexplained);
+      EXPECT_TRUE(s.large_fault);
+      EXPECT_NE(s.status, hal::LocalizationStatus::kLocalized);
+      EXPECT_EQ(s.reason, hal::StatusReason::kTrackFault);
+    } else {
+      EXPECT_EQ(s.status, hal::LocalizationStatus::kLocalized);  // the hole the test closes
+    }
+  }
+}
+
 // An odometry increment no robot can make between two scans cannot carry the pose.
 TEST(PoseTrackerTest, OdometryJumpContradicts) {
   PoseTracker t;
