@@ -44,7 +44,12 @@ struct CorrelativeSearchOptions {
   float angular_step_rad = 0.0175f;        // 1°
   float clip_m = 0.20f;                    // truncated score: ≥ the grid's worst offset at 10 m
   std::uint32_t max_points = 90;           // end-points scored per candidate (evenly subsampled)
-  std::uint32_t max_candidates = 20000;    // steps are coarsened until the window fits
+  // Steps are coarsened (×1.25 both) until the window fits. A budget of the sensor step: the search
+  // runs inside it, so candidates × max_points must fit the scan period with room for the rest of
+  // the step. Measured on the 2-core build VM: about 1 µs per candidate at 90 points (fr079 scan 1864:
+  // 14,553 candidates, 14.1 ms, a deadline miss at the former 20,000); 6000 keeps the search under
+  // 6 ms of the 13.3 ms period. A slower onboard computer needs a smaller cap (scripts/bench.sh realtime).
+  std::uint32_t max_candidates = 6000;
   // The searched alignment replaces the one from the prediction only when its mean truncated score
   // is higher by this much (a few end-points more on the walls, not quantisation noise).
   float min_score_gain = 0.02f;
