@@ -456,6 +456,37 @@ TEST(PoseTrackerTest, AliasDoubtNeedsARivalThePredictionCanReach) {
   }
 }
 
+// A rival that fits better than the fix is a place the robot could be even beyond the prediction's
+// protection level: the bound says where a track that was right can be, not where a carried robot
+// is (mit-killian kidnap 3908 → 3827). The robot stands at 15.1 m of the pillar corridor beside its
+// one cabinet; the track believes it is one pillar period on, at 17.1 m, where the scan's cabinet
+// falls on free space. The rival at 15.1 m explains it; the contradiction test is switched off
+// (alias_z) so that only the credibility rule decides.
+TEST(PoseTrackerTest, RivalThatFitsBetterIsCredibleBeyondThePrediction) {
+  GridWorld world = pillar_corridor(false);
+  world.box(15.6f, 2.3f, 16.4f, 2.95f);  // a cabinet beside the robot, the corridor's only one
+  world.finish();
+  const OwnedGlobalMap map(world);
+  const Se2f truth(15.1f, 2.0f, 0.0f), believed(17.1f, 2.0f, 0.0f);
+  for (const float credible_z : {1.645f, 100.0f}) {
+    PoseTracker t;
+    TrackOptions o;
+    o.alias_z = 100.0f;
+    o.alias_credible_z = credible_z;
+    ASSERT_TRUE(t.init(o, map.map).is_ok());
+    RandomStream rng(37, 0);
+    t.start(believed, small_cov(), Se2f());
+    const auto pts = testing::scan_at(world, truth, &rng, 0.01f, 4.0f);
+    const TrackStep s = t.step(pts.data(), pts.size(), Se2f(), /*predict=*/false);
+    ASSERT_EQ(s.verdict, ScanVerdict::kAmbiguous) << credible_z;
+    EXPECT_NE(s.status, hal::LocalizationStatus::kLocalized);
+    EXPECT_NEAR(s.alias_rival.x, truth.x, 0.2f);
+    EXPECT_LT(s.alias_rival_cost, s.alias_cost - o.alias_margin) << "the rival fits better";
+    EXPECT_EQ(s.alias_rival_credible, credible_z < 10.0f) << credible_z;
+    EXPECT_EQ(s.alias_beyond_alert, credible_z < 10.0f) << credible_z;
+  }
+}
+
 // A corridor without pillars: the walls fit wherever the robot stands along it, so the rival is
 // joined to the fix by poses that fit as well (one cost valley, one mode) and is never a place the
 // track could have taken instead — even with a prediction known only to 1.5 m. The scan is still

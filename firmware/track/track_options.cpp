@@ -88,6 +88,7 @@ Status TrackOptions::validate() const {
   FW_RETURN_IF_ERROR(check_range("alias_clip_m", alias_clip_m, 0.01f, 2.0f));
   FW_RETURN_IF_ERROR(check_range("alias_margin", alias_margin, 0.0f, 1.0f));
   FW_RETURN_IF_ERROR(check_range("alias_z", alias_z, 0.0f, 100.0f));
+  FW_RETURN_IF_ERROR(check_range("alias_credible_z", alias_credible_z, 0.0f, 100.0f));
   FW_RETURN_IF_ERROR(check_range("alias_rotation_step_rad", alias_rotation_step_rad, 0.0f, 1.0f));
   FW_RETURN_IF_ERROR(check_range("alias_max_rotation_rad", alias_max_rotation_rad, 0.0f, 3.1416f));
   FW_RETURN_IF_ERROR(check_range("alias_min_separation_rad", alias_min_separation_rad, 0.0f, 1.0f));

@@ -120,6 +120,11 @@ struct TrackOptions {
   // A better rival contradicts only when a paired test of the per-point costs says so at this z
   // (3.09: one-sided 1e-3), the end-points counted once per correlation cell.
   float alias_z = 3.09f;
+  // An ambiguous scan's rival that fits better than the fix at this z (1.645: one-sided 5 %) is a
+  // place the robot could be, whatever the prediction says (alias_rival_must_be_credible below):
+  // proof needs alias_z, doubt does not. Measured on the whole mit-killian log: the 47 scans at
+  // right poses this could turn all tested below z 1.0; the carry 3908 → 3827 above 1.64.
+  float alias_credible_z = 1.645f;
   // A heading-only fault is recovered by the track itself: the scan fix lies inside the prediction's
   // horizontal protection level (the position is where the track promised it) and turned beyond the
   // heading alert limit, and the paired test (alias_z) says the scan fits significantly better at the
@@ -161,7 +166,8 @@ struct TrackOptions {
   // hold only while no scan has contradicted it since the last `recovery_steps` unique scans
   // (pose_tracker.cpp, check_aliases: a kidnap along a mit-killian corridor seen as a heading fault).
   // The scan is still `ambiguous` and `recovery_steps` unique scans are still needed. Turned rivals
-  // always count (intel kidnap: rivals 5–10° turned). false = every alias beyond the alert limits waits.
+  // always count (intel kidnap: rivals 5–10° turned), and so do rivals that fit better than the fix at
+  // alias_credible_z. false = every alias beyond the alert limits waits.
   bool alias_rival_must_be_credible = true;
   // Protection level (protection_level.h): integrity risk per `localized` step and alert limits.
   float integrity_risk = 1e-3f;
