@@ -60,6 +60,8 @@ struct TrackStep {
   bool large_fault = false;
   // The map explains fewer than TrackOptions::min_explained_fraction of the scan's end-points.
   bool unexplained = false;
+  // The scan fits the map significantly worse than the previous one (TrackOptions::fit_drop_z).
+  bool fit_drop = false;
   // A fault in heading only, recovered by the track (TrackOptions::heading_fault_local_recovery).
   bool heading_fault = false;
   // The alias check found a rival that fits this scan as well as the fix and lies beyond the alert
@@ -152,6 +154,10 @@ class PoseTracker {
   // A contradicting scan since the last recovery_steps unique consistent scans (ambiguous scans do
   // not count either way): the track may be wrong, so no alias rival is ruled out (check_aliases).
   bool contradicted_ = false;
+  // Fit of the previous scan with enough points on known cells (inlier fraction, correlation
+  // cells), the reference of the fit-drop test (judge_scan); fit_cells_ = 0 until there is one.
+  float fit_fraction_ = 0.0f;
+  std::uint32_t fit_cells_ = 0;
   TrackStep last_;
 };
 

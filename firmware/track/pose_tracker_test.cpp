@@ -256,6 +256,43 @@ TEST(PoseTrackerTest, ScanTheMapCannotExplainIsALargeFault) {
   }
 }
 
+// A scan that fits the map significantly worse than the previous one (here 40 % of its end-points
+// suddenly on free space, though 60 % still fit: both the inlier and the explained tests pass) is a
+// fault — what a robot carried elsewhere sees first when that scan still fits near the old pose
+// (fr079 kidnap 2143 → 3613). The test compares consecutive scans: a second scan that fits as
+// (badly) as the first is not another drop.
+TEST(PoseTrackerTest, ScanThatSuddenlyFitsWorseIsAFault) {
+  const Se2f a(4.5f, 6.0f, -0.4f);
+  for (const float drop_z : {3.09f, 0.0f}) {
+    PoseTracker t;
+    TrackOptions o;
+    o.fit_drop_z = drop_z;
+    ASSERT_TRUE(t.init(o, room_map().map).is_ok());
+    RandomStream rng(41, 0);
+    t.start(a, small_cov(), Se2f());
+    for (int i = 0; i < 3; ++i) {
+      const auto pts = testing::scan_at(room(), a, &rng);
+      ASSERT_EQ(t.step(pts.data(), pts.size(), Se2f(), false).status, hal::LocalizationStatus::kLocalized) << i;
+    }
+    for (int i = 0; i < 2; ++i) {
+      auto pts = testing::scan_at(room(), a, &rng);
+      for (std::size_t k = 0; k < pts.size(); ++k)
+        if (k % 5 >= 3) pts[k] = Point2f(0.3f, 0.0f);  // 40 %: free space ahead of the robot
+      const TrackStep s = t.step(pts.data(), pts.size(), Se2f(), false);
+      ASSERT_GE(s.alignment.inlier_fraction(), o.min_inlier_fraction);
+      ASSERT_GE(static_cast<float>(s.alignment.inliers), o.min_explained_fraction * static_cast<float>(s.alignment.points));
+      const bool first_drop = drop_z > 0.0f && i == 0;
+      EXPECT_EQ(s.fit_drop, first_drop) << drop_z << " " << i;
+      if (first_drop) {
+        EXPECT_EQ(s.verdict, ScanVerdict::kContradicting);
+        EXPECT_NE(s.status, hal::LocalizationStatus::kLocalized);
+        EXPECT_EQ(s.reason, hal::StatusReason::kTrackFault);
+      }
+      if (drop_z == 0.0f) EXPECT_NE(s.verdict, ScanVerdict::kContradicting) << "nothing else faults this scan";
+    }
+  }
+}
+
 // An odometry increment no robot can make between two scans cannot carry the pose.
 TEST(PoseTrackerTest, OdometryJumpContradicts) {
   PoseTracker t;

@@ -66,6 +66,7 @@ Status TrackOptions::validate() const {
   }
   FW_RETURN_IF_ERROR(check_range("min_inlier_fraction", min_inlier_fraction, 0.0f, 1.0f));
   FW_RETURN_IF_ERROR(check_range("min_explained_fraction", min_explained_fraction, 0.0f, 1.0f));
+  FW_RETURN_IF_ERROR(check_range("fit_drop_z", fit_drop_z, 0.0f, 100.0f));
   FW_RETURN_IF_ERROR(check_range("innovation_chi2", innovation_chi2, 0.1f, 1e6f));
   FW_RETURN_IF_ERROR(check_range("outside_map_fraction", outside_map_fraction, 0.0f, 1.0f));
   if (max_faulty_steps < 1 || max_faulty_steps > 10000 || max_outside_steps < 1 || max_outside_steps > 10000) {

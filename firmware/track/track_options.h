@@ -82,6 +82,11 @@ struct TrackOptions {
   // pose; fewer is a large fault (the robot may have been carried). Measured on whole runs of the
   // seven logs: 3 of 42,537 scans at right poses below 0.5, the aces carry at 0.37. 0 = off.
   float min_explained_fraction = 0.5f;
+  // A scan whose inlier fraction (known cells) falls below the previous scan's by more than
+  // this many standard errors (two-proportion test over the correlation cells) contradicts the
+  // pose: what a robot carried elsewhere sees first, when that scan still fits near the old pose.
+  // 3.09 = one-sided 1e-3, the integrity risk. 0 = off.
+  float fit_drop_z = 3.09f;
   // χ²(3) at 1 − 1e-3: scan fix vs odometry prediction; a fault only when the fix also lies outside
   // the prediction's protection level.
   float innovation_chi2 = 16.27f;
