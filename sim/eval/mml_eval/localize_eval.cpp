@@ -12,6 +12,7 @@
 #include "firmware/base/rng.h"
 #include "sim/common/reason_list.h"
 #include "sim/eval/mml_eval/mml_systems.h"
+#include "sim/eval/mml_eval/reference_rest_scatter.h"
 
 namespace sim::mmleval {
 
@@ -101,6 +102,34 @@ void describe_failures(const LoadedDataset& ds, const std::string& label, std::s
   }
 }
 
+// Protection-level exceedances (judged, as counted in the PL exceedance rate), for the lead: the first
+// step of each run of exceedances, at most 5 per trial, with the error against both references, so
+// that an exceedance the reference's own scatter could explain (reference_rest_scatter.h) is seen as such.
+void describe_pl_exceedances(const LoadedDataset& ds, const std::string& label, std::size_t trial, const TrialResult& t,
+                             std::ostringstream* notes) {
+  auto exceeded = [](const StepLog& s) {
+    return s.status == hal::LocalizationStatus::kLocalized && s.ref_ok && std::isfinite(s.err_m) &&
+           (pl_xy_beyond(s) || pl_theta_beyond(s));
+  };
+  std::size_t shown = 0, total = 0;
+  for (std::size_t k = 0; k < t.steps.size(); ++k) {
+    const StepLog& s = t.steps[k];
+    if (!exceeded(s)) continue;
+    ++total;
+    if ((k > 0 && exceeded(t.steps[k - 1])) || shown >= 5) continue;
+    ++shown;
+    char buf[400];
+    std::snprintf(buf, sizeof(buf),
+                  "PL exceeded: %s %s trial %zu step %zu scan %zu: err %.3f m %.2f deg vs PL %.3f m %.2f deg; against "
+                  "the map's pose %.3f m %.2f deg; reference bound %.3f m %.2f deg",
+                  ds.name.c_str(), label.c_str(), trial, k + 1, s.scan, s.err_m, s.err_rad * 57.2958, s.pl_xy,
+                  s.pl_theta * 57.2958, s.map_err_m, s.map_err_rad * 57.2958, s.ref_bound_m, s.ref_bound_rad * 57.2958);
+    *notes << "- " << buf << "\n";
+  }
+  if (total > shown)
+    *notes << "  (" << ds.name << " " << label << " trial " << trial << ": " << total << " steps beyond the PL in total)\n";
+}
+
 void progress(const LoadedDataset& ds, const std::string& label, std::size_t k, std::size_t n, const TrialResult& t,
               const MetricBounds& b, double secs) {
   const TrialMetrics m = trial_metrics(t, b);
@@ -134,17 +163,20 @@ void write_plots(const LocalizePlan& plan, const LoadedDataset& ds, const std::s
   {
     std::ofstream csv(base + "_steps.csv");
     csv << "trial,step,scan,segment,status,mode,est_x,est_y,est_theta,ref_x,ref_y,ref_theta,ref_ok,err_m,err_deg,"
-           "pl_xy_m,pl_theta_deg,unsupported,reason\n";
+           "pl_xy_m,pl_theta_deg,unsupported,reason,map_err_m,map_err_deg\n";
     for (std::size_t k = 0; k < trials.size(); ++k)
       for (std::size_t i = 0; i < trials[k].steps.size(); ++i) {
         const StepLog& s = trials[k].steps[i];
         char buf[384];
-        std::snprintf(buf, sizeof(buf), "%zu,%zu,%zu,%zu,%s,%s,%.4f,%.4f,%.5f,%.4f,%.4f,%.5f,%d,%.4f,%.3f,%.3f,%.3f,%u,%s\n", k, i,
+        std::snprintf(buf, sizeof(buf), "%zu,%zu,%zu,%zu,%s,%s,%.4f,%.4f,%.5f,%.4f,%.4f,%.5f,%d,%.4f,%.3f,%.3f,%.3f,%u,%s", k, i,
                       s.scan, s.segment, hal::status_name(s.status),
                       s.mode == hal::LocalizationMode::kTracking ? "tracking" : "global", s.estimate.x, s.estimate.y,
                       s.estimate.theta, s.truth.x, s.truth.y, s.truth.theta, s.ref_ok ? 1 : 0, s.err_m,
                       s.err_rad * 57.29578, s.pl_xy, s.pl_theta * 57.29578, s.unsupported_steps,
                       hal::reason_name(s.reason));
+        csv << buf;
+        // The map's pose (reference_map_check.h), only where the step was judged against it.
+        std::snprintf(buf, sizeof(buf), ",%.4f,%.3f\n", s.map_err_m, s.map_err_rad * 57.29578);
         csv << buf;
       }
   }
@@ -165,7 +197,7 @@ struct LocalizeRun {
   BenchJson* json;
   std::chrono::steady_clock::time_point t_all;
   std::vector<SystemSummary> rows;
-  std::ostringstream notes, refnotes;
+  std::ostringstream notes, refnotes, plnotes;
   std::vector<double> track_ms_all;
   std::vector<TrialResult> kidnap_all;
   MetricBounds kidnap_bounds;
@@ -197,6 +229,7 @@ void run_whole_logs(LocalizeRun& run, const LoadedDataset& ds, OwnedLocalizer& l
     t.whole_log = true;
     if (plan.verbose) progress(ds, "whole-log", k, nwhole, t, b, since(tk));
     describe_failures(ds, "whole-log", k, t, b, &run.notes, plan.verbose);
+    describe_pl_exceedances(ds, "whole-log", k, t, &run.plnotes);
     whole.push_back(t);
     all->push_back(std::move(t));
   }
@@ -212,6 +245,7 @@ void run_fix_trials(LocalizeRun& run, const LoadedDataset& ds, OwnedLocalizer& l
     TrialResult t = run_trial(loc, ds, starts[k], fopt);
     if (run.plan.verbose) progress(ds, "fix-trial", k, starts.size(), t, b, since(tk));
     describe_failures(ds, "fix-trial", k, t, b, &run.notes, run.plan.verbose);
+    describe_pl_exceedances(ds, "fix-trial", k, t, &run.plnotes);
     fix.push_back(t);
     all->push_back(std::move(t));
   }
@@ -304,6 +338,7 @@ void run_kidnaps(LocalizeRun& run, const LoadedDataset& ds, OwnedLocalizer& loc,
     kt.push_back(run_trial(loc, ds, kstarts[k], kopt));
     if (plan.verbose) progress(ds, "kidnap", k, kstarts.size(), kt.back(), run.kidnap_bounds, since(tk));
     describe_failures(ds, "kidnap", k, kt.back(), b, &run.notes, plan.verbose);
+    describe_pl_exceedances(ds, "kidnap", k, kt.back(), &run.plnotes);
   }
   SystemSummary ks = summarize(ds.name, "mml-track kidnap", kt, 0, b);
   run.rows.push_back(ks);
@@ -311,6 +346,25 @@ void run_kidnaps(LocalizeRun& run, const LoadedDataset& ds, OwnedLocalizer& loc,
   run.json->add_int(ds.key + "_kidnap_integrity_failures", static_cast<long long>(ks.kidnap_integrity_failures));
   write_plots(plan, ds, "mml-track_kidnap", kt, nullptr);
   run.kidnap_all.insert(run.kidnap_all.end(), kt.begin(), kt.end());
+}
+
+// The reference's own motion where the wheels report rest (reference_rest_scatter.h): shown beside
+// the PL exceedance, never used to clear a step. Not for synthesised odometry (made from the
+// reference itself, so it rests exactly when the reference does).
+void add_rest_scatter(LocalizeRun& run, const LoadedDataset& ds) {
+  if (ds.synthetic_odometry) return;
+  const RestScatter r = reference_rest_scatter(ds.reference, ds.odometry);
+  char buf[400];
+  std::snprintf(buf, sizeof(buf),
+                "%s: reference at rest: %zu scan pairs where the wheels report no motion; the reference moves between "
+                "them p50 %.3f m / %.2f deg, p99 %.3f m / %.2f deg (its own per-scan error; a PL exceedance smaller "
+                "than that cannot be told from the reference's)",
+                ds.name.c_str(), r.pairs, r.m_p50, r.rad_p50 * 57.29578, r.m_p99, r.rad_p99 * 57.29578);
+  run.refnotes << "- " << buf << "\n";
+  if (run.plan.verbose) std::printf("  %s\n", buf);
+  run.json->add_int(ds.key + "_ref_rest_pairs", static_cast<long long>(r.pairs));
+  run.json->add(ds.key + "_ref_rest_scatter_m_p99", r.m_p99);
+  run.json->add(ds.key + "_ref_rest_scatter_deg_p99", r.rad_p99 * 57.29578);
 }
 
 // One dataset (built-in or given by path): whole logs, fix trials, MCL, kidnaps.
@@ -329,6 +383,7 @@ bool evaluate_dataset(LocalizeRun& run, const std::string& name, const DatasetFi
   }
   run.refnotes << "- " << ds.name << ": " << ds.ref_check_note << "\n";
   json->add_int(ds.key + "_ref_excluded_scans", static_cast<long long>(ds.ref_excluded_scans));
+  add_rest_scatter(run, ds);
   const MetricBounds b = bounds_for(ds);
   std::string e;
   auto loc = OwnedLocalizer::make_track(ds.map, ds.image, run.mml_cfg, plan.track, plan.threads, &e);
@@ -385,6 +440,7 @@ bool run_unknown_area(LocalizeRun& run, std::string* err) {
     ut.push_back(run_trial(*loc, ds, starts[k], uo, region));
     if (plan.verbose) progress(ds, "unknown-area", k, starts.size(), ut.back(), b, since(tk));
     describe_failures(ds, "unknown-area", k, ut.back(), b, &run.notes, plan.verbose);
+    describe_pl_exceedances(ds, "unknown-area", k, ut.back(), &run.plnotes);
   }
   SystemSummary us = summarize(ds.name + "-erased", "mml-track", ut, 0, b);
   run.rows.push_back(us);
@@ -439,7 +495,9 @@ void write_localize_report(LocalizeRun& run) {
         "Definitions: sim/eval/mml_eval/README.md.\n\n"
      << table << "\n## Where the availability went (share of the steps after the first fix, by the reason published)\n\n"
      << unavailable << "\n## Reference quality\n\n" << run.refnotes.str() << "\n## Integrity failures\n\n"
-     << (run.notes.str().empty() ? std::string("none\n") : run.notes.str());
+     << (run.notes.str().empty() ? std::string("none\n") : run.notes.str())
+     << "\n## Protection-level exceedances (judged; compare with the reference's scatter at rest above)\n\n"
+     << (run.plnotes.str().empty() ? std::string("none\n") : run.plnotes.str());
   if (plan.verbose)
     std::printf("\n%s\nnot localized after the first fix, by reason:\n%sreference:\n%s\ntotal %.1f s\n", table.c_str(),
                 unavailable.c_str(), run.refnotes.str().c_str(), since(run.t_all));
@@ -448,7 +506,7 @@ void write_localize_report(LocalizeRun& run) {
 }  // namespace
 
 bool run_localize_evaluation(const LocalizePlan& plan, BenchJson* json, std::string* err) {
-  LocalizeRun run{plan, json, std::chrono::steady_clock::now(), {}, {}, {}, {}, {}, {},
+  LocalizeRun run{plan, json, std::chrono::steady_clock::now(), {}, {}, {}, {}, {}, {}, {},
                   mml_track_config(plan.mml_config, plan.seed)};
   run.mml_cfg.mml.pool_cluster_support = plan.pool_cluster_support;
   run.mml_cfg.mml.keep_support_across_empty_steps = plan.keep_support_across_empty_steps;
