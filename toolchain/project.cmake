@@ -54,6 +54,22 @@ endif()
 
 # mmlfw_add_test(NAME SOURCES... LIBS ...): a gtest binary registered with CTest. Tests sit
 # beside the code they test (Cartographer style); the fault handler is made fatal by test_main.
+# Long tests start first. With no cost data (a clean CI clone) CTest starts tests in the order they
+# are defined, so a long one defined late runs alone at the end while the other core idles
+# (fresh-clone CI 2026-11-26: fw_antslam_test, 169 s under qemu-aarch64, started last of 34, and the
+# stage took 320 s of test time for about 540 s of work on 2 cores). COST is the weight CTest
+# schedules by; the figures are seconds measured under ASan / qemu on the 2-core machine.
+set(MMLFW_LONG_TESTS fw_antslam_test=190 sim_slam_data_test=160 fw_mml_test=120 sim_kidnap_twin_test=90
+    fw_rbsm_test=70 sim_transport_sick_aces_test=60 sim_transport_can_aces_test=55 fw_mml_handoff_test=55
+    pransam3d_data_test=50 user_building_cli_path=45 fw_track_test=40 fw_mml_reset_test=40)
+function(mmlfw_test_cost name)
+  foreach(_entry IN LISTS MMLFW_LONG_TESTS)
+    if(_entry MATCHES "^${name}=([0-9]+)$")
+      set_tests_properties(${name} PROPERTIES COST ${CMAKE_MATCH_1})
+    endif()
+  endforeach()
+endfunction()
+
 function(mmlfw_add_test name)
   cmake_parse_arguments(T "" "" "SOURCES;LIBS;LABELS" ${ARGN})
   add_executable(${name} ${T_SOURCES})
@@ -67,6 +83,7 @@ function(mmlfw_add_test name)
   else()
     set_tests_properties(${name} PROPERTIES ENVIRONMENT "MMLFW_DATA_DIR=${CMAKE_SOURCE_DIR}/../shared/data")
   endif()
+  mmlfw_test_cost(${name})
 endfunction()
 
 # mmlfw_add_benchmark(NAME SOURCES... LIBS ...): host benchmark executable bench_NAME in
