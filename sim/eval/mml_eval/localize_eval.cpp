@@ -168,15 +168,12 @@ void write_plots(const LocalizePlan& plan, const LoadedDataset& ds, const std::s
       for (std::size_t i = 0; i < trials[k].steps.size(); ++i) {
         const StepLog& s = trials[k].steps[i];
         char buf[384];
-        std::snprintf(buf, sizeof(buf), "%zu,%zu,%zu,%zu,%s,%s,%.4f,%.4f,%.5f,%.4f,%.4f,%.5f,%d,%.4f,%.3f,%.3f,%.3f,%u,%s", k, i,
+        std::snprintf(buf, sizeof(buf), "%zu,%zu,%zu,%zu,%s,%s,%.4f,%.4f,%.5f,%.4f,%.4f,%.5f,%d,%.4f,%.3f,%.3f,%.3f,%u,%s,%.4f,%.3f\n", k, i,
                       s.scan, s.segment, hal::status_name(s.status),
                       s.mode == hal::LocalizationMode::kTracking ? "tracking" : "global", s.estimate.x, s.estimate.y,
                       s.estimate.theta, s.truth.x, s.truth.y, s.truth.theta, s.ref_ok ? 1 : 0, s.err_m,
                       s.err_rad * 57.29578, s.pl_xy, s.pl_theta * 57.29578, s.unsupported_steps,
-                      hal::reason_name(s.reason));
-        csv << buf;
-        // The map's pose (reference_map_check.h), only where the step was judged against it.
-        std::snprintf(buf, sizeof(buf), ",%.4f,%.3f\n", s.map_err_m, s.map_err_rad * 57.29578);
+                      hal::reason_name(s.reason), s.map_err_m, s.map_err_rad * 57.29578);  // map: NaN if not judged
         csv << buf;
       }
   }

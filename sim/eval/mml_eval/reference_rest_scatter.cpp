@@ -4,17 +4,9 @@
 #include <cmath>
 #include <limits>
 
+#include "sim/eval/mml_eval/mml_eval.h"  // percentile
+
 namespace sim::mmleval {
-namespace {
-
-// Nearest-rank percentile of a non-empty vector (sorted in place).
-double nearest_rank(std::vector<double>& v, double p) {
-  std::sort(v.begin(), v.end());
-  const auto k = static_cast<std::size_t>(std::ceil(p * static_cast<double>(v.size())));
-  return v[std::min(v.size() - 1, k > 0 ? k - 1 : 0)];
-}
-
-}  // namespace
 
 RestScatter reference_rest_scatter(const std::vector<fw::Se2d>& reference, const std::vector<fw::Se2d>& odometry,
                                    const RestScatterOptions& opt) {
@@ -35,10 +27,10 @@ RestScatter reference_rest_scatter(const std::vector<fw::Se2d>& reference, const
     out.m_p50 = out.m_p99 = out.rad_p50 = out.rad_p99 = std::numeric_limits<double>::quiet_NaN();
     return out;
   }
-  out.m_p50 = nearest_rank(dm, 0.5);
-  out.m_p99 = nearest_rank(dm, 0.99);
-  out.rad_p50 = nearest_rank(dr, 0.5);
-  out.rad_p99 = nearest_rank(dr, 0.99);
+  out.m_p50 = percentile(dm, 50.0);
+  out.m_p99 = percentile(dm, 99.0);
+  out.rad_p50 = percentile(dr, 50.0);
+  out.rad_p99 = percentile(dr, 99.0);
   return out;
 }
 
