@@ -3,9 +3,10 @@
 #include <cmath>
 #include <cstring>
 
-#include "firmware/base/memory_report.h"
 #include "firmware/base/crc32.h"
+#include "firmware/base/memory_report.h"
 #include "firmware/map/edt.h"
+#include "firmware/map/le_fields.h"
 
 // The format is little-endian; bulk arrays are copied with memcpy, so the host must be too (x86-64,
 // aarch64 and armhf all are). A big-endian port would add byte swapping here.
@@ -13,20 +14,6 @@ static_assert(__BYTE_ORDER__ == __ORDER_LITTLE_ENDIAN__, "map image loader assum
 
 namespace fw {
 namespace {
-
-std::uint32_t rd_u32(const std::uint8_t* p) {
-  return static_cast<std::uint32_t>(p[0]) | (static_cast<std::uint32_t>(p[1]) << 8) |
-         (static_cast<std::uint32_t>(p[2]) << 16) | (static_cast<std::uint32_t>(p[3]) << 24);
-}
-std::uint64_t rd_u64(const std::uint8_t* p) {
-  return static_cast<std::uint64_t>(rd_u32(p)) | (static_cast<std::uint64_t>(rd_u32(p + 4)) << 32);
-}
-float rd_f32(const std::uint8_t* p) {
-  const std::uint32_t u = rd_u32(p);
-  float f;
-  std::memcpy(&f, &u, sizeof(f));
-  return f;
-}
 
 // Header + table structure (no CRCs). On success *count is the section count.
 Status check_structure(const std::uint8_t* bytes, std::size_t size, const char* name, std::size_t* count) {
@@ -38,17 +25,17 @@ Status check_structure(const std::uint8_t* bytes, std::size_t size, const char* 
   if (std::memcmp(bytes, kMapImageMagic, sizeof(kMapImageMagic)) != 0) {
     return Status::error(Errc::kCorruptData, "%s: bad magic (not a compiled map image)", name);
   }
-  const std::uint32_t version = rd_u32(bytes + 8);
+  const std::uint32_t version = read_le_u32(bytes + 8);
   if (version != kMapImageVersion) {
     return Status::error(Errc::kUnsupported, "%s: format version %u, this firmware reads version %u", name,
                          version, kMapImageVersion);
   }
-  const std::uint64_t total = rd_u64(bytes + 16);
+  const std::uint64_t total = read_le_u64(bytes + 16);
   if (total != size) {
     return Status::error(Errc::kCorruptData, "%s: header says %llu bytes, got %zu (truncated or padded)", name,
                          static_cast<unsigned long long>(total), size);
   }
-  const std::uint32_t n = rd_u32(bytes + 12);
+  const std::uint32_t n = read_le_u32(bytes + 12);
   if (n > kMaxMapSections) {
     return Status::error(Errc::kCorruptData, "%s: %u sections, at most %zu allowed", name, n, kMaxMapSections);
   }
@@ -58,9 +45,9 @@ Status check_structure(const std::uint8_t* bytes, std::size_t size, const char* 
   }
   for (std::uint32_t i = 0; i < n; ++i) {
     const std::uint8_t* e = bytes + kMapImageHeaderBytes + i * kMapSectionEntryBytes;
-    const std::uint64_t off = rd_u64(e + 8);
-    const std::uint64_t len = rd_u64(e + 16);
-    const std::uint32_t type = rd_u32(e);
+    const std::uint64_t off = read_le_u64(e + 8);
+    const std::uint64_t len = read_le_u64(e + 16);
+    const std::uint32_t type = read_le_u32(e);
     if (off < table_end || off > size || len > size - off) {
       return Status::error(Errc::kCorruptData, "%s: section %u (%s) [offset %llu, %llu bytes] outside the image", name,
                            i, map_section_name(static_cast<MapSectionType>(type)), static_cast<unsigned long long>(off),
@@ -68,8 +55,8 @@ Status check_structure(const std::uint8_t* bytes, std::size_t size, const char* 
     }
     for (std::uint32_t j = 0; j < i; ++j) {
       const std::uint8_t* f = bytes + kMapImageHeaderBytes + j * kMapSectionEntryBytes;
-      const std::uint64_t off2 = rd_u64(f + 8);
-      const std::uint64_t len2 = rd_u64(f + 16);
+      const std::uint64_t off2 = read_le_u64(f + 8);
+      const std::uint64_t len2 = read_le_u64(f + 16);
       if (len > 0 && len2 > 0 && off < off2 + len2 && off2 < off + len) {
         return Status::error(Errc::kCorruptData, "%s: sections %u and %u overlap", name, j, i);
       }
@@ -82,11 +69,11 @@ Status check_structure(const std::uint8_t* bytes, std::size_t size, const char* 
 MapSectionInfo entry(const std::uint8_t* bytes, std::size_t i) {
   const std::uint8_t* e = bytes + kMapImageHeaderBytes + i * kMapSectionEntryBytes;
   MapSectionInfo s;
-  s.type = static_cast<MapSectionType>(rd_u32(e));
-  s.version = rd_u32(e + 4);
-  s.offset = rd_u64(e + 8);
-  s.size = rd_u64(e + 16);
-  s.crc = rd_u32(e + 24);
+  s.type = static_cast<MapSectionType>(read_le_u32(e));
+  s.version = read_le_u32(e + 4);
+  s.offset = read_le_u64(e + 8);
+  s.size = read_le_u64(e + 16);
+  s.crc = read_le_u32(e + 24);
   return s;
 }
 
@@ -116,7 +103,7 @@ Status check_reserved_fields(const std::uint8_t* bytes, std::size_t count, const
   for (std::size_t i = 0; i < count; ++i) {
     const std::uint8_t* e = bytes + kMapImageHeaderBytes + i * kMapSectionEntryBytes;
     const MapSectionInfo s = entry(bytes, i);
-    const std::uint32_t reserved = rd_u32(e + 28);
+    const std::uint32_t reserved = read_le_u32(e + 28);
     if (reserved != 0) {
       return Status::error(Errc::kCorruptData, "%s: section %zu (%s): reserved field is 0x%08x, must be 0", name, i,
                            map_section_name(s.type), reserved);
@@ -191,7 +178,7 @@ Status recompute_distance_field(const GridGeometry& geometry, const std::uint8_t
   for (std::size_t i = 0; i < cells; ++i) {
     const float d2 = out[i];
     const float expected = std::sqrt(d2) * geometry.resolution;
-    const float stored = rd_f32(dist_bytes + 4 * i);
+    const float stored = read_le_f32(dist_bytes + 4 * i);
     const bool ok = d2 < kExactBelow ? stored == expected : std::fabs(stored - expected) <= 4e-7f * expected;
     if (!ok) {
       return Status::error(Errc::kCorruptData,
@@ -232,12 +219,11 @@ const char* map_section_name(MapSectionType type) {
 }
 
 namespace {
-
 Status verify_except_padding(const std::uint8_t* bytes, std::size_t size, const char* name) {
   std::size_t count = 0;
   FW_RETURN_IF_ERROR(check_structure(bytes, size, name, &count));
-  if (rd_u32(bytes + 24) != 0) {
-    return Status::error(Errc::kUnsupported, "%s: unknown header flags 0x%x", name, rd_u32(bytes + 24));
+  if (read_le_u32(bytes + 24) != 0) {
+    return Status::error(Errc::kUnsupported, "%s: unknown header flags 0x%x", name, read_le_u32(bytes + 24));
   }
   FW_RETURN_IF_ERROR(check_reserved_fields(bytes, count, name));
   for (std::size_t i = 0; i < count; ++i) {
@@ -252,7 +238,7 @@ Status verify_except_padding(const std::uint8_t* bytes, std::size_t size, const 
   std::uint32_t c = crc32_update(0u, bytes, 28);
   c = crc32_update(c, zero, 4);
   c = crc32_update(c, bytes + kMapImageHeaderBytes, size - kMapImageHeaderBytes);
-  const std::uint32_t stored = rd_u32(bytes + 28);
+  const std::uint32_t stored = read_le_u32(bytes + 28);
   if (c != stored) {
     return Status::error(Errc::kCorruptData, "%s: image CRC mismatch (stored 0x%08x, computed 0x%08x)", name, stored,
                          c);
@@ -268,7 +254,6 @@ Status verify_map_image(const std::uint8_t* bytes, std::size_t size, const char*
 }
 
 namespace {
-
 // The four sections every map image carries (required_section: exactly one of each, version 1).
 struct MapSections {
   MapSectionInfo geo, occ, dist, pts;
@@ -299,13 +284,13 @@ Status read_geometry(const std::uint8_t* bytes, const MapSectionInfo& geo, const
   }
   const std::uint8_t* g = bytes + geo.offset;
   GridGeometry geometry;
-  geometry.resolution = rd_f32(g);
-  geometry.origin_x = rd_f32(g + 4);
-  geometry.origin_y = rd_f32(g + 8);
-  geometry.width = rd_u32(g + 12);
-  geometry.height = rd_u32(g + 16);
-  const std::uint32_t num_points = rd_u32(g + 20);
-  const float max_distance = rd_f32(g + 24);
+  geometry.resolution = read_le_f32(g);
+  geometry.origin_x = read_le_f32(g + 4);
+  geometry.origin_y = read_le_f32(g + 8);
+  geometry.width = read_le_u32(g + 12);
+  geometry.height = read_le_u32(g + 16);
+  const std::uint32_t num_points = read_le_u32(g + 20);
+  const float max_distance = read_le_f32(g + 24);
   if (!std::isfinite(geometry.resolution) || !(geometry.resolution > 0.0f)) {
     return Status::error(Errc::kCorruptData, "%s: geometry: resolution %g is not a positive finite number", name,
                          static_cast<double>(geometry.resolution));
@@ -319,7 +304,7 @@ Status read_geometry(const std::uint8_t* bytes, const MapSectionInfo& geo, const
   if (!std::isfinite(max_distance) || max_distance < 0.0f) {
     return Status::error(Errc::kCorruptData, "%s: geometry: max distance is not a finite non-negative number", name);
   }
-  const std::uint32_t geometry_reserved = rd_u32(g + 28);
+  const std::uint32_t geometry_reserved = read_le_u32(g + 28);
   if (geometry_reserved != 0) {
     return Status::error(Errc::kCorruptData, "%s: geometry: reserved field is 0x%08x, must be 0", name,
                          geometry_reserved);
@@ -374,7 +359,7 @@ Status check_cells(const MapGeometry& map_geometry, const std::uint8_t* occ_byte
       return Status::error(Errc::kCorruptData, "%s: occupancy cell %llu has invalid value %u", name,
                            static_cast<unsigned long long>(i), o);
     }
-    const float d = rd_f32(dist_bytes + 4 * i);
+    const float d = read_le_f32(dist_bytes + 4 * i);
     if (!std::isfinite(d) || d < 0.0f) {
       return Status::error(Errc::kCorruptData, "%s: distance field cell %llu is %s", name,
                            static_cast<unsigned long long>(i), std::isnan(d) ? "NaN" : "negative or infinite");
@@ -411,8 +396,8 @@ Status check_points(const GridGeometry& geometry, std::uint32_t num_points, cons
   std::size_t previous_cell = 0;
   const float centre_tolerance = 0.25f * geometry.resolution;
   for (std::uint32_t i = 0; i < num_points; ++i) {
-    const float x = rd_f32(pts_bytes + 8u * i);
-    const float y = rd_f32(pts_bytes + 8u * i + 4);
+    const float x = read_le_f32(pts_bytes + 8u * i);
+    const float y = read_le_f32(pts_bytes + 8u * i + 4);
     std::int32_t cx = 0, cy = 0;
     if (!std::isfinite(x) || !std::isfinite(y) || !geometry.world_to_cell(x, y, &cx, &cy) ||
         occ_bytes[geometry.index(cx, cy)] != kCellOccupied) {
@@ -539,7 +524,7 @@ Status copy_map_to_arena(const MapGeometry& map_geometry, const std::uint8_t* oc
       fill_distance_field(layout, dist_bytes, arrays.dist_slots, arrays.dist_tiles, arrays.dist_table);
   const OccupancyTiles occupancy = fill_occupancy_tiles(occ_layout, occ_bytes, arrays.occ_slots, arrays.occ_cells);
   for (std::uint32_t i = 0; i < num_points; ++i) {
-    arrays.points[i] = Point2f(rd_f32(pts_bytes + 8u * i), rd_f32(pts_bytes + 8u * i + 4));
+    arrays.points[i] = Point2f(read_le_f32(pts_bytes + 8u * i), read_le_f32(pts_bytes + 8u * i + 4));
   }
   FW_RETURN_IF_ERROR(register_map_memory(occ_layout, layout, num_points));
 
@@ -579,14 +564,14 @@ std::size_t map_image_arena_bytes(const std::uint8_t* bytes, std::size_t size, c
   std::size_t len = 0;
   const std::uint8_t* g = find_section(bytes, size, MapSectionType::kGeometry, &len);
   if (g == nullptr || len != kMapGeometryBytes) return 0;
-  const std::uint64_t w = rd_u32(g + 12), h = rd_u32(g + 16), points = rd_u32(g + 20);
+  const std::uint64_t w = read_le_u32(g + 12), h = read_le_u32(g + 16), points = read_le_u32(g + 20);
   const std::uint64_t cells = w * h, longer = w > h ? w : h;
   // The distance tiles as load_map_image plans them (an absent or short distance section: 0).
   std::size_t dlen = 0;
   const std::uint8_t* d = find_section(bytes, size, MapSectionType::kDistanceField, &dlen);
   if (d == nullptr || dlen != cells * 4) return 0;
   DistanceFieldLayout layout;
-  if (!plan_distance_field(d, static_cast<std::uint32_t>(w), static_cast<std::uint32_t>(h), rd_f32(g),
+  if (!plan_distance_field(d, static_cast<std::uint32_t>(w), static_cast<std::uint32_t>(h), read_le_f32(g),
                            options.distance_truncation_m, &layout)) {
     return 0;
   }

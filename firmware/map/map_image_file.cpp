@@ -8,16 +8,11 @@
 #include <cerrno>
 #include <cstring>
 
+#include "firmware/map/le_fields.h"
 #include "firmware/map/map_image.h"
 
 namespace fw {
 namespace {
-
-std::uint64_t rd_u64(const std::uint8_t* p) {
-  std::uint64_t v = 0;
-  for (int i = 7; i >= 0; --i) v = (v << 8) | p[i];
-  return v;
-}
 
 std::size_t page_size() {
   const long p = ::sysconf(_SC_PAGESIZE);
@@ -81,7 +76,7 @@ Status MapImageFile::open(const char* path) {
     ::close(fd);
     return Status::error(Errc::kCorruptData, "map image '%s': bad magic (not a compiled map image)", path);
   }
-  const std::uint64_t declared = rd_u64(header + 16);
+  const std::uint64_t declared = read_le_u64(header + 16);
   if (declared != file_size) {
     ::close(fd);
     return Status::error(Errc::kCorruptData,

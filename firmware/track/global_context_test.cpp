@@ -16,7 +16,7 @@ namespace fw {
 namespace track {
 namespace {
 
-struct Rig {
+struct ScheduledRig {
   StartupArena arena;
   std::unique_ptr<mml::MmlLocalizer> mml = std::make_unique<mml::MmlLocalizer>();
   std::unique_ptr<TrackedLocalizer> loc = std::make_unique<TrackedLocalizer>();
@@ -26,12 +26,6 @@ struct Rig {
     return loc->init(TrackOptions(), map, mml.get(), schedule);
   }
 };
-
-std::vector<Se2f> tour() {
-  return mml::testing::waypoint_path({{1.5f, 1.5f}, {1.5f, 6.5f}, {4.5f, 6.5f}, {4.5f, 2.0f}, {10.5f, 3.5f},
-                                      {10.5f, 6.5f}, {8.0f, 6.5f}},
-                                     0.1f);
-}
 
 TEST(GlobalContextTest, ScheduleValidation) {
   GlobalScheduleOptions s;
@@ -51,9 +45,9 @@ TEST(GlobalContextTest, ScheduleValidation) {
 // Live schedule executed inline: still localizes on the synthetic room, never wrong; MML consumed
 // every period_scans-th scan while it searched.
 TEST(GlobalContextTest, LiveScheduleInlineLocalizes) {
-  Rig rig;
+  ScheduledRig rig;
   ASSERT_TRUE(rig.init(testing::room_map().map, live_global_schedule()).is_ok());
-  const auto path = tour();
+  const auto path = testing::room_tour();
   const auto rec = mml::testing::drive(rig.loc.get(), testing::room(), path, 1);
   int first = -1, wrong = 0;
   for (std::size_t i = 0; i < rec.size(); ++i) {
@@ -73,11 +67,11 @@ TEST(GlobalContextTest, LiveScheduleInlineLocalizes) {
 // The same schedule on the global thread gives bit-identical poses when every job finishes within
 // its window (the hook waits for it, as a fast enough global context would).
 TEST(GlobalContextTest, ThreadedEqualsInlineWhenOnTime) {
-  const auto path = tour();
-  Rig a;
+  const auto path = testing::room_tour();
+  ScheduledRig a;
   ASSERT_TRUE(a.init(testing::room_map().map, live_global_schedule()).is_ok());
   const auto ra = mml::testing::drive(a.loc.get(), testing::room(), path, 1);
-  Rig b;
+  ScheduledRig b;
   ASSERT_TRUE(b.init(testing::room_map().map, live_global_schedule()).is_ok());
   ASSERT_TRUE(b.loc->global_context().start_thread(kGlobalContext, false, nullptr).is_ok());
   ASSERT_TRUE(b.loc->global_context().threaded());
@@ -105,8 +99,8 @@ TEST(GlobalContextTest, ThreadedEqualsInlineWhenOnTime) {
 // A global step that does not finish within its window is counted, and the sensor step never
 // waits for it: the result is taken at the first step after it finished.
 TEST(GlobalContextTest, LateGlobalStepIsCountedNotWaitedFor) {
-  const auto path = tour();
-  Rig b;
+  const auto path = testing::room_tour();
+  ScheduledRig b;
   ASSERT_TRUE(b.init(testing::room_map().map, live_global_schedule()).is_ok());
   ASSERT_TRUE(b.loc->global_context().start_thread(kGlobalContext, false, nullptr).is_ok());
   // Steps back to back with no wait: MML (~ms per step) cannot keep up with a sensor step of µs.

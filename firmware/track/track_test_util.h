@@ -50,6 +50,13 @@ inline std::vector<Point2f> scan_at(const GridWorld& world, const Se2f& pose, Ra
   return pts;
 }
 
+// A tour through every part of the room (0.1 m steps), shared by the tracked-localizer tests.
+inline std::vector<Se2f> room_tour() {
+  return mml::testing::waypoint_path({{1.5f, 1.5f}, {1.5f, 6.5f}, {4.5f, 6.5f}, {4.5f, 2.0f}, {10.5f, 3.5f},
+                                      {10.5f, 6.5f}, {8.0f, 6.5f}},
+                                     0.1f);
+}
+
 }  // namespace testing
 }  // namespace track
 }  // namespace fw

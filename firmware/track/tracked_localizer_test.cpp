@@ -29,12 +29,6 @@ struct Rig {
 using testing::room;
 using testing::room_map;
 
-std::vector<Se2f> tour() {
-  return mml::testing::waypoint_path({{1.5f, 1.5f}, {1.5f, 6.5f}, {4.5f, 6.5f}, {4.5f, 2.0f}, {10.5f, 3.5f},
-                                      {10.5f, 6.5f}, {8.0f, 6.5f}},
-                                     0.1f);
-}
-
 struct Tally {
   int localized = 0, wrong = 0, outside_pl = 0, first = -1;
 };
@@ -61,7 +55,7 @@ Tally tally(const std::vector<mml::testing::StepRecord>& rec, std::size_t from =
 TEST(TrackedLocalizerTest, FixThenTrackEveryScan) {
   Rig rig;
   ASSERT_TRUE(rig.init(room_map().map).is_ok());
-  const auto path = tour();
+  const auto path = testing::room_tour();
   const auto rec = mml::testing::drive(rig.loc.get(), room(), path, 1);
   const Tally t = tally(rec);
   ASSERT_GE(t.first, 0) << "never localized";
@@ -134,7 +128,7 @@ struct JumpRun {
 };
 
 void drive_through_heading_jump(Rig& rig, JumpRun* r) {
-  const auto path = tour();
+  const auto path = testing::room_tour();
   const float kJump = 0.349f;
   int fixed_at = -1;
   // Driven by hand: the odometry must carry the jump that the truth does not.
@@ -225,7 +219,7 @@ TEST(TrackedLocalizerTest, DeterministicAndResettable) {
   Rig a, b;
   ASSERT_TRUE(a.init(room_map().map).is_ok());
   ASSERT_TRUE(b.init(room_map().map).is_ok());
-  const auto path = tour();
+  const auto path = testing::room_tour();
   const auto ra = mml::testing::drive(a.loc.get(), room(), path, 4);
   const auto other = mml::testing::drive(b.loc.get(), room(), mml::testing::waypoint_path({{10.0f, 6.0f}, {10.0f, 3.0f}}, 0.1f), 9);
   b.loc->reset();
@@ -244,7 +238,7 @@ TEST(TrackedLocalizerTest, NoHeapInSteps) {
   if (!mmlfw_test::AllocCounter::available()) GTEST_SKIP() << "allocation counter unavailable under sanitizers";
   Rig rig;
   ASSERT_TRUE(rig.init(room_map().map).is_ok());
-  const auto path = tour();
+  const auto path = testing::room_tour();
   static hal::LaserScan scan;
   Se2f odom;
   hal::PoseEstimate est;

@@ -3,13 +3,12 @@
 #include <cmath>
 
 #include "firmware/base/se2.h"
+#include "sim/common/units.h"
 #include "sim/eval/mml_eval/reference_map_check.h"
 
 namespace sim {
 
 namespace {
-
-constexpr double kRadToDeg = 180.0 / M_PI;
 
 // Beyond the integrity limits or the step's PL against the log reference alone: where the map is asked.
 bool beyond_a_limit(const StepRecord& r) {

@@ -5,12 +5,11 @@
 #include <vector>
 
 #include "sim/cli/sim_runner.h"
+#include "sim/common/units.h"
 
 namespace sim {
 
 namespace {
-
-constexpr double kRadToDeg = 180.0 / M_PI;
 
 // --transport: what went over the simulated bus and what the firmware's decoder made of it.
 void write_transport_json(std::FILE* f, const SimSummary& s) {

@@ -22,6 +22,7 @@
 #include "sim/cli/log_frames.h"
 #include "sim/cli/reference_judge.h"
 #include "sim/cli/run_picture.h"
+#include "sim/common/units.h"
 #include "sim/io/datasets.h"
 #include "sim/map/global_maps.h"
 #include "sim/map/map_image_writer.h"
@@ -30,8 +31,6 @@
 namespace sim {
 
 namespace {
-
-constexpr double kRadToDeg = 180.0 / M_PI;
 
 // What the run knows of the scan a published estimate belongs to (by scan id).
 struct FrameInfo {

@@ -4,13 +4,13 @@
 #include <vector>
 
 #include "sim/cli/sim_runner.h"
+#include "sim/common/units.h"
 #include "sim/eval/mml_eval/reference_map_check.h"
 
 namespace sim {
 
 namespace {
 
-constexpr double kRadToDeg = 180.0 / M_PI;
 // Success bounds of the dissertation (Sec. 5.7): a localized estimate farther off is a failure.
 constexpr double kWrongM = 0.5, kWrongDeg = 20.0;
 

@@ -1,6 +1,7 @@
 // Unit tests of the CARMEN reader/writer on small in-memory / temporary files: every record type,
 // strict errors naming file:line, skip_bad_lines, gzip (incl. corrupt), exact write/read round trip.
 #include "sim/io/carmen_log.h"
+#include "sim/io/test_files.h"
 
 #include <gtest/gtest.h>
 #include <sys/stat.h>
@@ -17,14 +18,8 @@
 namespace sim {
 namespace {
 
-std::string temp_path(const std::string& name) {
-  return std::string(::testing::TempDir()) + "/carmen_" + std::to_string(::getpid()) + "_" + name;
-}
-
-void write_text(const std::string& path, const std::string& text) {
-  std::ofstream f(path, std::ios::binary);
-  f << text;
-}
+using test_files::temp_path;
+using test_files::write_text;
 
 void write_gz(const std::string& path, const std::string& text) {
   gzFile f = gzopen(path.c_str(), "wb");
@@ -294,7 +289,7 @@ TEST(CarmenLog, MissingFileIsAnError) {
   EXPECT_FALSE(read_carmen_log(dir, {}, &log, &err));
   EXPECT_NE(err.find("not a regular file"), std::string::npos) << err;
   // An empty file is a valid, empty log; a bare gzip magic is a corrupt stream.
-  const std::string empty = temp_path("empty.clf"), magic = temp_path("magic.gz");
+  const std::string empty = temp_path("carmen", "empty.clf"), magic = temp_path("carmen", "magic.gz");
   write_text(empty, "");
   write_text(magic, "\x1f\x8b");
   EXPECT_TRUE(read_carmen_log(empty, {}, &log, &err)) << err;
@@ -307,7 +302,7 @@ TEST(CarmenLog, MissingFileIsAnError) {
 
 TEST(CarmenLog, PlainAndGzipReadAlike) {
   const std::string text = "# t\n" + flaser_line(180) + "ODOM 1 2 3 0 0 0 5.0 host 5.0\n" + flaser_line(360);
-  const std::string plain = temp_path("a.clf"), gz = temp_path("a.clf.gz");
+  const std::string plain = temp_path("carmen", "a.clf"), gz = temp_path("carmen", "a.clf.gz");
   write_text(plain, text);
   write_gz(gz, text);
   CarmenLog a, b;
@@ -326,7 +321,7 @@ TEST(CarmenLog, PlainAndGzipReadAlike) {
 TEST(CarmenLog, CorruptGzipIsAnError) {
   std::string text;
   for (int i = 0; i < 200; ++i) text += flaser_line(180, std::to_string(i * 0.01));
-  const std::string gz = temp_path("c.clf.gz");
+  const std::string gz = temp_path("carmen", "c.clf.gz");
   write_gz(gz, text);
   std::string bytes;
   {
@@ -390,7 +385,7 @@ std::string gzip_of(const std::string& chunk, size_t repeat = 1) {
 TEST(CarmenLog, GzipBombIsStoppedAtTheCap) {
   const std::string bomb = gzip_of(std::string(1 << 20, '\n'), 64);
   ASSERT_LT(bomb.size(), 1u << 20);
-  const std::string gz = temp_path("bomb.clf.gz");
+  const std::string gz = temp_path("carmen", "bomb.clf.gz");
   write_text(gz, bomb);
   CarmenReadOptions o;
   o.max_bytes = 8u << 20;
@@ -406,7 +401,7 @@ TEST(CarmenLog, GzipBombIsStoppedAtTheCap) {
   EXPECT_GE(kDefaultMaxLogBytes, 256u << 20);
   EXPECT_LT(kDefaultMaxLogBytes, 4ull << 30);
   // A plain file over the cap is refused by its size, before it is read.
-  const std::string plain = temp_path("big.clf");
+  const std::string plain = temp_path("carmen", "big.clf");
   write_text(plain, std::string(2 << 20, '\n'));
   o.max_bytes = 1u << 20;
   EXPECT_FALSE(read_carmen_log(plain, o, &log, &err));
@@ -419,7 +414,7 @@ TEST(CarmenLog, GzipBombIsStoppedAtTheCap) {
 // gzip members are data (gzip -d concatenates them); anything else is an error.
 TEST(CarmenLog, TrailingGarbageAfterGzipIsAnError) {
   const std::string a = flaser_line(180), b = "ODOM 1 2 3 0 0 0 5.0 host 5.0\n";
-  const std::string gz = temp_path("t.clf.gz");
+  const std::string gz = temp_path("carmen", "t.clf.gz");
   CarmenLog log;
   std::string err;
   write_text(gz, gzip_of(a) + gzip_of(b));
@@ -439,7 +434,7 @@ TEST(CarmenLog, TrailingGarbageAfterGzipIsAnError) {
 }
 
 TEST(CarmenLog, FifoAndDeviceAreRefusedWithoutBlocking) {
-  const std::string fifo = temp_path("fifo.clf");
+  const std::string fifo = temp_path("carmen", "fifo.clf");
   std::remove(fifo.c_str());
   ASSERT_EQ(::mkfifo(fifo.c_str(), 0600), 0);
   CarmenLog log;
@@ -485,7 +480,7 @@ TEST(CarmenLog, WriteReadRoundTripIsExact) {
   log.scans.push_back(rl);
   for (const char* ext : {".clf", ".clf.gz"}) {
     SCOPED_TRACE(ext);
-    const std::string path = temp_path(std::string("rt") + ext);
+    const std::string path = temp_path("carmen", std::string("rt") + ext);
     std::string err;
     ASSERT_TRUE(write_carmen_log(path, log, {}, &err)) << err;
     CarmenLog back;

@@ -1,3 +1,4 @@
+#include "sim/common/fail.h"
 #include "sim/io/file_io.h"
 
 #include <fcntl.h>
@@ -10,11 +11,6 @@
 
 namespace sim {
 namespace {
-
-bool fail(std::string* error, const std::string& msg) {
-  if (error != nullptr) *error = msg;
-  return false;
-}
 
 std::string bytes_text(std::uint64_t n) {
   std::string s = std::to_string(n) + " bytes";

@@ -9,12 +9,12 @@
 #include <cstdio>
 #include <string_view>
 
+#include "sim/common/units.h"
 #include "sim/io/text_fields.h"
 
 namespace sim {
 namespace {
 
-constexpr double kRad2Deg = 180.0 / 3.14159265358979323846;
 // A billion scans is 150 days of a 75 Hz laser; a larger index is a corrupt file, not a log.
 constexpr unsigned long long kMaxFlaserIndex = 1000000000ull;
 
@@ -164,7 +164,7 @@ ReferenceGapStats reference_gap_stats(const CarmenLog& raw, const std::vector<Co
     const size_t a = u[k].pos, b = u[k + 1].pos;
     const fw::Se2d closure = chain(u[k].c->pose, raw.scans[a].odom, raw.scans[b].odom).between(u[k + 1].c->pose);
     const double r = std::hypot(closure.x, closure.y);
-    const double rd = std::abs(closure.theta) * kRad2Deg;
+    const double rd = std::abs(closure.theta) * kRadToDeg;
     ++s.gaps;
     s.mean_gap_scans += static_cast<double>(b - a);
     s.max_gap_scans = std::max(s.max_gap_scans, static_cast<double>(b - a));

@@ -8,13 +8,12 @@
 #include <numeric>
 #include <string_view>
 
+#include "sim/common/units.h"
 #include "sim/io/carmen_log.h"
 #include "sim/io/text_fields.h"
 
 namespace sim {
 namespace {
-
-constexpr double kRad2Deg = 180.0 / 3.14159265358979323846;
 
 std::string format_limit(double v) {
   char b[32];
@@ -163,7 +162,7 @@ RelationsMetric evaluate_relations(const std::vector<Relation>& relations, const
       ++m.missing;
       continue;
     }
-    const double rd = std::abs(e.rot) * kRad2Deg;
+    const double rd = std::abs(e.rot) * kRadToDeg;
     t.push_back(e.trans);
     t2.push_back(e.trans * e.trans);
     r.push_back(rd);

@@ -9,17 +9,16 @@
 #include <fstream>
 
 #include "sim/io/reference_trajectory.h"
+#include "sim/io/test_files.h"
 
 namespace sim {
 namespace {
 
-std::string temp_path(const std::string& name) {
-  return std::string(::testing::TempDir()) + "/rel_" + std::to_string(::getpid()) + "_" + name;
-}
-void write_text(const std::string& path, const std::string& text) { std::ofstream(path) << text; }
+using test_files::temp_path;
+using test_files::write_text;
 
 TEST(Relations, ReadsFileAndSkipsComments) {
-  const std::string p = temp_path("ok.relations");
+  const std::string p = temp_path("rel", "ok.relations");
   write_text(p, "# c\n\n976052905.167303 976052911.885496 -0.056990 -0.128430 0.000000 0.000000 0.000000 -1.682210\n"
                 "1 2 1 0 0 0 0 0.5\n");
   std::vector<Relation> r;
@@ -50,7 +49,7 @@ TEST(Relations, MalformedInputIsAnErrorNamingFileAndLine) {
   };
   for (const auto& c : cases) {
     SCOPED_TRACE(c.name);
-    const std::string p = temp_path("bad.relations");
+    const std::string p = temp_path("rel", "bad.relations");
     write_text(p, c.text);
     std::vector<Relation> r;
     std::string err;
@@ -126,7 +125,7 @@ TEST(Relations, MetricIsFrameInvariantAndZeroOnOwnRelations) {
   }
   std::vector<Relation> rel;
   for (int i = 0; i + 7 < 200; i += 7) rel.push_back({traj[i].t, traj[i + 7].t, traj[i].pose.between(traj[i + 7].pose)});
-  const std::string p = temp_path("own.relations");
+  const std::string p = temp_path("rel", "own.relations");
   std::string err;
   ASSERT_TRUE(write_relations(p, rel, &err)) << err;
   std::vector<Relation> back;
@@ -163,7 +162,7 @@ TEST(Relations, LookupToleratesUnsortedAndDuplicateTimestamps) {
 
 TEST(Relations, TrajectoryFileRoundTripAndErrors) {
   Trajectory traj = {{976052857.33753, fw::Se2d(1.0 / 3, -2, 0.1)}, {976052858.5, fw::Se2d(4, 5, -3.1)}};
-  const std::string p = temp_path("traj.txt");
+  const std::string p = temp_path("rel", "traj.txt");
   std::string err;
   ASSERT_TRUE(write_trajectory(p, traj, &err)) << err;
   Trajectory back;
@@ -289,7 +288,7 @@ TEST(ReferenceTrajectory, CorruptedPosesFileIsAnError) {
       {"1 0 0 1 2 3\n2 0 0 1 2 3e5\n", "theta is 3e5, outside the plausible ±10000 rad"},
   };
   for (const auto& c : cases) {
-    const std::string p = temp_path("cp.txt");
+    const std::string p = temp_path("rel", "cp.txt");
     write_text(p, c.text);
     std::vector<CorrectedPose> out;
     std::string err;

@@ -1,5 +1,6 @@
 #include "sim/io/ros_map.h"
 
+#include "sim/common/fail.h"
 #include "sim/io/file_io.h"
 
 #include <cerrno>
@@ -16,11 +17,6 @@
 
 namespace sim {
 namespace {
-
-bool fail(std::string* error, const std::string& msg) {
-  if (error != nullptr) *error = msg;
-  return false;
-}
 
 std::string trim(const std::string& s) {
   std::size_t b = 0, e = s.size();

@@ -9,6 +9,7 @@
 #include <map>
 #include <sstream>
 
+#include "sim/common/fail.h"
 #include "sim/io/carmen_log.h"
 #include "sim/io/datasets.h"
 #include "sim/io/file_io.h"
@@ -23,11 +24,6 @@
 
 namespace sim {
 namespace {
-
-bool fail(std::string* error, const std::string& msg) {
-  if (error != nullptr) *error = msg;
-  return false;
-}
 
 bool known(const std::string& ds) {
   for (const std::string& d : global_map_datasets()) {

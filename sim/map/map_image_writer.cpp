@@ -11,15 +11,11 @@
 #include <iterator>
 
 #include "firmware/map/edt.h"
+#include "sim/common/fail.h"
 #include "sim/io/file_io.h"
 
 namespace sim {
 namespace {
-
-bool fail(std::string* error, const std::string& msg) {
-  if (error != nullptr) *error = msg;
-  return false;
-}
 
 void put_u32(std::vector<std::uint8_t>* b, std::uint32_t v) {
   for (int i = 0; i < 4; ++i) b->push_back(static_cast<std::uint8_t>(v >> (8 * i)));

@@ -1,3 +1,4 @@
+#include "sim/common/fail.h"
 #include "sim/map/occupancy_builder.h"
 
 #include <algorithm>
@@ -6,11 +7,6 @@
 
 namespace sim {
 namespace {
-
-bool fail(std::string* error, const std::string& msg) {
-  if (error != nullptr) *error = msg;
-  return false;
-}
 
 enum class BeamKind { kInvalid, kHit, kFreeOnly };
 

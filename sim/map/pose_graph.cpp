@@ -1,3 +1,4 @@
+#include "sim/common/fail.h"
 #include "sim/map/pose_graph.h"
 
 #include <Eigen/LU>
@@ -8,11 +9,6 @@ namespace {
 
 using Mat3 = Eigen::Matrix3d;
 using Vec3 = Eigen::Vector3d;
-
-bool fail(std::string* error, const std::string& msg) {
-  if (error != nullptr) *error = msg;
-  return false;
-}
 
 double chi2_of(const std::vector<fw::Se2d>& x, const std::vector<PoseGraphEdge>& edges) {
   double c = 0;

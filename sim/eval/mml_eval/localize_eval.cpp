@@ -11,16 +11,13 @@
 
 #include "firmware/base/rng.h"
 #include "sim/common/reason_list.h"
+#include "sim/common/stopwatch.h"
 #include "sim/eval/mml_eval/mml_systems.h"
 #include "sim/eval/mml_eval/reference_rest_scatter.h"
 
 namespace sim::mmleval {
 
 namespace {
-
-double since(std::chrono::steady_clock::time_point t0) {
-  return std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
-}
 
 std::size_t count_for(const std::vector<std::pair<std::string, std::size_t>>& ov, const std::string& name,
                       std::size_t def) {
@@ -224,7 +221,7 @@ void run_whole_logs(LocalizeRun& run, const LoadedDataset& ds, OwnedLocalizer& l
     const auto tk = std::chrono::steady_clock::now();
     TrialResult t = run_trial(loc, ds, start, opt);
     t.whole_log = true;
-    if (plan.verbose) progress(ds, "whole-log", k, nwhole, t, b, since(tk));
+    if (plan.verbose) progress(ds, "whole-log", k, nwhole, t, b, seconds_since(tk));
     describe_failures(ds, "whole-log", k, t, b, &run.notes, plan.verbose);
     describe_pl_exceedances(ds, "whole-log", k, t, &run.plnotes);
     whole.push_back(t);
@@ -240,7 +237,7 @@ void run_fix_trials(LocalizeRun& run, const LoadedDataset& ds, OwnedLocalizer& l
   for (std::size_t k = 0; k < starts.size(); ++k) {
     const auto tk = std::chrono::steady_clock::now();
     TrialResult t = run_trial(loc, ds, starts[k], fopt);
-    if (run.plan.verbose) progress(ds, "fix-trial", k, starts.size(), t, b, since(tk));
+    if (run.plan.verbose) progress(ds, "fix-trial", k, starts.size(), t, b, seconds_since(tk));
     describe_failures(ds, "fix-trial", k, t, b, &run.notes, run.plan.verbose);
     describe_pl_exceedances(ds, "fix-trial", k, t, &run.plnotes);
     fix.push_back(t);
@@ -293,7 +290,7 @@ bool run_mcl_baseline(LocalizeRun& run, const LoadedDataset& ds, const MetricBou
   for (std::size_t k = 0; k < std::min(plan.mcl_trials, starts.size()); ++k) {
     const auto tk = std::chrono::steady_clock::now();
     mt.push_back(run_trial(*mcl, ds, starts[k], fopt));
-    if (plan.verbose) progress(ds, label, k, std::min(plan.mcl_trials, starts.size()), mt.back(), b, since(tk));
+    if (plan.verbose) progress(ds, label, k, std::min(plan.mcl_trials, starts.size()), mt.back(), b, seconds_since(tk));
   }
   SystemSummary ms = summarize(ds.name, label, mt, mcl->static_bytes() / (1024.0 * 1024.0), b);
   run.rows.push_back(ms);
@@ -333,7 +330,7 @@ void run_kidnaps(LocalizeRun& run, const LoadedDataset& ds, OwnedLocalizer& loc,
   for (std::size_t k = 0; k < kstarts.size(); ++k) {
     const auto tk = std::chrono::steady_clock::now();
     kt.push_back(run_trial(loc, ds, kstarts[k], kopt));
-    if (plan.verbose) progress(ds, "kidnap", k, kstarts.size(), kt.back(), run.kidnap_bounds, since(tk));
+    if (plan.verbose) progress(ds, "kidnap", k, kstarts.size(), kt.back(), run.kidnap_bounds, seconds_since(tk));
     describe_failures(ds, "kidnap", k, kt.back(), b, &run.notes, plan.verbose);
     describe_pl_exceedances(ds, "kidnap", k, kt.back(), &run.plnotes);
   }
@@ -375,7 +372,7 @@ bool evaluate_dataset(LocalizeRun& run, const std::string& name, const DatasetFi
     std::printf("dataset %s: %zu scans, %.0f m of path, map %ux%u @ %.2f m, reference: %s%s (loaded in %.1f s)\n  %s\n",
                 ds.name.c_str(), ds.log.scans.size(), ds.travelled.back(), ds.map.geometry.width,
                 ds.map.geometry.height, ds.map.geometry.resolution, ds.reference_note.c_str(),
-                ds.synthetic_odometry ? " [synthetic odometry]" : "", since(t0), ds.ref_check_note.c_str());
+                ds.synthetic_odometry ? " [synthetic odometry]" : "", seconds_since(t0), ds.ref_check_note.c_str());
     std::fflush(stdout);
   }
   run.refnotes << "- " << ds.name << ": " << ds.ref_check_note << "\n";
@@ -409,7 +406,7 @@ bool evaluate_dataset(LocalizeRun& run, const std::string& name, const DatasetFi
     run_kidnaps(run, ds, *loc, b);
   }
   if (plan.verbose) {
-    std::printf("dataset %s done in %.1f s (total %.1f s)\n", ds.name.c_str(), since(t0), since(run.t_all));
+    std::printf("dataset %s done in %.1f s (total %.1f s)\n", ds.name.c_str(), seconds_since(t0), seconds_since(run.t_all));
     std::fflush(stdout);
   }
   return true;
@@ -435,7 +432,7 @@ bool run_unknown_area(LocalizeRun& run, std::string* err) {
   for (std::size_t k = 0; k < starts.size(); ++k) {
     const auto tk = std::chrono::steady_clock::now();
     ut.push_back(run_trial(*loc, ds, starts[k], uo, region));
-    if (plan.verbose) progress(ds, "unknown-area", k, starts.size(), ut.back(), b, since(tk));
+    if (plan.verbose) progress(ds, "unknown-area", k, starts.size(), ut.back(), b, seconds_since(tk));
     describe_failures(ds, "unknown-area", k, ut.back(), b, &run.notes, plan.verbose);
     describe_pl_exceedances(ds, "unknown-area", k, ut.back(), &run.plnotes);
   }
@@ -460,7 +457,7 @@ bool run_unknown_area(LocalizeRun& run, std::string* err) {
   if (plan.verbose)
     std::printf("unknown area (%s, 8 x 8 m erased): %zu in-region steps, %zu localized there (%zu wrong); integrity "
                 "failures %zu; done in %.1f s\n",
-                ds.name.c_str(), in_region, in_region_loc, in_region_wrong, us.integrity_failures, since(t0));
+                ds.name.c_str(), in_region, in_region_loc, in_region_wrong, us.integrity_failures, seconds_since(t0));
   return true;
 }
 
@@ -497,7 +494,7 @@ void write_localize_report(LocalizeRun& run) {
      << (run.plnotes.str().empty() ? std::string("none\n") : run.plnotes.str());
   if (plan.verbose)
     std::printf("\n%s\nnot localized after the first fix, by reason:\n%sreference:\n%s\ntotal %.1f s\n", table.c_str(),
-                unavailable.c_str(), run.refnotes.str().c_str(), since(run.t_all));
+                unavailable.c_str(), run.refnotes.str().c_str(), seconds_since(run.t_all));
 }
 
 }  // namespace
@@ -529,7 +526,7 @@ bool run_localize_evaluation(const LocalizePlan& plan, BenchJson* json, std::str
   if (plan.run_unknown && !run_unknown_area(run, err)) return false;
   json->add("track_step_ms_p50", percentile(run.track_ms_all, 50));
   json->add("track_step_ms_p99", percentile(run.track_ms_all, 99));
-  json->add("localize_eval_seconds", since(run.t_all));
+  json->add("localize_eval_seconds", seconds_since(run.t_all));
   write_localize_report(run);
   return true;
 }

@@ -16,6 +16,7 @@
 
 #include "firmware/base/rng.h"
 #include "firmware/map/map_image.h"
+#include "sim/common/fail.h"
 #include "sim/io/datasets.h"
 #include "sim/io/reference_trajectory.h"
 #include "sim/map/global_maps.h"
@@ -25,11 +26,6 @@
 namespace sim::mmleval {
 
 namespace {
-
-bool fail(std::string* err, const std::string& msg) {
-  if (err) *err = msg;
-  return false;
-}
 
 bool load_image(LoadedDataset* ds, std::string* err) {
   ds->arena = std::make_unique<fw::StartupArena>();

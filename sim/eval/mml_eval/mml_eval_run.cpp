@@ -9,15 +9,12 @@
 #include <limits>
 
 #include "firmware/base/rng.h"
+#include "sim/common/stopwatch.h"
 #include "sim/eval/mml_eval/mml_systems.h"
 
 namespace sim::mmleval {
 
 namespace {
-
-double since(std::chrono::steady_clock::time_point t0) {
-  return std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
-}
 
 struct SystemRun {
   std::string label;
@@ -47,7 +44,7 @@ SystemRun run_system(OwnedLocalizer& loc, const LoadedDataset& ds, const std::st
     }
   }
   r.summary = summarize(ds.name, label, r.trials, loc.static_bytes() / (1024.0 * 1024.0));
-  if (verbose) std::printf("  %-12s %-10s done in %.1f s\n", ds.name.c_str(), label.c_str(), since(t0));
+  if (verbose) std::printf("  %-12s %-10s done in %.1f s\n", ds.name.c_str(), label.c_str(), seconds_since(t0));
   return r;
 }
 
@@ -105,7 +102,7 @@ bool run_mml_configs(EvalRun& run, const LoadedDataset& ds, const std::vector<st
     auto loc = OwnedLocalizer::make_mml(ds.map, ds.image, configs[ci].cfg, plan.threads, &e);
     if (!loc) return (*err = e, false);
     if (plan.verbose) {
-      std::printf("  %s init %.1f s (precomputed table: %s)\n", configs[ci].label.c_str(), since(ti),
+      std::printf("  %s init %.1f s (precomputed table: %s)\n", configs[ci].label.c_str(), seconds_since(ti),
                   loc->mml()->using_precomputed_table() ? "yes" : "no");
     }
     SystemRun r = run_system(*loc, ds, configs[ci].label, starts, topt, plan.verbose);
@@ -200,7 +197,7 @@ bool evaluate_dataset(EvalRun& run, const std::string& name, std::string* err) {
   if (plan.verbose) {
     std::printf("dataset %s: %zu scans, %.0f m of path, map %ux%u @ %.2f m, %u points (loaded in %.1f s)\n",
                 name.c_str(), ds.log.scans.size(), ds.travelled.back(), ds.map.geometry.width, ds.map.geometry.height,
-                ds.map.geometry.resolution, ds.map.num_points, since(t0));
+                ds.map.geometry.resolution, ds.map.num_points, seconds_since(t0));
   }
   const bool mit = name == "mit-killian";
   const TrialOptions& topt = mit ? plan.trial_mit : plan.trial;
@@ -221,7 +218,7 @@ bool evaluate_dataset(EvalRun& run, const std::string& name, std::string* err) {
     run.json->add("mit_killian_mml_speedup_vs_mcl_p50", mcl_main.step_ms_p50 / mml_main.step_ms_p50);
   }
   if (!write_run_plots(plan, ds, runs, err)) return false;
-  if (plan.verbose) std::printf("dataset %s done in %.1f s\n", name.c_str(), since(t0));
+  if (plan.verbose) std::printf("dataset %s done in %.1f s\n", name.c_str(), seconds_since(t0));
   return true;
 }
 
@@ -261,7 +258,7 @@ bool run_unknown_area(EvalRun& run, std::string* err) {
       return (*err = e, false);
     }
   }
-  if (plan.verbose) std::printf("unknown area done in %.1f s\n", since(t0));
+  if (plan.verbose) std::printf("unknown area done in %.1f s\n", seconds_since(t0));
   return true;
 }
 

@@ -9,14 +9,9 @@
 #include "firmware/base/arena.h"
 #include "firmware/base/worker_pool.h"
 #include "firmware/pransam/matcher.h"
+#include "sim/common/stopwatch.h"
 
 namespace sim::pransam_eval {
-
-namespace {
-double now_ms() {
-  return std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now().time_since_epoch()).count();
-}
-}  // namespace
 
 bool run_pransam3d(const std::vector<CloudDraw>& draws, const Pransam3dConfig& config, int pool_threads,
                    MethodRun* out, std::string* error, bool verbose) {

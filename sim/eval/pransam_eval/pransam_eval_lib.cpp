@@ -8,6 +8,7 @@
 
 #include "firmware/map/map_image.h"
 #include "firmware/pransam/relation_table_io.h"
+#include "sim/common/stopwatch.h"
 #include "sim/eval/pransam_scenes.h"
 #include "sim/io/carmen_log.h"
 #include "sim/io/datasets.h"
@@ -17,9 +18,6 @@
 namespace sim::pransam_eval {
 
 namespace {
-double now_ms() {
-  return std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now().time_since_epoch()).count();
-}
 double wrap(double a) {
   while (a > M_PI) a -= 2 * M_PI;
   while (a <= -M_PI) a += 2 * M_PI;
