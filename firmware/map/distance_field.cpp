@@ -2,21 +2,15 @@
 
 #include <cstring>
 
+#include "firmware/map/le_fields.h"
+
 namespace fw {
 namespace {
-
-float load_le(const std::uint8_t* p) {
-  const std::uint32_t u = static_cast<std::uint32_t>(p[0]) | (static_cast<std::uint32_t>(p[1]) << 8) |
-                          (static_cast<std::uint32_t>(p[2]) << 16) | (static_cast<std::uint32_t>(p[3]) << 24);
-  float f;
-  std::memcpy(&f, &u, sizeof(f));
-  return f;
-}
 
 // The two sources (image bytes, a float array) read the same way.
 struct LeSource {
   const std::uint8_t* p;
-  float operator()(std::size_t i) const { return load_le(p + 4 * i); }
+  float operator()(std::size_t i) const { return read_le_f32(p + 4 * i); }
 };
 struct FloatSource {
   const float* p;

@@ -1,5 +1,5 @@
 // Little-endian fields of the map image format (map_image.h), read byte by byte so that a field may
-// sit at any alignment inside the mapped file. Shared by the image parser and the file loader.
+// sit at any alignment inside the mapped file. Shared by the image parser, the file loader and the distance field's image source.
 #pragma once
 
 #include <cstdint>

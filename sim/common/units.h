@@ -4,6 +4,5 @@
 namespace sim {
 
 inline constexpr double kRadToDeg = 57.29577951308232;  // 180 / π
-inline constexpr double kDegToRad = 0.017453292519943295;
 
 }  // namespace sim

@@ -25,6 +25,7 @@
 
 #include "sim/common/bench_json.h"
 #include "sim/common/cli_main.h"
+#include "sim/common/stopwatch.h"
 #include "sim/eval/mml_eval/localize_eval.h"
 #include "sim/io/datasets.h"
 #include "sim/io/reference_trajectory.h"
@@ -33,15 +34,13 @@
 
 namespace {
 
+using sim::seconds_since;
+
 // The thesis' 5000 iterations per loop, no early stop: a stall stop after 1000 iterations without
 // a better hypothesis saved < 1 s per log but left aces at 0.249 m instead of 0.177 m (the 28-edge
 // loop needs the long search). pRANSAM dominates the time (intel: 38 s of 77 s).
 constexpr std::uint32_t kAcoStall = 0;
 constexpr std::size_t kDeterminismScans = 2500;
-
-double seconds_since(std::chrono::steady_clock::time_point t0) {
-  return std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
-}
 
 // First-fix trials per map, 200 steps each: 20 (twice the localize benchmark's 10, so one trial is
 // 0.05 of the success rate, finer than the 0.1 target margin); ~35 s per data set and map.

@@ -4,6 +4,7 @@
 #include <cmath>
 #include <memory>
 
+#include "sim/common/stopwatch.h"
 #include "sim/io/reference_trajectory.h"
 #include "sim/io/ros_map.h"
 #include "sim/map/occupancy_builder.h"
@@ -21,10 +22,6 @@ class SteadyClock final : public hal::Clock {
             .count());
   }
 };
-
-double seconds_since(std::chrono::steady_clock::time_point t0) {
-  return std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
-}
 
 }  // namespace
 
