@@ -3,6 +3,7 @@
 #include <Eigen/Cholesky>
 #include <Eigen/LU>
 #include <cmath>
+#include <limits>
 
 #include "firmware/base/sym2_eigen.h"
 #include "firmware/map/distance_sample.h"
@@ -30,13 +31,21 @@ Status PoseTracker::init(const TrackOptions& options, const GlobalMap& map) {
   map_ = map;
   k_ = ProtectionFactors::for_risk(options.integrity_risk);
   odometry_check_.configure(options.odometry_window);
+  odom_noise_.configure(options.odom_noise_window, options.odom_noise_min_samples, options.odom_noise_min_scale,
+                        options.odom_noise_max_scale, options.integrity_risk);
   initialized_ = true;
   reset();
   return Status::ok();
 }
 
 void PoseTracker::reset() {
+  stop();
+  odom_noise_.clear();
+}
+
+void PoseTracker::stop() {
   active_ = false;
+  noise_origin_ = false;
   pose_ = Se2f();
   cov_.setZero();
   prev_odom_ = odom_at_fuse_ = Se2f();
@@ -56,7 +65,7 @@ void PoseTracker::reset() {
 }
 
 void PoseTracker::start(const Se2f& pose, const Eigen::Matrix3f& cov, const Se2f& odom) {
-  reset();
+  stop();
   active_ = initialized_;
   pose_ = pose;
   cov_ = cov * options_.init_cov_scale;
@@ -77,8 +86,12 @@ void PoseTracker::predict_to(const Se2f& odom) {
   const Se2f delta = prev_odom_.between(odom);
   prev_odom_ = odom;
   const float ds = std::hypot(delta.x, delta.y), da = std::fabs(delta.theta);
-  const float st = options_.odom_trans_per_m * ds + options_.odom_trans_per_rad * da;
-  const float sr = options_.odom_rot_per_rad * da + options_.odom_rot_per_m * ds;
+  const float st0 = options_.odom_trans_per_m * ds + options_.odom_trans_per_rad * da;
+  const float sr0 = options_.odom_rot_per_rad * da + options_.odom_rot_per_m * ds;
+  noise_model_var_t_ += st0 * st0;
+  noise_model_var_r_ += sr0 * sr0;
+  const float st = odom_noise_.scale().trans * st0;
+  const float sr = odom_noise_.scale().rot * sr0;
   Eigen::Matrix3f q = Eigen::Matrix3f::Zero();
   q(0, 0) = q(1, 1) = st * st;
   q(2, 2) = sr * sr;
@@ -397,8 +410,49 @@ PoseTracker::Update PoseTracker::propose_update(const Se2f& odom, bool predict, 
 
 // (6) The track's state after the verdict: fused (and the map bias of this scan), or the counters of
 // unsupported / faulty / outside scans and, after an innovation fault, a widened covariance.
+// Wheel-noise self-calibration (odometry_noise_estimate.h): one sample per `odom_noise_span` fused
+// scan fixes of a trusted track with only supported scans between them (a span, not one step: wheel
+// errors are correlated from step to step — a wheel base off by 1 % turns every turn wrong the same
+// way — and add up faster than the model's independent steps, which a span measures and one step
+// hides); the scans of a standing robot that are not fused keep adding the model's variance.
+void PoseTracker::sample_odometry_noise(const Se2f& odom, bool trusted, ScanVerdict v, bool fused,
+                                        const ScanAlignment& a) {
+  if (v != ScanVerdict::kSupported || !trusted) {
+    noise_origin_ = false;
+    return;
+  }
+  if (!fused) return;
+  float var_xy = std::numeric_limits<float>::infinity(), var_theta = var_xy;
+  const Eigen::Matrix3d h = a.information.cast<double>();
+  if (h.allFinite() && h.determinant() > 0.0) {
+    const Eigen::Matrix3d r = h.inverse();
+    if (r.allFinite()) {
+      var_xy = sym2_eigen(static_cast<float>(r(0, 0)), static_cast<float>(r(0, 1)), static_cast<float>(r(1, 1))).lambda_max;
+      var_theta = static_cast<float>(r(2, 2));
+    }
+  }
+  if (noise_origin_ && ++noise_span_ < options_.odom_noise_span) return;
+  if (noise_origin_) {
+    const Se2f fix = noise_fix_.between(a.pose);
+    const Se2f wheels = noise_odom_.between(odom);
+    const float rx = fix.x - wheels.x, ry = fix.y - wheels.y, rt = wrap_angle(fix.theta - wheels.theta);
+    const float snr = options_.odom_noise_min_snr;
+    if (noise_model_var_t_ >= snr * (noise_fix_var_xy_ + var_xy)) odom_noise_.add_translation(rx * rx + ry * ry, noise_model_var_t_);
+    if (noise_model_var_r_ >= snr * (noise_fix_var_theta_ + var_theta)) odom_noise_.add_rotation(rt * rt, noise_model_var_r_);
+  }
+  noise_origin_ = true;
+  noise_span_ = 0;
+  noise_fix_ = a.pose;
+  noise_odom_ = odom;
+  noise_fix_var_xy_ = var_xy;
+  noise_fix_var_theta_ = var_theta;
+  noise_model_var_t_ = noise_model_var_r_ = 0.0f;
+}
+
 void PoseTracker::apply_verdict(const Se2f& odom, const StepWork& w, const Update& u, TrackStep* out) {
   const ScanVerdict v = w.v;
+  sample_odometry_noise(odom, !had_fault_ || consistent_since_fault_ >= options_.recovery_steps, v, u.fuse,
+                        out->alignment);
   if (v == ScanVerdict::kSupported || v == ScanVerdict::kAmbiguous) {
     if (u.fuse) {
       pose_ = u.pose;
@@ -467,6 +521,7 @@ void PoseTracker::publish(const Point2f* points, std::size_t n, const StepWork& 
   out->pl.xy_m += excess_xy_m_;
   out->pl.theta_rad += excess_theta_rad_;
   out->unsupported_steps = unsupported_;
+  out->odom_noise = odom_noise_.scale();
   out->faulty_steps = faulty_;
   out->outside_steps = outside_;
   const bool within = out->pl.xy_m <= o.alert_limit_m && out->pl.theta_rad <= o.alert_limit_rad;

@@ -27,6 +27,7 @@
 #include "firmware/base/status.h"
 #include "firmware/map/global_map.h"
 #include "firmware/track/odometry_consistency.h"
+#include "firmware/track/odometry_noise_estimate.h"
 #include "firmware/track/correlative_search.h"
 #include "firmware/track/protection_level.h"
 #include "firmware/track/scan_alignment.h"
@@ -80,13 +81,17 @@ struct TrackStep {
   bool alias_rival_credible = false;
   std::uint32_t search_candidates = 0;  // correlative pre-search (0 = not run: prediction tight)
   bool search_moved = false;            // the alignment started from the search's best pose
+  OdometryNoiseScale odom_noise;        // wheel-noise self-calibration in use (odometry_noise_estimate.h)
   ScanAlignment alignment;
 };
 
 class PoseTracker {
  public:
   Status init(const TrackOptions& options, const GlobalMap& map);
+  // A fresh start (a new trial): no track, and the wheel-noise estimate forgotten.
   void reset();
+  // Ends the track (back to global localization); what was learnt about the wheels is kept.
+  void stop();
   bool active() const { return active_; }
   // Starts a track at a global fix (`cov` = the fix's covariance, inflated and floored per options).
   void start(const Se2f& pose, const Eigen::Matrix3f& cov, const Se2f& odom);
@@ -131,6 +136,15 @@ class PoseTracker {
   // which halves its cost at the 360 points of the alignment and keeps one point = 1/180 of the cost.
   static constexpr std::size_t kAliasMaxPoints = 180;
   Point2f alias_points_[kAliasMaxPoints];
+  // Wheel-noise self-calibration: the origin of the next increment sample (a trusted fused scan
+  // fix, its odometry, its variances) and the model's variance accumulated since, at the configured α.
+  void sample_odometry_noise(const Se2f& odom, bool trusted, ScanVerdict v, bool fused, const ScanAlignment& a);
+  OdometryNoiseEstimate odom_noise_;
+  bool noise_origin_ = false;
+  std::uint32_t noise_span_ = 0;  // fused scans since the origin
+  Se2f noise_fix_, noise_odom_;
+  float noise_fix_var_xy_ = 0.0f, noise_fix_var_theta_ = 0.0f;
+  float noise_model_var_t_ = 0.0f, noise_model_var_r_ = 0.0f;
   OdometryConsistency odometry_check_;
   TrackOptions options_;
   GlobalMap map_;

@@ -57,6 +57,19 @@ Status TrackOptions::validate() const {
   FW_RETURN_IF_ERROR(check_range("odom_trans_per_rad", odom_trans_per_rad, 0.0f, 10.0f));
   FW_RETURN_IF_ERROR(check_range("odom_rot_per_rad", odom_rot_per_rad, 0.0f, 10.0f));
   FW_RETURN_IF_ERROR(check_range("odom_rot_per_m", odom_rot_per_m, 0.0f, 10.0f));
+  if (odom_noise_window > 128 || (odom_noise_window > 0 && (odom_noise_min_samples < 2 ||
+                                                            odom_noise_min_samples > odom_noise_window))) {
+    return Status::error(Errc::kInvalidArgument,
+                         "TrackOptions.odom_noise_window = %u / odom_noise_min_samples = %u: window at most 128, "
+                         "min_samples in [2, window]", odom_noise_window, odom_noise_min_samples);
+  }
+  if (odom_noise_span < 1 || odom_noise_span > 1000) {
+    return Status::error(Errc::kInvalidArgument, "TrackOptions.odom_noise_span = %u out of range [1, 1000]",
+                         odom_noise_span);
+  }
+  FW_RETURN_IF_ERROR(check_range("odom_noise_min_snr", odom_noise_min_snr, 1.0f, 1000.0f));
+  FW_RETURN_IF_ERROR(check_range("odom_noise_min_scale", odom_noise_min_scale, 0.01f, 1.0f));
+  FW_RETURN_IF_ERROR(check_range("odom_noise_max_scale", odom_noise_max_scale, odom_noise_min_scale, 10.0f));
   FW_RETURN_IF_ERROR(check_range("max_odom_step_m", max_odom_step_m, 0.01f, 100.0f));
   FW_RETURN_IF_ERROR(check_range("max_odom_step_rad", max_odom_step_rad, 0.01f, 6.3f));
   FW_RETURN_IF_ERROR(check_range("update_min_d_m", update_min_d_m, 0.0f, 10.0f));

@@ -137,7 +137,7 @@ bool TrackedLocalizer::start_from_fix(const hal::PoseEstimate& g, const Se2f& wh
     return true;
   }
   ++fix_rejections_;
-  tracker_.reset();
+  tracker_.stop();
   out->status = hal::LocalizationStatus::kAmbiguous;
   out->reason = hal::StatusReason::kFixRejected;
   out->mode = hal::LocalizationMode::kGlobal;

@@ -50,6 +50,7 @@ const char kUsage[] =
     "                [--fix-steps 200] [--mcl-trials 3] [--mcl-datasets intel,fr079] [--kidnap-runs 2]\n"
     "                [--kidnap-datasets intel,fr079,aces] [--no-unknown] [--seed 1] [--threads 2] [--out DIR]\n"
     "                [--no-pool] [--global ref|live|live-deadline] [--odom-noise TT,TR,RR,RT]\n"
+    "                [--odom-adapt]\n"
     "       mml-eval --log LOG.clf[.gz] --map MAP.yaml|MAP.mmap --reference POSES.txt|CORRECTED.log[.gz]\n"
     "                [--relations R] [--name NAME] [--synthetic-odometry]   (any building by path)\n"
     "Datasets (--datasets, --mcl-datasets, --kidnap-datasets): intel, fr079, aces, mit-killian, fr-clinic,\n"
@@ -59,7 +60,8 @@ const char kUsage[] =
     "Your own building: --log RAW.clf --map MAP.yaml or MAP.mmap (a compiled image: its relation table is\n"
     "used) --reference REF (REF: 'mml-carmen reference' rows or a CARMEN log with one pose per scan of\n"
     "RAW). --odom-noise: the tracker's odometry noise model (mmlfw's config key odom_noise; default\n"
-    "0.2,0.2,0.2,0.2). Definitions of every figure: sim/eval/mml_eval/README.md.\n";
+    "0.2,0.2,0.2,0.2). --odom-adapt: the tracker's wheel-noise self-calibration (off by default;\n"
+    "firmware/track/track_options.h says why). Definitions of every figure: sim/eval/mml_eval/README.md.\n";
 int usage(const char* msg) {
   std::fprintf(stderr, "mml-eval: %s\n%s", msg, kUsage);
   return 2;
@@ -134,6 +136,7 @@ static int run_main(int argc, char** argv) {
     else if (a == "--no-keep-support") lp.keep_support_across_empty_steps = false;
     else if (a == "--keep-contested") lp.keep_support_across_contested_steps = true;
     else if (a == "--no-keep-contested") lp.keep_support_across_contested_steps = false;
+    else if (a == "--odom-adapt") { lp.track.odom_noise_window = 64; localize = true; }
     else if (a == "--odom-noise") {
       const std::string v = str();
       if (!sim::mmleval::set_odom_noise(v, &lp.track)) {

@@ -162,9 +162,10 @@ static bool parse_odom_noise(const std::map<std::string, std::string>& options, 
 
 // The product's system (firmware default): MML fix confirmed and tracked with a protection level.
 // Options: config=1..4, correct=0|1, reduce=0|1, pool=0|1, keep=0|1, contested=0|1, rivals=0|1 (MML part); alert=M (alert limit, metres);
-// odom_noise=TT,TR,RR,RT (the tracker's odometry noise model, as mmlfw's config key odom_noise).
+// odom_noise=TT,TR,RR,RT (the tracker's odometry noise model, as mmlfw's config key odom_noise);
+// odom_adapt=0|1 (wheel-noise self-calibration, TrackOptions::odom_noise_window 64; 0 = default).
 std::unique_ptr<fw::Localizer> make_track_localizer(const LocalizerContext& ctx, std::string* err) {
-  const std::string bad = check_keys("mml-track", ctx.options, {"config", "correct", "reduce", "pool", "keep", "contested", "rivals", "alert", "odom_noise"});
+  const std::string bad = check_keys("mml-track", ctx.options, {"config", "correct", "reduce", "pool", "keep", "contested", "rivals", "alert", "odom_noise", "odom_adapt"});
   if (!bad.empty()) { *err = bad; return nullptr; }
   if (ctx.global_map == nullptr) { *err = "localizer mml-track: needs a global map"; return nullptr; }
   long config = 3;
@@ -184,6 +185,9 @@ std::unique_ptr<fw::Localizer> make_track_localizer(const LocalizerContext& ctx,
     if (to.lost_limit_m < to.alert_limit_m) to.lost_limit_m = to.alert_limit_m;
   }
   if (!parse_odom_noise(ctx.options, &to, err)) return nullptr;
+  long adapt = 0;
+  if (!parse_int(ctx.options, "odom_adapt", 0, 1, &adapt, "mml-track", err)) return nullptr;
+  if (adapt == 1) to.odom_noise_window = 64;
   static const std::vector<std::uint8_t> kEmpty;
   return wrap_hooks(OwnedLocalizer::make_track(*ctx.global_map, ctx.map_image ? *ctx.map_image : kEmpty, cfg, to,
                                                ctx.threads, err),
