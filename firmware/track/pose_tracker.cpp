@@ -88,8 +88,10 @@ void PoseTracker::predict_to(const Se2f& odom) {
   const float ds = std::hypot(delta.x, delta.y), da = std::fabs(delta.theta);
   const float st0 = options_.odom_trans_per_m * ds + options_.odom_trans_per_rad * da;
   const float sr0 = options_.odom_rot_per_rad * da + options_.odom_rot_per_m * ds;
-  noise_model_var_t_ += st0 * st0;
-  noise_model_var_r_ += sr0 * sr0;
+  if (options_.odom_noise_window > 0) {
+    noise_model_var_t_ += st0 * st0;
+    noise_model_var_r_ += sr0 * sr0;
+  }
   const float st = odom_noise_.scale().trans * st0;
   const float sr = odom_noise_.scale().rot * sr0;
   Eigen::Matrix3f q = Eigen::Matrix3f::Zero();
@@ -408,8 +410,6 @@ PoseTracker::Update PoseTracker::propose_update(const Se2f& odom, bool predict, 
   return u;
 }
 
-// (6) The track's state after the verdict: fused (and the map bias of this scan), or the counters of
-// unsupported / faulty / outside scans and, after an innovation fault, a widened covariance.
 // Wheel-noise self-calibration (odometry_noise_estimate.h): one sample per `odom_noise_span` fused
 // scan fixes of a trusted track with only supported scans between them (a span, not one step: wheel
 // errors are correlated from step to step — a wheel base off by 1 % turns every turn wrong the same
@@ -417,6 +417,7 @@ PoseTracker::Update PoseTracker::propose_update(const Se2f& odom, bool predict, 
 // hides); the scans of a standing robot that are not fused keep adding the model's variance.
 void PoseTracker::sample_odometry_noise(const Se2f& odom, bool trusted, ScanVerdict v, bool fused,
                                         const ScanAlignment& a) {
+  if (options_.odom_noise_window == 0) return;  // off: the configured model, nothing to measure
   if (v != ScanVerdict::kSupported || !trusted) {
     noise_origin_ = false;
     return;
@@ -449,6 +450,8 @@ void PoseTracker::sample_odometry_noise(const Se2f& odom, bool trusted, ScanVerd
   noise_model_var_t_ = noise_model_var_r_ = 0.0f;
 }
 
+// (6) The track's state after the verdict: fused (and the map bias of this scan), or the counters of
+// unsupported / faulty / outside scans and, after an innovation fault, a widened covariance.
 void PoseTracker::apply_verdict(const Se2f& odom, const StepWork& w, const Update& u, TrackStep* out) {
   const ScanVerdict v = w.v;
   sample_odometry_noise(odom, !had_fault_ || consistent_since_fault_ >= options_.recovery_steps, v, u.fuse,
