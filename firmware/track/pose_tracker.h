@@ -171,6 +171,7 @@ class PoseTracker {
   // Fit of the previous scan with enough points on known cells (inlier fraction, correlation
   // cells), the reference of the fit-drop test (judge_scan); fit_cells_ = 0 until there is one.
   float fit_fraction_ = 0.0f;
+  float fit_rms_m_ = 0.0f;  // RMS residual of its inliers (the fit-drop test's residual form)
   std::uint32_t fit_cells_ = 0;
   TrackStep last_;
 };

@@ -108,6 +108,9 @@ struct TrackOptions {
   // pose: what a robot carried elsewhere sees first, when that scan still fits near the old pose.
   // 3.09 = one-sided 1e-3, the integrity risk. 0 = off.
   float fit_drop_z = 3.09f;
+  // The same test on the residuals: the inliers' variance rising against the previous scan's by an F
+  // test at fit_drop_z (pose_tracker.cpp, judge_scan). false = the inlier fraction only.
+  bool fit_drop_rms = true;
   // χ²(3) at 1 − 1e-3: scan fix vs odometry prediction; a fault only when the fix also lies outside
   // the prediction's protection level.
   float innovation_chi2 = 16.27f;
