@@ -65,9 +65,10 @@ void PoseTracker::stop() {
   last_ = TrackStep();
 }
 
-void PoseTracker::start(const Se2f& pose, const Eigen::Matrix3f& cov, const Se2f& odom) {
+void PoseTracker::start(const Se2f& pose, const Eigen::Matrix3f& cov, const Se2f& odom, bool confirm) {
   stop();
   active_ = initialized_;
+  had_fault_ = contradicted_ = confirm;
   pose_ = pose;
   cov_ = cov * options_.init_cov_scale;
   const float fxy = options_.init_sigma_xy_floor_m * options_.init_sigma_xy_floor_m;

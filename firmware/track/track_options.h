@@ -198,6 +198,13 @@ struct TrackOptions {
   // always count (intel kidnap: rivals 5–10° turned), and so do rivals that fit better than the fix at
   // alias_credible_z. false = every alias beyond the alert limits waits.
   bool alias_rival_must_be_credible = true;
+  // A track started from MML's fix is `localized` only after recovery_steps unique consistent scans,
+  // as after a fault, and rules out no alias rival until then (check_aliases). One scan can be fit
+  // at a wrong local minimum next to MML's pose; consecutive scans from moving poses rarely all are
+  // (fr-clinic, kidnap stress seed 11 trial 5, MML at 30 m: the re-fix's first scan fit best 7.4° from
+  // the truth with an RMS residual of 0.14 m and was published `localized` 0.50 m / 7.4° off; its
+  // next scan was already ambiguous). false = MML's fix is `localized` on its first consistent scan.
+  bool confirm_fix = true;
   // Protection level (protection_level.h): integrity risk per `localized` step and alert limits.
   float integrity_risk = 1e-3f;
   float alert_limit_m = 0.5f;             // PL beyond → not `localized` (the product's 0.5 m bound)
