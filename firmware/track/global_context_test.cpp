@@ -59,7 +59,9 @@ TEST(GlobalContextTest, LiveScheduleInlineLocalizes) {
   EXPECT_EQ(wrong, 0);
   const GlobalContext& gc = rig.loc->global_context();
   EXPECT_GT(gc.jobs(), 0u);
-  EXPECT_LE(gc.jobs(), static_cast<std::uint64_t>(first) / kGlobalContext.period_scans + 2)
+  // MML keeps running after the fix while the track confirms it (TrackOptions::confirm_fix) and the
+  // background cross-check runs on, but never on more scans than the schedule gives it.
+  EXPECT_LE(gc.jobs(), static_cast<std::uint64_t>(rec.size()) / kGlobalContext.period_scans + 2)
       << "MML ran on more scans than the schedule gives it";
   EXPECT_EQ(gc.overruns(), 0u);
 }

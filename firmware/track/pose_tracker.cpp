@@ -59,14 +59,16 @@ void PoseTracker::stop() {
   had_fault_ = false;
   contradicted_ = false;
   fit_fraction_ = 0.0f;
+  fit_rms_m_ = 0.0f;
   fit_cells_ = 0;
   odometry_check_.clear();
   last_ = TrackStep();
 }
 
-void PoseTracker::start(const Se2f& pose, const Eigen::Matrix3f& cov, const Se2f& odom) {
+void PoseTracker::start(const Se2f& pose, const Eigen::Matrix3f& cov, const Se2f& odom, bool confirm) {
   stop();
   active_ = initialized_;
+  had_fault_ = contradicted_ = confirm;
   pose_ = pose;
   cov_ = cov * options_.init_cov_scale;
   const float fxy = options_.init_sigma_xy_floor_m * options_.init_sigma_xy_floor_m;
@@ -106,6 +108,12 @@ void PoseTracker::predict_to(const Se2f& odom) {
 }
 
 namespace {
+// Normal deviate of F with (d1, d2) degrees of freedom (Paulson's approximation of the F distribution).
+float f_test_z(float f, float d1, float d2) {
+  const float a1 = 2.0f / (9.0f * d1), a2 = 2.0f / (9.0f * d2);
+  const float c = std::cbrt(f);
+  return ((1.0f - a2) * c - (1.0f - a1)) / std::sqrt(a2 * c * c + a1);
+}
 bool outside_bound(const Eigen::Vector3f& e, const ProtectionLevel& pl) {
   return std::hypot(e(0), e(1)) > pl.xy_m || std::fabs(e(2)) > pl.theta_rad;
 }
@@ -221,6 +229,7 @@ TrackStep PoseTracker::step(const Point2f* points, std::size_t n, const Se2f& od
   // scan is compared with the dropped one, so a place that fits worse faults once, not at every scan.
   if (out.alignment.inliers + out.alignment.contradicting >= o.min_points) {
     fit_fraction_ = out.alignment.inlier_fraction();
+    fit_rms_m_ = out.alignment.rms_m;
     fit_cells_ = out.alignment.independent;
   }
   publish(points, n, w, &out);
@@ -278,6 +287,20 @@ void PoseTracker::judge_scan(const Point2f* points, std::size_t n, bool odom_jum
       w->v = ScanVerdict::kContradicting;
       out->fit_drop = true;
       return;
+    }
+    // The same drop seen in the residuals: the inliers' variance against the previous scan's (F test,
+    // the correlation cells as degrees of freedom, the previous RMS floored at the per-point noise
+    // floor). The 0.3 m inlier gate hides a place that fits only roughly (intel kidnap 4658 → 6330,
+    // 15 m and 28° away: inliers 1.00 → 0.87 of 19 → 20 cells, z 1.7, but the RMS 0.023 → 0.105 m,
+    // F 21; `localized` 15.1 m off for one scan without this).
+    if (o.fit_drop_rms && a.inliers > 0 && fit_rms_m_ >= 0.0f) {
+      const float ref = std::fmax(fit_rms_m_, o.align.min_sigma_m);
+      const float f = (a.rms_m * a.rms_m) / (ref * ref);
+      if (f > 1.0f && f_test_z(f, n2, n1) > o.fit_drop_z) {
+        w->v = ScanVerdict::kContradicting;
+        out->fit_drop = true;
+        return;
+      }
     }
   }
   // Innovation of the scan fix against the prediction: d² = eᵀ S⁻¹ e with S = P⁻ + H⁻¹, computed as

@@ -94,7 +94,9 @@ class PoseTracker {
   void stop();
   bool active() const { return active_; }
   // Starts a track at a global fix (`cov` = the fix's covariance, inflated and floored per options).
-  void start(const Se2f& pose, const Eigen::Matrix3f& cov, const Se2f& odom);
+  // `confirm`: the pose is not `localized` until recovery_steps unique consistent scans have followed
+  // (as after a fault), and no alias rival is ruled out until then (TrackOptions::confirm_fix).
+  void start(const Se2f& pose, const Eigen::Matrix3f& cov, const Se2f& odom, bool confirm = false);
   // One scan: `points` in the sensor frame (beam order), `odom` the wheel odometry pose at the scan.
   // `predict` = false checks/fuses the scan at the current pose without an odometry step (the scan
   // the track was started on). Returns the published view; `lost` ends the track (active() false).
@@ -171,6 +173,7 @@ class PoseTracker {
   // Fit of the previous scan with enough points on known cells (inlier fraction, correlation
   // cells), the reference of the fit-drop test (judge_scan); fit_cells_ = 0 until there is one.
   float fit_fraction_ = 0.0f;
+  float fit_rms_m_ = 0.0f;  // RMS residual of its inliers (the fit-drop test's residual form)
   std::uint32_t fit_cells_ = 0;
   TrackStep last_;
 };

@@ -293,6 +293,69 @@ TEST(PoseTrackerTest, ScanThatSuddenlyFitsWorseIsAFault) {
   }
 }
 
+// TrackOptions::fit_drop_rms (extension, off by default): a scan whose points still all lie within
+// the inlier gate but scatter about the walls far more than the previous scan's is a fault only with
+// the residual (F) form of the fit-drop test; the inlier-fraction form cannot see it.
+TEST(PoseTrackerTest, ResidualsThatRiseAreAFaultOnlyWithTheRmsTest) {
+  const Se2f a(4.5f, 6.0f, -0.4f);
+  for (const bool rms : {false, true}) {
+    PoseTracker t;
+    TrackOptions o;
+    o.fit_drop_rms = rms;
+    ASSERT_TRUE(t.init(o, room_map().map).is_ok());
+    RandomStream rng(43, 0);
+    t.start(a, small_cov(), Se2f());
+    for (int i = 0; i < 3; ++i) {
+      const auto pts = testing::scan_at(room(), a, &rng);
+      ASSERT_EQ(t.step(pts.data(), pts.size(), Se2f(), false).status, hal::LocalizationStatus::kLocalized) << i;
+    }
+    auto pts = testing::scan_at(room(), a, &rng);
+    for (std::size_t k = 0; k < pts.size(); ++k) {  // every point 0.15 m nearer or farther, alternately
+      const float r = std::hypot(pts[k].x(), pts[k].y());
+      const float f = (r + (k % 2 == 0 ? 0.15f : -0.15f)) / r;
+      pts[k] = Point2f(pts[k].x() * f, pts[k].y() * f);
+    }
+    const TrackStep s = t.step(pts.data(), pts.size(), Se2f(), false);
+    ASSERT_GE(s.alignment.inlier_fraction(), 0.9f) << "the scatter stays within the inlier gate";
+    EXPECT_EQ(s.fit_drop, rms) << "rms " << rms << ": residual RMS " << s.alignment.rms_m;
+    if (rms) {
+      EXPECT_EQ(s.verdict, ScanVerdict::kContradicting);
+      EXPECT_NE(s.status, hal::LocalizationStatus::kLocalized);
+    }
+  }
+}
+
+// TrackOptions::confirm_fix: a track started from a global fix with `confirm` publishes
+// `track-recovering` (never `localized`) until recovery_steps consistent scans have followed, as after
+// a fault; without it the first consistent scan is `localized`.
+TEST(PoseTrackerTest, ConfirmedStartIsLocalizedOnlyAfterRecoverySteps) {
+  const auto path = mml::testing::waypoint_path({{1.5f, 1.5f}, {1.5f, 6.5f}}, 0.1f);
+  for (const bool confirm : {false, true}) {
+    PoseTracker t;
+    const TrackOptions o;
+    ASSERT_TRUE(t.init(o, room_map().map).is_ok());
+    RandomStream rng(5, 0);
+    Se2f odom(0, 0, 0);
+    t.start(path[0], small_cov(), odom, confirm);
+    int first_localized = -1;
+    for (std::size_t i = 0; i < path.size(); ++i) {
+      if (i > 0) odom = odom.compose(path[i - 1].between(path[i]));
+      const auto pts = testing::scan_at(room(), path[i], &rng);
+      const TrackStep s = t.step(pts.data(), pts.size(), odom, i > 0);
+      ASSERT_FALSE(s.lost) << i;
+      const bool loc = s.status == hal::LocalizationStatus::kLocalized;
+      if (first_localized < 0 && loc) first_localized = static_cast<int>(i);
+      if (first_localized < 0) {
+        EXPECT_EQ(s.reason, hal::StatusReason::kTrackRecovering) << "confirm " << confirm << " step " << i;
+      } else {
+        EXPECT_TRUE(loc) << "confirm " << confirm << " step " << i << ": dropped on a clean path";
+      }
+    }
+    if (confirm) EXPECT_EQ(first_localized, static_cast<int>(o.recovery_steps) - 1);
+    else EXPECT_EQ(first_localized, 0);
+  }
+}
+
 // An odometry increment no robot can make between two scans cannot carry the pose.
 TEST(PoseTrackerTest, OdometryJumpContradicts) {
   PoseTracker t;

@@ -108,6 +108,13 @@ struct TrackOptions {
   // pose: what a robot carried elsewhere sees first, when that scan still fits near the old pose.
   // 3.09 = one-sided 1e-3, the integrity risk. 0 = off.
   float fit_drop_z = 3.09f;
+  // Extension, off: the same test on the residuals, the inliers' variance rising against the previous
+  // scan's by an F test at fit_drop_z (pose_tracker.cpp, judge_scan). It caught one kidnap the inlier
+  // test missed (intel 4658 → 6330: inliers 1.00 → 0.87, RMS 0.023 → 0.105 m), but the residuals of
+  // real scans vary far more from scan to scan than an F test over the correlation cells assumes:
+  // on whole runs it faulted right poses again and again (fr101 availability 0.95 → 0.70, fr-campus
+  // 0.54 → 0.45, intel 0.94 → 0.91; README "Protection level"). false = the inlier fraction only.
+  bool fit_drop_rms = false;
   // χ²(3) at 1 − 1e-3: scan fix vs odometry prediction; a fault only when the fix also lies outside
   // the prediction's protection level.
   float innovation_chi2 = 16.27f;
@@ -195,6 +202,13 @@ struct TrackOptions {
   // always count (intel kidnap: rivals 5–10° turned), and so do rivals that fit better than the fix at
   // alias_credible_z. false = every alias beyond the alert limits waits.
   bool alias_rival_must_be_credible = true;
+  // A track started from MML's fix is `localized` only after recovery_steps unique consistent scans,
+  // as after a fault, and rules out no alias rival until then (check_aliases). One scan can be fit
+  // at a wrong local minimum next to MML's pose; consecutive scans from moving poses rarely all are
+  // (fr-clinic, kidnap stress seed 11 trial 5, MML at 30 m: the re-fix's first scan fit best 7.4° from
+  // the truth with an RMS residual of 0.14 m and was published `localized` 0.50 m / 7.4° off; its
+  // next scan was already ambiguous). false = MML's fix is `localized` on its first consistent scan.
+  bool confirm_fix = true;
   // Protection level (protection_level.h): integrity risk per `localized` step and alert limits.
   float integrity_risk = 1e-3f;
   float alert_limit_m = 0.5f;             // PL beyond → not `localized` (the product's 0.5 m bound)

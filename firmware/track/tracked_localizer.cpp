@@ -128,9 +128,14 @@ bool TrackedLocalizer::start_from_fix(const hal::PoseEstimate& g, const Se2f& wh
   Eigen::Matrix3f cov;
   for (int r = 0; r < 3; ++r)
     for (int c = 0; c < 3; ++c) cov(r, c) = g.cov[r * 3 + c];
-  tracker_.start(Se2f(g.x, g.y, g.theta), cov, wheel);
+  const bool confirm = tracker_.options().confirm_fix;
+  tracker_.start(Se2f(g.x, g.y, g.theta), cov, wheel, confirm);
   const TrackStep ts = tracker_.step(pts_, n, wheel, /*predict=*/false);
-  if (ts.status == hal::LocalizationStatus::kLocalized && !ts.lost) {
+  // The scan must support MML's pose; with confirm_fix every test but the hysteresis must pass
+  // (the scan is consistent, unique, within the alert limits), and the track then recovers.
+  const bool accepted = confirm ? ts.reason == hal::StatusReason::kTrackRecovering
+                                : ts.status == hal::LocalizationStatus::kLocalized;
+  if (accepted && !ts.lost) {
     ++fixes_;
     unconfirmed_ = false;  // MML has just isolated this pose
     publish_track(ts, out);
