@@ -383,9 +383,9 @@ run:
                           rings (none, default); through our CAN encoder, the hal/sim loopback bus and
                           the firmware's CanNode decoder (can); scans as SICK LMS2xx telegrams on the
                           hal/sim serial port through the firmware's SickLaser driver (sick)
-  --sensor-resolution exact|can|sick  what the simulated sensors report: exact floats (default with
-                          --transport none) or what that wire carries (always with can / sick); with
-                          --timing none, `none --sensor-resolution X` and `X` give the same steps.csv
+  --sensor-resolution exact|can|sick  what the simulated sensors report: what a wire carries (can:
+                          the default with --transport none, so none and can give the same steps.csv
+                          with --timing none; sick: always with --transport sick) or exact floats
   --byte-fault-rate P     with --transport can|sick: drop or bit-flip each frame / telegram with
                           probability P (seeded by --seed); the firmware's decoder drops and counts
                           what it cannot use (summary.json, summary line)

@@ -2,16 +2,17 @@
 # Drivers in every simulation (issue 16): mml-sim through the firmware's drivers (--transport can:
 # our CAN encoder -> hal/sim loopback bus -> CanNode; --transport sick: SICK LMS2xx telegrams ->
 # hal/sim serial port -> SickLaser) gives the same steps.csv as the direct path fed the same sensor
-# values (--transport none --sensor-resolution X: what that wire carries), byte for byte, with
-# --timing none; byte faults are dropped, counted and reported, never a crash.
+# values, byte for byte, with --timing none: plain --transport none for can (its sensors report the
+# CAN wire's values by default), --transport none --sensor-resolution sick for sick; byte faults are
+# dropped, counted and reported, never a crash. Exit 77 (skipped) without the data directory.
 # Usage: transport_test.sh MML_SIM can|sick SOURCE-ARGS...   (e.g. can --world small-office --steps 150)
 set -eu
 sim=$1
 tr=$2
 shift 2
 if [ "$1" = "--dataset" ] && [ ! -d "${MMLFW_DATA_DIR:-/nonexistent}" ]; then
-  echo "no data dir: skipped"
-  exit 0
+  echo "SKIP: no data directory (MMLFW_DATA_DIR=${MMLFW_DATA_DIR:-unset})"
+  exit 77
 fi
 case $tr in
   can) dropped_key=decoder_scans_dropped; rate=0.01 ;;   # per CAN frame (126 per 361-beam scan)
@@ -20,13 +21,15 @@ case $tr in
 esac
 t=$(mktemp -d)
 trap 'rm -rf "$t"' EXIT
-"$sim" "$@" --transport none --sensor-resolution "$tr" --timing none --quiet --no-pictures --out "$t/none" > "$t/none.txt"
+if [ "$tr" = can ]; then res=""; else res="--sensor-resolution $tr"; fi
+# shellcheck disable=SC2086  # $res is empty or two words
+"$sim" "$@" --transport none $res --timing none --quiet --no-pictures --out "$t/none" > "$t/none.txt"
 "$sim" "$@" --transport "$tr" --timing none --quiet --no-pictures --out "$t/drv" > "$t/drv.txt"
 grep -q "\"transport\": \"$tr\"" "$t/drv/summary.json"
 grep -q "\"$dropped_key\": 0[,]*\$" "$t/drv/summary.json"
 if ! cmp "$t/none/steps.csv" "$t/drv/steps.csv"; then
   diff "$t/none/steps.csv" "$t/drv/steps.csv" | head -20
-  echo "FAIL: --transport $tr differs from --transport none --sensor-resolution $tr"
+  echo "FAIL: --transport $tr differs from --transport none $res"
   exit 1
 fi
 echo "identical: $(wc -l < "$t/none/steps.csv") lines of steps.csv, $(md5sum < "$t/none/steps.csv" | cut -c1-32)"

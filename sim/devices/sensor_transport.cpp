@@ -93,6 +93,11 @@ class FixedClock final : public hal::Clock {
   std::uint64_t t_ns = 0;
 };
 
+}  // namespace
+
+// Named (not anonymous): fields of SensorTransport::Parts, a class with linkage.
+namespace transport_detail {
+
 // Scans the SickLaser delivers carry its own counter; the simulator needs its step index back. The
 // device side notes (sample time, index) per telegram, and a delivered scan (stamped at receipt,
 // which in lockstep is its sample time) takes the index of its time; telegrams lost on the way are
@@ -124,7 +129,7 @@ class IndexedSickLaser final : public hal::LaserScanSource {
   fw::RingBuffer<Sent, 64> sent_;
 };
 
-}  // namespace
+}  // namespace transport_detail
 
 void to_sick_resolution(hal::LaserScan* scan, float fov_rad) {
   if (scan->beam_count == 0) return;
@@ -147,7 +152,7 @@ void to_sick_resolution(hal::LaserScan* scan, float fov_rad) {
   if (rt->laser.poll(scan)) scan->scan_id = id;
 }
 
-namespace {
+namespace transport_detail {
 
 // The wire carries 16 bits of the scan id; the simulator finds a step's truth by the full index,
 // so the ids the CanNode delivers are extended (they only grow in a run). A robot's loop sees the
@@ -174,9 +179,11 @@ class UnwrappedLaser final : public hal::LaserScanSource {
   bool have_last_ = false;
 };
 
-}  // namespace
+}  // namespace transport_detail
 
 struct SensorTransport::Parts {
+  using UnwrappedLaser = transport_detail::UnwrappedLaser;
+  using IndexedSickLaser = transport_detail::IndexedSickLaser;
   hal_sim::SimCanBus bus;
   hal_can::CanNode node;
   UnwrappedLaser laser{&node.laser()};
@@ -200,9 +207,10 @@ bool SensorTransport::init(const TransportOptions& options, const hal::Clock* cl
     return false;
   }
   options_ = options;
-  const SensorResolution own = options.transport == Transport::kCan    ? SensorResolution::kCan
-                               : options.transport == Transport::kSick ? SensorResolution::kSick
-                                                                       : SensorResolution::kExact;
+  const SensorResolution own = options.transport == Transport::kSick ? SensorResolution::kSick : SensorResolution::kCan;
+  // The direct path's sensors report what the product's own wire carries (CAN: ranges in mm, angles
+  // in µrad, times in µs), as the firmware on a robot only ever sees: `--transport none` and
+  // `--transport can` give the same run. Exact floats only when asked for (kExact).
   if (options_.resolution == SensorResolution::kAuto) options_.resolution = own;
   if (options_.transport != Transport::kNone && options_.resolution != own) {
     *err = std::string("--sensor-resolution: --transport ") + transport_name(options.transport) +

@@ -45,7 +45,8 @@ namespace sim {
 
 enum class Transport : std::uint8_t { kNone, kCan, kSick };
 // What the simulated sensors report: exact floats, or the values a wire carries. kAuto: the
-// transport's own (the only possible one with can / sick), kExact with none.
+// transport's own (the only possible one with can / sick); with none, the CAN wire's (the product's
+// wire: a robot's firmware never sees more than it carries), so none and can give the same run.
 enum class SensorResolution : std::uint8_t { kAuto, kExact, kCan, kSick };
 const char* transport_name(Transport t);
 // false for an unknown name (expected none, can or sick).
