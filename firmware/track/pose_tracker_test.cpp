@@ -25,6 +25,17 @@ Eigen::Matrix3f small_cov() {
 
 float err_xy(const Se2f& a, const Se2f& b) { return std::hypot(a.x - b.x, a.y - b.y); }
 
+// Initialises `t` with `o`, starts it at `a` and feeds it three scans seen from there; each must be
+// `localized`.
+void settle_at(PoseTracker* t, const TrackOptions& o, const Se2f& a, RandomStream* rng) {
+  ASSERT_TRUE(t->init(o, room_map().map).is_ok());
+  t->start(a, small_cov(), Se2f());
+  for (int i = 0; i < 3; ++i) {
+    const auto pts = testing::scan_at(room(), a, rng);
+    ASSERT_EQ(t->step(pts.data(), pts.size(), Se2f(), false).status, hal::LocalizationStatus::kLocalized) << i;
+  }
+}
+
 // Drives along a path with noisy odometry: every `localized` pose is inside its protection level and
 // the tracking error stays at the centimetre level.
 TEST(PoseTrackerTest, TracksWithinProtectionLevel) {
@@ -267,13 +278,8 @@ TEST(PoseTrackerTest, ScanThatSuddenlyFitsWorseIsAFault) {
     PoseTracker t;
     TrackOptions o;
     o.fit_drop_z = drop_z;
-    ASSERT_TRUE(t.init(o, room_map().map).is_ok());
     RandomStream rng(41, 0);
-    t.start(a, small_cov(), Se2f());
-    for (int i = 0; i < 3; ++i) {
-      const auto pts = testing::scan_at(room(), a, &rng);
-      ASSERT_EQ(t.step(pts.data(), pts.size(), Se2f(), false).status, hal::LocalizationStatus::kLocalized) << i;
-    }
+    ASSERT_NO_FATAL_FAILURE(settle_at(&t, o, a, &rng));
     for (int i = 0; i < 2; ++i) {
       auto pts = testing::scan_at(room(), a, &rng);
       for (std::size_t k = 0; k < pts.size(); ++k)
@@ -302,13 +308,8 @@ TEST(PoseTrackerTest, ResidualsThatRiseAreAFaultOnlyWithTheRmsTest) {
     PoseTracker t;
     TrackOptions o;
     o.fit_drop_rms = rms;
-    ASSERT_TRUE(t.init(o, room_map().map).is_ok());
     RandomStream rng(43, 0);
-    t.start(a, small_cov(), Se2f());
-    for (int i = 0; i < 3; ++i) {
-      const auto pts = testing::scan_at(room(), a, &rng);
-      ASSERT_EQ(t.step(pts.data(), pts.size(), Se2f(), false).status, hal::LocalizationStatus::kLocalized) << i;
-    }
+    ASSERT_NO_FATAL_FAILURE(settle_at(&t, o, a, &rng));
     auto pts = testing::scan_at(room(), a, &rng);
     for (std::size_t k = 0; k < pts.size(); ++k) {  // every point 0.15 m nearer or farther, alternately
       const float r = std::hypot(pts[k].x(), pts[k].y());
