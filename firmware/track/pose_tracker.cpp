@@ -420,7 +420,11 @@ PoseTracker::Update PoseTracker::propose_update(const Se2f& odom, bool predict, 
   const bool moved = fuse_next_ || !predict || beyond_update_thresholds(since, o) ||
                      (trusted && beyond_update_thresholds(seen, o));
   const Eigen::Vector3f dx = w->p_post * (a.information * w->e);
-  if (!moved || !dx.allFinite()) return u;
+  if (!dx.allFinite()) return u;
+  if (!moved) {
+    w->unfused = dx;
+    return u;
+  }
   u.fuse = true;
   u.pose = Se2f(w->pred.x + dx(0), w->pred.y + dx(1), wrap_angle(w->pred.theta + dx(2)));
   u.cov = 0.5f * (w->p_post + w->p_post.transpose());
@@ -546,6 +550,10 @@ void PoseTracker::publish(const Point2f* points, std::size_t n, const StepWork& 
   }
   out->pl.xy_m += excess_xy_m_;
   out->pl.theta_rad += excess_theta_rad_;
+  if (o.cover_unfused_update && !out->fused && (v == ScanVerdict::kSupported || v == ScanVerdict::kAmbiguous)) {
+    out->pl.xy_m += std::hypot(w.unfused(0), w.unfused(1));
+    out->pl.theta_rad += std::fabs(w.unfused(2));
+  }
   out->unsupported_steps = unsupported_;
   out->odom_noise = odom_noise_.scale();
   out->faulty_steps = faulty_;

@@ -115,6 +115,7 @@ class PoseTracker {
     ProtectionLevel pred_pl;                         // its protection level
     Eigen::Matrix3f p_post = Eigen::Matrix3f::Zero();  // posterior covariance if fused
     Eigen::Vector3f e = Eigen::Vector3f::Zero();     // scan fix − prediction
+    Eigen::Vector3f unfused = Eigen::Vector3f::Zero();  // the update a scan not fused would make
   };
   struct Update {
     bool fuse = false;

@@ -357,6 +357,38 @@ TEST(PoseTrackerTest, ConfirmedStartIsLocalizedOnlyAfterRecoverySteps) {
   }
 }
 
+// TrackOptions::cover_unfused_update: a standing robot's scans are not fused (the update thresholds),
+// so a small turn the wheels miss leaves the published heading off by it until the robot moves. With
+// the option the heading PL of every such scan grows by the update the scan would make (a Kalman
+// step toward the fix: part of the turn, never more); without it the PL stays the covariance's.
+TEST(PoseTrackerTest, UnfusedScansWidenTheProtectionLevelByTheirUpdate) {
+  const Se2f a(6.0f, 2.5f, 0.2f);
+  float pl[2] = {0.0f, 0.0f}, err[2] = {0.0f, 0.0f}, turn = 0.0f;
+  for (const bool cover : {false, true}) {
+    PoseTracker t;
+    TrackOptions o;
+    o.cover_unfused_update = cover;
+    RandomStream rng(5, 0);
+    ASSERT_NO_FATAL_FAILURE(settle_at(&t, o, a, &rng));
+    turn = 0.6f * t.last().pl.theta_rad;  // inside the PL: no fault, and below the update thresholds
+    const Se2f truth(a.x, a.y, a.theta + turn);
+    TrackStep s;
+    for (int i = 0; i < 6; ++i) {
+      const auto pts = testing::scan_at(room(), truth, &rng);
+      s = t.step(pts.data(), pts.size(), Se2f());
+      ASSERT_FALSE(s.lost) << i;
+      EXPECT_FALSE(s.fused) << "cover " << cover << " step " << i;
+      EXPECT_EQ(s.status, hal::LocalizationStatus::kLocalized) << "cover " << cover << " step " << i;
+    }
+    pl[cover] = s.pl.theta_rad;
+    err[cover] = std::fabs(wrap_angle(s.pose.theta - truth.theta));
+  }
+  EXPECT_FLOAT_EQ(err[0], err[1]);  // the pose itself is the same
+  EXPECT_GT(err[1], 0.9f * turn);   // held at the prediction
+  EXPECT_GE(pl[1] - pl[0], 0.1f * turn);
+  EXPECT_LE(pl[1] - pl[0], turn);
+}
+
 // An odometry increment no robot can make between two scans cannot carry the pose.
 TEST(PoseTrackerTest, OdometryJumpContradicts) {
   PoseTracker t;

@@ -177,6 +177,13 @@ struct TrackOptions {
   // default there.
   bool confidence_extent_xy = true;
   bool confidence_extent_theta = false;
+  // A supported scan is fused only once the robot moved (update thresholds): a standing robot's
+  // scans would re-count one view. Until then the published pose is the prediction, which may lie
+  // up to the thresholds (5 cm, 2.9°) from what this scan's update would make it (x⁻ + P⁺He), and
+  // the covariance's PL does not know it (intel scans 5490–5495, 12926–12931: a standing pose
+  // 2.3° off its map pose, PL 2.2°). With this on, the PL of an unfused scan grows by the size of
+  // that update, per axis: |true − published| ≤ |true − updated| + |updated − published|.
+  bool cover_unfused_update = true;
   // Global cross-check (tracked_localizer.h): when the track stops being `localized` while still
   // tracked (an alias, a fault being recovered, scans that say nothing), MML searches in the
   // background from a fresh local map for at most this many scans; if it isolates a pose outside the
