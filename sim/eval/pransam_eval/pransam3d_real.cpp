@@ -13,6 +13,13 @@
 
 namespace sim::pransam_eval {
 
+namespace {
+// Pransam3dConfig::smaller_as_scene: match the model onto the scene when it has fewer points.
+bool swapped(const CloudDraw& d, const Pransam3dConfig& config) {
+  return config.smaller_as_scene && d.model.size() < d.scene.size();
+}
+}  // namespace
+
 bool run_pransam3d(const std::vector<CloudDraw>& draws, const Pransam3dConfig& config, int pool_threads,
                    MethodRun* out, std::string* error, bool verbose) {
   out->method = "pransam";
@@ -22,17 +29,23 @@ bool run_pransam3d(const std::vector<CloudDraw>& draws, const Pransam3dConfig& c
   std::size_t max_scene = 3, max_model = 3, max_cells = 0;
   std::uint32_t max_axis = 0;
   for (const CloudDraw& d : draws) {
-    max_scene = std::max(max_scene, d.scene.size());
-    max_model = std::max(max_model, d.model.size());
-    Eigen::Vector3f lo = d.model[0], hi = d.model[0];
-    for (const auto& p : d.model) {
-      lo = lo.cwiseMin(p);
-      hi = hi.cwiseMax(p);
+    // Each cloud that may be B (both with retry_other_way) sizes the field; each that may be A the scene.
+    for (const bool swap : {false, true}) {
+      if (swap != swapped(d, config) && !config.retry_other_way) continue;
+      const std::vector<Eigen::Vector3f>& a = swap ? d.model : d.scene;
+      const std::vector<Eigen::Vector3f>& b = swap ? d.scene : d.model;
+      max_scene = std::max(max_scene, a.size());
+      max_model = std::max(max_model, b.size());
+      Eigen::Vector3f lo = b[0], hi = b[0];
+      for (const auto& p : b) {
+        lo = lo.cwiseMin(p);
+        hi = hi.cwiseMax(p);
+      }
+      const float res = config.field_voxels * d.voxel;
+      const Eigen::Vector3f cells = (hi - lo) / res + Eigen::Vector3f::Constant(2.0f * (config.eps_soft_voxels / config.field_voxels) + 8.0f);
+      max_cells = std::max(max_cells, static_cast<std::size_t>(cells.prod()) + 1024);
+      max_axis = std::max(max_axis, static_cast<std::uint32_t>(cells.maxCoeff()) + 16);
     }
-    const float res = config.field_voxels * d.voxel;
-    const Eigen::Vector3f cells = (hi - lo) / res + Eigen::Vector3f::Constant(2.0f * (config.eps_soft_voxels / config.field_voxels) + 8.0f);
-    max_cells = std::max(max_cells, static_cast<std::size_t>(cells.prod()) + 1024);
-    max_axis = std::max(max_axis, static_cast<std::uint32_t>(cells.maxCoeff()) + 16);
   }
   fw::pransam::MatcherOptions o;
   o.num_workers = config.workers;
@@ -79,23 +92,44 @@ bool run_pransam3d(const std::vector<CloudDraw>& draws, const Pransam3dConfig& c
     p.refine_iterations = config.refine_iterations;
     p.refine_min_quality = config.refine_min_quality;
     p.refine_cutoff = 2.0f * d.voxel;
-    if (config.free_space && d.scene_sensor_known) {
-      p.scene_origin_is_sensor = true;
-      for (int a = 0; a < 3; ++a) p.scene_sensor[a] = d.scene_sensor(a);
-      p.free_space_min_quality = config.free_space_min_quality;
-      p.free_space_margin = config.free_space_margin_voxels * d.voxel;
-      p.free_space_block_radius = config.free_space_block_voxels * d.voxel;
-      p.max_blocked_fraction = config.max_blocked;
-    }
+    // One direction: A matched onto B (swap: the model onto the scene; no free-space test, whose
+    // sensor is the scene's).
+    auto match_one_way = [&](bool swap, fw::pransam::MatchResult<3>* r) {
+      p.scene_origin_is_sensor = false;
+      if (config.free_space && d.scene_sensor_known && !swap) {
+        p.scene_origin_is_sensor = true;
+        for (int a = 0; a < 3; ++a) p.scene_sensor[a] = d.scene_sensor(a);
+        p.free_space_min_quality = config.free_space_min_quality;
+        p.free_space_margin = config.free_space_margin_voxels * d.voxel;
+        p.free_space_block_radius = config.free_space_block_voxels * d.voxel;
+        p.max_blocked_fraction = config.max_blocked;
+      }
+      const std::vector<Eigen::Vector3f>& a = swap ? d.model : d.scene;
+      const std::vector<Eigen::Vector3f>& b = swap ? d.scene : d.model;
+      fw::Status st = matcher->set_model(b.data(), b.size(), d.cloud.c_str());
+      if (st.is_ok()) st = matcher->match(a.data(), a.size(), p, r);
+      return st;
+    };
     fw::pransam::MatchResult<3> r;
     const double t0 = now_ms();
-    s = matcher->set_model(d.model.data(), d.model.size(), d.cloud.c_str());
-    if (s.is_ok()) s = matcher->match(d.scene.data(), d.scene.size(), p, &r);
+    bool swap = swapped(d, config);
+    s = match_one_way(swap, &r);
+    bool reported = s.is_ok() && r.best_valid && r.best.quality >= config.omega_thres;
+    bool retried = false;
+    if (s.is_ok() && !reported && config.retry_other_way) {
+      swap = !swap;
+      retried = true;
+      s = match_one_way(swap, &r);
+      reported = s.is_ok() && r.best_valid && r.best.quality >= config.omega_thres;
+    }
     double ms = now_ms() - t0;
     if (!s.is_ok()) break;
-    const bool reported = r.best_valid && r.best.quality >= config.omega_thres;
-    const Eigen::Matrix3f rot = r.best_valid ? r.best.rotation : Eigen::Matrix3f::Identity();
-    const Eigen::Vector3f tr = r.best_valid ? r.best.translation : Eigen::Vector3f::Zero();
+    Eigen::Matrix3f rot = r.best_valid ? r.best.rotation : Eigen::Matrix3f::Identity();
+    Eigen::Vector3f tr = r.best_valid ? r.best.translation : Eigen::Vector3f::Zero();
+    if (swap) {  // scene = R model + t, so the scene → model answer is (Rᵀ, −Rᵀ t)
+      rot.transposeInPlace();
+      tr = -(rot * tr);
+    }
     PlaneModel pm;
     pm.build(&d.model, 3.0f * d.voxel);
     CloudOutcome oc = score_answer(d, pm, rot, tr, reported, ms);
@@ -129,9 +163,9 @@ bool run_pransam3d(const std::vector<CloudDraw>& draws, const Pransam3dConfig& c
         const IcpResult t = refine_point_to_plane(d.scene, pm, d.voxel, d.truth_rotation, d.truth_translation);
         k_truth = t.inlier_fraction * static_cast<double>(d.scene.size());
       }
-      std::printf("  %s #%zu |A| %zu |B| %zu ov %.2f: %.1f ms it %llu coll %llu fs-rej %llu Ω %.3f %s  err %.4f m %.2f°  rms %.4f"
+      std::printf("  %s #%zu scene %zu model %zu%s ov %.2f: %.1f ms it %llu coll %llu fs-rej %llu Ω %.3f %s  err %.4f m %.2f°  rms %.4f"
                   "  k %.0f ±%.0f rival %s %.0f z %.2f (%.1f° %.3f m) k_truth %.0f\n",
-                  d.cloud.c_str(), d.index, d.scene.size(), d.model.size(), d.overlap, ms,
+                  d.cloud.c_str(), d.index, d.scene.size(), d.model.size(), swap ? (retried ? " (A = model, retried)" : " (A = model)") : (retried ? " (retried)" : ""), d.overlap, ms,
                   static_cast<unsigned long long>(r.stats.iterations), static_cast<unsigned long long>(r.stats.collisions),
                   static_cast<unsigned long long>(r.stats.free_space_rejected),
                   r.best_valid ? r.best.quality : 0.0f,

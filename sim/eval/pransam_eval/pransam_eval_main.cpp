@@ -5,7 +5,7 @@
 //   mml-pransam-eval theorem1 [--dataset intel] [--queries 20]
 //   mml-pransam-eval 3d [--cloud office1|car6|milk|bunny|all|room] [--draws 100] [--threads 2] [--iters 200000]
 //                       [--thres 0.55] [--stop 1] [--extent-voxels 24] [--refine 10] [--refine-min 0.35]
-//                       [--seed 1] [--voxel V] [--no-ambiguity] [--amb-z 3] [--amb-cell 0] [--amb-margin] [--verbose]   (real clouds of ../shared/data/pcl3d, issue 17;
+//                       [--seed 1] [--voxel V] [--no-ambiguity] [--amb-z 3] [--amb-cell 0] [--amb-margin] [--no-retry] [--smaller-first] [--verbose]   (real clouds of ../shared/data/pcl3d, issue 17;
 //                       --cloud room: the synthetic textured room with --trials 10)
 //   mml-pransam-eval build-table [--dataset intel] [--triples 2000000] [--extent 10] --out FILE.mmap
 #include <cstdio>
@@ -45,6 +45,8 @@ Pransam3dConfig config_3d(const std::map<std::string, std::string>& a) {
   c.free_space_margin_voxels = std::stof(get(a, "fs-margin", std::to_string(c.free_space_margin_voxels)));
   c.max_blocked = std::stof(get(a, "max-blocked", std::to_string(c.max_blocked)));
   c.ambiguity = a.count("no-ambiguity") == 0;
+  c.smaller_as_scene = a.count("smaller-first") != 0;  // --smaller-first: A = the cloud of fewer points (Pransam3dConfig)
+  c.retry_other_way = a.count("no-retry") == 0;  // --no-retry: one direction only
   c.ambiguity_options.z = std::stod(get(a, "amb-z", std::to_string(c.ambiguity_options.z)));
   c.ambiguity_options.paired = a.count("amb-margin") == 0;
   c.ambiguity_options.cell_voxels = std::stod(get(a, "amb-cell", std::to_string(c.ambiguity_options.cell_voxels)));  // --amb-margin: the unpaired margin rule (ambiguity3d.h)
