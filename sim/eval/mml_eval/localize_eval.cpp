@@ -417,11 +417,11 @@ bool run_unknown_area(LocalizeRun& run, std::string* err) {
   const LocalizePlan& plan = run.plan;
   BenchJson* json = run.json;
   const auto t0 = std::chrono::steady_clock::now();
-  LoadedDataset ds;
-  double region[4];
-  std::vector<std::size_t> starts;
-  if (!prepare_unknown_area(plan.unknown_dataset, plan.seed, plan.unknown_trials, &ds, region, &starts, err))
-    return false;
+  UnknownArea ua;
+  if (!prepare_unknown_area(plan.unknown_dataset, plan.seed, plan.unknown_trials, &ua, err)) return false;
+  const LoadedDataset& ds = ua.ds;
+  const double* region = ua.region;
+  const std::vector<std::size_t>& starts = ua.starts;
   std::string e;
   auto loc = OwnedLocalizer::make_track(ds.map, ds.image, run.mml_cfg, plan.track, plan.threads, &e);
   if (!loc) return (*err = "unknown area: mml-track: " + e, false);

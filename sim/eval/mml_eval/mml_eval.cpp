@@ -321,8 +321,11 @@ bool erase_region(LoadedDataset* ds, double x0, double y0, double x1, double y1,
   return load_image(ds, err);
 }
 
-bool prepare_unknown_area(const std::string& name, std::uint64_t seed, std::size_t trials, LoadedDataset* ds,
-                          double region[4], std::vector<std::size_t>* starts, std::string* err) {
+bool prepare_unknown_area(const std::string& name, std::uint64_t seed, std::size_t trials, UnknownArea* out,
+                          std::string* err) {
+  LoadedDataset* ds = &out->ds;
+  double* region = out->region;
+  std::vector<std::size_t>* starts = &out->starts;
   if (!load_dataset(name, ds, err)) return false;
   fw::RandomStream rng(seed, 991);
   const std::size_t n = ds->log.scans.size();

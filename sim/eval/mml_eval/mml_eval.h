@@ -98,8 +98,13 @@ bool erase_region(LoadedDataset* ds, double x0, double y0, double x1, double y1,
 // The unknown-area experiment, one definition for mml-eval and bench_localize: loads `name`, erases
 // an 8 × 8 m box around a scan drawn from `seed` in the middle half of the log (region = x0 y0 x1
 // y1) and returns `trials` starts 8, 18, 28 … m of travel before it.
-bool prepare_unknown_area(const std::string& name, std::uint64_t seed, std::size_t trials, LoadedDataset* ds,
-                          double region[4], std::vector<std::size_t>* starts, std::string* err);
+struct UnknownArea {
+  LoadedDataset ds;                  // the log with its map erased in `region`
+  double region[4] = {0, 0, 0, 0};   // x0 y0 x1 y1
+  std::vector<std::size_t> starts;
+};
+bool prepare_unknown_area(const std::string& name, std::uint64_t seed, std::size_t trials, UnknownArea* out,
+                          std::string* err);
 
 struct TrialOptions {
   std::size_t max_steps = 150;      // localizer steps per trial

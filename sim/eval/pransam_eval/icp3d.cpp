@@ -28,25 +28,17 @@ void PlaneModel::build(const std::vector<Eigen::Vector3f>* points, float normal_
   const float r2 = normal_radius * normal_radius;
   for (std::size_t i = 0; i < points->size(); ++i) {
     const Eigen::Vector3f& p = (*points)[i];
-    const long cx = static_cast<long>(std::floor(p.x() / cell_)), cy = static_cast<long>(std::floor(p.y() / cell_)),
-               cz = static_cast<long>(std::floor(p.z() / cell_));
     Eigen::Vector3d mean = Eigen::Vector3d::Zero();
     Eigen::Matrix3d cov = Eigen::Matrix3d::Zero();
     int n = 0;
-    for (long dx = -1; dx <= 1; ++dx)
-      for (long dy = -1; dy <= 1; ++dy)
-        for (long dz = -1; dz <= 1; ++dz) {
-          auto it = grid_.find(key(cx + dx, cy + dy, cz + dz));
-          if (it == grid_.end()) continue;
-          for (std::uint32_t j : it->second) {
-            const Eigen::Vector3f& q = (*points)[j];
-            if ((q - p).squaredNorm() > r2) continue;
-            const Eigen::Vector3d qd = q.cast<double>();
-            mean += qd;
-            cov += qd * qd.transpose();
-            ++n;
-          }
-        }
+    for_each_near(p, [&](std::uint32_t j) {
+      const Eigen::Vector3f& q = (*points)[j];
+      if ((q - p).squaredNorm() > r2) return;
+      const Eigen::Vector3d qd = q.cast<double>();
+      mean += qd;
+      cov += qd * qd.transpose();
+      ++n;
+    });
     if (n < 3) continue;
     mean /= n;
     cov = cov / n - mean * mean.transpose();
@@ -56,23 +48,15 @@ void PlaneModel::build(const std::vector<Eigen::Vector3f>* points, float normal_
 }
 
 int PlaneModel::nearest(const Eigen::Vector3f& p, float max_dist) const {
-  const long cx = static_cast<long>(std::floor(p.x() / cell_)), cy = static_cast<long>(std::floor(p.y() / cell_)),
-             cz = static_cast<long>(std::floor(p.z() / cell_));
   float best = max_dist * max_dist;
   int bi = -1;
-  for (long dx = -1; dx <= 1; ++dx)
-    for (long dy = -1; dy <= 1; ++dy)
-      for (long dz = -1; dz <= 1; ++dz) {
-        auto it = grid_.find(key(cx + dx, cy + dy, cz + dz));
-        if (it == grid_.end()) continue;
-        for (std::uint32_t j : it->second) {
-          const float d2 = ((*points_)[j] - p).squaredNorm();
-          if (d2 < best) {
-            best = d2;
-            bi = static_cast<int>(j);
-          }
-        }
-      }
+  for_each_near(p, [&](std::uint32_t j) {
+    const float d2 = ((*points_)[j] - p).squaredNorm();
+    if (d2 < best) {
+      best = d2;
+      bi = static_cast<int>(j);
+    }
+  });
   return bi;
 }
 

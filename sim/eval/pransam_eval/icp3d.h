@@ -6,6 +6,7 @@
 #pragma once
 
 #include <Eigen/Core>
+#include <cmath>
 #include <cstdint>
 #include <unordered_map>
 #include <vector>
@@ -25,6 +26,19 @@ class PlaneModel {
  private:
   std::uint64_t key(const Eigen::Vector3f& p) const;
   std::uint64_t key(long x, long y, long z) const;
+  // Calls f(j) for every model point j in the 3×3×3 cells around p (one cell = the normal radius).
+  template <class F>
+  void for_each_near(const Eigen::Vector3f& p, F&& f) const {
+    const long cx = static_cast<long>(std::floor(p.x() / cell_)), cy = static_cast<long>(std::floor(p.y() / cell_)),
+               cz = static_cast<long>(std::floor(p.z() / cell_));
+    for (long dx = -1; dx <= 1; ++dx)
+      for (long dy = -1; dy <= 1; ++dy)
+        for (long dz = -1; dz <= 1; ++dz) {
+          auto it = grid_.find(key(cx + dx, cy + dy, cz + dz));
+          if (it == grid_.end()) continue;
+          for (std::uint32_t j : it->second) f(j);
+        }
+  }
   const std::vector<Eigen::Vector3f>* points_ = nullptr;
   std::vector<Eigen::Vector3f> normals_;
   float cell_ = 1.0f;
