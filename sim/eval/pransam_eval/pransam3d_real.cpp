@@ -18,18 +18,13 @@ namespace {
 bool swapped(const CloudDraw& d, const Pransam3dConfig& config) {
   return config.smaller_as_scene && d.model.size() < d.scene.size();
 }
-}  // namespace
 
-bool run_pransam3d(const std::vector<CloudDraw>& draws, const Pransam3dConfig& config, int pool_threads,
-                   MethodRun* out, std::string* error, bool verbose) {
-  out->method = "pransam";
-  out->outcomes.clear();
-  if (draws.empty()) return true;
-  // Size the matcher once for the largest draw (cells of the model's box + the ε_s margin).
+// Matcher sized once for the largest draw (cells of the model's box + the ε_s margin). Each cloud
+// that may be B (both with retry_other_way) sizes the field; each that may be A the scene.
+fw::pransam::MatcherOptions matcher_options_for(const std::vector<CloudDraw>& draws, const Pransam3dConfig& config) {
   std::size_t max_scene = 3, max_model = 3, max_cells = 0;
   std::uint32_t max_axis = 0;
   for (const CloudDraw& d : draws) {
-    // Each cloud that may be B (both with retry_other_way) sizes the field; each that may be A the scene.
     for (const bool swap : {false, true}) {
       if (swap != swapped(d, config) && !config.retry_other_way) continue;
       const std::vector<Eigen::Vector3f>& a = swap ? d.model : d.scene;
@@ -55,6 +50,17 @@ bool run_pransam3d(const std::vector<CloudDraw>& draws, const Pransam3dConfig& c
   o.field.max_axis = max_axis;
   o.max_batch = 1024;
   o.collect_capacity = 64;
+  return o;
+}
+}  // namespace
+
+bool run_pransam3d(const std::vector<CloudDraw>& draws, const Pransam3dConfig& config, int pool_threads,
+                   MethodRun* out, std::string* error, bool verbose) {
+  out->method = "pransam";
+  out->outcomes.clear();
+  if (draws.empty()) return true;
+  fw::pransam::MatcherOptions o = matcher_options_for(draws, config);
+  const std::size_t max_scene = o.max_scene_points, max_model = o.max_model_points, max_cells = o.field.max_cells;
   const std::size_t bytes = 2 * fw::pransam::kNumSlots * 12 + max_cells * 5 + (max_scene + max_model) * 64 +
                             static_cast<std::size_t>(o.num_workers) * (std::size_t(1) << 20) + (std::size_t(64) << 20);
   fw::StartupArena arena;
