@@ -1,5 +1,5 @@
 // mml-pransam-pcl: the PCL peers of pRANSAM 3-D (issue 17) on the draws of cloud_draws.h.
-//   mml-pransam-pcl [--cloud office1|car6|milk|bunny|all] [--method fpfh|k4pcs|both] [--draws 100]
+//   mml-pransam-pcl [--cloud office1|car6|milk|bunny|all] [--method fpfh|k4pcs|both] [--draws 100] [--first 0]
 //                   [--threads 2] [--max-seconds 0] [--seed 1] [--k4pcs-samples 0] [--verbose]
 // Reproducible per --seed: FPFH + prerejective always; K-4PCS with --threads 1 and --max-seconds 0
 // (pcl_peers.cpp: PCL seeds rand() from time(), which is wrapped in this tool).
@@ -157,11 +157,14 @@ static int run_main(int argc, char** argv) {
   const std::size_t n = std::stoul(get(a, "draws", "100"));
   const std::uint64_t seed = std::stoull(get(a, "seed", "1"));
   const int k4pcs_samples = std::stoi(get(a, "k4pcs-samples", "0"));
+  const std::size_t first = std::stoul(get(a, "first", "0"));  // skip draws 0 … first − 1 (resume a long run)
   std::string err;
   for (const char* c : {"office1", "car6", "milk", "bunny"}) {
     if (which != "all" && which != c) continue;
     std::vector<CloudDraw> draws;
-    if (!draws_of(c, std::string(c) == "bunny" ? 10 : n, &draws, &err)) return fail(err);
+    const bool bunny = std::string(c) == "bunny";
+    if (!draws_of(c, bunny ? 10 : first + n, &draws, &err)) return fail(err);
+    if (!bunny) draws.erase(draws.begin(), draws.begin() + static_cast<std::ptrdiff_t>(first));
     for (PclMethod m : {PclMethod::kFpfhPrerejective, PclMethod::kK4pcs}) {
       if (method != "both" && method != (m == PclMethod::kK4pcs ? "k4pcs" : "fpfh")) continue;
       MethodRun r;
