@@ -165,14 +165,18 @@ ScanAlignment PoseTracker::align_from_prediction(const Point2f* points, std::siz
   return a;
 }
 
-// The scan's own confidence region (track_options.h, fit_comparison.h), bounded by the prediction's PL:
-// where it reaches farther than the covariance's protection level `pl`, the excess is kept and
-// added to the PL of this and of every following scan until the next scan that supports the pose
-// (so the bound never shrinks on scans that say nothing; the covariance itself is left alone —
-// widening it instead weakened the fusion and the innovation tests: aces availability 0.98 → 0.64).
+// The scan's own confidence region (track_options.h, fit_comparison.h), bounded by what the prediction
+// already promised: where it reaches farther than the covariance's protection level `pl`, the excess
+// is kept and added to the PL of this and of every following scan until the next scan that supports
+// the pose (so the bound never shrinks on scans that say nothing; the covariance itself is left alone
+// — widening it instead weakened the fusion and the innovation tests: aces availability 0.98 → 0.64).
+// The cap is the prediction's PL *plus how far the update moved the pose from the prediction*: the
+// truth lies within pred_pl of the prediction, so within pred_pl + |published − prediction| of the
+// published pose (triangle inequality). Capping at pred_pl alone bounded the error about a point the
+// tracker no longer publishes (fr079 scans 2166–2172, aces 5119/5122: fused corridor steps 0.11–0.25 m
+// off with a PL 0.03–0.06 m short).
 void PoseTracker::update_confidence_excess(const Point2f* points, std::size_t n, const ScanAlignment& a,
-                                           const ProtectionLevel& pred_pl, const ProtectionLevel& pl,
-                                           TrackStep* out) {
+                                           const StepWork& w, const ProtectionLevel& pl, TrackStep* out) {
   const TrackOptions& o = options_;
   ConfidenceExtentOptions co;
   co.clip_m = o.alias_clip_m;
@@ -185,14 +189,16 @@ void PoseTracker::update_confidence_excess(const Point2f* points, std::size_t n,
   out->confidence_xy_m = ce.xy_m;
   out->confidence_theta_rad = ce.theta_rad;
   excess_xy_m_ = excess_theta_rad_ = 0.0f;
+  const float moved_xy = o.confidence_cap_with_update ? std::hypot(pose_.x - w.pred.x, pose_.y - w.pred.y) : 0.0f;
+  const float moved_theta = o.confidence_cap_with_update ? std::fabs(wrap_angle(pose_.theta - w.pred.theta)) : 0.0f;
   if (o.confidence_extent_xy) {
     const float bound = std::fmin(ce.xy_m + std::hypot(pose_.x - a.pose.x, pose_.y - a.pose.y) + bias_xy_m_,
-                                  pred_pl.xy_m);
+                                  w.pred_pl.xy_m + moved_xy);
     excess_xy_m_ = std::fmax(bound - pl.xy_m, 0.0f);
   }
   if (o.confidence_extent_theta) {
     const float bound = std::fmin(ce.theta_rad + std::fabs(wrap_angle(pose_.theta - a.pose.theta)) + bias_theta_rad_,
-                                  pred_pl.theta_rad);
+                                  w.pred_pl.theta_rad + moved_theta);
     excess_theta_rad_ = std::fmax(bound - pl.theta_rad, 0.0f);
   }
 }
@@ -546,7 +552,7 @@ void PoseTracker::publish(const Point2f* points, std::size_t n, const StepWork& 
   // scans that constrains what this one scan may leave open (a corridor's axis).
   if ((o.confidence_extent_xy || o.confidence_extent_theta) && w.predicted &&
       (v == ScanVerdict::kSupported || v == ScanVerdict::kAmbiguous)) {
-    update_confidence_excess(points, n, out->alignment, w.pred_pl, out->pl, out);
+    update_confidence_excess(points, n, out->alignment, w, out->pl, out);
   }
   out->pl.xy_m += excess_xy_m_;
   out->pl.theta_rad += excess_theta_rad_;

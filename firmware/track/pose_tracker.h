@@ -130,8 +130,8 @@ class PoseTracker {
   void apply_verdict(const Se2f& odom, const StepWork& w, const Update& u, TrackStep* out);
   void publish(const Point2f* points, std::size_t n, const StepWork& w, TrackStep* out);
   std::size_t subsample_alias_points(const Point2f* points, std::size_t n);
-  void update_confidence_excess(const Point2f* points, std::size_t n, const ScanAlignment& a,
-                                const ProtectionLevel& pred_pl, const ProtectionLevel& pl, TrackStep* out);
+  void update_confidence_excess(const Point2f* points, std::size_t n, const ScanAlignment& a, const StepWork& w,
+                                const ProtectionLevel& pl, TrackStep* out);
   ScanAlignment align_from_prediction(const Point2f* points, std::size_t n, const Se2f& pred, TrackStep* out);
   static constexpr std::size_t kSearchScratch = 2 * 1081;
   Point2f search_scratch_[kSearchScratch];

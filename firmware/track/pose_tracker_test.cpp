@@ -525,6 +525,46 @@ GridWorld pillar_corridor(bool unique_pillar) {
   return g;
 }
 
+// The confidence extent of a scan along a featureless corridor reaches farther than anything the
+// covariance claims, so it is capped by what the prediction promised. The truth is within the
+// prediction's PL of the *prediction*; the published pose is the update, which the scan pulled
+// across the corridor. So the cap must include that shift (triangle inequality): capped at the
+// prediction's PL alone, the bound is about a point the tracker no longer publishes.
+TEST(PoseTrackerTest, ConfidenceCapIncludesTheUpdatesShift) {
+  GridWorld world;
+  world.w = 600; world.h = 80;
+  world.occ.assign(world.w * world.h, 0);
+  world.box(0.5f, 1.0f, 29.5f, 3.0f);  // walls only: nothing along the corridor's axis
+  world.finish();
+  const OwnedGlobalMap map(world);
+  Eigen::Matrix3f start_cov = Eigen::Matrix3f::Zero();
+  start_cov(0, 0) = start_cov(1, 1) = 0.0025f;  // 5 cm
+  start_cov(2, 2) = 0.0004f;
+  const Se2f start(15.0f, 2.0f, 0.0f);
+  const Se2f truth(15.1f, 1.93f, 0.0f);  // 0.1 m along (odometry knows it), 7 cm across (it does not)
+  float pl[2] = {0.0f, 0.0f}, moved[2] = {0.0f, 0.0f}, err[2] = {0.0f, 0.0f};
+  for (const bool cap_with_update : {false, true}) {
+    PoseTracker t;
+    TrackOptions o;
+    o.confidence_cap_with_update = cap_with_update;
+    ASSERT_TRUE(t.init(o, map.map).is_ok());
+    RandomStream rng(31, 0);
+    t.start(start, start_cov, Se2f());
+    const auto pts = testing::scan_at(world, truth, &rng, 0.01f, 4.0f);
+    const TrackStep s = t.step(pts.data(), pts.size(), Se2f(0.1f, 0.0f, 0.0f));
+    ASSERT_FALSE(s.lost);
+    ASSERT_TRUE(s.fused);
+    ASSERT_GE(s.confidence_xy_m, s.pl.xy_m) << "the corridor's axis must be left open by the scan";
+    pl[cap_with_update] = s.pl.xy_m;
+    moved[cap_with_update] = std::hypot(s.pose.x - 15.1f, s.pose.y - 2.0f);
+    err[cap_with_update] = err_xy(s.pose, truth);
+  }
+  EXPECT_FLOAT_EQ(moved[0], moved[1]);  // only the bound differs
+  EXPECT_GT(moved[1], 0.05f) << "the scan pulls the pose across the corridor";
+  EXPECT_GE(pl[1] - pl[0], 0.5f * moved[1]) << "PL " << pl[0] << " -> " << pl[1] << ", moved " << moved[1];
+  EXPECT_GT(pl[1], err[1]);
+}
+
 // Ambiguity along a weak axis: the protection level describes one Gaussian mode and cannot cover an
 // alias one period away, so the alias check keeps the status from `localized` (still tracked).
 // Without the check the same scans would be published `localized`.

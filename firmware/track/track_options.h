@@ -177,6 +177,10 @@ struct TrackOptions {
   // default there.
   bool confidence_extent_xy = true;
   bool confidence_extent_theta = false;
+  // The confidence extent is capped at the prediction's PL plus the update's shift from the
+  // prediction (the truth is within pred PL of the prediction, the published pose that far from it);
+  // false = the old cap at the prediction's PL alone, which can be shorter than the error it bounds.
+  bool confidence_cap_with_update = true;
   // A supported scan is fused only once the robot moved (update thresholds): a standing robot's
   // scans would re-count one view. Until then the published pose is the prediction, which may lie
   // up to the thresholds (5 cm, 2.9°) from what this scan's update would make it (x⁻ + P⁺He), and

@@ -64,7 +64,9 @@ const char kUsage[] =
     "firmware/track/track_options.h says why). --fit-drop-rms: the residual (F) form of the fit-drop test\n"
     "(off by default, same header). --no-confirm-fix: MML's fix `localized` on its first consistent scan\n"
     "(TrackOptions::confirm_fix). --no-cover-unfused: the PL of a scan not fused (standing robot) leaves\n"
-    "out the update the scan would make (TrackOptions::cover_unfused_update). Definitions of every figure: sim/eval/mml_eval/README.md.\n";
+    "out the update the scan would make (TrackOptions::cover_unfused_update). --confidence-cap-pred-pl: the\n"
+    "scan's confidence extent capped at the prediction's PL alone (TrackOptions::confidence_cap_with_update).\n"
+    "Definitions of every figure: sim/eval/mml_eval/README.md.\n";
 int usage(const char* msg) {
   std::fprintf(stderr, "mml-eval: %s\n%s", msg, kUsage);
   return 2;
@@ -142,6 +144,7 @@ static int run_main(int argc, char** argv) {
     else if (a == "--fit-drop-rms") { lp.track.fit_drop_rms = true; localize = true; }
     else if (a == "--no-confirm-fix") { lp.track.confirm_fix = false; localize = true; }
     else if (a == "--no-cover-unfused") { lp.track.cover_unfused_update = false; localize = true; }
+    else if (a == "--confidence-cap-pred-pl") { lp.track.confidence_cap_with_update = false; localize = true; }
     else if (a == "--odom-adapt") { lp.track.odom_noise_window = 64; localize = true; }
     else if (a == "--odom-noise") {
       const std::string v = str();
