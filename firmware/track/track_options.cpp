@@ -1,6 +1,7 @@
 #include "firmware/track/track_options.h"
 
 #include <cmath>
+#include <cstdint>
 
 namespace fw {
 namespace track {
@@ -13,15 +14,17 @@ Status check_range(const char* name, float v, float lo, float hi) {
   }
   return Status::ok();
 }
+Status check_count(const char* name, std::uint32_t v, std::uint32_t lo, std::uint32_t hi) {
+  if (v < lo || v > hi) {
+    return Status::error(Errc::kInvalidArgument, "TrackOptions.%s = %u out of range [%u, %u]", name, v, lo, hi);
+  }
+  return Status::ok();
+}
 }  // namespace
 
 Status ScanAlignOptions::validate() const {
-  if (max_points < 10 || max_points > 1081) {
-    return Status::error(Errc::kInvalidArgument, "TrackOptions.align.max_points = %u out of range [10, 1081]", max_points);
-  }
-  if (iterations < 1 || iterations > 100) {
-    return Status::error(Errc::kInvalidArgument, "TrackOptions.align.iterations = %u out of range [1, 100]", iterations);
-  }
+  FW_RETURN_IF_ERROR(check_count("align.max_points", max_points, 10, 1081));
+  FW_RETURN_IF_ERROR(check_count("align.iterations", iterations, 1, 100));
   FW_RETURN_IF_ERROR(check_range("align.max_range_m", max_range_m, 0.5f, 1000.0f));
   FW_RETURN_IF_ERROR(check_range("align.outlier_m", outlier_m, 0.01f, 5.0f));
   FW_RETURN_IF_ERROR(check_range("align.huber_m", huber_m, 0.001f, 5.0f));
@@ -40,13 +43,8 @@ Status CorrelativeSearchOptions::validate() const {
   FW_RETURN_IF_ERROR(check_range("search.angular_step_rad", angular_step_rad, 0.001f, 0.5f));
   FW_RETURN_IF_ERROR(check_range("search.clip_m", clip_m, 0.01f, 2.0f));
   FW_RETURN_IF_ERROR(check_range("search.min_score_gain", min_score_gain, 0.0f, 1.0f));
-  if (max_points < 10 || max_points > 1081) {
-    return Status::error(Errc::kInvalidArgument, "TrackOptions.search.max_points = %u out of range [10, 1081]", max_points);
-  }
-  if (max_candidates < 1 || max_candidates > 1000000) {
-    return Status::error(Errc::kInvalidArgument, "TrackOptions.search.max_candidates = %u out of range [1, 1000000]",
-                         max_candidates);
-  }
+  FW_RETURN_IF_ERROR(check_count("search.max_points", max_points, 10, 1081));
+  FW_RETURN_IF_ERROR(check_count("search.max_candidates", max_candidates, 1, 1000000));
   return Status::ok();
 }
 
@@ -63,10 +61,7 @@ Status TrackOptions::validate() const {
                          "TrackOptions.odom_noise_window = %u / odom_noise_min_samples = %u: window at most 128, "
                          "min_samples in [2, window]", odom_noise_window, odom_noise_min_samples);
   }
-  if (odom_noise_span < 1 || odom_noise_span > 1000) {
-    return Status::error(Errc::kInvalidArgument, "TrackOptions.odom_noise_span = %u out of range [1, 1000]",
-                         odom_noise_span);
-  }
+  FW_RETURN_IF_ERROR(check_count("odom_noise_span", odom_noise_span, 1, 1000));
   FW_RETURN_IF_ERROR(check_range("odom_noise_min_snr", odom_noise_min_snr, 1.0f, 1000.0f));
   FW_RETURN_IF_ERROR(check_range("odom_noise_min_scale", odom_noise_min_scale, 0.01f, 1.0f));
   FW_RETURN_IF_ERROR(check_range("odom_noise_max_scale", odom_noise_max_scale, odom_noise_min_scale, 10.0f));
@@ -74,28 +69,17 @@ Status TrackOptions::validate() const {
   FW_RETURN_IF_ERROR(check_range("max_odom_step_rad", max_odom_step_rad, 0.01f, 6.3f));
   FW_RETURN_IF_ERROR(check_range("update_min_d_m", update_min_d_m, 0.0f, 10.0f));
   FW_RETURN_IF_ERROR(check_range("update_min_a_rad", update_min_a_rad, 0.0f, 3.2f));
-  if (min_points < 3 || min_points > 1081) {
-    return Status::error(Errc::kInvalidArgument, "TrackOptions.min_points = %u out of range [3, 1081]", min_points);
-  }
+  FW_RETURN_IF_ERROR(check_count("min_points", min_points, 3, 1081));
   FW_RETURN_IF_ERROR(check_range("min_inlier_fraction", min_inlier_fraction, 0.0f, 1.0f));
   FW_RETURN_IF_ERROR(check_range("min_explained_fraction", min_explained_fraction, 0.0f, 1.0f));
   FW_RETURN_IF_ERROR(check_range("fit_drop_z", fit_drop_z, 0.0f, 100.0f));
   FW_RETURN_IF_ERROR(check_range("innovation_chi2", innovation_chi2, 0.1f, 1e6f));
   FW_RETURN_IF_ERROR(check_range("outside_map_fraction", outside_map_fraction, 0.0f, 1.0f));
-  if (max_faulty_steps < 1 || max_faulty_steps > 10000 || max_outside_steps < 1 || max_outside_steps > 10000) {
-    return Status::error(Errc::kInvalidArgument, "TrackOptions: max_faulty_steps %u / max_outside_steps %u out of range [1, 10000]",
-                         max_faulty_steps, max_outside_steps);
-  }
-  if (cross_check_steps > 1000000) {
-    return Status::error(Errc::kInvalidArgument, "TrackOptions.cross_check_steps = %u out of range [0, 1000000]",
-                         cross_check_steps);
-  }
-  if (odometry_window > 32) {
-    return Status::error(Errc::kInvalidArgument, "TrackOptions.odometry_window = %u out of range [0, 32]", odometry_window);
-  }
-  if (recovery_steps > 10000) {
-    return Status::error(Errc::kInvalidArgument, "TrackOptions.recovery_steps = %u out of range [0, 10000]", recovery_steps);
-  }
+  FW_RETURN_IF_ERROR(check_count("max_faulty_steps", max_faulty_steps, 1, 10000));
+  FW_RETURN_IF_ERROR(check_count("max_outside_steps", max_outside_steps, 1, 10000));
+  FW_RETURN_IF_ERROR(check_count("cross_check_steps", cross_check_steps, 0, 1000000));
+  FW_RETURN_IF_ERROR(check_count("odometry_window", odometry_window, 0, 32));
+  FW_RETURN_IF_ERROR(check_count("recovery_steps", recovery_steps, 0, 10000));
   FW_RETURN_IF_ERROR(check_range("alias_max_shift_m", alias_max_shift_m, 0.0f, 50.0f));
   FW_RETURN_IF_ERROR(check_range("alias_step_m", alias_step_m, 0.05f, 10.0f));
   FW_RETURN_IF_ERROR(check_range("alias_min_separation_m", alias_min_separation_m, 0.01f, 10.0f));
