@@ -173,8 +173,8 @@ ScanAlignment PoseTracker::align_from_prediction(const Point2f* points, std::siz
 // The cap is the prediction's PL *plus how far the update moved the pose from the prediction*: the
 // truth lies within pred_pl of the prediction, so within pred_pl + |published − prediction| of the
 // published pose (triangle inequality). Capping at pred_pl alone bounded the error about a point the
-// tracker no longer publishes (fr079 scans 2166–2172, aces 5119/5122: fused corridor steps 0.11–0.25 m
-// off with a PL 0.03–0.06 m short).
+// tracker no longer publishes (aces scans 4807, 6560: fused corridor steps 0.14–0.17 m off with a PL
+// 0.006–0.016 m short; both covered with the shift added).
 void PoseTracker::update_confidence_excess(const Point2f* points, std::size_t n, const ScanAlignment& a,
                                            const StepWork& w, const ProtectionLevel& pl, TrackStep* out) {
   const TrackOptions& o = options_;
@@ -189,16 +189,18 @@ void PoseTracker::update_confidence_excess(const Point2f* points, std::size_t n,
   out->confidence_xy_m = ce.xy_m;
   out->confidence_theta_rad = ce.theta_rad;
   excess_xy_m_ = excess_theta_rad_ = 0.0f;
-  const float moved_xy = o.confidence_cap_with_update ? std::hypot(pose_.x - w.pred.x, pose_.y - w.pred.y) : 0.0f;
-  const float moved_theta = o.confidence_cap_with_update ? std::fabs(wrap_angle(pose_.theta - w.pred.theta)) : 0.0f;
+  // The update's shift from the prediction, per axis (0 = the old cap).
+  const float with_update = o.confidence_cap_with_update ? 1.0f : 0.0f;
   if (o.confidence_extent_xy) {
+    const float moved = with_update * std::hypot(pose_.x - w.pred.x, pose_.y - w.pred.y);
     const float bound = std::fmin(ce.xy_m + std::hypot(pose_.x - a.pose.x, pose_.y - a.pose.y) + bias_xy_m_,
-                                  w.pred_pl.xy_m + moved_xy);
+                                  w.pred_pl.xy_m + moved);
     excess_xy_m_ = std::fmax(bound - pl.xy_m, 0.0f);
   }
   if (o.confidence_extent_theta) {
+    const float moved = with_update * std::fabs(wrap_angle(pose_.theta - w.pred.theta));
     const float bound = std::fmin(ce.theta_rad + std::fabs(wrap_angle(pose_.theta - a.pose.theta)) + bias_theta_rad_,
-                                  w.pred_pl.theta_rad + moved_theta);
+                                  w.pred_pl.theta_rad + moved);
     excess_theta_rad_ = std::fmax(bound - pl.theta_rad, 0.0f);
   }
 }
