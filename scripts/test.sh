@@ -39,47 +39,31 @@ stage() {
 }
 wanted() { [[ " $STAGES " == *" $1 "* ]]; }
 
-release() {
-  echo "=== host (release) build ==="
-  cmake --preset release >/dev/null
-  cmake --build --preset release -j "$JOBS"
-  echo "=== host (release) tests ==="
-  ctest --preset release -j "$JOBS" --timeout 1200
+# build_and_test PRESET TITLE [CTEST ARGS...]: configure and build the preset, then run its tests.
+build_and_test() {
+  local preset=$1 title=$2; shift 2
+  echo "=== $title build ==="
+  cmake --preset "$preset" >/dev/null
+  cmake --build --preset "$preset" -j "$JOBS" ${BUILD_TARGETS:+--target $BUILD_TARGETS}
+  echo "=== $title tests ==="
+  ctest --preset "$preset" "$@"
 }
-aarch64() {
-  echo "=== aarch64 cross build ==="
-  cmake --preset aarch64 >/dev/null
-  cmake --build --preset aarch64 -j "$JOBS"
-  echo "=== aarch64 tests under qemu-aarch64 ==="
-  ctest --preset aarch64 -j "$JOBS" --timeout 1200
-}
+release() { build_and_test release "host (release)" -j "$JOBS" --timeout 1200; }
+aarch64() { build_and_test aarch64 "aarch64 cross (tests under qemu-aarch64)" -j "$JOBS" --timeout 1200; }
 # ASan + UBSan: every unit, data and rules test (not hil: the HIL scripts measure the release
 # binaries inside UML; not budget: timing under ASan says nothing about the firmware's budget).
 asan() {
-  echo "=== ASan+UBSan build ==="
-  cmake --preset asan >/dev/null
-  cmake --build --preset asan -j "$JOBS"
-  echo "=== ASan+UBSan tests (labels unit, data, rules) ==="
   ASAN_OPTIONS=detect_leaks=1:abort_on_error=1 UBSAN_OPTIONS=print_stacktrace=1 \
-    ctest --preset asan -j "$JOBS" --timeout 1200 -L '^(unit|data|rules)$'
+    build_and_test asan "ASan+UBSan (labels unit, data, rules)" -j "$JOBS" --timeout 1200 -L '^(unit|data|rules)$'
 }
 # TSan: the tests where threads meet (tests/CMakeLists.txt, label tsan); only their targets are built.
 tsan() {
-  echo "=== TSan build (threaded tests only) ==="
-  cmake --preset tsan >/dev/null
-  cmake --build --preset tsan -j "$JOBS" --target fw_base_test fw_pransam_test fw_mml_reset_test replay_budget_test fw_track_test
-  echo "=== TSan tests (label tsan) ==="
-  ctest --preset tsan -j 1 --timeout 1200 -L '^tsan$'
+  BUILD_TARGETS="fw_base_test fw_pransam_test fw_mml_reset_test replay_budget_test fw_track_test" \
+    build_and_test tsan "TSan (threaded tests only, label tsan)" -j 1 --timeout 1200 -L '^tsan$'
 }
 # libFuzzer: seeds from the real logs, every target over its seeds + committed reproducers + a
 # fixed number of mutations (tests/fuzz/CMakeLists.txt); scripts/bench.sh fuzz runs them for minutes.
-fuzz() {
-  echo "=== fuzz build (clang, libFuzzer + ASan/UBSan) ==="
-  cmake --preset fuzz >/dev/null
-  cmake --build --preset fuzz -j "$JOBS"
-  echo "=== fuzz smoke (label fuzz) ==="
-  ctest --preset fuzz -j "$JOBS" --timeout 600 -L '^fuzz$'
-}
+fuzz() { build_and_test fuzz "fuzz (clang, libFuzzer + ASan/UBSan; label fuzz)" -j "$JOBS" --timeout 600 -L '^fuzz$'; }
 
 for s in release aarch64 asan tsan fuzz; do
   if wanted $s; then stage $s $s; fi

@@ -97,26 +97,28 @@ struct PoseWithCovariance {
   Eigen::Matrix<S, 3, 3> cov = Eigen::Matrix<S, 3, 3>::Zero();
 };
 
+// First-order propagation of two independent pose covariances through a pose function f(a, b):
+// Σ = J_a Σ_a J_aᵀ + J_b Σ_b J_bᵀ (the shape of Eq. 3.4 and Eq. 5.13).
+template <typename S, typename JA, typename JB, typename C>
+PoseWithCovariance<S> propagate(const Se2<S>& pose, const JA& ja, const C& cov_a, const JB& jb, const C& cov_b) {
+  PoseWithCovariance<S> out;
+  out.pose = pose;
+  out.cov = ja * cov_a * ja.transpose() + jb * cov_b * jb.transpose();
+  return out;
+}
+
 // x_t = x_{t-1} ⊕ u_t with Σ_t = J_x Σ_{t-1} J_xᵀ + J_u G J_uᵀ  (Eq. 3.4; also Eq. 5.8–5.9).
 template <typename S>
 PoseWithCovariance<S> compose_with_covariance(const PoseWithCovariance<S>& a, const PoseWithCovariance<S>& u) {
-  PoseWithCovariance<S> out;
-  out.pose = a.pose.compose(u.pose);
-  const auto jx = a.pose.jacobian_compose_first(u.pose);
-  const auto ju = a.pose.jacobian_compose_second();
-  out.cov = jx * a.cov * jx.transpose() + ju * u.cov * ju.transpose();
-  return out;
+  return propagate(a.pose.compose(u.pose), a.pose.jacobian_compose_first(u.pose), a.cov,
+                   a.pose.jacobian_compose_second(), u.cov);
 }
 
 // r_h = (⊖x_e) ⊕ x_h with R_h = J_⊖ P_e J_⊖ᵀ + J_⊕ P_h J_⊕ᵀ  (Eq. 5.11–5.13).
 template <typename S>
 PoseWithCovariance<S> between_with_covariance(const PoseWithCovariance<S>& e, const PoseWithCovariance<S>& h) {
-  PoseWithCovariance<S> out;
-  out.pose = e.pose.between(h.pose);
-  const auto jm = e.pose.jacobian_between_first(h.pose);
-  const auto jp = e.pose.jacobian_between_second();
-  out.cov = jm * e.cov * jm.transpose() + jp * h.cov * jp.transpose();
-  return out;
+  return propagate(e.pose.between(h.pose), e.pose.jacobian_between_first(h.pose), e.cov,
+                   e.pose.jacobian_between_second(), h.cov);
 }
 
 }  // namespace fw

@@ -150,13 +150,7 @@ class FrameBuilder {
 
   hal::Odometry odometry_sample(const fw::Se2d& src, std::uint64_t t_ns, double v, double w) {
     const fw::Se2d o = A_.compose(src);
-    hal::Odometry h;
-    h.timestamp_ns = t_ns;
-    h.x = static_cast<float>(o.x);
-    h.y = static_cast<float>(o.y);
-    h.theta = static_cast<float>(o.theta);
-    h.v = static_cast<float>(v);
-    h.omega = static_cast<float>(w);
+    const hal::Odometry h = odometry_message(o, v, w, t_ns);
     last_src_odom_ = src;
     last_out_odom_ = o;
     have_odom_ = true;

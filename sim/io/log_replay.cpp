@@ -64,24 +64,24 @@ std::uint64_t seconds_to_ns(double seconds) {
   return static_cast<std::uint64_t>(std::llround(seconds * 1e9));
 }
 
-hal::Odometry to_odometry(const CarmenOdom& odom, std::uint64_t timestamp_ns) {
+hal::Odometry odometry_message(const fw::Se2d& pose, double v, double omega, std::uint64_t timestamp_ns) {
   hal::Odometry m;
   m.timestamp_ns = timestamp_ns;
-  m.x = static_cast<float>(odom.pose.x);
-  m.y = static_cast<float>(odom.pose.y);
-  m.theta = static_cast<float>(odom.pose.theta);
-  m.v = static_cast<float>(odom.tv);
-  m.omega = static_cast<float>(odom.rv);
+  m.x = static_cast<float>(pose.x);
+  m.y = static_cast<float>(pose.y);
+  m.theta = static_cast<float>(pose.theta);
+  m.v = static_cast<float>(v);
+  m.omega = static_cast<float>(omega);
   return m;
 }
 
+hal::Odometry to_odometry(const CarmenOdom& odom, std::uint64_t timestamp_ns) {
+  return odometry_message(odom.pose, odom.tv, odom.rv, timestamp_ns);
+}
+
+// A scan's own odometry triple carries no velocities.
 hal::Odometry to_odometry(const CarmenScan& scan, std::uint64_t timestamp_ns) {
-  hal::Odometry m;
-  m.timestamp_ns = timestamp_ns;
-  m.x = static_cast<float>(scan.odom.x);
-  m.y = static_cast<float>(scan.odom.y);
-  m.theta = static_cast<float>(scan.odom.theta);
-  return m;
+  return odometry_message(scan.odom, 0.0, 0.0, timestamp_ns);
 }
 
 hal::LaserScan event_scan(const CarmenLog& log, const ReplayEvent& e) { return to_laser_scan(log.scans[e.index], e.t_ns); }

@@ -45,6 +45,8 @@ std::vector<ReplayEvent> make_replay_events(const CarmenLog& log, const ReplayOp
 // NaN gives 0.
 std::uint64_t seconds_to_ns(double seconds);
 
+// An odometry message of a pose (and velocities, 0 = unknown) at timestamp_ns.
+hal::Odometry odometry_message(const fw::Se2d& pose, double v, double omega, std::uint64_t timestamp_ns);
 hal::Odometry to_odometry(const CarmenOdom& odom, std::uint64_t timestamp_ns);
 hal::Odometry to_odometry(const CarmenScan& scan, std::uint64_t timestamp_ns);  // the scan's odom pose
 // Message of one event (kind must match).

@@ -13,6 +13,15 @@
 namespace sim {
 
 namespace {
+// A trajectory (one pose per scan) as a line of the picture.
+Polyline trajectory_line(const std::vector<fw::Se2d>& poses, Rgb color, double width_px, const char* label) {
+  Polyline l;
+  l.color = color;
+  l.width_px = width_px;
+  l.label = label;
+  for (const auto& p : poses) l.points.push_back({p.x, p.y});
+  return l;
+}
 
 class SteadyClock final : public hal::Clock {
  public:
@@ -176,18 +185,8 @@ bool write_slam_svg(const SlamRun& run, const std::string& title, const std::str
     }
   }
   pic.point_sets.push_back(std::move(pts));
-  Polyline raw;
-  raw.color = Rgb{230, 150, 40};
-  raw.width_px = 1.0;
-  raw.label = "RBSM front end";
-  for (const auto& p : run.frontend) raw.points.push_back({p.x, p.y});
-  pic.lines.push_back(std::move(raw));
-  Polyline traj;
-  traj.color = Rgb{30, 60, 220};
-  traj.width_px = 1.2;
-  traj.label = "AntSLAM";
-  for (const auto& p : run.poses) traj.points.push_back({p.x, p.y});
-  pic.lines.push_back(std::move(traj));
+  pic.lines.push_back(trajectory_line(run.frontend, Rgb{230, 150, 40}, 1.0, "RBSM front end"));
+  pic.lines.push_back(trajectory_line(run.poses, Rgb{30, 60, 220}, 1.2, "AntSLAM"));
   bool first_closure = true;
   for (const auto& e : run.edges) {
     if (!e.closure || e.from >= run.fragments.size() || e.to >= run.fragments.size()) continue;

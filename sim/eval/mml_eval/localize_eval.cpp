@@ -419,9 +419,7 @@ bool run_unknown_area(LocalizeRun& run, std::string* err) {
   const auto t0 = std::chrono::steady_clock::now();
   UnknownArea ua;
   if (!prepare_unknown_area(plan.unknown_dataset, plan.seed, plan.unknown_trials, &ua, err)) return false;
-  const LoadedDataset& ds = ua.ds;
-  const double* region = ua.region;
-  const std::vector<std::size_t>& starts = ua.starts;
+  const auto& [ds, region, starts] = ua;
   std::string e;
   auto loc = OwnedLocalizer::make_track(ds.map, ds.image, run.mml_cfg, plan.track, plan.threads, &e);
   if (!loc) return (*err = "unknown area: mml-track: " + e, false);

@@ -230,9 +230,7 @@ bool run_unknown_area(EvalRun& run, std::string* err) {
   const auto t0 = std::chrono::steady_clock::now();
   UnknownArea ua;
   if (!prepare_unknown_area(plan.unknown_dataset, plan.seed, plan.unknown_trials, &ua, err)) return false;
-  const LoadedDataset& ds = ua.ds;
-  const double* region = ua.region;
-  const std::vector<std::size_t>& starts = ua.starts;
+  const auto& [ds, region, starts] = ua;
   TrialOptions uo = plan.trial;
   uo.max_steps = plan.trial.max_steps + 60;
   std::string e;

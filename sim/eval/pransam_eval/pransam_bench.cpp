@@ -70,30 +70,31 @@ bool add_precomputed_one_thread(const RealCase& intel, const ScanMapRun& r2, sim
   return true;
 }
 
+// One variant of the matching parameters on the same matcher: its p50 time and success rate
+// (scan_map_ms_p50_2t_precomp_<suffix>, scan_map_success_precomp_<suffix>).
+void add_precomputed_variant(const RealCase& intel, MatcherHandle& m, const fw::pransam::MatchParams& params,
+                             const char* label, const std::string& suffix, sim::BenchJson* json) {
+  const ScanMapRun r = run_scan_map(intel, m, params);
+  report(label, r);
+  json->add("scan_map_ms_p50_2t_precomp_" + suffix, r.p50());
+  json->add("scan_map_success_precomp_" + suffix, r.success());
+}
+
 // Hard contact, plain pRANSAM and a stricter Ω_thres on the same matcher.
 void add_precomputed_variants(const RealCase& intel, MatcherHandle& m, sim::BenchJson* json) {
   // Hard contact with the same threshold (Eq. 4.31 vs 4.33).
   fw::pransam::MatchParams hard = scan_params();
   hard.fuzzy = false;
-  const ScanMapRun rh = run_scan_map(intel, m, hard);
-  report("intel precomp 2 threads, hard", rh);
-  json->add("scan_map_ms_p50_2t_precomp_hard", rh.p50());
-  json->add("scan_map_success_precomp_hard", rh.success());
+  add_precomputed_variant(intel, m, hard, "intel precomp 2 threads, hard", "hard", json);
   // The dissertation's plain pRANSAM (no refinement) for reference.
   fw::pransam::MatchParams plain = scan_params();
   plain.refine_iterations = 0;
   plain.omega_thres = 0.95f;
-  const ScanMapRun rp = run_scan_map(intel, m, plain);
-  report("intel precomp 2t, no refine, Ω 0.95", rp);
-  json->add("scan_map_ms_p50_2t_precomp_norefine", rp.p50());
-  json->add("scan_map_success_precomp_norefine", rp.success());
+  add_precomputed_variant(intel, m, plain, "intel precomp 2t, no refine, Ω 0.95", "norefine", json);
   // Trade-off: a stricter Ω_thres leaves fewer wrong answers, more runs go to I_max (slower).
   fw::pransam::MatchParams strict = scan_params();
   strict.omega_thres = 0.99f;
-  const ScanMapRun rs = run_scan_map(intel, m, strict);
-  report("intel precomp 2t, Ω_thres 0.99", rs);
-  json->add("scan_map_success_precomp_thres099", rs.success());
-  json->add("scan_map_ms_p50_2t_precomp_thres099", rs.p50());
+  add_precomputed_variant(intel, m, strict, "intel precomp 2t, Ω_thres 0.99", "thres099", json);
 }
 
 // intel with the precomputed relation table over 2 threads, then the variants.

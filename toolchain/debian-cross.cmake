@@ -1,0 +1,15 @@
+# Shared body of the Debian cross toolchain files (aarch64-linux-gnu.cmake, arm-linux-gnueabihf.cmake):
+# the caller sets MMLFW_CROSS_TRIPLET (the Debian multiarch triplet, also the compilers' prefix),
+# MMLFW_CROSS_PROCESSOR and MMLFW_CROSS_QEMU (the qemu-user binary that runs the unit tests through
+# CMAKE_CROSSCOMPILING_EMULATOR), then includes this file.
+set(CMAKE_SYSTEM_NAME Linux)
+set(CMAKE_SYSTEM_PROCESSOR ${MMLFW_CROSS_PROCESSOR})
+set(CMAKE_C_COMPILER ${MMLFW_CROSS_TRIPLET}-gcc)
+set(CMAKE_CXX_COMPILER ${MMLFW_CROSS_TRIPLET}-g++)
+set(CMAKE_FIND_ROOT_PATH /usr/${MMLFW_CROSS_TRIPLET})
+set(CMAKE_FIND_ROOT_PATH_MODE_PROGRAM NEVER)
+set(CMAKE_FIND_ROOT_PATH_MODE_LIBRARY ONLY)
+set(CMAKE_FIND_ROOT_PATH_MODE_INCLUDE ONLY)
+set(CMAKE_CROSSCOMPILING_EMULATOR ${MMLFW_CROSS_QEMU};-L;/usr/${MMLFW_CROSS_TRIPLET})
+set(MMLFW_BUILD_HOST_TOOLS OFF CACHE BOOL "" FORCE)
+set(MMLFW_BUILD_BENCHMARKS OFF CACHE BOOL "" FORCE)
