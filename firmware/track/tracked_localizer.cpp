@@ -11,6 +11,11 @@ namespace track {
 Status TrackedLocalizer::init(const TrackOptions& options, const GlobalMap& map, mml::MmlLocalizer* global,
                               const GlobalScheduleOptions& schedule) {
   if (global == nullptr) return Status::error(Errc::kInvalidArgument, "TrackedLocalizer: null global localizer");
+  if (options.confirm_fix && options.confirm_fix_on_past_scans && options.recovery_steps > kFixHistoryScans) {
+    return Status::error(Errc::kInvalidArgument,
+                         "TrackOptions.recovery_steps = %u exceeds the %u scans kept for confirm_fix_on_past_scans",
+                         options.recovery_steps, kFixHistoryScans);
+  }
   FW_RETURN_IF_ERROR(tracker_.init(options, map));
   FW_RETURN_IF_ERROR(global_.init(global, schedule));
   mml_ = global;
@@ -21,9 +26,24 @@ Status TrackedLocalizer::init(const TrackOptions& options, const GlobalMap& map,
 void TrackedLocalizer::reset() {
   tracker_.reset();
   global_.restart();
-  fixes_ = fix_rejections_ = tracks_lost_ = cross_check_switches_ = confirmations_ = cross_check_conflicts_ = 0;
+  fixes_ = fix_rejections_ = tracks_lost_ = cross_check_switches_ = confirmations_ = cross_check_conflicts_ = fixes_on_past_scans_ = 0;
   cross_check_left_ = 0;
   unconfirmed_ = false;
+  history_head_ = history_size_ = 0;
+  have_prev_ = false;
+}
+
+void TrackedLocalizer::remember_previous_scan() {
+  if (!have_prev_ || !tracker_.options().confirm_fix_on_past_scans) return;
+  const std::uint32_t slot = (history_head_ + history_size_) % kFixHistoryScans;
+  for (std::size_t k = 0; k < prev_n_; ++k) history_pts_[slot][k] = pts_[k];
+  history_n_[slot] = prev_n_;
+  history_wheel_[slot] = prev_wheel_;
+  if (history_size_ < kFixHistoryScans) {
+    ++history_size_;
+  } else {
+    history_head_ = (history_head_ + 1) % kFixHistoryScans;
+  }
 }
 
 // End-points within the tracker's range, evenly subsampled to at most align.max_points (beam order
@@ -73,7 +93,11 @@ Status TrackedLocalizer::step(const hal::LaserScan& scan, const hal::Odometry& o
   }
   global_.tick();
   const Se2f wheel(odom.x, odom.y, odom.theta);
+  remember_previous_scan();
   const std::size_t n = scan_points(scan);
+  prev_n_ = n;
+  prev_wheel_ = wheel;
+  have_prev_ = true;
   if (tracker_.active()) {
     const TrackStep ts = tracker_.step(pts_, n, wheel);
     *out = hal::PoseEstimate();
@@ -129,6 +153,10 @@ bool TrackedLocalizer::start_from_fix(const hal::PoseEstimate& g, const Se2f& wh
   for (int r = 0; r < 3; ++r)
     for (int c = 0; c < 3; ++c) cov(r, c) = g.cov[r * 3 + c];
   const bool confirm = tracker_.options().confirm_fix;
+  if (confirm && tracker_.options().confirm_fix_on_past_scans &&
+      confirm_on_past_scans(Se2f(g.x, g.y, g.theta), cov, wheel, n, out)) {
+    return true;
+  }
   tracker_.start(Se2f(g.x, g.y, g.theta), cov, wheel, confirm);
   const TrackStep ts = tracker_.step(pts_, n, wheel, /*predict=*/false);
   // The scan must support MML's pose; with confirm_fix every test but the hysteresis must pass
@@ -148,6 +176,34 @@ bool TrackedLocalizer::start_from_fix(const hal::PoseEstimate& g, const Se2f& wh
   out->mode = hal::LocalizationMode::kGlobal;
   out->protection_xy_m = out->protection_theta_rad = 0.0f;
   return false;
+}
+
+// TrackOptions::confirm_fix_on_past_scans. The tracker starts recovery_steps scans back, at MML's pose
+// carried back by the wheels (pose_{t−k} = fix ⊕ (wheel_t ⊖ wheel_{t−k})), as it would start on a fix
+// there (MML's covariance, confirmation pending), and steps through the remembered scans and this
+// one with their odometry. Nothing is published on the way; only the end counts.
+bool TrackedLocalizer::confirm_on_past_scans(const Se2f& fix, const Eigen::Matrix3f& cov, const Se2f& wheel,
+                                             std::size_t n, hal::PoseEstimate* out) {
+  const std::uint32_t k = tracker_.options().recovery_steps;
+  if (k == 0 || history_size_ < k) return false;
+  const std::uint32_t first = history_head_ + history_size_ - k;
+  const std::uint32_t s0 = first % kFixHistoryScans;
+  tracker_.start(fix.compose(wheel.between(history_wheel_[s0])), cov, history_wheel_[s0], /*confirm=*/true);
+  TrackStep ts = tracker_.step(history_pts_[s0], history_n_[s0], history_wheel_[s0], /*predict=*/false);
+  for (std::uint32_t j = 1; j < k && !ts.lost; ++j) {
+    const std::uint32_t sj = (first + j) % kFixHistoryScans;
+    ts = tracker_.step(history_pts_[sj], history_n_[sj], history_wheel_[sj]);
+  }
+  if (!ts.lost) ts = tracker_.step(pts_, n, wheel);
+  if (ts.lost || ts.status != hal::LocalizationStatus::kLocalized) {
+    tracker_.stop();
+    return false;
+  }
+  ++fixes_;
+  ++fixes_on_past_scans_;
+  unconfirmed_ = false;
+  publish_track(ts, out);
+  return true;
 }
 
 Status TrackedLocalizer::cross_check(const hal::LaserScan& scan, const hal::Odometry& odom, const Se2f& wheel,

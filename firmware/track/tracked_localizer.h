@@ -34,6 +34,9 @@ namespace track {
 
 class TrackedLocalizer final : public Localizer {
  public:
+  // Scans kept for confirming MML's fix on the scans before it (TrackOptions::confirm_fix_on_past_scans):
+  // recovery_steps must not exceed this when that option is on (init() says so).
+  static constexpr std::uint32_t kFixHistoryScans = 8;
   // `global` must be initialised and outlive this object. Every MML step and reset goes through
   // the global context (global_context.h): by default inline on every scan (the reference
   // schedule); mmlfw runs it threaded on the schedule of the execution-context table.
@@ -52,6 +55,8 @@ class TrackedLocalizer final : public Localizer {
   // Since reset: fixes accepted, MML fixes the tracker did not confirm, tracks given up.
   std::uint32_t fixes() const { return fixes_; }
   std::uint32_t fix_rejections() const { return fix_rejections_; }
+  // Fixes confirmed on the scans before them (TrackOptions::confirm_fix_on_past_scans), of fixes().
+  std::uint32_t fixes_on_past_scans() const { return fixes_on_past_scans_; }
   std::uint32_t tracks_lost() const { return tracks_lost_; }
   std::uint32_t cross_check_switches() const { return cross_check_switches_; }  // tracks replaced by MML
   // MML isolated a pose outside a track that had seen no large fault, and the scan did not prefer
@@ -68,15 +73,30 @@ class TrackedLocalizer final : public Localizer {
   void await_mml_confirmation();
   // MML's fix in `g` → tracker started and confirmed on this scan; false (tracker reset) if not.
   bool start_from_fix(const hal::PoseEstimate& g, const Se2f& wheel, std::size_t n, hal::PoseEstimate* out);
+  // The fix confirmed on the recovery_steps scans before it, then this one: true when the track ends
+  // `localized` on this scan (published in `out`); false with the tracker stopped otherwise.
+  bool confirm_on_past_scans(const Se2f& fix, const Eigen::Matrix3f& cov, const Se2f& wheel, std::size_t n,
+                             hal::PoseEstimate* out);
+  // The previous scan (points in pts_, n, wheel) into the history ring, before pts_ is overwritten.
+  void remember_previous_scan();
   Status cross_check(const hal::LaserScan& scan, const hal::Odometry& odom, const Se2f& wheel, std::size_t n,
                      const TrackStep& ts, hal::PoseEstimate* out);
   mml::MmlLocalizer* mml_ = nullptr;
   GlobalContext global_;
   PoseTracker tracker_;
   Point2f pts_[hal::LaserScan::kMaxBeams];
+  // The last scans as the tracker uses them (points, count, wheel pose), oldest first from
+  // history_head_; pts_ of the previous step waits in prev_n_ / prev_wheel_ until the next step.
+  Point2f history_pts_[kFixHistoryScans][hal::LaserScan::kMaxBeams];
+  std::size_t history_n_[kFixHistoryScans] = {};
+  Se2f history_wheel_[kFixHistoryScans];
+  std::uint32_t history_head_ = 0, history_size_ = 0;
+  std::size_t prev_n_ = 0;
+  Se2f prev_wheel_;
+  bool have_prev_ = false;
   std::uint32_t fixes_ = 0, fix_rejections_ = 0, tracks_lost_ = 0, cross_check_switches_ = 0;
   std::uint32_t cross_check_left_ = 0;  // scans the background search still runs (0 = idle)
-  std::uint32_t confirmations_ = 0, cross_check_conflicts_ = 0;
+  std::uint32_t confirmations_ = 0, cross_check_conflicts_ = 0, fixes_on_past_scans_ = 0;
   bool unconfirmed_ = false;
 };
 

@@ -66,6 +66,48 @@ TEST(TrackedLocalizerTest, FixThenTrackEveryScan) {
   EXPECT_EQ(rig.loc->tracks_lost(), 0u);
 }
 
+// TrackOptions::confirm_fix_on_past_scans: MML's fix is confirmed on the recovery_steps scans the
+// robot saw before it (replayed from the fix carried back by the wheels) and the fix's own scan, so
+// the first `localized` comes on the fix's scan instead of recovery_steps scans later — never
+// wrong, always within the protection level. Forward-only confirmation is the reference.
+TEST(TrackedLocalizerTest, FixIsConfirmedOnTheScansBeforeIt) {
+  TrackOptions forward_only, on_past_scans;
+  forward_only.confirm_fix_on_past_scans = false;
+  on_past_scans.confirm_fix_on_past_scans = true;
+  const auto path = testing::room_tour();
+  Rig fwd, past;
+  ASSERT_TRUE(fwd.init(room_map().map, forward_only).is_ok());
+  ASSERT_TRUE(past.init(room_map().map, on_past_scans).is_ok());
+  const auto rf = mml::testing::drive(fwd.loc.get(), room(), path, 1);
+  const auto rp = mml::testing::drive(past.loc.get(), room(), path, 1);
+  const Tally tf = tally(rf), tp = tally(rp);
+  ASSERT_GE(tf.first, 0);
+  ASSERT_GE(tp.first, 0);
+  EXPECT_EQ(tp.wrong, 0);
+  EXPECT_EQ(tp.outside_pl, 0);
+  EXPECT_EQ(fwd.loc->fixes_on_past_scans(), 0u);
+  EXPECT_GE(past.loc->fixes_on_past_scans(), 1u) << "no fix was confirmed on the scans before it";
+  // MML's steps do not depend on the tracker, so MML fixes on the same scan in both runs; the
+  // forward confirmation needs recovery_steps more scans (a scan earlier at most for the hysteresis).
+  const int k = static_cast<int>(TrackOptions().recovery_steps);
+  EXPECT_LE(tp.first, tf.first - (k - 1)) << "forward " << tf.first << ", on past scans " << tp.first;
+  EXPECT_EQ(rp[static_cast<std::size_t>(tp.first)].est.mode, hal::LocalizationMode::kTracking);
+}
+
+// More scans of confirmation than the history holds is a configuration error, named as such.
+TEST(TrackedLocalizerTest, RecoveryStepsBeyondTheScanHistoryIsRefused) {
+  TrackOptions o;
+  o.confirm_fix_on_past_scans = true;
+  o.recovery_steps = TrackedLocalizer::kFixHistoryScans + 1;
+  Rig rig;
+  const Status st = rig.init(room_map().map, o);
+  ASSERT_FALSE(st.is_ok());
+  EXPECT_NE(std::string(st.message()).find("recovery_steps"), std::string::npos) << st.message();
+  o.confirm_fix_on_past_scans = false;
+  Rig rig2;
+  EXPECT_TRUE(rig2.init(room_map().map, o).is_ok()) << "forward confirmation keeps no history";
+}
+
 // Kidnap half way (the truth jumps, the odometry does not): never `localized` at a wrong pose, the
 // track is given up, and MML finds the robot again.
 TEST(TrackedLocalizerTest, KidnapIsDetectedAndRefixed) {
