@@ -29,21 +29,7 @@ void TrackedLocalizer::reset() {
   fixes_ = fix_rejections_ = tracks_lost_ = cross_check_switches_ = confirmations_ = cross_check_conflicts_ = fixes_on_past_scans_ = 0;
   cross_check_left_ = 0;
   unconfirmed_ = false;
-  history_head_ = history_size_ = 0;
-  have_prev_ = false;
-}
-
-void TrackedLocalizer::remember_previous_scan() {
-  if (!have_prev_ || !tracker_.options().confirm_fix_on_past_scans) return;
-  const std::uint32_t slot = (history_head_ + history_size_) % kFixHistoryScans;
-  for (std::size_t k = 0; k < prev_n_; ++k) history_pts_[slot][k] = pts_[k];
-  history_n_[slot] = prev_n_;
-  history_wheel_[slot] = prev_wheel_;
-  if (history_size_ < kFixHistoryScans) {
-    ++history_size_;
-  } else {
-    history_head_ = (history_head_ + 1) % kFixHistoryScans;
-  }
+  history_.clear();
 }
 
 // End-points within the tracker's range, evenly subsampled to at most align.max_points (beam order
@@ -93,11 +79,14 @@ Status TrackedLocalizer::step(const hal::LaserScan& scan, const hal::Odometry& o
   }
   global_.tick();
   const Se2f wheel(odom.x, odom.y, odom.theta);
-  remember_previous_scan();
   const std::size_t n = scan_points(scan);
-  prev_n_ = n;
-  prev_wheel_ = wheel;
-  have_prev_ = true;
+  if (tracker_.options().confirm_fix_on_past_scans) {
+    history_.push_overwrite(RememberedScan());
+    RememberedScan& r = history_[history_.size() - 1];
+    for (std::size_t k = 0; k < n; ++k) r.pts[k] = pts_[k];
+    r.n = n;
+    r.wheel = wheel;
+  }
   if (tracker_.active()) {
     const TrackStep ts = tracker_.step(pts_, n, wheel);
     *out = hal::PoseEstimate();
@@ -184,15 +173,15 @@ bool TrackedLocalizer::start_from_fix(const hal::PoseEstimate& g, const Se2f& wh
 // one with their odometry. Nothing is published on the way; only the end counts.
 bool TrackedLocalizer::confirm_on_past_scans(const Se2f& fix, const Eigen::Matrix3f& cov, const Se2f& wheel,
                                              std::size_t n, hal::PoseEstimate* out) {
-  const std::uint32_t k = tracker_.options().recovery_steps;
-  if (k == 0 || history_size_ < k) return false;
-  const std::uint32_t first = history_head_ + history_size_ - k;
-  const std::uint32_t s0 = first % kFixHistoryScans;
-  tracker_.start(fix.compose(wheel.between(history_wheel_[s0])), cov, history_wheel_[s0], /*confirm=*/true);
-  TrackStep ts = tracker_.step(history_pts_[s0], history_n_[s0], history_wheel_[s0], /*predict=*/false);
-  for (std::uint32_t j = 1; j < k && !ts.lost; ++j) {
-    const std::uint32_t sj = (first + j) % kFixHistoryScans;
-    ts = tracker_.step(history_pts_[sj], history_n_[sj], history_wheel_[sj]);
+  // history_ ends with this scan; the k before it are replayed first.
+  const std::size_t k = tracker_.options().recovery_steps;
+  if (k == 0 || history_.size() < k + 1) return false;
+  const std::size_t first = history_.size() - 1 - k;
+  const RememberedScan& r0 = history_[first];
+  tracker_.start(fix.compose(wheel.between(r0.wheel)), cov, r0.wheel, /*confirm=*/true);
+  TrackStep ts = tracker_.step(r0.pts, r0.n, r0.wheel, /*predict=*/false);
+  for (std::size_t j = first + 1; j < first + k && !ts.lost; ++j) {
+    ts = tracker_.step(history_[j].pts, history_[j].n, history_[j].wheel);
   }
   if (!ts.lost) ts = tracker_.step(pts_, n, wheel);
   if (ts.lost || ts.status != hal::LocalizationStatus::kLocalized) {

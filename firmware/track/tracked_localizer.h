@@ -24,6 +24,7 @@
 
 #include <cstdint>
 
+#include "firmware/base/ring_buffer.h"
 #include "firmware/mml/mml_localizer.h"
 #include "firmware/runtime/localizer.h"
 #include "firmware/track/global_context.h"
@@ -77,23 +78,19 @@ class TrackedLocalizer final : public Localizer {
   // `localized` on this scan (published in `out`); false with the tracker stopped otherwise.
   bool confirm_on_past_scans(const Se2f& fix, const Eigen::Matrix3f& cov, const Se2f& wheel, std::size_t n,
                              hal::PoseEstimate* out);
-  // The previous scan (points in pts_, n, wheel) into the history ring, before pts_ is overwritten.
-  void remember_previous_scan();
   Status cross_check(const hal::LaserScan& scan, const hal::Odometry& odom, const Se2f& wheel, std::size_t n,
                      const TrackStep& ts, hal::PoseEstimate* out);
   mml::MmlLocalizer* mml_ = nullptr;
   GlobalContext global_;
   PoseTracker tracker_;
   Point2f pts_[hal::LaserScan::kMaxBeams];
-  // The last scans as the tracker uses them (points, count, wheel pose), oldest first from
-  // history_head_; pts_ of the previous step waits in prev_n_ / prev_wheel_ until the next step.
-  Point2f history_pts_[kFixHistoryScans][hal::LaserScan::kMaxBeams];
-  std::size_t history_n_[kFixHistoryScans] = {};
-  Se2f history_wheel_[kFixHistoryScans];
-  std::uint32_t history_head_ = 0, history_size_ = 0;
-  std::size_t prev_n_ = 0;
-  Se2f prev_wheel_;
-  bool have_prev_ = false;
+  // The last scans as the tracker uses them, this step's the newest (only with confirm_fix_on_past_scans).
+  struct RememberedScan {
+    Point2f pts[hal::LaserScan::kMaxBeams];
+    std::size_t n = 0;
+    Se2f wheel;
+  };
+  RingBuffer<RememberedScan, kFixHistoryScans + 1> history_;
   std::uint32_t fixes_ = 0, fix_rejections_ = 0, tracks_lost_ = 0, cross_check_switches_ = 0;
   std::uint32_t cross_check_left_ = 0;  // scans the background search still runs (0 = idle)
   std::uint32_t confirmations_ = 0, cross_check_conflicts_ = 0, fixes_on_past_scans_ = 0;
