@@ -91,9 +91,14 @@ sim::RelationsMetricSplit score(const BenchCase& c, const std::vector<fw::Se2d>&
 
 // The ICP baselines: "icp" = PL-ICP laser-to-laser (the honest baseline, issue 15), "trimicp" = the
 // dissertation's trimmed ICP against the end-point map (the figure "icp" meant before). *pl_icp:
-// PL-ICP's figures.
+// PL-ICP's figures, poses and CPU per scan (the fusion below runs both matchers).
+struct PlIcpRun {
+  sim::RelationsMetricSplit m;
+  std::vector<fw::Se2d> poses;
+  double cpu_ms_per_scan = 0;
+};
 bool add_icp_baselines(const BenchCase& c, const sim::MatcherConfig& cfg, const sim::RelationsMetricSplit& mo,
-                       sim::RelationsMetricSplit* pl_icp, sim::BenchJson* json, std::string* err) {
+                       PlIcpRun* pl_icp, sim::BenchJson* json, std::string* err) {
   for (sim::MatcherKind k : sim::icp_baselines()) {
     const std::string who = k == sim::MatcherKind::kPlIcp ? "icp" : "trimicp";
     sim::OdometryRun icp;
@@ -104,7 +109,11 @@ bool add_icp_baselines(const BenchCase& c, const sim::MatcherConfig& cfg, const 
     json->add(who + "_cpu_ms_per_scan_" + c.ds, sim::cpu_ms_per_scan(icp));
     json->add(c.ds + "_" + who + "_vs_odom_factor", mo.all.trans_mean / m.all.trans_mean);
     std::printf("%s %s:\n%s\n", c.ds.c_str(), sim::matcher_name(k), sim::to_string(m).c_str());
-    if (k == sim::MatcherKind::kPlIcp) *pl_icp = m;
+    if (k == sim::MatcherKind::kPlIcp) {
+      pl_icp->m = m;
+      pl_icp->poses = icp.poses;
+      pl_icp->cpu_ms_per_scan = sim::cpu_ms_per_scan(icp);
+    }
   }
   return true;
 }
@@ -112,11 +121,16 @@ bool add_icp_baselines(const BenchCase& c, const sim::MatcherConfig& cfg, const 
 // RBSM over kSeeds seeds: per-seed relation errors, and every match's times pooled.
 struct RbsmSeedFigures {
   std::vector<double> tm, rm, tmax, ms, cpu_ms, scan_cpu, st, sr, lt, lr;
+  // RBSM fused with PL-ICP's increments (fw::IncrementFusion), when PL-ICP's poses are given.
+  std::vector<double> ftm, frm, fst, fsr, flt;
+  uint32_t fused_gated = 0;
+  double pl_icp_cpu_ms_per_scan = 0;
   size_t failures = 0;
 };
 
 // Leaves cfg->rbsm.seed at the last seed (the pairwise experiment runs with it).
-bool run_rbsm_seeds(const BenchCase& c, sim::MatcherConfig* cfg, RbsmSeedFigures* f, std::string* err) {
+bool run_rbsm_seeds(const BenchCase& c, sim::MatcherConfig* cfg, RbsmSeedFigures* f, std::string* err,
+                    const std::vector<fw::Se2d>* pl_icp_poses = nullptr) {
   for (int s = 1; s <= kSeeds; ++s) {
     cfg->rbsm.seed = static_cast<uint64_t>(s);
     sim::OdometryRun run;
@@ -134,6 +148,19 @@ bool run_rbsm_seeds(const BenchCase& c, sim::MatcherConfig* cfg, RbsmSeedFigures
     f->cpu_ms.insert(f->cpu_ms.end(), run.match_cpu_ms.begin(), run.match_cpu_ms.end());
     f->scan_cpu.push_back(sim::cpu_ms_per_scan(run));
     f->failures += run.failures;
+    if (pl_icp_poses == nullptr) continue;
+    std::vector<fw::Se2d> fused;
+    uint32_t restarts = 0;
+    if (!sim::fuse_increments(run.poses, *pl_icp_poses, cfg->fusion, &fused, &restarts, err)) return false;
+    const auto fm = score(c, fused);
+    std::printf("%s rbsm seed %d fused with pl-icp increments (%u gated updates):\n%s\n", c.ds.c_str(), s, restarts,
+                sim::to_string(fm).c_str());
+    f->ftm.push_back(fm.all.trans_mean);
+    f->frm.push_back(fm.all.rot_mean_deg);
+    f->fst.push_back(fm.short_rel.trans_mean);
+    f->fsr.push_back(fm.short_rel.rot_mean_deg);
+    f->flt.push_back(fm.long_rel.trans_mean);
+    f->fused_gated += restarts;
   }
   return true;
 }
@@ -160,6 +187,15 @@ void add_rbsm_figures(const std::string& ds, const RbsmSeedFigures& f, const sim
   json->add(ds + "_rbsm_match_cpu_ms_p50_full", sim::percentile(f.cpu_ms, 50));
   // CPU per scan including the map update (integrate), mean over all scans and seeds.
   json->add("rbsm_cpu_ms_per_scan_" + ds, mean(f.scan_cpu));
+  if (f.ftm.empty()) return;
+  // RBSM fused with PL-ICP's increments (extension, fw::IncrementFusion): same seeds.
+  json->add(ds + "_trans_err_fused", mean(f.ftm));
+  json->add(ds + "_rot_err_fused", mean(f.frm));
+  json->add(ds + "_short_trans_err_fused", mean(f.fst));
+  json->add(ds + "_short_rot_err_fused", mean(f.fsr));
+  json->add(ds + "_long_trans_err_fused", mean(f.flt));
+  json->add_int(ds + "_fused_gated_updates", static_cast<long long>(f.fused_gated));
+  json->add("fused_cpu_ms_per_scan_" + ds, mean(f.scan_cpu) + f.pl_icp_cpu_ms_per_scan);
 }
 
 // Pure Alg. 1 (refine = false, motion_prior = false: both extensions off), one seed: what they change.
@@ -233,10 +269,12 @@ bool bench_case(const BenchCase& c, sim::BenchJson* json, std::string* err) {
   for (const auto& s : c.log.scans) odom.push_back(s.odom);
   const auto mo = score(c, odom);
   add_split(c.ds, "odom", mo, json);
-  sim::RelationsMetricSplit mi;
-  if (!add_icp_baselines(c, cfg, mo, &mi, json, err)) return false;
+  PlIcpRun pl;
+  if (!add_icp_baselines(c, cfg, mo, &pl, json, err)) return false;
+  const sim::RelationsMetricSplit& mi = pl.m;
   RbsmSeedFigures f;
-  if (!run_rbsm_seeds(c, &cfg, &f, err)) return false;
+  f.pl_icp_cpu_ms_per_scan = pl.cpu_ms_per_scan;
+  if (!run_rbsm_seeds(c, &cfg, &f, err, &pl.poses)) return false;
   add_rbsm_figures(c.ds, f, mi, mo, json);
   if (!add_pure_alg1(c, cfg, json, err)) return false;
   if (!add_motion_prior(c, cfg, json, err)) return false;

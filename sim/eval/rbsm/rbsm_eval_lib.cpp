@@ -172,6 +172,28 @@ bool run_scan_matching_odometry(const CarmenLog& log, MatcherKind kind, const Ma
   return true;
 }
 
+bool fuse_increments(const std::vector<fw::Se2d>& absolute, const std::vector<fw::Se2d>& relative,
+                     const fw::IncrementFusionOptions& options, std::vector<fw::Se2d>* out, uint32_t* restarts,
+                     std::string* error) {
+  if (absolute.size() != relative.size()) {
+    *error = "fuse_increments: " + std::to_string(absolute.size()) + " RBSM poses but " +
+             std::to_string(relative.size()) + " PL-ICP poses";
+    return false;
+  }
+  fw::IncrementFusion fusion;
+  fw::Status st = fusion.init(options);
+  out->clear();
+  for (size_t i = 0; st.is_ok() && i < absolute.size(); ++i) {
+    const fw::Se2d u = i == 0 ? fw::Se2d() : relative[i - 1].between(relative[i]);
+    st = fusion.update(absolute[i], i > 0, u);
+    if (st.is_ok()) out->push_back(fusion.pose());
+    else *error = "fuse_increments: scan " + std::to_string(i) + ": " + st.message();
+  }
+  if (!st.is_ok() && error->empty()) *error = std::string("fuse_increments: ") + st.message();
+  *restarts = fusion.gated_updates();
+  return st.is_ok();
+}
+
 double cpu_ms_per_scan(const OdometryRun& run) {
   if (run.scan_cpu_ms.empty()) return std::nan("");
   double s = 0;

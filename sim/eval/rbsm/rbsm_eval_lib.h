@@ -13,6 +13,7 @@
 #include "firmware/base/worker_pool.h"
 #include "firmware/baselines/icp/pl_icp.h"
 #include "firmware/baselines/icp/trimmed_icp.h"
+#include "firmware/rbsm/increment_fusion.h"
 #include "firmware/rbsm/rbsm.h"
 #include "firmware/rbsm/scan_matching_odometry.h"
 #include "sim/io/carmen_log.h"
@@ -34,6 +35,7 @@ struct MatcherConfig {
   fw::TrimmedIcpOptions icp;
   fw::PlIcpOptions plicp;
   fw::ScanMatchingOdometryOptions front;
+  fw::IncrementFusionOptions fusion;  // RBSM ⊕ PL-ICP increments (extension, fuse_increments)
   int workers = 1;  // >1: RBSM sampling/weighting over a fw::WorkerPool
 };
 // 5 cm cells, 1024-cell (51 m) scrolling window, 1000 particles, points up to 15 m, at least 3
@@ -76,6 +78,13 @@ struct OdometryRun {
 bool run_scan_matching_odometry(const CarmenLog& log, MatcherKind kind, const MatcherConfig& config, size_t max_scans,
                                 OdometryRun* out, std::string* error,
                                 const std::function<void(size_t, size_t)>& progress = {});
+
+// RBSM's poses (`absolute`) fused with the increments of PL-ICP's poses (`relative`, same scans) by
+// fw::IncrementFusion (an extension of Alg. 1, issue 15): one pose per scan in *out; *restarts:
+// gate violations. False (with *error) when the lengths differ or a pose is not finite.
+bool fuse_increments(const std::vector<fw::Se2d>& absolute, const std::vector<fw::Se2d>& relative,
+                     const fw::IncrementFusionOptions& options, std::vector<fw::Se2d>* out, uint32_t* restarts,
+                     std::string* error);
 
 // Mean of scan_cpu_ms: CPU per scan including the map update (the throughput figure).
 double cpu_ms_per_scan(const OdometryRun& run);

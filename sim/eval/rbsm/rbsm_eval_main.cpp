@@ -4,12 +4,18 @@
 //     scan-matcher-only odometry; relations metric (Kümmerle et al. 2009) per seed and mean ± std,
 //     overall and split by relation length (≤ 10 s / > 10 s); CPU per scan including the map update;
 //     writes DIR/NAME_{rbsm_best,rbsm_worst,icp,odom}.png and trajectories DIR/NAME_odom.txt,
-//     DIR/NAME_<icp>.txt and one per seed, DIR/NAME_rbsm_seedNN.txt (mml-carmen eval rescores them).
+//     DIR/NAME_<icp>.txt and one per seed, DIR/NAME_rbsm_seedNN.txt (mml-carmen eval rescores them);
+//     with the ICP baselines also RBSM fused with PL-ICP's increments per seed (fw::IncrementFusion, an
+//     extension), DIR/NAME_fused_seedNN.txt.
 //   mml-rbsm-eval pairwise DATASET [--pairs N] [--seeds N] [--particles N]
+//   mml-rbsm-eval fuse RBSM.txt PL-ICP.txt OUT.txt [--set fuse_KEY=VALUE …]
+//     fuses two saved trajectories of the same scans (RBSM's poses, PL-ICP's increments) with
+//     fw::IncrementFusion and writes OUT.txt (score it with mml-carmen eval RELATIONS OUT.txt).
 //   --set KEY=VALUE overrides the matcher configuration (max_range, resolution, size_log2, subcell_log2,
 //     shrink, accept_ratio, min_iterations, max_iterations, sigma_xy2, sigma_psi2, hill_climbing, mahalanobis,
 //     min_translation, min_rotation_deg, icp_max_corr, refine (0: pure Alg. 1 with prior=0), prior (odometry motion prior, 0/1), prior_xy (its σ in m), refine_radius, refine_iterations,
-//     refine_gate, refine_eigen, refine_score_loss, chain_refined, plicp_max_corr, plicp_kf_dist, plicp_kf_deg, plicp_trim); --no-maps skips the PNGs.
+//     refine_gate, refine_eigen, refine_score_loss, chain_refined, plicp_max_corr, plicp_kf_dist, plicp_kf_deg, plicp_trim,
+//     fuse_abs_xy, fuse_abs_deg (RBSM's σ in the fusion), fuse_rel_xy, fuse_rel_per_m, fuse_rel_deg, fuse_gate); --no-maps skips the PNGs.
 //     consecutive corrected-scan pairs, guess perturbed by N(0, 10 cm, 6°): mean/p95/max errors.
 #include <algorithm>
 #include <cmath>
@@ -33,7 +39,8 @@ int usage() {
                "usage: mml-rbsm-eval odometry DATASET [--seeds N] [--scans N] [--particles N] [--workers N] "
                "[--out DIR] [--no-icp]\n"
                "       mml-rbsm-eval odometry --log LOG --relations RELATIONS [--name NAME] [options as above]\n"
-               "       mml-rbsm-eval pairwise DATASET [--pairs N] [--seeds N] [--particles N]\n");
+               "       mml-rbsm-eval pairwise DATASET [--pairs N] [--seeds N] [--particles N]\n"
+               "       mml-rbsm-eval fuse RBSM.txt PL-ICP.txt OUT.txt [--set fuse_KEY=VALUE ...]\n");
   return 2;
 }
 
@@ -182,6 +189,12 @@ bool apply_front_and_icp_setting(const std::string& key, double v, sim::MatcherC
   else if (key == "plicp_kf_dist") cfg->plicp.keyframe_translation_m = static_cast<float>(v);
   else if (key == "plicp_kf_deg") cfg->plicp.keyframe_rotation_rad = static_cast<float>(v * M_PI / 180.0);
   else if (key == "plicp_trim") cfg->plicp.trim_fraction = static_cast<float>(v);
+  else if (key == "fuse_abs_xy") cfg->fusion.absolute_sigma_m = v;
+  else if (key == "fuse_abs_deg") cfg->fusion.absolute_sigma_rad = v * M_PI / 180.0;
+  else if (key == "fuse_rel_xy") cfg->fusion.relative_sigma_m = v;
+  else if (key == "fuse_rel_per_m") cfg->fusion.relative_sigma_per_m = v;
+  else if (key == "fuse_rel_deg") cfg->fusion.relative_sigma_rad = v * M_PI / 180.0;
+  else if (key == "fuse_gate") cfg->fusion.gate_chi2 = v;
   else return false;
   return true;
 }
@@ -249,6 +262,7 @@ struct OdometryInput {
   sim::CarmenLog head;
   size_t n = 0;
   std::vector<sim::Relation> rel;
+  std::vector<fw::Se2d> pl_icp;  // PL-ICP's poses (for the fusion), when the baselines ran
 };
 
 // Raw odometry scored: the reference every matcher is compared with.
@@ -262,8 +276,9 @@ sim::RelationsMetricSplit evaluate_raw_odometry(const EvalArgs& a, const Odometr
   return mo;
 }
 
-int run_icp_baselines(const EvalArgs& a, const OdometryInput& in, const sim::MatcherConfig& cfg,
+int run_icp_baselines(const EvalArgs& a, OdometryInput* in_out, const sim::MatcherConfig& cfg,
                       const sim::RelationsMetricSplit& mo, std::string* err) {
+  const OdometryInput& in = *in_out;
   for (sim::MatcherKind k : sim::icp_baselines()) {
     sim::OdometryRun run;
     if (!sim::run_scan_matching_odometry(in.log, k, cfg, in.n, &run, err)) {
@@ -280,6 +295,7 @@ int run_icp_baselines(const EvalArgs& a, const OdometryInput& in, const sim::Mat
       sim::write_map_png(a.out_dir + "/" + a.ds + "_" + kn + ".png", in.log, run.poses, nullptr, 0.05, 15.0f, 1, err);
     }
     write_traj(a.out_dir + "/" + a.ds + "_" + kn + ".txt", in.log, run.poses);
+    if (k == sim::MatcherKind::kPlIcp) in_out->pl_icp = run.poses;
   }
   return kGoOn;
 }
@@ -288,6 +304,7 @@ int run_icp_baselines(const EvalArgs& a, const OdometryInput& in, const sim::Mat
 // best and worst seed so far (by mean translation error) for the pictures.
 struct SeedFigures {
   std::vector<double> tm, rm, stm, srm, ltm, lrm, cpu;
+  std::vector<double> ftm, frm, fstm, fsrm, fltm;  // RBSM fused with PL-ICP's increments
   double best = 1e9, worst = -1;
 };
 
@@ -330,6 +347,24 @@ int run_rbsm_seed(const EvalArgs& a, const OdometryInput& in, sim::MatcherConfig
     std::fprintf(stderr, "mml-rbsm-eval: cannot write %s/%s%s\n", a.out_dir.c_str(), a.ds.c_str(), seed_name);
     return 1;
   }
+  if (!in.pl_icp.empty()) {
+    std::vector<fw::Se2d> fused;
+    uint32_t restarts = 0;
+    if (!sim::fuse_increments(run.poses, in.pl_icp, cfg->fusion, &fused, &restarts, err)) {
+      std::fprintf(stderr, "mml-rbsm-eval: %s\n", err->c_str());
+      return 1;
+    }
+    const auto fm = sim::evaluate_relations_split(in.rel, sim::make_trajectory(in.head, fused));
+    f->ftm.push_back(fm.all.trans_mean);
+    f->frm.push_back(fm.all.rot_mean_deg);
+    f->fstm.push_back(fm.short_rel.trans_mean);
+    f->fsrm.push_back(fm.short_rel.rot_mean_deg);
+    f->fltm.push_back(fm.long_rel.trans_mean);
+    std::printf("%s rbsm seed %2d fused with pl-icp increments (%u gated updates):\n%s\n", a.ds.c_str(), s, restarts,
+                sim::to_string(fm).c_str());
+    std::snprintf(seed_name, sizeof seed_name, "_fused_seed%02d.txt", s);
+    write_traj(a.out_dir + "/" + a.ds + seed_name, in.log, fused);
+  }
   if (a.maps && m.trans_mean < f->best) {
     f->best = m.trans_mean;
     sim::write_map_png(a.out_dir + "/" + a.ds + "_rbsm_best.png", in.log, run.poses, nullptr, 0.05, 15.0f, 1, err);
@@ -358,7 +393,7 @@ int run_odometry(const EvalArgs& a, const sim::EvalDataset& d, const sim::Carmen
   in.head.scans.resize(in.n);
   const sim::RelationsMetricSplit mo = evaluate_raw_odometry(a, in, err);
   if (a.icp) {
-    const int rc = run_icp_baselines(a, in, cfg, mo, err);
+    const int rc = run_icp_baselines(a, &in, cfg, mo, err);
     if (rc != kGoOn) return rc;
   }
   SeedFigures f;
@@ -371,12 +406,64 @@ int run_odometry(const EvalArgs& a, const sim::EvalDataset& d, const sim::Carmen
               "trans %.4f m rot %.3f deg | long (> 10 s) trans %.4f m rot %.3f deg | %.3f ms CPU/scan\n",
               a.ds.c_str(), a.seeds, mean(f.tm), stddev(f.tm), mean(f.rm), stddev(f.rm), mo.all.trans_mean,
               mo.all.rot_mean_deg, mean(f.stm), mean(f.srm), mean(f.ltm), mean(f.lrm), mean(f.cpu));
+  if (!f.ftm.empty()) {
+    std::printf("%s rbsm fused with pl-icp increments over %d seeds: trans %.4f ± %.4f m, rot %.3f deg | short (<= 10 s) "
+                "trans %.4f m rot %.3f deg | long (> 10 s) trans %.4f m\n",
+                a.ds.c_str(), a.seeds, mean(f.ftm), stddev(f.ftm), mean(f.frm), mean(f.fstm), mean(f.fsrm),
+                mean(f.fltm));
+  }
   return 0;
 }
 
 }  // namespace
 
+// mml-rbsm-eval fuse RBSM.txt PL-ICP.txt OUT.txt [--set fuse_KEY=VALUE …]
+int run_fuse(int argc, char** argv) {
+  if (argc < 5) return usage();
+  sim::MatcherConfig cfg = sim::default_matcher_config();
+  for (int i = 5; i < argc; ++i) {
+    const std::string arg = argv[i];
+    const std::string kv = arg == "--set" && i + 1 < argc ? argv[++i] : "";
+    const size_t eq = kv.find('=');
+    const double v = eq == std::string::npos ? NAN : std::atof(kv.c_str() + eq + 1);
+    if (kv.compare(0, 5, "fuse_") != 0 || std::isnan(v) || !apply_front_and_icp_setting(kv.substr(0, eq), v, &cfg)) {
+      std::fprintf(stderr, "mml-rbsm-eval fuse: '%s': expected --set fuse_KEY=VALUE\n", arg == "--set" ? kv.c_str() : arg.c_str());
+      return 2;
+    }
+  }
+  std::string err;
+  sim::Trajectory rb, pl;
+  if (!sim::read_trajectory(argv[2], &rb, &err) || !sim::read_trajectory(argv[3], &pl, &err)) {
+    std::fprintf(stderr, "mml-rbsm-eval fuse: %s\n", err.c_str());
+    return 1;
+  }
+  for (size_t i = 0; i < rb.size() && i < pl.size(); ++i) {
+    if (std::fabs(rb[i].t - pl[i].t) > 1e-5) {
+      std::fprintf(stderr, "mml-rbsm-eval fuse: pose %zu of %s (t %.6f) and of %s (t %.6f) are not the same scan\n", i + 1,
+                   argv[2], rb[i].t, argv[3], pl[i].t);
+      return 1;
+    }
+  }
+  std::vector<fw::Se2d> a, b, fused;
+  for (const auto& p : rb) a.push_back(p.pose);
+  for (const auto& p : pl) b.push_back(p.pose);
+  uint32_t gated = 0;
+  if (!sim::fuse_increments(a, b, cfg.fusion, &fused, &gated, &err)) {
+    std::fprintf(stderr, "mml-rbsm-eval fuse: %s\n", err.c_str());
+    return 1;
+  }
+  sim::Trajectory out = rb;
+  for (size_t i = 0; i < out.size(); ++i) out[i].pose = fused[i];
+  if (!sim::write_trajectory(argv[4], out, &err)) {
+    std::fprintf(stderr, "mml-rbsm-eval fuse: %s\n", err.c_str());
+    return 1;
+  }
+  std::printf("%zu poses fused, %u updates down-weighted at the gate\n", fused.size(), gated);
+  return 0;
+}
+
 static int run_main(int argc, char** argv) {
+  if (argc > 1 && std::strcmp(argv[1], "fuse") == 0) return run_fuse(argc, argv);
   EvalArgs a;
   int rc = parse_args(argc, argv, &a);
   if (rc != kGoOn) return rc;
