@@ -116,6 +116,51 @@ bool selfmap_localization(const sim::CarmenLog& log, const sim::EvalDataset& d, 
   return ok;
 }
 
+// One front end (cfg.fuse_front) with both back ends: the ant colony on it, then LM on the same front
+// end and loops. Keys P slam_trans_err_m, slam_lm_*, front_trans_err_m (and rbsm_trans_err_m for the
+// default), times, fragments, loops.
+bool run_front_and_back(const std::string& ds, const sim::CarmenLog& log, const std::vector<sim::Relation>& rel,
+                        const sim::SlamConfig& cfg, const std::string& p, sim::BenchJson* json, sim::SlamRun* aco,
+                        std::string* err) {
+  const auto t0 = std::chrono::steady_clock::now();
+  if (!sim::run_slam(log, cfg, aco, err)) {
+    std::fprintf(stderr, "bench_slam: %s: %s\n", ds.c_str(), err->c_str());
+    return false;
+  }
+  const double slam_s = seconds_since(t0);
+  sim::SlamConfig lm_cfg = cfg;
+  lm_cfg.slam.optimizer = fw::antslam::LoopOptimizer::kLevenbergMarquardt;
+  sim::SlamRun lm;
+  if (!sim::run_slam_backend(log, aco->frontend, lm_cfg, &lm, err)) {
+    std::fprintf(stderr, "bench_slam: %s (LM): %s\n", ds.c_str(), err->c_str());
+    return false;
+  }
+  const auto m_aco = sim::evaluate_relations(rel, sim::make_trajectory(log, aco->poses));
+  const auto m_lm = sim::evaluate_relations(rel, sim::make_trajectory(log, lm.poses));
+  const auto m_front = sim::evaluate_relations(rel, sim::make_trajectory(log, aco->frontend));
+  const double log_s = log.scans.back().ipc_timestamp - log.scans.front().ipc_timestamp;
+  std::printf("%s, front end %s: front %.4f m, AntSLAM ACO %.4f m, LM %.4f m, %u loops, %.1f s\n", ds.c_str(),
+              cfg.fuse_front ? "fused" : "rbsm", m_front.trans_mean, m_aco.trans_mean, m_lm.trans_mean,
+              aco->stats.loops, slam_s);
+  json->add(p + "slam_trans_err_m", m_aco.trans_mean);
+  json->add(p + "slam_rot_err_deg", m_aco.rot_mean_deg);
+  json->add(p + "slam_lm_trans_err_m", m_lm.trans_mean);
+  json->add(p + "slam_lm_rot_err_deg", m_lm.rot_mean_deg);
+  json->add(p + "front_trans_err_m", m_front.trans_mean);
+  if (!cfg.fuse_front) json->add(p + "rbsm_trans_err_m", m_front.trans_mean);
+  json->add(p + "slam_s", slam_s);
+  json->add(p + "log_s", log_s);
+  json->add(p + "slam_speedup", log_s / slam_s);
+  json->add(p + "aco_ms", aco->optimizer_ms);
+  json->add(p + "lm_ms", lm.optimizer_ms);
+  json->add(p + "pransam_ms", aco->matcher_ms);
+  json->add_int(p + "fragments", static_cast<long long>(aco->fragments.size()));
+  json->add_int(p + "loops", aco->stats.loops);
+  json->add_int(p + "loop_candidates", aco->stats.candidates);
+  json->add_int(p + "relations_used", static_cast<long long>(m_aco.used));
+  return true;
+}
+
 }  // namespace
 
 static int run_main(int argc, char** argv) {
@@ -151,45 +196,25 @@ static int run_main(int argc, char** argv) {
     sim::SlamConfig cfg;
     cfg.workers = 1;
     cfg.slam.aco.stall_iterations = kAcoStall;
-    const auto t0 = std::chrono::steady_clock::now();
     sim::SlamRun aco;
-    if (!sim::run_slam(log, cfg, &aco, &err)) {
-      std::fprintf(stderr, "bench_slam: %s: %s\n", ds.c_str(), err.c_str());
+    if (!run_front_and_back(ds, log, rel, cfg, key + "_", &json, &aco, &err)) {
       all_ok = false;
       continue;
     }
-    const double slam_s = seconds_since(t0);
-    sim::SlamConfig lm_cfg = cfg;
-    lm_cfg.slam.optimizer = fw::antslam::LoopOptimizer::kLevenbergMarquardt;
-    sim::SlamRun lm;
-    if (!sim::run_slam_backend(log, aco.frontend, lm_cfg, &lm, &err)) {
-      std::fprintf(stderr, "bench_slam: %s (LM): %s\n", ds.c_str(), err.c_str());
+    // The other front end on the same log (issue 12/15): the fused one when the default is RBSM
+    // alone, and the reverse — D_slam_<front>_* keys, same seed, same back end.
+    sim::SlamConfig other = cfg;
+    other.fuse_front = !cfg.fuse_front;
+    sim::SlamRun other_run;
+    if (!run_front_and_back(ds, log, rel, other, key + (other.fuse_front ? "_fusedfront_" : "_rbsmfront_"), &json,
+                            &other_run, &err)) {
       all_ok = false;
       continue;
     }
     std::vector<fw::Se2d> odom;
     for (const auto& s : log.scans) odom.push_back(s.odom);
-    const auto m_aco = sim::evaluate_relations(rel, sim::make_trajectory(log, aco.poses));
-    const auto m_lm = sim::evaluate_relations(rel, sim::make_trajectory(log, lm.poses));
-    const auto m_rbsm = sim::evaluate_relations(rel, sim::make_trajectory(log, aco.frontend));
-    const auto m_odom = sim::evaluate_relations(rel, sim::make_trajectory(log, odom));
-    const double log_s = log.scans.back().ipc_timestamp - log.scans.front().ipc_timestamp;
-    json.add(key + "_slam_trans_err_m", m_aco.trans_mean);
-    json.add(key + "_slam_rot_err_deg", m_aco.rot_mean_deg);
-    json.add(key + "_slam_lm_trans_err_m", m_lm.trans_mean);
-    json.add(key + "_slam_lm_rot_err_deg", m_lm.rot_mean_deg);
-    json.add(key + "_rbsm_trans_err_m", m_rbsm.trans_mean);
-    json.add(key + "_odom_trans_err_m", m_odom.trans_mean);
-    json.add_int(key + "_relations_used", static_cast<long long>(m_aco.used));
-    json.add(key + "_slam_s", slam_s);
-    json.add(key + "_log_s", log_s);
-    json.add(key + "_slam_speedup", log_s / slam_s);
-    json.add(key + "_aco_ms", aco.optimizer_ms);
-    json.add(key + "_lm_ms", lm.optimizer_ms);
-    json.add(key + "_pransam_ms", aco.matcher_ms);
-    json.add_int(key + "_fragments", static_cast<long long>(aco.fragments.size()));
-    json.add_int(key + "_loops", aco.stats.loops);
-    json.add_int(key + "_loop_candidates", aco.stats.candidates);
+    json.add(key + "_odom_trans_err_m", sim::evaluate_relations(rel, sim::make_trajectory(log, odom)).trans_mean);
+    json.add_bool(key + "_slam_front_fused", cfg.fuse_front);
     if (ds == "intel" || ds == "fr079" || ds == "aces") {
       if (!selfmap_localization(log, d, aco.poses, key, out_dir, &json, &err)) {
         std::fprintf(stderr, "bench_slam: %s: self-built map localization: %s\n", ds.c_str(), err.c_str());

@@ -26,16 +26,18 @@ const char* kHelp =
     "outputs (each optional; nothing is written unless asked):\n"
     "  --trajectory FILE     corrected pose of every scan, 't x y theta' per line (t = ipc timestamp);\n"
     "                        score it with: mml-carmen eval RELATIONS FILE\n"
-    "  --rbsm-trajectory FILE  the same for the RBSM front end alone (before AntSLAM)\n"
+    "  --rbsm-trajectory FILE  the same for the front end alone (before AntSLAM; see --front)\n"
     "  --map FILE.yaml       ROS map_server map (YAML + PGM beside it); compile it with mml-mapc\n"
     "  --svg FILE.svg        picture of fragments, edges and closed loops (FILE.png: a PNG)\n"
-    "  --relations FILE      print the relations metric (Kuemmerle et al. 2009) of RBSM and AntSLAM\n"
+    "  --relations FILE      print the relations metric (Kuemmerle et al. 2009) of the front end and AntSLAM\n"
     "                        (default with --dataset: the data set's relations; mit-killian: relations\n"
     "                        between its consecutive GMapping-corrected poses)\n"
     "options:\n"
     "  --optimizer aco|lm    loop optimiser (default aco: the ant colony of Eq. 3.13-3.14)\n"
     "  --edge-model sensor|motion  edge covariance: from poses weighted by the sensor model (Eq. 3.9, default)\n"
     "                        or the front end's propagated motion covariance (Eq. 3.4; closures: --closure-sigma)\n"
+    "  --front fused|rbsm    front end: RBSM fused with PL-ICP's laser-to-laser increments (default;\n"
+    "                        fw::IncrementFusion, an extension: firmware/rbsm/README.md) or RBSM alone (the dissertation's)\n"
     "  --ants N              ants per iteration (default 20)\n"
     "  --iterations N        ant-colony iterations per loop (default 5000)\n"
     "  --fragment-length M   metres travelled per fragment (default 5; 10 for long loops)\n"
@@ -133,6 +135,10 @@ Parsed parse_run_option(const std::string& a, const std::string& v, SlamArgs* o)
     if (v == "sensor") cfg.slam.edge_model = fw::antslam::EdgeModel::kSensorModel;
     else if (v == "motion") cfg.slam.edge_model = fw::antslam::EdgeModel::kMotionModel;
     else return failed("--edge-model: '" + v + "' is not sensor or motion");
+  } else if (a == "--front") {
+    if (v == "rbsm") cfg.fuse_front = false;
+    else if (v == "fused") cfg.fuse_front = true;
+    else return failed("--front: '" + v + "' is not rbsm or fused");
   } else if (a == "--ants") {
     if (!parse_u64(v, 1, 1024, &u)) return failed("--ants: '" + v + "' is not an integer in 1..1024");
     cfg.slam.aco.ants = static_cast<std::uint32_t>(u);
@@ -287,7 +293,7 @@ void print_summary(const sim::CarmenLog& log, const sim::SlamConfig& cfg, const 
     std::printf("mml-slam: edge covariances from the sensor model (Eq. 3.9): %u, fallback (too few points: Eq. 3.4, or closure-sigma for a closure): %u\n",
                 run.stats.sensor_fits, run.stats.motion_fallbacks);
   }
-  std::printf("mml-slam: RBSM %.1f s + AntSLAM %.1f s (pRANSAM %.0f ms, %s %.0f ms) for %.0f s of log\n", run.frontend_s,
+  std::printf("mml-slam: front end %.1f s + AntSLAM %.1f s (pRANSAM %.0f ms, %s %.0f ms) for %.0f s of log\n", run.frontend_s,
               run.backend_s, run.matcher_ms,
               cfg.slam.optimizer == fw::antslam::LoopOptimizer::kAntColony ? "ant colony" : "LM", run.optimizer_ms, log_s);
   if (verbose) {
@@ -343,7 +349,7 @@ int run(int argc, char** argv) {
   if (!rel.empty()) {
     const auto mf = sim::evaluate_relations(rel, sim::make_trajectory(log, run.frontend));
     const auto ms = sim::evaluate_relations(rel, sim::make_trajectory(log, run.poses));
-    std::printf("relations, RBSM alone: %s\nrelations, AntSLAM:    %s\n", sim::to_string(mf).c_str(),
+    std::printf("relations, front end alone: %s\nrelations, AntSLAM:          %s\n", sim::to_string(mf).c_str(),
                 sim::to_string(ms).c_str());
   }
   return write_outputs(o, log, run);

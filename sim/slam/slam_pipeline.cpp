@@ -123,6 +123,17 @@ bool run_slam(const CarmenLog& log, const SlamConfig& config, SlamRun* out, std:
   if (!run_scan_matching_odometry(log, MatcherKind::kRbsm, mc, config.max_scans, &odo, error, front_progress)) {
     return false;
   }
+  if (config.fuse_front) {
+    if (config.progress) front_progress = [&config](size_t done, size_t total) { config.progress(done, total, "pl-icp"); };
+    OdometryRun icp;
+    if (!run_scan_matching_odometry(log, MatcherKind::kPlIcp, mc, config.max_scans, &icp, error, front_progress)) {
+      return false;
+    }
+    std::vector<fw::Se2d> fused;
+    std::uint32_t gated = 0;
+    if (!fuse_increments(odo.poses, icp.poses, mc.fusion, &fused, &gated, error)) return false;
+    odo.poses = std::move(fused);
+  }
   const double front_s = seconds_since(t0);
   if (!run_slam_backend(log, odo.poses, config, out, error)) return false;
   out->frontend_s = front_s;
