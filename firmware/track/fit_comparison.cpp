@@ -16,7 +16,8 @@ ConfidenceExtent confidence_extent(const GlobalMap& map, const Point2f* pts, std
   const Sym2Eigen ev = sym2_eigen(info_xx, info_xy, info_yy);
   // The weak axis (least information) and its normal; both directions of each.
   const float ax[2][2] = {{ev.vmin_x, ev.vmin_y}, {-ev.vmin_y, ev.vmin_x}};
-  for (const auto& a : ax) {
+  for (int axis = 0; axis < 2; ++axis) {
+    const auto& a = ax[axis];
     for (const float sign : {1.0f, -1.0f}) {
       float open = 0.0f;
       for (float s = o.step_m; s <= o.max_xy_m + 1e-6f; s += o.step_m) {
@@ -25,6 +26,7 @@ ConfidenceExtent confidence_extent(const GlobalMap& map, const Point2f* pts, std
         open = s;
       }
       e.xy_m = std::fmax(e.xy_m, open);
+      e.axis_m[axis] = std::fmax(e.axis_m[axis], open);
     }
   }
   for (const float sign : {1.0f, -1.0f}) {

@@ -30,6 +30,7 @@ struct ConfidenceExtentOptions {
 struct ConfidenceExtent {
   float xy_m = 0.0f;       // farthest shift not rejected (0: even the first step is rejected)
   float theta_rad = 0.0f;  // farthest turn not rejected
+  float axis_m[2] = {0.0f, 0.0f};  // the same along the weak axis [0] and across it [1]
 };
 ConfidenceExtent confidence_extent(const GlobalMap& map, const Point2f* pts, std::size_t n, const Se2f& fix,
                                    float info_xx, float info_xy, float info_yy, std::uint32_t independent,

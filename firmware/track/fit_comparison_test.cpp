@@ -3,6 +3,7 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <vector>
 
 #include "firmware/track/scan_alignment.h"
 #include "firmware/track/track_test_util.h"
@@ -45,6 +46,32 @@ TEST(ConfidenceExtentTest, OpenAlongACorridorClosedInARoom) {
   const ConfidenceExtent r = extent_at(testing::room(), testing::room_map(), Se2f(5.0f, 3.0f, 0.3f), 8.0f, 5);
   EXPECT_LE(r.xy_m, 0.1f);
   EXPECT_LE(r.theta_rad, 0.035f);  // 2°: in heading the test is weak (track_options.h)
+}
+
+// Per axis: a corridor pins the position across it and leaves it open along it; a room pins both;
+// a scan the map cannot explain pins neither — the case
+// TrackOptions::confidence_cap_needs_a_pinned_axis keeps from being carried by the odometry.
+TEST(ConfidenceExtentTest, PerAxisExtentsTellACorridorFromAScanThatFitsNothing) {
+  const GridWorld corridor = plain_corridor();
+  const OwnedGlobalMap corridor_map(corridor);
+  const ConfidenceExtent c = extent_at(corridor, corridor_map, Se2f(15.0f, 2.0f, 0.0f), 4.0f, 3);
+  EXPECT_GE(c.axis_m[0], 0.45f);  // along
+  EXPECT_LE(c.axis_m[1], 0.1f);   // across
+  EXPECT_EQ(c.xy_m, std::fmax(c.axis_m[0], c.axis_m[1]));
+  const ConfidenceExtent r = extent_at(testing::room(), testing::room_map(), Se2f(5.0f, 3.0f, 0.3f), 8.0f, 5);
+  EXPECT_LE(r.axis_m[0], 0.1f);
+  EXPECT_LE(r.axis_m[1], 0.1f);
+  // A scan the map cannot explain anywhere near: end-points on a 0.6 m ring (clutter around the
+  // robot), all farther from the corridor's walls than the clip distance.
+  std::vector<Point2f> pts;
+  for (int i = 0; i < 90; ++i) pts.push_back(Point2f(0.6f * std::cos(0.07f * i), 0.6f * std::sin(0.07f * i)));
+  const Se2f there(15.0f, 2.0f, 0.0f);
+  const ScanAlignment a = align_scan(corridor_map.map, pts.data(), pts.size(), there, ScanAlignOptions());
+  const ConfidenceExtent n = confidence_extent(corridor_map.map, pts.data(), pts.size(), a.pose, a.information(0, 0),
+                                               a.information(0, 1), a.information(1, 1), a.independent,
+                                               ConfidenceExtentOptions());
+  EXPECT_GE(n.axis_m[0], 0.45f);
+  EXPECT_GE(n.axis_m[1], 0.45f);
 }
 
 // The paired test itself: a pose 0.3 m off in the room is significantly worse than the truth, and

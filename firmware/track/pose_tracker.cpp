@@ -191,10 +191,14 @@ void PoseTracker::update_confidence_excess(const Point2f* points, std::size_t n,
   excess_xy_m_ = excess_theta_rad_ = 0.0f;
   // The update's shift from the prediction, per axis (0 = the old cap).
   const float with_update = o.confidence_cap_with_update ? 1.0f : 0.0f;
+  // Open along both axes up to the alert limit: the scan checks nothing of the odometry (track_options.h).
+  const bool pins_nothing = o.confidence_cap_needs_a_pinned_axis && ce.axis_m[0] >= co.max_xy_m - 1e-4f &&
+                            ce.axis_m[1] >= co.max_xy_m - 1e-4f;
+  out->confidence_pins_nothing = pins_nothing;
   if (o.confidence_extent_xy) {
     const float moved = with_update * std::hypot(pose_.x - w.pred.x, pose_.y - w.pred.y);
-    const float bound = std::fmin(ce.xy_m + std::hypot(pose_.x - a.pose.x, pose_.y - a.pose.y) + bias_xy_m_,
-                                  w.pred_pl.xy_m + moved);
+    const float cap = pins_nothing ? INFINITY : w.pred_pl.xy_m + moved;
+    const float bound = std::fmin(ce.xy_m + std::hypot(pose_.x - a.pose.x, pose_.y - a.pose.y) + bias_xy_m_, cap);
     excess_xy_m_ = std::fmax(bound - pl.xy_m, 0.0f);
   }
   if (o.confidence_extent_theta) {

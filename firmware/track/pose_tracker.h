@@ -71,6 +71,7 @@ struct TrackStep {
   bool alias_beyond_alert = false;
   // Confidence extent of the scan fix (fit_comparison.h; 0 when not computed).
   float confidence_xy_m = 0.0f, confidence_theta_rad = 0.0f;
+  bool confidence_pins_nothing = false;  // open to the alert limit along both axes (no prediction cap)
   std::uint32_t unsupported_steps = 0, faulty_steps = 0, outside_steps = 0;
   float innovation_chi2 = 0.0f;
   float odometry_chi2 = 0.0f;   // odometry consistency over the window (0 = not tested)

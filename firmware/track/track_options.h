@@ -181,6 +181,16 @@ struct TrackOptions {
   // prediction (the truth is within pred PL of the prediction, the published pose that far from it);
   // false = the old cap at the prediction's PL alone, which can be shorter than the error it bounds.
   bool confidence_cap_with_update = true;
+  // That cap leans on the odometry (the truth is within the prediction's PL of the prediction), which
+  // is right where the scan pins one axis and leaves the other open (a corridor: the scan checks the
+  // odometry across it). A scan whose confidence extent reaches the alert limit along *both* axes
+  // checks nothing: no shift up to the alert limit in any direction fits significantly worse. Then
+  // the position rests on the odometry alone, which a carried robot's wheels do not see (intel seed 13,
+  // carry 4658 → 6330: the first carried scan open 0.5 m both ways, inliers 180 → 129, 19 contradicting,
+  // PL capped at the prediction's 0.23 + 0.05 m, `localized` 15 m off). true = no cap for such a
+  // scan: its PL is at least the extent, i.e. beyond the alert limit, until a scan pins an axis again
+  // (the excess carries over as for any unsupported step). false = the cap for every scan.
+  bool confidence_cap_needs_a_pinned_axis = true;
   // A supported scan is fused only once the robot moved (update thresholds): a standing robot's
   // scans would re-count one view. Until then the published pose is the prediction, which may lie
   // up to the thresholds (5 cm, 2.9°) from what this scan's update would make it (x⁻ + P⁺He), and

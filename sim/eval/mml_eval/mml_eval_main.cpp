@@ -68,7 +68,8 @@ const char kUsage[] =
     "(TrackOptions::confirm_fix_on_past_scans, off by default). --no-cover-unfused: the PL of a\n"
     "scan not fused (standing robot) leaves out the update the scan would make\n"
     "(TrackOptions::cover_unfused_update). --confidence-cap-pred-pl: the scan's confidence extent capped at\n"
-    "the prediction's PL alone (TrackOptions::confidence_cap_with_update).\n"
+    "the prediction's PL alone (TrackOptions::confidence_cap_with_update). --cap-unpinned-scans: that cap\n"
+    "also for a scan open to the alert limit along both axes (TrackOptions::confidence_cap_needs_a_pinned_axis).\n"
     "Definitions of every figure: sim/eval/mml_eval/README.md.\n";
 int usage(const char* msg) {
   std::fprintf(stderr, "mml-eval: %s\n%s", msg, kUsage);
@@ -149,6 +150,7 @@ static int run_main(int argc, char** argv) {
     else if (a == "--confirm-on-past-scans") { lp.track.confirm_fix_on_past_scans = true; localize = true; }
     else if (a == "--no-cover-unfused") { lp.track.cover_unfused_update = false; localize = true; }
     else if (a == "--confidence-cap-pred-pl") { lp.track.confidence_cap_with_update = false; localize = true; }
+    else if (a == "--cap-unpinned-scans") { lp.track.confidence_cap_needs_a_pinned_axis = false; localize = true; }
     else if (a == "--odom-adapt") { lp.track.odom_noise_window = 64; localize = true; }
     else if (a == "--odom-noise") {
       const std::string v = str();
