@@ -192,8 +192,8 @@ void PoseTracker::update_confidence_excess(const Point2f* points, std::size_t n,
   // The update's shift from the prediction, per axis (0 = the old cap).
   const float with_update = o.confidence_cap_with_update ? 1.0f : 0.0f;
   // Open along both axes up to the alert limit: the scan checks nothing of the odometry (track_options.h).
-  const bool pins_nothing = o.confidence_cap_needs_a_pinned_axis && ce.axis_m[0] >= co.max_xy_m - 1e-4f &&
-                            ce.axis_m[1] >= co.max_xy_m - 1e-4f;
+  const bool pins_nothing = o.confidence_cap_needs_a_pinned_axis && o.confidence_extent_xy &&
+                            ce.axis_m[0] >= co.max_xy_m - 1e-4f && ce.axis_m[1] >= co.max_xy_m - 1e-4f;
   out->confidence_pins_nothing = pins_nothing;
   if (o.confidence_extent_xy) {
     const float moved = with_update * std::hypot(pose_.x - w.pred.x, pose_.y - w.pred.y);
