@@ -150,17 +150,17 @@ bool run_rbsm_seeds(const BenchCase& c, sim::MatcherConfig* cfg, RbsmSeedFigures
     f->failures += run.failures;
     if (pl_icp_poses == nullptr) continue;
     std::vector<fw::Se2d> fused;
-    uint32_t restarts = 0;
-    if (!sim::fuse_increments(run.poses, *pl_icp_poses, cfg->fusion, &fused, &restarts, err)) return false;
+    uint32_t gated = 0;
+    if (!sim::fuse_increments(run.poses, *pl_icp_poses, cfg->fusion, &fused, &gated, err)) return false;
     const auto fm = score(c, fused);
-    std::printf("%s rbsm seed %d fused with pl-icp increments (%u gated updates):\n%s\n", c.ds.c_str(), s, restarts,
+    std::printf("%s rbsm seed %d fused with pl-icp increments (%u gated updates):\n%s\n", c.ds.c_str(), s, gated,
                 sim::to_string(fm).c_str());
     f->ftm.push_back(fm.all.trans_mean);
     f->frm.push_back(fm.all.rot_mean_deg);
     f->fst.push_back(fm.short_rel.trans_mean);
     f->fsr.push_back(fm.short_rel.rot_mean_deg);
     f->flt.push_back(fm.long_rel.trans_mean);
-    f->fused_gated += restarts;
+    f->fused_gated += gated;
   }
   return true;
 }

@@ -173,7 +173,7 @@ bool run_scan_matching_odometry(const CarmenLog& log, MatcherKind kind, const Ma
 }
 
 bool fuse_increments(const std::vector<fw::Se2d>& absolute, const std::vector<fw::Se2d>& relative,
-                     const fw::IncrementFusionOptions& options, std::vector<fw::Se2d>* out, uint32_t* restarts,
+                     const fw::IncrementFusionOptions& options, std::vector<fw::Se2d>* out, uint32_t* gated,
                      std::string* error) {
   if (absolute.size() != relative.size()) {
     *error = "fuse_increments: " + std::to_string(absolute.size()) + " RBSM poses but " +
@@ -181,17 +181,23 @@ bool fuse_increments(const std::vector<fw::Se2d>& absolute, const std::vector<fw
     return false;
   }
   fw::IncrementFusion fusion;
-  fw::Status st = fusion.init(options);
-  out->clear();
-  for (size_t i = 0; st.is_ok() && i < absolute.size(); ++i) {
-    const fw::Se2d u = i == 0 ? fw::Se2d() : relative[i - 1].between(relative[i]);
-    st = fusion.update(absolute[i], i > 0, u);
-    if (st.is_ok()) out->push_back(fusion.pose());
-    else *error = "fuse_increments: scan " + std::to_string(i) + ": " + st.message();
+  const fw::Status init = fusion.init(options);
+  if (!init.is_ok()) {
+    *error = std::string("fuse_increments: ") + init.message();
+    return false;
   }
-  if (!st.is_ok() && error->empty()) *error = std::string("fuse_increments: ") + st.message();
-  *restarts = fusion.gated_updates();
-  return st.is_ok();
+  out->clear();
+  for (size_t i = 0; i < absolute.size(); ++i) {
+    const fw::Se2d u = i == 0 ? fw::Se2d() : relative[i - 1].between(relative[i]);
+    const fw::Status st = fusion.update(absolute[i], i > 0, u);
+    if (!st.is_ok()) {
+      *error = "fuse_increments: scan " + std::to_string(i) + ": " + st.message();
+      return false;
+    }
+    out->push_back(fusion.pose());
+  }
+  *gated = fusion.gated_updates();
+  return true;
 }
 
 double cpu_ms_per_scan(const OdometryRun& run) {

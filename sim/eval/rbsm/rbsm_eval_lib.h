@@ -80,10 +80,10 @@ bool run_scan_matching_odometry(const CarmenLog& log, MatcherKind kind, const Ma
                                 const std::function<void(size_t, size_t)>& progress = {});
 
 // RBSM's poses (`absolute`) fused with the increments of PL-ICP's poses (`relative`, same scans) by
-// fw::IncrementFusion (an extension of Alg. 1, issue 15): one pose per scan in *out; *restarts:
-// gate violations. False (with *error) when the lengths differ or a pose is not finite.
+// fw::IncrementFusion (an extension of Alg. 1, issue 15): one pose per scan in *out; *gated:
+// updates down-weighted at the gate. False (with *error) when the lengths differ or a pose is not finite.
 bool fuse_increments(const std::vector<fw::Se2d>& absolute, const std::vector<fw::Se2d>& relative,
-                     const fw::IncrementFusionOptions& options, std::vector<fw::Se2d>* out, uint32_t* restarts,
+                     const fw::IncrementFusionOptions& options, std::vector<fw::Se2d>* out, uint32_t* gated,
                      std::string* error);
 
 // Mean of scan_cpu_ms: CPU per scan including the map update (the throughput figure).

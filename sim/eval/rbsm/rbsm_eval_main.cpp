@@ -349,8 +349,8 @@ int run_rbsm_seed(const EvalArgs& a, const OdometryInput& in, sim::MatcherConfig
   }
   if (!in.pl_icp.empty()) {
     std::vector<fw::Se2d> fused;
-    uint32_t restarts = 0;
-    if (!sim::fuse_increments(run.poses, in.pl_icp, cfg->fusion, &fused, &restarts, err)) {
+    uint32_t gated = 0;
+    if (!sim::fuse_increments(run.poses, in.pl_icp, cfg->fusion, &fused, &gated, err)) {
       std::fprintf(stderr, "mml-rbsm-eval: %s\n", err->c_str());
       return 1;
     }
@@ -360,7 +360,7 @@ int run_rbsm_seed(const EvalArgs& a, const OdometryInput& in, sim::MatcherConfig
     f->fstm.push_back(fm.short_rel.trans_mean);
     f->fsrm.push_back(fm.short_rel.rot_mean_deg);
     f->fltm.push_back(fm.long_rel.trans_mean);
-    std::printf("%s rbsm seed %2d fused with pl-icp increments (%u gated updates):\n%s\n", a.ds.c_str(), s, restarts,
+    std::printf("%s rbsm seed %2d fused with pl-icp increments (%u gated updates):\n%s\n", a.ds.c_str(), s, gated,
                 sim::to_string(fm).c_str());
     std::snprintf(seed_name, sizeof seed_name, "_fused_seed%02d.txt", s);
     write_traj(a.out_dir + "/" + a.ds + seed_name, in.log, fused);
