@@ -8,6 +8,7 @@ namespace fw::antslam {
 namespace {
 constexpr std::uint32_t kMaxCandidates = 16;
 constexpr std::uint32_t kNoHops = 0xffffffffu;
+constexpr std::uint32_t kNoEdge = 0xffffffffu;
 
 // Largest eigenvalue of the 2×2 position covariance (closed form; no Eigen solver, no heap), as a
 // standard deviation.
@@ -76,6 +77,12 @@ Status AntSlamOptions::validate() const {
   if (!(candidate_mahalanobis > 0 && closure_gate_chi2 > 0 && overlap_radius_m >= 0 && frozen_cov_scale > 0)) {
     return Status::error(Errc::kInvalidArgument, "antslam: loop-closing gates must be > 0");
   }
+  if (traversal && (max_borders_per_fragment < 2 || max_hull_points < 3 || !(border.alpha >= 0.0 && border.alpha <= 1.0) ||
+                    !(border.max_angle_off_rad > 0.0))) {
+    return Status::error(Errc::kInvalidArgument,
+                         "antslam: traversal needs max_borders_per_fragment >= 2, max_hull_points >= 3, border "
+                         "alpha in [0, 1] and max_angle_off_rad > 0");
+  }
   FW_RETURN_IF_ERROR(aco.validate());
   FW_RETURN_IF_ERROR(edge_fit.validate());
   return lm.validate();
@@ -100,6 +107,7 @@ pransam::MatcherOptions sized_matcher(const AntSlamOptions& o) {
   return m;
 }
 std::uint32_t max_edges(const AntSlamOptions& o) { return o.max_fragments + o.max_closures; }
+using FragmentStateStorage = AntSlam::FragmentState;
 }  // namespace
 
 std::size_t AntSlam::required_arena_bytes(const AntSlamOptions& o) {
@@ -111,6 +119,9 @@ std::size_t AntSlam::required_arena_bytes(const AntSlamOptions& o) {
   b += f * o.max_points_per_fragment * sizeof(Point2f) + f * o.max_keyframes_per_fragment * sizeof(Se2d);
   b += e * (sizeof(SampledEdge) + o.samples_per_edge * (sizeof(Se2d) + sizeof(double)));
   b += o.max_closures * sizeof(ClosureRecord);
+  b += f * (sizeof(std::uint32_t) + sizeof(FragmentStateStorage) + 2 * sizeof(std::uint32_t) +
+            o.max_borders_per_fragment * sizeof(Border) + o.max_hull_points * sizeof(Point2f));
+  b += o.max_points_per_fragment * sizeof(Point2f);
   b += o.max_loop_steps * (sizeof(LoopStep) + sizeof(Se2d));
   b += AntColony::required_arena_bytes(o.aco, o.max_loop_steps, o.samples_per_edge);
   b += LoopLm::required_arena_bytes(o.max_loop_steps);
@@ -141,6 +152,13 @@ Status AntSlam::init(const AntSlamOptions& options, StartupArena& arena, WorkerP
   FW_ANTSLAM_ALLOC(fragment_first_scan_, std::uint32_t, f, "antslam first scans");
   FW_ANTSLAM_ALLOC(adjacent_edge_, std::uint32_t, f, "antslam adjacent edges");
   FW_ANTSLAM_ALLOC(num_points_, std::uint32_t, f, "antslam point counts");
+  FW_ANTSLAM_ALLOC(entry_edge_, std::uint32_t, f, "antslam entry edges");
+  FW_ANTSLAM_ALLOC(state_, FragmentState, f, "antslam fragment states");
+  FW_ANTSLAM_ALLOC(num_borders_, std::uint32_t, f, "antslam border counts");
+  FW_ANTSLAM_ALLOC(hull_size_, std::uint32_t, f, "antslam hull sizes");
+  FW_ANTSLAM_ALLOC(borders_, Border, static_cast<std::size_t>(f) * options.max_borders_per_fragment, "antslam borders");
+  FW_ANTSLAM_ALLOC(hull_, Point2f, static_cast<std::size_t>(f) * options.max_hull_points, "antslam hulls");
+  FW_ANTSLAM_ALLOC(hull_scratch_, Point2f, options.max_points_per_fragment, "antslam hull scratch");
   FW_ANTSLAM_ALLOC(num_keyframes_, std::uint32_t, f, "antslam keyframe counts");
   FW_ANTSLAM_ALLOC(points_, Point2f, static_cast<std::size_t>(f) * options.max_points_per_fragment, "antslam points");
   FW_ANTSLAM_ALLOC(keyframes_, Se2d, static_cast<std::size_t>(f) * options.max_keyframes_per_fragment,
@@ -162,6 +180,9 @@ Status AntSlam::init(const AntSlamOptions& options, StartupArena& arena, WorkerP
   FW_RETURN_IF_ERROR(matcher_.init(sized_matcher(options), arena, pool));
   edge_rng_.reseed(options.seed, 0xED6E);
   num_scans_ = num_fragments_ = num_edges_ = num_closures_ = 0;
+  active_ = pending_parent_ = 0;
+  traversing_ = false;
+  model_of_ = kNoEdge;
   stats_ = AntSlamStats{};
   initialized_ = true;
   return Status::ok();
@@ -198,30 +219,43 @@ Status AntSlam::start_fragment(const Se2d& frontend_pose, const Point2f* points,
   fragment_first_scan_[f] = num_scans_;
   num_points_[f] = 0;
   num_keyframes_[f] = 0;
+  num_borders_[f] = 0;
+  hull_size_[f] = 0;
+  state_[f] = FragmentState::kExplore;
+  adjacent_edge_[f] = kNoEdge;
+  entry_edge_[f] = kNoEdge;
   if (f == 0) {
     world_[0] = frontend_pose;
   } else {
-    // Adjacent edge T(F_f−1 → F_f) ~ N(μ, Σ): μ the tracked pose, Σ by Eq. 3.9 (or Eq. 3.4), sampled (Eq. 3.10).
+    // Entry edge T(F_p → F_f) ~ N(μ, Σ) from the fragment p the robot was in (F_f−1 unless it was
+    // traversing): μ the tracked pose, Σ by Eq. 3.9 (or Eq. 3.4), sampled (Eq. 3.10).
+    const std::uint32_t p = pending_parent_;
     Mat3 motion = rel_cov_;
     motion.diagonal().array() += options_.var_floor;
     motion = 0.5 * (motion + motion.transpose());
     // Eq. 3.9: the scan that opens F_f placed on F_f−1's points around the front end's pose.
     Mat3 cov = motion;
     if (options_.edge_model == EdgeModel::kSensorModel) {
-      const bool fitted = points != nullptr && num_points_[f - 1] >= options_.min_fragment_points &&
-                          matcher_.set_model(points_ + static_cast<std::size_t>(f - 1) * options_.max_points_per_fragment,
-                                             num_points_[f - 1], "antslam fragment")
+      const bool fitted = points != nullptr && num_points_[p] >= options_.min_fragment_points &&
+                          (model_of_ = kNoEdge, true) &&
+                          matcher_.set_model(points_ + static_cast<std::size_t>(p) * options_.max_points_per_fragment,
+                                             num_points_[p], "antslam fragment")
                               .is_ok() &&
                           sensor_model_cov(points, count, rel_, &cov);
       if (fitted) ++stats_.sensor_fits; else ++stats_.motion_fallbacks;
     }
     std::uint32_t e = 0;
-    FW_RETURN_IF_ERROR(add_edge(f - 1, f, rel_, cov, motion, &e));
-    fragment_length_[f - 1] = travelled_;
-    adjacent_edge_[f - 1] = e;
-    world_[f] = world_[f - 1].compose(edges_[e].value);
+    FW_RETURN_IF_ERROR(add_edge(p, f, rel_, cov, motion, &e));
+    entry_edge_[f] = e;
+    if (!traversing_) {  // p's exploration ends here: the edge its scans' correction is spread along
+      fragment_length_[p] = travelled_;
+      adjacent_edge_[p] = e;
+    }
+    world_[f] = world_[p].compose(edges_[e].value);
   }
   ++num_fragments_;
+  active_ = f;
+  traversing_ = false;
   rel_ = Se2d();
   rel_cov_ = Mat3::Zero();
   travelled_ = 0.0;
@@ -251,19 +285,33 @@ Status AntSlam::add_scan(const Se2d& pose, const Point2f* points, std::size_t co
     const Mat3 ju = rel_.jacobian_compose_second();
     rel_cov_ = jx * rel_cov_ * jx.transpose() + ju * g * ju.transpose();
     rel_ = rel_.compose(u);
-    travelled_ += d;
-    if (travelled_ >= options_.fragment_length_m) {
-      FW_RETURN_IF_ERROR(start_fragment(pose, points, count));
-      closed_fragment = true;
+    if (traversing_) {
+      FW_RETURN_IF_ERROR(traverse(pose, points, count));
+    } else {
+      travelled_ += d;
+      if (travelled_ >= options_.fragment_length_m) {
+        if (options_.traversal) {
+          FW_RETURN_IF_ERROR(end_exploration(pose, points, count));
+        } else {
+          pending_parent_ = active_;
+          FW_RETURN_IF_ERROR(start_fragment(pose, points, count));
+          closed_fragment = true;
+        }
+      }
     }
   }
   last_frontend_ = pose;
-  const std::uint32_t f = num_fragments_ - 1;
+  const std::uint32_t f = active_;
   scan_fragment_[num_scans_] = f;
   scan_rel_[num_scans_] = rel_;
-  scan_along_[num_scans_] = static_cast<float>(travelled_);
-  fragment_length_[f] = travelled_;
+  // A traversed fragment's outgoing correction is not spread over a revisit (scan_pose).
+  scan_along_[num_scans_] = traversing_ ? -1.0f : static_cast<float>(travelled_);
   ++num_scans_;
+  if (traversing_) {  // TRAVERSAL: tracked, not mapped
+    ++stats_.traversal_scans;
+    return Status::ok();
+  }
+  fragment_length_[f] = travelled_;
   // Keyframe: keep this scan's points (fragment frame) for loop closing.
   const bool key = !have_keyframe_ ||
                    std::hypot(rel_.x - last_keyframe_.x, rel_.y - last_keyframe_.y) >= options_.keyframe_step_m ||
@@ -293,8 +341,140 @@ Status AntSlam::add_scan(const Se2d& pose, const Point2f* points, std::size_t co
 
 Status AntSlam::finish() {
   if (!initialized_) return Status::error(Errc::kNotInitialized, "antslam: init() not called");
-  if (num_fragments_ == 0) return Status::ok();
-  return close_loop(num_fragments_ - 1);
+  if (num_fragments_ == 0 || traversing_) return Status::ok();  // a traversed fragment's loop was tried when it ended
+  return close_loop(active_);
+}
+
+bool AntSlam::inside(std::uint32_t f, const Se2d& at) const {
+  const std::size_t bo = static_cast<std::size_t>(f) * options_.max_borders_per_fragment;
+  const std::size_t ho = static_cast<std::size_t>(f) * options_.max_hull_points;
+  return state_[f] == FragmentState::kTraversal &&
+         inside_fragment(borders_ + bo, num_borders_[f], hull_ + ho, hull_size_[f], at.x, at.y);
+}
+
+void AntSlam::add_border(std::uint32_t f, const Border& b) {
+  if (num_borders_[f] >= options_.max_borders_per_fragment) {
+    ++stats_.dropped_borders;
+    return;
+  }
+  borders_[static_cast<std::size_t>(f) * options_.max_borders_per_fragment + num_borders_[f]++] = b;
+}
+
+bool AntSlam::cut_border(std::uint32_t f, const Se2d& at, Border* out) {
+  if (!select_border(points_ + static_cast<std::size_t>(f) * options_.max_points_per_fragment, num_points_[f], at,
+                     options_.border, out)) {
+    ++stats_.no_border;
+    return false;
+  }
+  add_border(f, *out);
+  ++stats_.borders;
+  return true;
+}
+
+void AntSlam::enter(std::uint32_t g, const Se2d& g_from_active, const Mat3& extra_cov) {
+  const Mat3 j = g_from_active.jacobian_compose_second();
+  rel_cov_ = j * rel_cov_ * j.transpose() + extra_cov;
+  rel_ = g_from_active.compose(rel_);
+  active_ = g;
+  traversing_ = true;
+  have_keyframe_ = false;
+  ++stats_.traversals;
+}
+
+Status AntSlam::end_exploration(const Se2d& frontend_pose, const Point2f* points, std::size_t count) {
+  const std::uint32_t a = active_;
+  Border b;
+  const bool have_border = cut_border(a, rel_, &b);
+  state_[a] = FragmentState::kTraversal;  // never back to EXPLORE
+  hull_size_[a] = static_cast<std::uint32_t>(
+      convex_hull(points_ + static_cast<std::size_t>(a) * options_.max_points_per_fragment, num_points_[a], hull_scratch_,
+                  hull_ + static_cast<std::size_t>(a) * options_.max_hull_points, options_.max_hull_points));
+  if (hull_size_[a] == 0) ++stats_.no_hull;
+  fragment_length_[a] = travelled_;
+  // The loop first: a revisit puts the robot into the fragment it closed with.
+  last_closed_ = false;
+  FW_RETURN_IF_ERROR(close_loop(a));
+  if (last_closed_) {
+    const std::uint32_t c = last_closure_c_;
+    const Se2d c_from_a = world_[c].inverse().compose(world_[a]);
+    if (inside(c, c_from_a.compose(rel_))) {
+      enter(c, c_from_a, last_closure_cov_);
+      return Status::ok();
+    }
+  }
+  const Se2d at = rel_;
+  pending_parent_ = a;
+  FW_RETURN_IF_ERROR(start_fragment(frontend_pose, points, count));
+  if (have_border) add_border(active_, b.reversed().transformed(at.inverse()));
+  return Status::ok();
+}
+
+// Tracking w.r.t. the traversed fragment: every keyframe step the scan is fitted on f's distance
+// field from the tracked pose (the front end maps against its own local map, not f's), accepted when
+// it fits as well as a loop closure must and the correction is inside the tracked covariance's gate.
+void AntSlam::track_in_fragment(std::uint32_t f, const Point2f* points, std::size_t count) {
+  if (points == nullptr || count == 0 || num_points_[f] < options_.min_fragment_points) return;
+  if (have_keyframe_ && std::hypot(rel_.x - last_keyframe_.x, rel_.y - last_keyframe_.y) < options_.keyframe_step_m &&
+      std::fabs(wrap_angle(rel_.theta - last_keyframe_.theta)) < options_.keyframe_turn_rad) {
+    return;
+  }
+  if (model_of_ != f) {
+    model_of_ = kNoEdge;
+    if (!matcher_.set_model(points_ + static_cast<std::size_t>(f) * options_.max_points_per_fragment, num_points_[f],
+                            "antslam fragment")
+             .is_ok()) {
+      return;
+    }
+    model_of_ = f;
+  }
+  std::size_t n = 0;
+  for (std::size_t k = 0; k < count && n < options_.max_points_per_fragment; k += options_.beam_stride) {
+    if (std::isfinite(points[k](0)) && std::isfinite(points[k](1))) hull_scratch_[n++] = points[k];
+  }
+  have_keyframe_ = true;
+  last_keyframe_ = rel_;
+  const FieldFit fit = fit_on_field(matcher_.field(), hull_scratch_, n, rel_, options_.refine_iterations,
+                                    options_.refine_cutoff_start, options_.refine_cutoff_end);
+  if (!(fit.quality >= options_.min_closure_quality)) return;
+  Mat3 gate = rel_cov_;
+  gate(0, 0) += options_.closure_sigma_xy * options_.closure_sigma_xy;
+  gate(1, 1) += options_.closure_sigma_xy * options_.closure_sigma_xy;
+  gate(2, 2) += options_.closure_sigma_theta * options_.closure_sigma_theta;
+  const Vec3 d = se2_difference(fit.pose, rel_);
+  if (!(d.dot(gate.inverse() * d) <= options_.closure_gate_chi2)) return;
+  rel_ = fit.pose;
+  rel_cov_ = Mat3::Zero();
+  rel_cov_.diagonal() << options_.closure_sigma_xy * options_.closure_sigma_xy,
+      options_.closure_sigma_xy * options_.closure_sigma_xy, options_.closure_sigma_theta * options_.closure_sigma_theta;
+  last_keyframe_ = rel_;
+  ++stats_.traversal_fits;
+}
+
+Status AntSlam::traverse(const Se2d& frontend_pose, const Point2f* points, std::size_t count) {
+  const std::uint32_t c = active_;
+  if (inside(c, rel_)) {
+    if (options_.traversal_tracking) track_in_fragment(c, points, count);
+    return Status::ok();
+  }
+  // Into a fragment joined to c by an edge (a measured relation) whose region the robot is in.
+  for (std::uint32_t e = 0; e < num_edges_; ++e) {
+    const SampledEdge& ed = edges_[e];
+    if (ed.from != c && ed.to != c) continue;
+    const std::uint32_t g = ed.from == c ? ed.to : ed.from;
+    const Se2d g_from_c = world_[g].inverse().compose(world_[c]);
+    if (inside(g, g_from_c.compose(rel_))) {
+      enter(g, g_from_c, Mat3::Zero());
+      return Status::ok();
+    }
+  }
+  // Unexplored terrain: a border on c where the robot leaves it, and a new fragment from c.
+  Border b;
+  const bool have_border = cut_border(c, rel_, &b);
+  const Se2d at = rel_;
+  pending_parent_ = c;
+  FW_RETURN_IF_ERROR(start_fragment(frontend_pose, points, count));
+  if (have_border) add_border(active_, b.reversed().transformed(at.inverse()));
+  return Status::ok();
 }
 
 void AntSlam::shortest_paths(std::uint32_t a) {
@@ -352,7 +532,9 @@ std::uint32_t AntSlam::build_path(std::uint32_t c, std::uint32_t a) {
 
 Se2d AntSlam::scan_pose(std::uint32_t i) const {
   const std::uint32_t f = scan_fragment_[i];
-  if (f + 1 >= num_fragments_ || !(fragment_length_[f] > 0.0)) return world_[f].compose(scan_rel_[i]);
+  if (adjacent_edge_[f] == kNoEdge || !(fragment_length_[f] > 0.0) || scan_along_[i] < 0.0f) {
+    return world_[f].compose(scan_rel_[i]);
+  }
   const SampledEdge& e = edges_[adjacent_edge_[f]];
   const Se2d delta = e.value.compose(e.mean.inverse());
   double alpha = static_cast<double>(scan_along_[i]) / fragment_length_[f];
@@ -362,8 +544,10 @@ Se2d AntSlam::scan_pose(std::uint32_t i) const {
 }
 
 void AntSlam::recompute_world() {
+  // Entry edges come from older fragments: one pass in order.
   for (std::uint32_t f = 1; f < num_fragments_; ++f) {
-    world_[f] = world_[f - 1].compose(edges_[adjacent_edge_[f - 1]].value);
+    const SampledEdge& e = edges_[entry_edge_[f]];
+    world_[f] = world_[e.from].compose(e.value);
   }
 }
 
@@ -373,6 +557,8 @@ std::uint32_t AntSlam::find_candidates(std::uint32_t a, std::uint32_t* cand) {
   std::uint32_t num_cand = 0;
   for (std::uint32_t c = 0; c + options_.min_fragment_gap <= a; ++c) {
     if (hops_[c] == kNoHops || num_points_[c] < options_.min_fragment_points) continue;
+    // With traversal the graph is a tree: a fragment opened from an old one is near it in hops.
+    if (options_.traversal && hops_[c] < options_.min_fragment_gap) continue;
     const std::uint32_t n = build_path(c, a);
     if (n == 0) continue;
     double m = 0.0;
@@ -408,6 +594,7 @@ bool AntSlam::match_closure(std::uint32_t a, std::uint32_t c, const Se2d& x, Se2
   ++stats_.candidates;
   const std::uint64_t t0 = now();
   // A fragment pRANSAM cannot take as a model (degenerate, too large for the field) is no candidate.
+  model_of_ = kNoEdge;
   if (!matcher_.set_model(points_ + static_cast<std::size_t>(c) * options_.max_points_per_fragment, num_points_[c],
                           "antslam fragment")
            .is_ok()) {
@@ -540,6 +727,9 @@ Status AntSlam::try_closure(std::uint32_t a, std::uint32_t c, bool* closed) {
                                              static_cast<float>(w1)};
   ++stats_.loops;
   recompute_world();
+  last_closed_ = true;
+  last_closure_c_ = c;
+  last_closure_cov_ = cov_h;
   *closed = true;
   return Status::ok();
 }

@@ -24,9 +24,16 @@
 // (Eq. 3.13–3.14, ant_colony.h) or Levenberg–Marquardt (loop_lm.h) — options.optimizer — and its
 // edges, with the new closing edge, are frozen ("corrected loops are frozen").
 //
-// Not implemented (issue 12 item 1): fragment borders, the convex hull and the EXPLORE → TRAVERSAL
-// states (a revisited area gets new fragments, which close loops with the old ones), the
-// covariance of the pose w.r.t. every fragment (only the active one).
+// Borders and EXPLORE → TRAVERSAL (Sec. 3.4, fragment_borders.h; AntSlamOptions::traversal): a
+// fragment is explored (mapped) until fragment_length_m, then a border is cut across the path, its
+// convex hull is taken and it turns TRAVERSAL for good. When the loop closed at that moment puts the
+// robot inside the closing fragment c (right of c's borders, inside its hull), the robot traverses c
+// instead of opening a new fragment: its pose is tracked in F_c (Eq. 3.4), nothing is mapped, and it
+// moves on into any fragment joined to the current one by an edge (a measured relation) whose region
+// it enters. Leaving into unexplored terrain cuts a new border on the fragment left and opens a new
+// fragment from it. Fragments form a tree of entry edges (plus closures), not a chain.
+// Not implemented: the covariance of the pose w.r.t. every fragment (only the active one, and the
+// entry into a traversed fragment only through a confirmed closure or a direct edge).
 //
 // Embedded rules: all storage from the StartupArena in init(), sized by AntSlamOptions; errors
 // as Status; deterministic per seed (pRANSAM and the ants own their streams; the optional
@@ -39,6 +46,7 @@
 #include "firmware/antslam/ant_colony.h"
 #include "firmware/antslam/edge_fit.h"
 #include "firmware/antslam/field_fit.h"
+#include "firmware/antslam/fragment_borders.h"
 #include "firmware/antslam/loop_lm.h"
 #include "firmware/antslam/sampled_edge.h"
 #include "firmware/base/arena.h"
@@ -99,6 +107,18 @@ struct AntSlamOptions {
   pransam::MatcherOptions matcher;       // sizes taken from max_points_per_fragment in validate()
   pransam::MatchParams match;
 
+  // Borders, convex hull and EXPLORE → TRAVERSAL (Sec. 3.4; see above). Off (default): every
+  // fragment is explored and a revisit opens new fragments that close loops with the old ones —
+  // measured better on the CARMEN logs (firmware/antslam/README.md: traversal closes fewer loops).
+  bool traversal = false;
+  BorderOptions border;
+  std::uint32_t max_borders_per_fragment = 8;
+  std::uint32_t max_hull_points = 256;
+  // While traversing, the scan is fitted on the traversed fragment's distance field every keyframe
+  // step (track_in_fragment); off: the pose in the fragment is the front end's increments only.
+  // Measured: aces better, intel much worse (the fits' corrections jump) — off by default.
+  bool traversal_tracking = false;
+
   LoopOptimizer optimizer = LoopOptimizer::kAntColony;
   AntColonyOptions aco;
   LoopLmOptions lm;
@@ -117,6 +137,13 @@ struct AntSlamStats {
   std::uint32_t motion_fallbacks = 0;  // edges that kept the Eq. 3.4 Σ (no fit possible: too few points)
   std::uint32_t loops = 0;             // loops closed and corrected
   std::uint32_t dropped_points = 0;    // points beyond a fragment's capacity
+  std::uint32_t borders = 0;           // borders cut (each stored on both sides)
+  std::uint32_t no_border = 0;         // a fragment left where Eq. 3.7 found no point on one side
+  std::uint32_t dropped_borders = 0;   // beyond max_borders_per_fragment
+  std::uint32_t no_hull = 0;           // fragments whose hull did not fit max_hull_points (never entered)
+  std::uint32_t traversals = 0;        // entries into a TRAVERSAL fragment
+  std::uint32_t traversal_scans = 0;   // scans tracked in a TRAVERSAL fragment (not mapped)
+  std::uint32_t traversal_fits = 0;    // of them, fitted on the fragment's field and accepted
   double aco_initial_cost = 0, aco_final_cost = 0;  // sums over the loops
   std::uint64_t optimizer_ns = 0;      // time in the loop optimiser (with a clock)
   std::uint64_t matcher_ns = 0;        // time in pRANSAM (with a clock)
@@ -161,12 +188,39 @@ class AntSlam {
     *count = num_points_[f];
     return points_ + static_cast<std::size_t>(f) * options_.max_points_per_fragment;
   }
+  enum class FragmentState : std::uint8_t { kExplore = 0, kTraversal = 1 };
+  FragmentState fragment_state(std::uint32_t f) const { return state_[f]; }
+  const Border* fragment_borders(std::uint32_t f, std::uint32_t* count) const {
+    *count = num_borders_[f];
+    return borders_ + static_cast<std::size_t>(f) * options_.max_borders_per_fragment;
+  }
+  const Point2f* fragment_hull(std::uint32_t f, std::uint32_t* count) const {
+    *count = hull_size_[f];
+    return hull_ + static_cast<std::size_t>(f) * options_.max_hull_points;
+  }
+  // The fragment the robot is in (the newest one while exploring) and whether it is traversing.
+  std::uint32_t active_fragment() const { return active_; }
+  bool traversing() const { return traversing_; }
   const SampledEdge& edge(std::uint32_t i) const { return edges_[i]; }
   const ClosureRecord& closure(std::uint32_t i) const { return closures_[i]; }
   const AntSlamStats& stats() const { return stats_; }
 
  private:
+  // A new EXPLORE fragment entered from `parent` (the active one; none for the first) at the
+  // tracked pose rel_ in F_parent.
   Status start_fragment(const Se2d& frontend_pose, const Point2f* points, std::size_t count);
+  // Sec. 3.4: the fragment's exploration ends (border, hull, TRAVERSAL), and with traversal on the
+  // loop is closed first and the robot may enter the closing fragment instead of a new one.
+  Status end_exploration(const Se2d& frontend_pose, const Point2f* points, std::size_t count);
+  // One scan while traversing: stay, move into a fragment joined by an edge, or open a new one.
+  Status traverse(const Se2d& frontend_pose, const Point2f* points, std::size_t count);
+  // Border of fragment f at the robot's pose `at` (F_f), stored on f; *out for the fragment entered.
+  bool cut_border(std::uint32_t f, const Se2d& at, Border* out);
+  void add_border(std::uint32_t f, const Border& b);
+  bool inside(std::uint32_t f, const Se2d& at) const;
+  // Enter TRAVERSAL fragment g from the active fragment; `g_from_active` = F_active in F_g.
+  void enter(std::uint32_t g, const Se2d& g_from_active, const Mat3& extra_cov);
+  void track_in_fragment(std::uint32_t f, const Point2f* points, std::size_t count);
   // `predict_cov`: the edge's Eq. 3.4 covariance for path predictions (SampledEdge::predict_cov).
   Status add_edge(std::uint32_t from, std::uint32_t to, const Se2d& mean, const Mat3& cov, const Mat3& predict_cov,
                   std::uint32_t* index);
@@ -210,7 +264,22 @@ class AntSlam {
   Se2d* world_ = nullptr;           // F_i corrected
   std::uint32_t* fragment_first_scan_ = nullptr;
   double* fragment_length_ = nullptr;  // distance travelled in the fragment (m)
-  std::uint32_t* adjacent_edge_ = nullptr;  // edge index of F_i → F_i+1
+  std::uint32_t* adjacent_edge_ = nullptr;  // edge index of F_i → the fragment opened at its end (kNoEdge: none)
+  std::uint32_t* entry_edge_ = nullptr;     // edge from the fragment F_i was opened from (i ≥ 1)
+  FragmentState* state_ = nullptr;
+  Border* borders_ = nullptr;               // [fragment][max_borders_per_fragment], fragment frame
+  std::uint32_t* num_borders_ = nullptr;
+  Point2f* hull_ = nullptr;                 // [fragment][max_hull_points], fragment frame, CCW
+  std::uint32_t* hull_size_ = nullptr;
+  Point2f* hull_scratch_ = nullptr;         // max_points_per_fragment
+  std::uint32_t active_ = 0;
+  bool traversing_ = false;
+  std::uint32_t pending_parent_ = 0;        // the fragment start_fragment() opens from
+  std::uint32_t model_of_ = 0xffffffffu;    // the fragment whose field the matcher holds (none: ~0)
+  // The last closure of close_loop(): its fragment and Σ_h (for entering it).
+  bool last_closed_ = false;
+  std::uint32_t last_closure_c_ = 0;
+  Mat3 last_closure_cov_ = Mat3::Zero();
   Point2f* points_ = nullptr;               // [fragment][max_points_per_fragment], fragment frame
   std::uint32_t* num_points_ = nullptr;
   Se2d* keyframes_ = nullptr;               // [fragment][max_keyframes_per_fragment], fragment frame

@@ -38,6 +38,10 @@ const char* kHelp =
     "                        or the front end's propagated motion covariance (Eq. 3.4; closures: --closure-sigma)\n"
     "  --front fused|rbsm    front end: RBSM fused with PL-ICP's laser-to-laser increments (default;\n"
     "                        fw::IncrementFusion, an extension: firmware/rbsm/README.md) or RBSM alone (the dissertation's)\n"
+    "  --traversal off|on|tracked  fragment borders, convex hulls and EXPLORE -> TRAVERSAL (Sec. 3.4): a\n"
+    "                        revisited fragment is traversed, not mapped again (tracked: the scan is also fitted\n"
+    "                        on the fragment every keyframe step); off (default, measured better on the logs):\n"
+    "                        every revisit opens new fragments that close loops with the old ones\n"
     "  --ants N              ants per iteration (default 20)\n"
     "  --iterations N        ant-colony iterations per loop (default 5000)\n"
     "  --fragment-length M   metres travelled per fragment (default 5; 10 for long loops)\n"
@@ -135,6 +139,10 @@ Parsed parse_run_option(const std::string& a, const std::string& v, SlamArgs* o)
     if (v == "sensor") cfg.slam.edge_model = fw::antslam::EdgeModel::kSensorModel;
     else if (v == "motion") cfg.slam.edge_model = fw::antslam::EdgeModel::kMotionModel;
     else return failed("--edge-model: '" + v + "' is not sensor or motion");
+  } else if (a == "--traversal") {
+    cfg.slam.traversal = v == "on" || v == "tracked";
+    cfg.slam.traversal_tracking = v == "tracked";
+    if (!cfg.slam.traversal && v != "off") return failed("--traversal: '" + v + "' is not off, on or tracked");
   } else if (a == "--front") {
     if (v == "rbsm") cfg.fuse_front = false;
     else if (v == "fused") cfg.fuse_front = true;
@@ -292,6 +300,10 @@ void print_summary(const sim::CarmenLog& log, const sim::SlamConfig& cfg, const 
   if (cfg.slam.edge_model == fw::antslam::EdgeModel::kSensorModel) {
     std::printf("mml-slam: edge covariances from the sensor model (Eq. 3.9): %u, fallback (too few points: Eq. 3.4, or closure-sigma for a closure): %u\n",
                 run.stats.sensor_fits, run.stats.motion_fallbacks);
+  }
+  if (cfg.slam.traversal) {
+    std::printf("mml-slam: %u borders cut (%u fragments left with no point on one side), %u entries into a TRAVERSAL fragment, %u scans traversed (not mapped; %u fitted on the fragment)\n",
+                run.stats.borders, run.stats.no_border, run.stats.traversals, run.stats.traversal_scans, run.stats.traversal_fits);
   }
   std::printf("mml-slam: front end %.1f s + AntSLAM %.1f s (pRANSAM %.0f ms, %s %.0f ms) for %.0f s of log\n", run.frontend_s,
               run.backend_s, run.matcher_ms,

@@ -96,6 +96,11 @@ bool run_slam_backend(const CarmenLog& log, const std::vector<fw::Se2d>& fronten
     std::uint32_t np = 0;
     const fw::Point2f* p = slam->fragment_points(f, &np);
     fi.points.assign(p, p + np);
+    std::uint32_t nb = 0, nh = 0;
+    const fw::antslam::Border* b = slam->fragment_borders(f, &nb);
+    fi.borders.assign(b, b + nb);
+    const fw::Point2f* h = slam->fragment_hull(f, &nh);
+    fi.hull.assign(h, h + nh);
     out->fragments.push_back(std::move(fi));
   }
   out->edges.clear();
@@ -209,6 +214,21 @@ bool write_slam_svg(const SlamRun& run, const std::string& title, const std::str
     l.points = {{run.fragments[e.from].pose.x, run.fragments[e.from].pose.y},
                 {run.fragments[e.to].pose.x, run.fragments[e.to].pose.y}};
     pic.lines.push_back(std::move(l));
+  }
+  // Borders (Sec. 3.4): one segment per border, drawn once (each is stored on both of its fragments).
+  bool first_border = true;
+  for (const auto& f : run.fragments) {
+    const double c = std::cos(f.pose.theta), s = std::sin(f.pose.theta);
+    for (const auto& b : f.borders) {
+      Polyline l;
+      l.color = Rgb{150, 40, 170};
+      l.width_px = 1.2;
+      if (first_border) l.label = "fragment borders (Eq. 3.6-3.8)";
+      first_border = false;
+      l.points = {{f.pose.x + c * b.x1 - s * b.y1, f.pose.y + s * b.x1 + c * b.y1},
+                  {f.pose.x + c * b.x2 - s * b.y2, f.pose.y + s * b.x2 + c * b.y2}};
+      pic.lines.push_back(std::move(l));
+    }
   }
   PointSet frames;
   frames.color = Rgb{20, 160, 60};

@@ -33,6 +33,8 @@ struct SlamConfig {
 struct SlamFragmentInfo {
   fw::Se2d pose;
   std::vector<fw::Point2f> points;  // fragment frame
+  std::vector<fw::antslam::Border> borders;  // fragment frame (Sec. 3.4; empty with traversal off)
+  std::vector<fw::Point2f> hull;             // fragment frame, counter-clockwise
 };
 struct SlamEdgeInfo {
   std::uint32_t from = 0, to = 0;
