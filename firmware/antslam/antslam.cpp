@@ -237,11 +237,7 @@ Status AntSlam::start_fragment(const Se2d& frontend_pose, const Point2f* points,
     Mat3 cov = motion;
     if (options_.edge_model == EdgeModel::kSensorModel) {
       const bool fitted = points != nullptr && num_points_[p] >= options_.min_fragment_points &&
-                          (model_of_ = kNoEdge, true) &&
-                          matcher_.set_model(points_ + static_cast<std::size_t>(p) * options_.max_points_per_fragment,
-                                             num_points_[p], "antslam fragment")
-                              .is_ok() &&
-                          sensor_model_cov(points, count, rel_, &cov);
+                          use_fragment_model(p) && sensor_model_cov(points, count, rel_, &cov);
       if (fitted) ++stats_.sensor_fits; else ++stats_.motion_fallbacks;
     }
     std::uint32_t e = 0;
@@ -345,6 +341,35 @@ Status AntSlam::finish() {
   return close_loop(active_);
 }
 
+bool AntSlam::use_fragment_model(std::uint32_t f) {
+  model_of_ = kNoEdge;
+  if (!matcher_.set_model(points_ + static_cast<std::size_t>(f) * options_.max_points_per_fragment, num_points_[f],
+                          "antslam fragment")
+           .is_ok()) {
+    return false;
+  }
+  model_of_ = f;
+  return true;
+}
+
+bool AntSlam::pose_in_fragment(std::uint32_t c, Se2d* pose, Mat3* cov) {
+  if (c >= num_fragments_) return false;
+  Se2d x;
+  Mat3 cx = Mat3::Zero();
+  if (c != active_) {
+    shortest_paths(active_);
+    if (hops_[c] == kNoHops) return false;
+    const std::uint32_t n = build_path(c, active_);
+    if (n == 0) return false;
+    compound_path(n, &x, &cx);
+  }
+  // x ⊕ rel: Σ = J1 Σ_x J1ᵀ + J2 Σ_rel J2ᵀ (Eq. 3.4's propagation, one step).
+  const Mat3 j1 = x.jacobian_compose_first(rel_), j2 = x.jacobian_compose_second();
+  *cov = j1 * cx * j1.transpose() + j2 * rel_cov_ * j2.transpose();
+  *pose = x.compose(rel_);
+  return true;
+}
+
 bool AntSlam::inside(std::uint32_t f, const Se2d& at) const {
   const std::size_t bo = static_cast<std::size_t>(f) * options_.max_borders_per_fragment;
   const std::size_t ho = static_cast<std::size_t>(f) * options_.max_hull_points;
@@ -418,15 +443,7 @@ void AntSlam::track_in_fragment(std::uint32_t f, const Point2f* points, std::siz
       std::fabs(wrap_angle(rel_.theta - last_keyframe_.theta)) < options_.keyframe_turn_rad) {
     return;
   }
-  if (model_of_ != f) {
-    model_of_ = kNoEdge;
-    if (!matcher_.set_model(points_ + static_cast<std::size_t>(f) * options_.max_points_per_fragment, num_points_[f],
-                            "antslam fragment")
-             .is_ok()) {
-      return;
-    }
-    model_of_ = f;
-  }
+  if (model_of_ != f && !use_fragment_model(f)) return;
   std::size_t n = 0;
   for (std::size_t k = 0; k < count && n < options_.max_points_per_fragment; k += options_.beam_stride) {
     if (std::isfinite(points[k](0)) && std::isfinite(points[k](1))) hull_scratch_[n++] = points[k];

@@ -32,8 +32,8 @@
 // moves on into any fragment joined to the current one by an edge (a measured relation) whose region
 // it enters. Leaving into unexplored terrain cuts a new border on the fragment left and opens a new
 // fragment from it. Fragments form a tree of entry edges (plus closures), not a chain.
-// Not implemented: the covariance of the pose w.r.t. every fragment (only the active one, and the
-// entry into a traversed fragment only through a confirmed closure or a direct edge).
+// The pose w.r.t. any fragment with its covariance: pose_in_fragment() (on demand). A traversed
+// fragment is entered only through a confirmed closure or a direct edge, not on that pose alone.
 //
 // Embedded rules: all storage from the StartupArena in init(), sized by AntSlamOptions; errors
 // as Status; deterministic per seed (pRANSAM and the ants own their streams; the optional
@@ -201,6 +201,12 @@ class AntSlam {
   // The fragment the robot is in (the newest one while exploring) and whether it is traversing.
   std::uint32_t active_fragment() const { return active_; }
   bool traversing() const { return traversing_; }
+  // The robot's pose w.r.t. fragment c and its covariance (Eq. 3.4): the pose tracked in the active
+  // fragment compounded along the shortest fragment sequence c → active (frozen edges at
+  // frozen_cov_scale, as the loop candidates' prediction). Computed on demand instead of propagated
+  // for every fragment at every scan (same mean and covariance to first order, O(edges) per query
+  // instead of O(fragments) per scan). False when c is unknown or not connected.
+  bool pose_in_fragment(std::uint32_t c, Se2d* pose, Mat3* cov);
   const SampledEdge& edge(std::uint32_t i) const { return edges_[i]; }
   const ClosureRecord& closure(std::uint32_t i) const { return closures_[i]; }
   const AntSlamStats& stats() const { return stats_; }
@@ -221,6 +227,7 @@ class AntSlam {
   // Enter TRAVERSAL fragment g from the active fragment; `g_from_active` = F_active in F_g.
   void enter(std::uint32_t g, const Se2d& g_from_active, const Mat3& extra_cov);
   void track_in_fragment(std::uint32_t f, const Point2f* points, std::size_t count);
+  bool use_fragment_model(std::uint32_t f);  // the matcher's model (and field) = f's points
   // `predict_cov`: the edge's Eq. 3.4 covariance for path predictions (SampledEdge::predict_cov).
   Status add_edge(std::uint32_t from, std::uint32_t to, const Se2d& mean, const Mat3& cov, const Mat3& predict_cov,
                   std::uint32_t* index);

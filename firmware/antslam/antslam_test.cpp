@@ -213,6 +213,58 @@ TEST(AntSlamTest, SecondLapTraversesTheFirstLapsFragments) {
   EXPECT_FALSE(bad.validate().is_ok());
 }
 
+// Eq. 3.4 w.r.t. every fragment: the pose in an older fragment, compounded along the fragment
+// sequence on demand, equals the pose and covariance propagated scan by scan from that fragment's frame.
+TEST(AntSlamTest, PoseInEveryFragmentMatchesPropagationFromItsFrame) {
+  AntSlamOptions o = default_antslam_options();
+  o.max_scans = 400;
+  o.max_fragments = 8;
+  o.max_closures = 4;
+  o.max_loop_steps = 8;
+  o.edge_model = EdgeModel::kMotionModel;  // no points: the Eq. 3.4 covariance on every edge
+  std::vector<unsigned char> block(AntSlam::required_arena_bytes(o));
+  StartupArena arena;
+  ASSERT_TRUE(arena.init(block.data(), block.size(), "test").is_ok());
+  auto slam = std::make_unique<AntSlam>();
+  ASSERT_TRUE(slam->init(o, arena).is_ok());
+  // 13 m along a gentle curve: fragments 0, 1, 2. Direct propagation from F_0 (the first pose).
+  std::vector<Se2d> poses;
+  for (int i = 0; i <= 130; ++i) poses.emplace_back(0.1 * i, 0.002 * i * i * 0.01, 0.004 * i);
+  Se2d x;
+  Mat3 cov = Mat3::Zero();
+  for (std::size_t i = 0; i < poses.size(); ++i) {
+    ASSERT_TRUE(slam->add_scan(poses[i], nullptr, 0).is_ok());
+    if (i == 0) continue;
+    const Se2d u = poses[i - 1].between(poses[i]);
+    const double d = std::hypot(u.x, u.y);
+    Mat3 g = Mat3::Zero();
+    g(0, 0) = g(1, 1) = o.var_xy_per_m * d;
+    g(2, 2) = o.var_theta_per_m * d + o.var_theta_per_rad * std::fabs(u.theta);
+    const Mat3 jx = x.jacobian_compose_first(u), ju = x.jacobian_compose_second();
+    cov = jx * cov * jx.transpose() + ju * g * ju.transpose();
+    x = x.compose(u);
+  }
+  ASSERT_EQ(slam->num_fragments(), 3u);
+  Se2d p;
+  Mat3 c;
+  ASSERT_TRUE(slam->pose_in_fragment(0, &p, &c));
+  const Se2d truth = poses[0].between(poses.back());
+  EXPECT_NEAR(p.x, truth.x, 1e-9);
+  EXPECT_NEAR(p.y, truth.y, 1e-9);
+  EXPECT_NEAR(p.theta, truth.theta, 1e-9);
+  for (int r = 0; r < 3; ++r) {
+    for (int k = 0; k < 3; ++k) EXPECT_NEAR(c(r, k), cov(r, k), 1e-6 + 1e-3 * std::fabs(cov(r, k))) << r << "," << k;
+  }
+  // Nearer fragments know the pose better; the active one is the tracked pose itself.
+  Se2d p1, p2;
+  Mat3 c1, c2;
+  ASSERT_TRUE(slam->pose_in_fragment(1, &p1, &c1));
+  ASSERT_TRUE(slam->pose_in_fragment(2, &p2, &c2));
+  EXPECT_GT(c.trace(), c1.trace());
+  EXPECT_GT(c1.trace(), c2.trace());
+  EXPECT_FALSE(slam->pose_in_fragment(3, &p, &c));
+}
+
 TEST(AntSlamTest, RejectsBadOptionsAndFullCapacity) {
   AntSlamOptions o = default_antslam_options();
   o.fragment_length_m = 0;
