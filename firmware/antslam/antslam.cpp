@@ -435,8 +435,8 @@ Status AntSlam::end_exploration(const Se2d& frontend_pose, const Point2f* points
 }
 
 // Tracking w.r.t. the traversed fragment: every keyframe step the scan is fitted on f's distance
-// field from the tracked pose (the front end maps against its own local map, not f's), accepted when
-// it fits as well as a loop closure must and the correction is inside the tracked covariance's gate.
+// field from the tracked pose (the front end maps against its own local map, not f's); a fit as good
+// as a loop closure must be and inside the tracked covariance's gate is fused by a Kalman update.
 void AntSlam::track_in_fragment(std::uint32_t f, const Point2f* points, std::size_t count) {
   if (points == nullptr || count == 0 || num_points_[f] < options_.min_fragment_points) return;
   if (have_keyframe_ && std::hypot(rel_.x - last_keyframe_.x, rel_.y - last_keyframe_.y) < options_.keyframe_step_m &&
@@ -459,10 +459,17 @@ void AntSlam::track_in_fragment(std::uint32_t f, const Point2f* points, std::siz
   gate(2, 2) += options_.closure_sigma_theta * options_.closure_sigma_theta;
   const Vec3 d = se2_difference(fit.pose, rel_);
   if (!(d.dot(gate.inverse() * d) <= options_.closure_gate_chi2)) return;
-  rel_ = fit.pose;
-  rel_cov_ = Mat3::Zero();
-  rel_cov_.diagonal() << options_.closure_sigma_xy * options_.closure_sigma_xy,
+  // Kalman update of the tracked pose with the fit (Σ of the fit by Eq. 3.9 where it can be
+  // fitted, else the closure sigmas): the correction is weighed, not snapped to.
+  Mat3 r = Mat3::Zero();
+  r.diagonal() << options_.closure_sigma_xy * options_.closure_sigma_xy,
       options_.closure_sigma_xy * options_.closure_sigma_xy, options_.closure_sigma_theta * options_.closure_sigma_theta;
+  sensor_model_cov(hull_scratch_, n, fit.pose, &r);
+  const Mat3 k = rel_cov_ * (rel_cov_ + r).inverse();
+  const Vec3 step = k * d;
+  rel_ = Se2d(rel_.x + step(0), rel_.y + step(1), wrap_angle(rel_.theta + step(2)));
+  rel_cov_ = (Mat3::Identity() - k) * rel_cov_;
+  rel_cov_ = 0.5 * (rel_cov_ + rel_cov_.transpose()).eval();
   last_keyframe_ = rel_;
   ++stats_.traversal_fits;
 }

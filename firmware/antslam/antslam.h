@@ -116,7 +116,7 @@ struct AntSlamOptions {
   std::uint32_t max_hull_points = 256;
   // While traversing, the scan is fitted on the traversed fragment's distance field every keyframe
   // step (track_in_fragment); off: the pose in the fragment is the front end's increments only.
-  // Measured: aces better, intel much worse (the fits' corrections jump) — off by default.
+  // Measured: aces better, intel / fr079 / fr-clinic worse than traversal off (README) — off by default.
   bool traversal_tracking = false;
 
   LoopOptimizer optimizer = LoopOptimizer::kAntColony;
