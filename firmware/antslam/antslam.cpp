@@ -309,9 +309,7 @@ Status AntSlam::add_scan(const Se2d& pose, const Point2f* points, std::size_t co
   }
   fragment_length_[f] = travelled_;
   // Keyframe: keep this scan's points (fragment frame) for loop closing.
-  const bool key = !have_keyframe_ ||
-                   std::hypot(rel_.x - last_keyframe_.x, rel_.y - last_keyframe_.y) >= options_.keyframe_step_m ||
-                   std::fabs(wrap_angle(rel_.theta - last_keyframe_.theta)) >= options_.keyframe_turn_rad;
+  const bool key = keyframe_due();
   if (key && points != nullptr && count > 0) {
     have_keyframe_ = true;
     last_keyframe_ = rel_;
@@ -339,6 +337,19 @@ Status AntSlam::finish() {
   if (!initialized_) return Status::error(Errc::kNotInitialized, "antslam: init() not called");
   if (num_fragments_ == 0 || traversing_) return Status::ok();  // a traversed fragment's loop was tried when it ended
   return close_loop(active_);
+}
+
+bool AntSlam::keyframe_due() const {
+  return !have_keyframe_ ||
+         std::hypot(rel_.x - last_keyframe_.x, rel_.y - last_keyframe_.y) >= options_.keyframe_step_m ||
+         std::fabs(wrap_angle(rel_.theta - last_keyframe_.theta)) >= options_.keyframe_turn_rad;
+}
+
+Mat3 AntSlam::closure_prior() const {
+  Mat3 c = Mat3::Zero();
+  c.diagonal() << options_.closure_sigma_xy * options_.closure_sigma_xy,
+      options_.closure_sigma_xy * options_.closure_sigma_xy, options_.closure_sigma_theta * options_.closure_sigma_theta;
+  return c;
 }
 
 bool AntSlam::use_fragment_model(std::uint32_t f) {
@@ -427,10 +438,17 @@ Status AntSlam::end_exploration(const Se2d& frontend_pose, const Point2f* points
       return Status::ok();
     }
   }
+  return open_fragment_from(a, have_border ? &b : nullptr, frontend_pose, points, count);
+}
+
+// A new EXPLORE fragment from `parent` at the tracked pose; it gets the reversed border the robot
+// crossed (if one was cut), expressed in its own frame.
+Status AntSlam::open_fragment_from(std::uint32_t parent, const Border* crossed, const Se2d& frontend_pose,
+                                   const Point2f* points, std::size_t count) {
   const Se2d at = rel_;
-  pending_parent_ = a;
+  pending_parent_ = parent;
   FW_RETURN_IF_ERROR(start_fragment(frontend_pose, points, count));
-  if (have_border) add_border(active_, b.reversed().transformed(at.inverse()));
+  if (crossed != nullptr) add_border(active_, crossed->reversed().transformed(at.inverse()));
   return Status::ok();
 }
 
@@ -439,10 +457,7 @@ Status AntSlam::end_exploration(const Se2d& frontend_pose, const Point2f* points
 // as a loop closure must be and inside the tracked covariance's gate is fused by a Kalman update.
 void AntSlam::track_in_fragment(std::uint32_t f, const Point2f* points, std::size_t count) {
   if (points == nullptr || count == 0 || num_points_[f] < options_.min_fragment_points) return;
-  if (have_keyframe_ && std::hypot(rel_.x - last_keyframe_.x, rel_.y - last_keyframe_.y) < options_.keyframe_step_m &&
-      std::fabs(wrap_angle(rel_.theta - last_keyframe_.theta)) < options_.keyframe_turn_rad) {
-    return;
-  }
+  if (!keyframe_due()) return;
   if (model_of_ != f && !use_fragment_model(f)) return;
   std::size_t n = 0;
   for (std::size_t k = 0; k < count && n < options_.max_points_per_fragment; k += options_.beam_stride) {
@@ -453,17 +468,12 @@ void AntSlam::track_in_fragment(std::uint32_t f, const Point2f* points, std::siz
   const FieldFit fit = fit_on_field(matcher_.field(), hull_scratch_, n, rel_, options_.refine_iterations,
                                     options_.refine_cutoff_start, options_.refine_cutoff_end);
   if (!(fit.quality >= options_.min_closure_quality)) return;
-  Mat3 gate = rel_cov_;
-  gate(0, 0) += options_.closure_sigma_xy * options_.closure_sigma_xy;
-  gate(1, 1) += options_.closure_sigma_xy * options_.closure_sigma_xy;
-  gate(2, 2) += options_.closure_sigma_theta * options_.closure_sigma_theta;
+  const Mat3 gate = rel_cov_ + closure_prior();
   const Vec3 d = se2_difference(fit.pose, rel_);
   if (!(d.dot(gate.inverse() * d) <= options_.closure_gate_chi2)) return;
   // Kalman update of the tracked pose with the fit (Σ of the fit by Eq. 3.9 where it can be
   // fitted, else the closure sigmas): the correction is weighed, not snapped to.
-  Mat3 r = Mat3::Zero();
-  r.diagonal() << options_.closure_sigma_xy * options_.closure_sigma_xy,
-      options_.closure_sigma_xy * options_.closure_sigma_xy, options_.closure_sigma_theta * options_.closure_sigma_theta;
+  Mat3 r = closure_prior();
   sensor_model_cov(hull_scratch_, n, fit.pose, &r);
   const Mat3 k = rel_cov_ * (rel_cov_ + r).inverse();
   const Vec3 step = k * d;
@@ -494,11 +504,7 @@ Status AntSlam::traverse(const Se2d& frontend_pose, const Point2f* points, std::
   // Unexplored terrain: a border on c where the robot leaves it, and a new fragment from c.
   Border b;
   const bool have_border = cut_border(c, rel_, &b);
-  const Se2d at = rel_;
-  pending_parent_ = c;
-  FW_RETURN_IF_ERROR(start_fragment(frontend_pose, points, count));
-  if (have_border) add_border(active_, b.reversed().transformed(at.inverse()));
-  return Status::ok();
+  return open_fragment_from(c, have_border ? &b : nullptr, frontend_pose, points, count);
 }
 
 void AntSlam::shortest_paths(std::uint32_t a) {
@@ -618,10 +624,7 @@ bool AntSlam::match_closure(std::uint32_t a, std::uint32_t c, const Se2d& x, Se2
   ++stats_.candidates;
   const std::uint64_t t0 = now();
   // A fragment pRANSAM cannot take as a model (degenerate, too large for the field) is no candidate.
-  model_of_ = kNoEdge;
-  if (!matcher_.set_model(points_ + static_cast<std::size_t>(c) * options_.max_points_per_fragment, num_points_[c],
-                          "antslam fragment")
-           .is_ok()) {
+  if (!use_fragment_model(c)) {
     ++stats_.rejected_quality;
     return false;
   }
@@ -657,9 +660,7 @@ Se2d AntSlam::refine_hypothesis(const Point2f* scene, std::uint32_t n, const Se2
 
 // Σ_h of the closing edge: the fixed closure sigmas, replaced by the Eq. 3.9 fit where it succeeds.
 Mat3 AntSlam::closure_cov(const Point2f* scene, std::uint32_t n, const Se2d& h) {
-  Mat3 cov_h = Mat3::Zero();
-  cov_h.diagonal() << options_.closure_sigma_xy * options_.closure_sigma_xy,
-      options_.closure_sigma_xy * options_.closure_sigma_xy, options_.closure_sigma_theta * options_.closure_sigma_theta;
+  Mat3 cov_h = closure_prior();
   // Eq. 3.9 for the closing edge: a's points around h on c's field (the matcher's model).
   if (options_.edge_model == EdgeModel::kSensorModel) {
     if (sensor_model_cov(scene, n, h, &cov_h)) ++stats_.sensor_fits; else ++stats_.motion_fallbacks;

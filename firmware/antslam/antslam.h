@@ -228,6 +228,10 @@ class AntSlam {
   void enter(std::uint32_t g, const Se2d& g_from_active, const Mat3& extra_cov);
   void track_in_fragment(std::uint32_t f, const Point2f* points, std::size_t count);
   bool use_fragment_model(std::uint32_t f);  // the matcher's model (and field) = f's points
+  Status open_fragment_from(std::uint32_t parent, const Border* crossed, const Se2d& frontend_pose,
+                            const Point2f* points, std::size_t count);
+  bool keyframe_due() const;  // moved keyframe_step_m or turned keyframe_turn_rad since the last keyframe
+  Mat3 closure_prior() const;  // Σ_h from the closure sigmas
   // `predict_cov`: the edge's Eq. 3.4 covariance for path predictions (SampledEdge::predict_cov).
   Status add_edge(std::uint32_t from, std::uint32_t to, const Se2d& mean, const Mat3& cov, const Mat3& predict_cov,
                   std::uint32_t* index);
