@@ -136,7 +136,6 @@ void MmlLocalizer::reset() {
   pending_cov_ = Eigen::Matrix3f::Identity();
   pending_steps_ = pending_isolations_ = 0;
   last_out_ = hal::PoseEstimate();
-  perf_match_.reset();
   have_newest_ = false;
   newest_id_ = 0;
   corrections_applied_ = 0;
@@ -351,7 +350,11 @@ Status MmlLocalizer::step(const hal::LaserScan& scan, const hal::Odometry& odom,
     return Status::ok();
   }
   float omega_thres = 0.0f;
+  const std::uint64_t match_begin_ns = deadline_clock_ != nullptr ? deadline_clock_->now_ns() : 0;
+  if (deadline_clock_ != nullptr) perf_front_end_.add_ns(match_begin_ns - step_begin_ns);
   const std::size_t nh = global_match_stage(local_pose, step_begin_ns, &omega_thres);
+  const std::uint64_t match_end_ns = deadline_clock_ != nullptr ? deadline_clock_->now_ns() : 0;
+  if (deadline_clock_ != nullptr) perf_match_.add_ns(match_end_ns - match_begin_ns);
   const Se2f wheel(odom.x, odom.y, odom.theta);
   // x_r of Eq. 5.8 from the wheel odometry (thesis); the RBSM pose can slip in corridors.
   const Se2f odom_delta = have_wheel_ ? prev_wheel_.between(wheel) : Se2f();
@@ -362,6 +365,7 @@ Status MmlLocalizer::step(const hal::LaserScan& scan, const hal::Odometry& odom,
   have_wheel_ = true;
   if (config_.mml.correct_local_map) correct_local_map(local_pose);
   publish(out);
+  if (deadline_clock_ != nullptr) perf_after_match_.add_ns(deadline_clock_->now_ns() - match_end_ns);
   return Status::ok();
 }
 

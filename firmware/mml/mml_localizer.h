@@ -85,7 +85,12 @@ class MmlLocalizer final : public Localizer {
   std::uint32_t rival_rejections() const { return rival_rejections_; }
   // Candidates isolated later, once the growing local map contradicted the rivals that held them back.
   std::uint32_t pending_isolations() const { return pending_isolations_; }
+  // Stage timing (timed only in deadline mode, by its clock): front end + scene (before pRANSAM),
+  // pRANSAM, and everything after it (interpretation, published pose, the integrity checks). They
+  // describe the CPU, not the search: reset() keeps them (a live search is reset on every doubt).
+  const PerfCounter& front_end_perf() const { return perf_front_end_; }
   const PerfCounter& match_perf() const { return perf_match_; }
+  const PerfCounter& after_match_perf() const { return perf_after_match_; }
   std::uint32_t front_end_failures() const { return front_end_failures_; }
   bool using_precomputed_table() const { return matcher_.has_precomputed_table(); }
   const LocalMap& local_map() const { return local_map_; }
@@ -185,7 +190,9 @@ class MmlLocalizer final : public Localizer {
   std::uint32_t pending_steps_ = 0;
   std::uint32_t pending_isolations_ = 0;
   hal::PoseEstimate last_out_;
+  PerfCounter perf_front_end_{"mml.front_end"};
   PerfCounter perf_match_{"mml.pransam"};
+  PerfCounter perf_after_match_{"mml.after_match"};
   const hal::Clock* deadline_clock_ = nullptr;
   std::uint64_t deadline_budget_ns_ = 0;
   float deadline_share_ = 0.6f;

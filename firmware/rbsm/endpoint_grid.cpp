@@ -3,6 +3,7 @@
 #include "firmware/base/memory_report.h"
 
 #include <cmath>
+#include <algorithm>
 #include <cstring>
 
 namespace fw {
@@ -107,21 +108,53 @@ void EndpointGrid::clear_cell(std::int32_t gx, std::int32_t gy) {
   }
 }
 
+// The dirty box's occupancy, row by row (a row's run wraps around the toroidal window at most once).
+void EndpointGrid::clear_box_rows(std::int64_t w, std::int64_t h) {
+  const std::uint32_t cols = w >= side_ ? side_ : static_cast<std::uint32_t>(w);
+  const std::uint32_t rows = h >= side_ ? side_ : static_cast<std::uint32_t>(h);
+  const std::uint32_t x0 = static_cast<std::uint32_t>(dirty_x0_) & cell_mask_;
+  for (std::uint32_t r = 0; r < rows; ++r) {
+    std::uint8_t* row = occupancy_ + (static_cast<std::size_t>((static_cast<std::uint32_t>(dirty_y0_) + r) & cell_mask_) << options_.size_log2);
+    const std::uint32_t first = cols <= side_ - x0 ? cols : side_ - x0;
+    std::memset(row + x0, 0, first);
+    if (first < cols) std::memset(row, 0, cols - first);
+  }
+}
+
+// The lookup's 64 × 64 sub-cell pages (4 KiB, tiled_index) that meet the dirty box and its 1-cell
+// border: every raised value lies in that box, so whole pages are zeroed. A reset used to clear
+// the box cell by cell (16 scattered bytes each): 14-17 ms for the aces local map, longer than the
+// global context's window; the pages take a memset each.
+void EndpointGrid::clear_box_tiles() {
+  const std::int64_t k = k_;
+  const std::int64_t sx0 = (static_cast<std::int64_t>(dirty_x0_) - 1) * k, sx1 = (static_cast<std::int64_t>(dirty_x1_) + 2) * k - 1;
+  const std::int64_t sy0 = (static_cast<std::int64_t>(dirty_y0_) - 1) * k, sy1 = (static_cast<std::int64_t>(dirty_y1_) + 2) * k - 1;
+  const std::int64_t pages_per_side = static_cast<std::int64_t>(sub_mask_ + 1) >> 6;
+  const std::int64_t tx0 = sx0 >> 6, ty0 = sy0 >> 6;  // floor (arithmetic shift, C++20)
+  const std::int64_t ntx = std::min((sx1 >> 6) - tx0 + 1, pages_per_side);
+  const std::int64_t nty = std::min((sy1 >> 6) - ty0 + 1, pages_per_side);
+  const std::int64_t page_mask = pages_per_side - 1;
+  for (std::int64_t j = 0; j < nty; ++j) {
+    const std::int64_t py = (ty0 + j) & page_mask;
+    for (std::int64_t i = 0; i < ntx; ++i) {
+      const std::int64_t px = (tx0 + i) & page_mask;
+      const std::size_t page = static_cast<std::size_t>((py << (sub_shift_ - 6)) | px);
+      std::memset(lookup_ + (page << 12), 0, std::size_t{1} << 12);
+    }
+  }
+}
+
 void EndpointGrid::clear() {
   if (!initialized()) return;
   const std::int64_t w = static_cast<std::int64_t>(dirty_x1_) - dirty_x0_ + 1;
   const std::int64_t h = static_cast<std::int64_t>(dirty_y1_) - dirty_y0_ + 1;
   if (w > 0 && h > 0) {
-    if (w * h * 2 >= static_cast<std::int64_t>(side_) * side_) {
+    if (w * h * 2 >= static_cast<std::int64_t>(side_) * side_ || sub_shift_ < 6) {
       std::memset(occupancy_, 0, static_cast<std::size_t>(side_) * side_);
       std::memset(lookup_, 0, static_cast<std::size_t>(sub_mask_ + 1) * (sub_mask_ + 1));
     } else {
-      // The lookup of the dirty box's 1-cell border was raised too.
-      for (std::int32_t gy = dirty_y0_ - 1; gy <= dirty_y1_ + 1; ++gy) {
-        for (std::int32_t gx = dirty_x0_ - 1; gx <= dirty_x1_ + 1; ++gx) {
-          if (in_window(gx, gy)) clear_cell(gx, gy);
-        }
-      }
+      clear_box_rows(w, h);
+      clear_box_tiles();
     }
   }
   occupied_count_ = 0;

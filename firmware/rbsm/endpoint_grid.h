@@ -113,6 +113,8 @@ class EndpointGrid {
   float resolution() const { return options_.resolution; }
 
  private:
+  void clear_box_rows(std::int64_t w, std::int64_t h);
+  void clear_box_tiles();
   std::size_t cell_index(std::int32_t gx, std::int32_t gy) const {
     return (static_cast<std::size_t>(static_cast<std::uint32_t>(gy) & cell_mask_) << options_.size_log2) |
            (static_cast<std::uint32_t>(gx) & cell_mask_);

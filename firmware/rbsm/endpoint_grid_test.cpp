@@ -90,6 +90,33 @@ TEST_F(GridFixture, ClearForgetsTheScrolledWindow) {
   EXPECT_GT(grid.likelihood(0.026f, 0.026f), 200);
 }
 
+// clear() zeroes only what the points touched when that is a small part of the window (whole 4 KiB
+// lookup pages, occupancy rows): afterwards every byte of the grid's storage must be zero again, as
+// after init(), also when the window scrolled and the points wrap around the toroidal storage.
+TEST_F(GridFixture, ClearOfAPartlyUsedWindowZeroesEveryByte) {
+  fw::EndpointGridOptions o;
+  o.size_log2 = 8;  // 256 cells = 12.8 m; lookup 1024 x 1024 sub-cells = 16 x 16 pages
+  make(o);
+  for (int trial = 0; trial < 3; ++trial) {
+    const float ox = -3.1f + 2.7f * static_cast<float>(trial), oy = 1.3f - 1.9f * static_cast<float>(trial);
+    grid.center_on(ox, oy);
+    for (int i = 0; i < 200; ++i) {  // a ring of radius 2.4 m: the dirty box ~ 96 x 96 cells < half the window
+      const float a = 0.0314f * static_cast<float>(i);
+      grid.insert(ox + 2.4f * std::cos(a), oy + 2.4f * std::sin(a));
+    }
+    if (trial == 2) {  // scroll so the box straddles the storage's wrap-around
+      grid.follow(ox + 4.0f, oy - 3.0f);
+      for (int i = 0; i < 50; ++i) grid.insert(ox + 4.0f + 0.05f * static_cast<float>(i), oy - 3.0f);
+    }
+    ASSERT_GT(grid.occupied_count(), 0u);
+    grid.clear();
+    EXPECT_EQ(grid.occupied_count(), 0u);
+    std::size_t nonzero = 0;
+    for (unsigned char b : block) nonzero += b != 0;
+    EXPECT_EQ(nonzero, 0u) << "trial " << trial;
+  }
+}
+
 TEST(EndpointGridOptionsTest, RejectsBadValues) {
   fw::EndpointGridOptions o;
   o.resolution = 0;

@@ -79,8 +79,16 @@ class GlobalContext {
   void tick();
   void reset();   // MML forgets everything before its next job
   void restart(); // reset() and the scan index back to 0 (TrackedLocalizer::reset)
-  // See the header comment. `out` is always written.
+  // See the header comment. `out` is always written. step() = collect() then offer().
   Status step(const hal::LaserScan& scan, const hal::Odometry& odom, hal::PoseEstimate* out);
+  // The two halves of step(), for a caller that decides after seeing the result whether this scan
+  // is still wanted (results_delayed() only: with result_delay_scans = 0 a scan's result exists only
+  // once it is offered). collect(): a finished result whose window has come, else `searching`
+  // without a pose (`out` always written). offer(): this scan for MML if the schedule says so and
+  // the mailbox is free (run inline when not threaded; with no delay its result goes to `out`).
+  bool results_delayed() const { return schedule_.result_delay_scans > 0; }
+  Status collect(const hal::LaserScan& scan, const hal::Odometry& odom, hal::PoseEstimate* out);
+  Status offer(const hal::LaserScan& scan, const hal::Odometry& odom, hal::PoseEstimate* out);
 
   const GlobalScheduleOptions& schedule() const { return schedule_; }
   // A job handed to the global thread and not finished yet.

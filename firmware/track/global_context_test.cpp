@@ -66,6 +66,34 @@ TEST(GlobalContextTest, LiveScheduleInlineLocalizes) {
   EXPECT_EQ(gc.overruns(), 0u);
 }
 
+// The live schedule's result comes before this scan's offer: on the scan where the tracker confirms
+// MML's fix the search is over, so that scan is not handed to MML (its job would be thrown away by
+// the reset before MML's next use, and would share the cores with the confirming step). On every
+// other scan of the search one job per scan; the poses are those of the step-then-decide order.
+TEST(GlobalContextTest, ConfirmedFixScanIsNotOffered) {
+  ScheduledRig rig;
+  ASSERT_TRUE(rig.init(testing::room_map().map, live_global_schedule()).is_ok());
+  const GlobalContext& gc = rig.loc->global_context();
+  std::uint64_t jobs_before = 0;
+  std::uint32_t fixes_before = 0;
+  int fix_scans = 0, searching_scans_without_job = 0;
+  mml::testing::drive(rig.loc.get(), testing::room(), testing::room_tour(), 1, [&](mml::testing::StepRecord*) {
+    const std::uint64_t jobs = gc.jobs();
+    const std::uint32_t fixes = rig.loc->fixes();
+    const bool in_search = !rig.loc->tracking();
+    if (fixes > fixes_before) {
+      ++fix_scans;
+      EXPECT_EQ(jobs, jobs_before) << "the scan of a confirmed fix went to MML";
+    } else if (in_search && jobs == jobs_before) {
+      ++searching_scans_without_job;
+    }
+    jobs_before = jobs;
+    fixes_before = fixes;
+  });
+  ASSERT_GT(fix_scans, 0) << "never fixed";
+  EXPECT_EQ(searching_scans_without_job, 0);
+}
+
 // The same schedule on the global thread gives bit-identical poses when every job finishes within
 // its window (the hook waits for it, as a fast enough global context would).
 TEST(GlobalContextTest, ThreadedEqualsInlineWhenOnTime) {

@@ -430,6 +430,11 @@ void collect_results(ReplayRig& rig, double wall_s, ReplayResult* r) {
     r->global_overruns = gc.overruns();
     r->global_skipped_offers = gc.skipped_offers();
     r->global_deadline_stops = sys.mml() != nullptr ? sys.mml()->deadline_stops() : 0;
+    if (sys.mml() != nullptr) {
+      r->global_front_end = sys.mml()->front_end_perf().stats();
+      r->global_match = sys.mml()->match_perf().stats();
+      r->global_after_match = sys.mml()->after_match_perf().stats();
+    }
   }
   if (r->localized) r->mean_err_localized_m /= static_cast<double>(r->localized);
   if (r->after_first_fix) {

@@ -14,6 +14,7 @@
 #include <string>
 #include <vector>
 
+#include "firmware/base/perf_counter.h"
 #include "hal/msg/laser_scan.h"
 #include "hal/msg/odometry.h"
 
@@ -105,6 +106,8 @@ struct ReplayResult {
   size_t global_jobs = 0, global_overruns = 0, global_skipped_offers = 0;
   double global_period_ms = 0;    // the global context's window (its deadline)
   size_t global_deadline_stops = 0;  // pRANSAM runs cut by the deadline (anytime mode)
+  // The global step's stages (MML's perf counters): before pRANSAM, pRANSAM, after it.
+  fw::PerfStats global_front_end, global_match, global_after_match;
   size_t scans_unpaired = 0, scans_out_of_order = 0, scans_malformed = 0;  // loop counters (dropped scans)
   bool odometry_from_scans = false;
   bool realtime = false;             // ran with SCHED_FIFO  // the log has no ODOM records: the scans' odometry triple was used

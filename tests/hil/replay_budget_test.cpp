@@ -71,6 +71,10 @@ std::vector<std::string> replay_and_check(const std::map<std::string, double>& b
               "skipped offers %zu\n",
               r.global_context.c_str(), r.global_jobs, r.global_step_p50_ms, r.global_step_p99_ms, r.global_step_max_ms,
               r.global_period_ms, r.global_overruns, r.global_skipped_offers);
+  std::printf("  stages: before pRANSAM p50 %.2f max %.2f ms, pRANSAM p50 %.2f max %.2f ms (%zu cut by the deadline), "
+              "after it p50 %.2f max %.2f ms\n",
+              r.global_front_end.p50_ms, r.global_front_end.max_ms, r.global_match.p50_ms, r.global_match.max_ms,
+              r.global_deadline_stops, r.global_after_match.p50_ms, r.global_after_match.max_ms);
   std::printf("localized %zu (first at scan %ld, availability after it %.1f %%), wrong (> %.1f m) %zu, mean error while "
               "localized %.3f m\n",
               r.localized, r.first_localized_scan, 100.0 * r.availability, o.localized_bound_m, r.wrong_localized,
