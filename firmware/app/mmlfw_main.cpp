@@ -391,6 +391,12 @@ void print_timing_report(const Startup& su) {
     const fw::track::GlobalContext& gc = t->global_context();
     row(su.global_thread ? "global" : "sensor", "global.step", gc.step_stats(),
         su.global_thread ? su.global_ctx.deadline_ns * 1e-6 : 0);
+    if (const fw::mml::MmlLocalizer* m = g_system.mml(); m != nullptr && su.global_thread) {
+      // The global step's stages (timed in deadline mode; read after the global thread stopped).
+      row("global", m->front_end_perf().name(), m->front_end_perf().stats(), 0);
+      row("global", m->match_perf().name(), m->match_perf().stats(), 0);
+      row("global", m->after_match_perf().name(), m->after_match_perf().stats(), 0);
+    }
     std::fprintf(stderr, "  global: jobs %llu, overruns %llu, skipped offers %llu (every %u scans, result after %u)\n",
                  static_cast<unsigned long long>(gc.jobs()), static_cast<unsigned long long>(gc.overruns()),
                  static_cast<unsigned long long>(gc.skipped_offers()), gc.schedule().every_n_scans,
