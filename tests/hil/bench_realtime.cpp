@@ -71,6 +71,14 @@ int run_one(const std::string& name, const std::string& out_path, size_t scans) 
   f << "\"" << key << "_global_jobs\": " << r.global_jobs << ",\n";
   f << "\"" << key << "_global_deadline_stops\": " << r.global_deadline_stops << ",\n";
   f << "\"" << key << "_global_overruns\": " << r.global_overruns << ",\n";
+  // The global step's stages (MML's perf counters): where a long global step spent its time.
+  f << "\"" << key << "_global_before_pransam_ms_p50\": " << r.global_front_end.p50_ms << ",\n";
+  f << "\"" << key << "_global_before_pransam_ms_max\": " << r.global_front_end.max_ms << ",\n";
+  f << "\"" << key << "_global_pransam_ms_p50\": " << r.global_match.p50_ms << ",\n";
+  f << "\"" << key << "_global_pransam_ms_max\": " << r.global_match.max_ms << ",\n";
+  f << "\"" << key << "_global_after_pransam_ms_p50\": " << r.global_after_match.p50_ms << ",\n";
+  f << "\"" << key << "_global_after_pransam_ms_max\": " << r.global_after_match.max_ms << ",\n";
+  f << "\"" << key << "_track_step_ms_p50\": " << r.step_p50_ms << ",\n";
   f << "\"" << key << "_first_fix_scan\": " << r.first_localized_scan << ",\n";
   f << "\"" << key << "_localized\": " << r.localized << ",\n";
   f << "\"" << key << "_wrong_localized\": " << r.wrong_localized << ",\n";
@@ -80,10 +88,13 @@ int run_one(const std::string& name, const std::string& out_path, size_t scans) 
   double load[3] = {0, 0, 0};
   if (getloadavg(load, 3) == 3) f << "\"" << key << "_loadavg_1min_after\": " << load[0] << ",\n";
   std::printf("%s: %zu scans at 75 Hz, %zu deadline misses, track step max %.2f ms p99 %.2f ms; global (%s) %zu jobs p50 "
-              "%.2f p99 %.2f max %.2f ms (window %.1f ms), %zu overruns; first fix at scan %ld, localized %zu, wrong %zu\n",
+              "%.2f p99 %.2f max %.2f ms (window %.1f ms; before pRANSAM p50 %.2f max %.2f, pRANSAM p50 %.2f max %.2f, "
+              "after p50 %.2f max %.2f), %zu overruns; first fix at scan %ld, localized %zu, wrong %zu\n",
               name.c_str(), r.scans_processed, r.deadline_misses, r.step_max_ms, r.step_p99_ms, r.global_context.c_str(),
               r.global_jobs, r.global_step_p50_ms, r.global_step_p99_ms, r.global_step_max_ms, r.global_period_ms,
-              r.global_overruns, r.first_localized_scan, r.localized, r.wrong_localized);
+              r.global_front_end.p50_ms, r.global_front_end.max_ms, r.global_match.p50_ms, r.global_match.max_ms,
+              r.global_after_match.p50_ms, r.global_after_match.max_ms, r.global_overruns, r.first_localized_scan,
+              r.localized, r.wrong_localized);
   return 0;
 }
 
