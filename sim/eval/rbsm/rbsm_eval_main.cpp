@@ -8,9 +8,10 @@
 //     with the ICP baselines also RBSM fused with PL-ICP's increments per seed (fw::IncrementFusion, an
 //     extension), DIR/NAME_fused_seedNN.txt.
 //   mml-rbsm-eval pairwise DATASET [--pairs N] [--seeds N] [--particles N]
-//   mml-rbsm-eval fuse RBSM.txt PL-ICP.txt OUT.txt [--set fuse_KEY=VALUE …]
+//   mml-rbsm-eval fuse RBSM.txt PL-ICP.txt OUT.txt [--relations RELATIONS] [--set fuse_KEY=VALUE …]
 //     fuses two saved trajectories of the same scans (RBSM's poses, PL-ICP's increments) with
-//     fw::IncrementFusion and writes OUT.txt (score it with mml-carmen eval RELATIONS OUT.txt).
+//     fw::IncrementFusion and writes OUT.txt; --relations prints its relations metric (as
+//     mml-carmen eval RELATIONS OUT.txt does).
 //   --set KEY=VALUE overrides the matcher configuration (max_range, resolution, size_log2, subcell_log2,
 //     shrink, accept_ratio, min_iterations, max_iterations, sigma_xy2, sigma_psi2, hill_climbing, mahalanobis,
 //     min_translation, min_rotation_deg, icp_max_corr, refine (0: pure Alg. 1 with prior=0), prior (odometry motion prior, 0/1), prior_xy (its σ in m), refine_radius, refine_iterations,
@@ -40,7 +41,7 @@ int usage() {
                "[--out DIR] [--no-icp]\n"
                "       mml-rbsm-eval odometry --log LOG --relations RELATIONS [--name NAME] [options as above]\n"
                "       mml-rbsm-eval pairwise DATASET [--pairs N] [--seeds N] [--particles N]\n"
-               "       mml-rbsm-eval fuse RBSM.txt PL-ICP.txt OUT.txt [--set fuse_KEY=VALUE ...]\n");
+               "       mml-rbsm-eval fuse RBSM.txt PL-ICP.txt OUT.txt [--relations RELATIONS] [--set fuse_KEY=VALUE ...]\n");
   return 2;
 }
 
@@ -421,8 +422,13 @@ int run_odometry(const EvalArgs& a, const sim::EvalDataset& d, const sim::Carmen
 int run_fuse(int argc, char** argv) {
   if (argc < 5) return usage();
   sim::MatcherConfig cfg = sim::default_matcher_config();
+  std::string relations_path;
   for (int i = 5; i < argc; ++i) {
     const std::string arg = argv[i];
+    if (arg == "--relations" && i + 1 < argc) {
+      relations_path = argv[++i];
+      continue;
+    }
     const std::string kv = arg == "--set" && i + 1 < argc ? argv[++i] : "";
     const size_t eq = kv.find('=');
     const double v = eq == std::string::npos ? NAN : std::atof(kv.c_str() + eq + 1);
@@ -432,6 +438,11 @@ int run_fuse(int argc, char** argv) {
     }
   }
   std::string err;
+  std::vector<sim::Relation> rel;  // --relations: the fused trajectory scored as `odometry` scores it
+  if (!relations_path.empty() && !sim::read_relations(relations_path, &rel, &err)) {
+    std::fprintf(stderr, "mml-rbsm-eval fuse: %s\n", err.c_str());
+    return 1;
+  }
   sim::Trajectory rb, pl;
   if (!sim::read_trajectory(argv[2], &rb, &err) || !sim::read_trajectory(argv[3], &pl, &err)) {
     std::fprintf(stderr, "mml-rbsm-eval fuse: %s\n", err.c_str());
@@ -459,6 +470,7 @@ int run_fuse(int argc, char** argv) {
     return 1;
   }
   std::printf("%zu poses fused, %u updates down-weighted at the gate\n", fused.size(), gated);
+  if (!relations_path.empty()) std::printf("%s\n", sim::to_string(sim::evaluate_relations_split(rel, out)).c_str());
   return 0;
 }
 
