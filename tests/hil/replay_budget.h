@@ -58,8 +58,8 @@ struct ReplayOptions {
   std::string global_context = "auto";
   bool pin_sensor_thread = true;  // rate mode: pin this (the sensor) thread as the table says
   // Rate mode: SCHED_FIFO at the table's priorities for the sensor (this thread, restored after),
-  // global and worker threads, as mmlfw with realtime = true (memory is not locked here). An
-  // error when the OS refuses it.
+  // global and worker threads, and every page locked (mlockall), as mmlfw with realtime = true. An
+  // error when the OS refuses either.
   bool realtime = false;
   // Overrides of the schedule for experiments (0 / -1 = as global_context says).
   unsigned schedule_every = 0;

@@ -48,13 +48,13 @@ std::vector<std::string> replay_and_check(const std::map<std::string, double>& b
   o.rate_hz = budget.count("scan_rate_hz") ? budget.at("scan_rate_hz") : 75.0;
   o.deadline_ms = 1000.0 / o.rate_hz;
   apply_localizer_env(&o);
-  // As mmlfw with realtime = true (SCHED_FIFO at the execution-context table's priorities) where the
+  // As mmlfw with realtime = true (SCHED_FIFO at the execution-context table's priorities, memory locked) where the
   // OS permits it; otherwise as realtime = false (then the limits hold only on a quiet machine).
   o.realtime = std::getenv("MMLFW_REPLAY_NO_FIFO") == nullptr;
   mmlfw_hil::ReplayResult r;
   std::string err;
   if (!mmlfw_hil::run_replay(o, &r, &err) && o.realtime) {
-    std::printf("SCHED_FIFO refused (%s): replay without it\n", err.c_str());
+    std::printf("real-time refused (%s): replay without SCHED_FIFO and locked memory\n", err.c_str());
     o.realtime = false;
     err.clear();
     if (!mmlfw_hil::run_replay(o, &r, &err)) return {"replay: " + err};
