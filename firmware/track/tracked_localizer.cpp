@@ -126,31 +126,26 @@ Status TrackedLocalizer::step(const hal::LaserScan& scan, const hal::Odometry& o
     }
     return Status::ok();
   }
-  if (!global_.results_delayed()) {
-    FW_RETURN_IF_ERROR(global_.step(scan, odom, out));
-    out->mode = hal::LocalizationMode::kGlobal;
-    out->protection_xy_m = out->protection_theta_rad = 0.0f;
-    if (out->status != hal::LocalizationStatus::kLocalized) return Status::ok();
-    // MML says the pose is isolated: the tracker must confirm it on this scan before it is published.
-    const hal::PoseEstimate g = *out;
-    start_from_fix(g, wheel, n, out);
-    return Status::ok();
-  }
+  // MML says the pose is isolated: the tracker must confirm it on this scan before it is published.
   // Live schedule (results of earlier scans): the result first, then this scan for MML only if the
   // search goes on. A fix the tracker confirms ends the search: MML's next job starts from a fresh
   // local map (a lost track and every cross-check reset it first), so a job on this scan would be
   // thrown away, and on the 2-core board it would share the cores with the confirming step, the
   // sensor context's longest (aces replay: 10.5 ms, which stretched that global step to 16 ms).
-  const Status collected = global_.collect(scan, odom, out);
+  const bool delayed = global_.results_delayed();
+  const Status got = delayed ? global_.collect(scan, odom, out) : global_.step(scan, odom, out);
+  if (!delayed) FW_RETURN_IF_ERROR(got);
   out->mode = hal::LocalizationMode::kGlobal;
   out->protection_xy_m = out->protection_theta_rad = 0.0f;
-  if (collected.is_ok() && out->status == hal::LocalizationStatus::kLocalized) {
+  if (got.is_ok() && out->status == hal::LocalizationStatus::kLocalized) {
     const hal::PoseEstimate g = *out;
-    if (start_from_fix(g, wheel, n, out)) return Status::ok();
+    if (start_from_fix(g, wheel, n, out) || !delayed) return Status::ok();
   }
-  hal::PoseEstimate unused;
-  FW_RETURN_IF_ERROR(global_.offer(scan, odom, &unused));
-  return collected;
+  if (delayed) {
+    hal::PoseEstimate unused;
+    FW_RETURN_IF_ERROR(global_.offer(scan, odom, &unused));
+  }
+  return got;
 }
 
 bool TrackedLocalizer::start_from_fix(const hal::PoseEstimate& g, const Se2f& wheel, std::size_t n,
