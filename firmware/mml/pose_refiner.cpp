@@ -3,7 +3,7 @@
 #include <Eigen/Cholesky>
 #include <cmath>
 
-#include "firmware/map/distance_sample.h"
+#include "firmware/map/distance_batch.h"
 #include "firmware/scan/point_to_line.h"
 
 namespace fw {
@@ -15,7 +15,7 @@ RefineResult refine_pose(const GlobalMap& map, const Point2f* points, std::size_
   r.pose = initial;
   if (!map.valid() || n == 0) return r;
   Se2f t = initial;
-  const DistanceSampler<float> sample(map);
+  DistanceBatch batch;  // the samples of one pass, kDistanceBatch end-points at a time
   std::size_t inl = 0;
   double sq = 0.0;
   PointToLineSystem sys;  // the shared 2-D solver (firmware/scan/point_to_line.h)
@@ -28,14 +28,17 @@ RefineResult refine_pose(const GlobalMap& map, const Point2f* points, std::size_
     const double wd = 1.0 / (static_cast<double>(o.sigma_m) * o.sigma_m);
     // The last pass only counts (no step follows it): the alias check refines ~36 rivals per scan.
     const bool last = it == o.iterations;
-    for (std::size_t i = 0; i < n; ++i) {
-      const float px = points[i].x(), py = points[i].y();
-      const float qx = t.x + c * px - s * py, qy = t.y + s * px + c * py;
-      float d, gx, gy;
-      if (!sample(qx, qy, &d, &gx, &gy) || d > clip) continue;
-      ++inl;
-      sq += static_cast<double>(d) * d;
-      if (!last) sys.add(px, py, c, s, gx, gy, d, wd);  // on the distance field: residual d, normal ∇d
+    for (std::size_t i0 = 0; i0 < n; i0 += kDistanceBatch) {
+      const std::size_t m = n - i0 < kDistanceBatch ? n - i0 : kDistanceBatch;
+      sample_distance_batch(map, points + i0, m, t.x, t.y, c, s, clip, &batch);
+      for (std::size_t j = 0; j < m; ++j) {
+        if (!batch.use[j]) continue;
+        const float d = batch.d[j];
+        ++inl;
+        sq += static_cast<double>(d) * d;
+        // On the distance field: residual d, normal ∇d.
+        if (!last) sys.add_jacobian(batch.gx[j], batch.gy[j], batch.jt[j], d, wd);
+      }
     }
     if (it == o.iterations || inl < 3) break;
     // Prior N(initial, diag(σ_xy², σ_xy², σ_θ²)) and a Levenberg damping of 1e-6 of the scale.

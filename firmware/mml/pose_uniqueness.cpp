@@ -3,6 +3,7 @@
 #include <cmath>
 
 #include "firmware/base/sym2_eigen.h"
+#include "firmware/map/distance_batch.h"
 #include "firmware/map/distance_sample.h"
 #include "firmware/mml/pose_refiner.h"
 
@@ -11,18 +12,17 @@ namespace mml {
 
 float truncated_scan_cost(const GlobalMap& map, const Point2f* points, std::size_t n, const Se2f& pose, float clip_m) {
   if (n == 0) return 1.0f;
-  const DistanceSampler<float> sample(map);
   const float c = std::cos(pose.theta), s = std::sin(pose.theta);
   const double clip2 = static_cast<double>(clip_m) * clip_m;
   double sum = 0.0;
-  for (std::size_t i = 0; i < n; ++i) {
-    const float px = points[i].x(), py = points[i].y();
-    float d, gx, gy;
-    if (!sample(pose.x + c * px - s * py, pose.y + s * px + c * py, &d, &gx, &gy) || d > clip_m) {
-      sum += 1.0;
-      continue;
+  DistanceBatch batch;
+  for (std::size_t i0 = 0; i0 < n; i0 += kDistanceBatch) {
+    const std::size_t m = n - i0 < kDistanceBatch ? n - i0 : kDistanceBatch;
+    sample_distance_batch(map, points + i0, m, pose.x, pose.y, c, s, clip_m, &batch);
+    for (std::size_t j = 0; j < m; ++j) {
+      const double d = batch.d[j];
+      sum += batch.use[j] ? d * d / clip2 : 1.0;  // off the map or beyond the clip: the full cost
     }
-    sum += static_cast<double>(d) * d / clip2;
   }
   return static_cast<float>(sum / static_cast<double>(n));
 }

@@ -37,7 +37,11 @@ struct PointToLineSystem {
   // One term: sensor point (px, py), current rotation (c, s) = (cos θ, sin θ), normal (nx, ny)
   // (unit, or the distance-field gradient), residual r, weight w (IRLS weight of a robust loss).
   void add(float px, float py, float c, float s, float nx, float ny, float r, double w) {
-    const double j[3] = {nx, ny, static_cast<double>(nx * (-s * px - c * py) + ny * (c * px - s * py))};
+    add_jacobian(nx, ny, nx * (-s * px - c * py) + ny * (c * px - s * py), r, w);
+  }
+  // The same term with the heading column jt = nᵀ ∂q/∂θ already computed (DistanceBatch::jt).
+  void add_jacobian(float nx, float ny, float jt, float r, double w) {
+    const double j[3] = {nx, ny, static_cast<double>(jt)};
     const double wj[3] = {w * j[0], w * j[1], w * j[2]};
     for (int a = 0; a < 3; ++a)
       for (int e = 0; e <= a; ++e) h[3 * a + e] += wj[a] * j[e];
