@@ -1,5 +1,7 @@
 #include "firmware/map/distance_batch.h"
 
+#include <bit>
+
 #include "firmware/map/distance_sample.h"
 
 #if defined(__x86_64__) && (defined(__GNUC__) || defined(__clang__))
@@ -34,14 +36,14 @@ void sample_scalar(const GlobalMap& map, const Point2f* points, std::size_t n, f
 __attribute__((always_inline)) inline void sample_kernel(const GlobalMap& map, const Point2f* points, std::size_t n,
                                                           float tx, float ty, float c, float s, float clip_m,
                                                           DistanceBatch* out) {
-  const DistanceField& f = map.distance;
+  const DistanceField f = map.distance;  // a copy: its pointers stay in registers across the stores below
   const float inv = 1.0f / map.geometry.resolution, ox = map.geometry.origin_x, oy = map.geometry.origin_y;
   const float max_fx = static_cast<float>(map.geometry.width) - 1.0f;
   const float max_fy = static_cast<float>(map.geometry.height) - 1.0f;
   alignas(32) float px[kDistanceBatch], py[kDistanceBatch], ax[kDistanceBatch], ay[kDistanceBatch];
   alignas(32) std::int32_t ix[kDistanceBatch], iy[kDistanceBatch];
   alignas(32) float c00[kDistanceBatch], c10[kDistanceBatch], c01[kDistanceBatch], c11[kDistanceBatch];
-  alignas(32) std::uint8_t inside[kDistanceBatch];
+  alignas(32) std::int32_t inside[kDistanceBatch];
   for (std::size_t i = 0; i < n; ++i) {
     px[i] = points[i].x();
     py[i] = points[i].y();
@@ -50,14 +52,16 @@ __attribute__((always_inline)) inline void sample_kernel(const GlobalMap& map, c
     const float qx = tx + c * px[i] - s * py[i], qy = ty + s * px[i] + c * py[i];
     float fx = (qx - ox) * inv - 0.5f, fy = (qy - oy) * inv - 0.5f;
     // NaN compares false: outside, as DistanceSampler's !(fx >= 0 && …).
-    const bool in = (fx >= 0.0f) & (fy >= 0.0f) & (fx < max_fx) & (fy < max_fy);
-    fx = in ? fx : 0.0f;  // off the grid: cell (0, 0), read and masked
-    fy = in ? fy : 0.0f;
+    const std::int32_t in = static_cast<std::int32_t>(fx >= 0.0f) & static_cast<std::int32_t>(fy >= 0.0f) &
+                            static_cast<std::int32_t>(fx < max_fx) & static_cast<std::int32_t>(fy < max_fy);
+    // Off the grid: +0 (cell (0, 0), read and masked). A bit mask, not a branch, so the loop vectorises.
+    fx = std::bit_cast<float>(std::bit_cast<std::int32_t>(fx) & -in);
+    fy = std::bit_cast<float>(std::bit_cast<std::int32_t>(fy) & -in);
     ix[i] = static_cast<std::int32_t>(fx);
     iy[i] = static_cast<std::int32_t>(fy);
     ax[i] = fx - static_cast<float>(ix[i]);
     ay[i] = fy - static_cast<float>(iy[i]);
-    inside[i] = in ? 1 : 0;
+    inside[i] = in;
   }
   for (std::size_t i = 0; i < n; ++i) {
     float cc[4];
@@ -76,7 +80,7 @@ __attribute__((always_inline)) inline void sample_kernel(const GlobalMap& map, c
     out->gx[i] = gx;
     out->gy[i] = gy;
     out->jt[i] = gx * (-s * px[i] - c * py[i]) + gy * (c * px[i] - s * py[i]);
-    out->use[i] = static_cast<std::uint8_t>(inside[i] & (d > clip_m ? 0 : 1));
+    out->use[i] = static_cast<std::uint8_t>(inside[i] & static_cast<std::int32_t>(!(d > clip_m)));
   }
 }
 
