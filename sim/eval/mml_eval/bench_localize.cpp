@@ -4,8 +4,8 @@
 // mit-killian and fr-campus, the long ones) + 10 kidnapped-start trials of 200 steps (5 on
 // mit-killian/fr-clinic/fr-campus); MCL (30k particles) first-fix metres on intel and fr079 (3
 // trials); 3 kidnap runs on every dataset; unknown area on intel (3 runs); the built-in large office
-// through mml-sim (5 seeds, large_office_*). (mml-track tracks in
-// well under 1 ms per step; MCL and the first-time map builds dominate the run time.) Then the vcan
+// through mml-sim (5 seeds, large_office_*). (mml-track's tracking
+// steps take 1–2 ms, `track_step_ms_p50`; MCL and the first-time map builds dominate the run time.) Then the vcan
 // HIL (tests/hil/hil_vcan.sh: mmlfw inside user-mode Linux, scans over virtual CAN) for
 // hil_vcan_availability — the same localizer, built by the same start-up code, behind the drivers.
 // Full runs: mml-eval --localize (flags in mml_eval_main.cpp).
