@@ -9,9 +9,10 @@
 // time. Each lane does DistanceSampler's IEEE operations in its order, no fused multiply-add (the
 // build has -ffp-contract=off; AVX2 does not imply FMA), so every build gives the scalar sampler's
 // bits (distance_batch_test) and a run gives the same output on every machine.
-// Measured (mml-eval --localize intel --whole-runs 1 --steps 5000, alias check per tracked scan):
-// 1.54–1.67 ms → 1.18–1.38 ms. A branch-free scalar sampler was 25 % slower than the branchy one, and
-// AVX2 gathers of every look-up no faster on the AMD EPYC measured: the look-ups stay scalar.
+// Measured (mml-eval --localize --whole-runs 1, tracked-scan step p50): intel 1.95 → 1.33 ms, fr079
+// 2.47 → 1.52 ms, aces 2.02 → 1.38 ms (README "Real time"). A branch-free scalar sampler was 25 %
+// slower than the branchy one, and AVX2 gathers of every look-up no faster than scalar loads on the
+// AMD EPYC measured: the look-ups stay scalar.
 #pragma once
 
 #include <cstddef>
