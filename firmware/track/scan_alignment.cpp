@@ -3,6 +3,7 @@
 #include <Eigen/Cholesky>
 #include <cmath>
 
+#include "firmware/map/distance_batch.h"
 #include "firmware/map/distance_sample.h"
 #include "firmware/scan/point_to_line.h"
 
@@ -35,19 +36,22 @@ ScanAlignment align_scan(const GlobalMap& map, const Point2f* points, std::size_
   const double reg_xy = 1.0 / (1.0 * 1.0), reg_th = 1.0 / (0.5 * 0.5);
   Se2f t = seed;
   const DistanceSampler<float> sample(map);
+  DistanceBatch batch;  // the Gauss–Newton passes sample kDistanceBatch end-points at a time
   PointToLineSystem sys;  // shared with RBSM's refinement and PL-ICP (firmware/scan/point_to_line.h)
   for (std::uint32_t it = 0; it < o.iterations; ++it) {
     const float outlier = (it < o.iterations / 2) ? 2.0f * o.outlier_m : o.outlier_m;
     const float c = std::cos(t.theta), s = std::sin(t.theta);
     sys.clear();
-    for (std::size_t i = 0; i < n; ++i) {
-      const float px = points[i].x(), py = points[i].y();
-      const float qx = t.x + c * px - s * py, qy = t.y + s * px + c * py;
-      float d = 0.0f, gx = 0.0f, gy = 0.0f;
-      if (!sample(qx, qy, &d, &gx, &gy) || d > outlier) continue;
-      // On the distance field the residual is d itself and the line normal its gradient.
-      const double w = d <= o.huber_m ? 1.0 : static_cast<double>(o.huber_m) / d;  // Huber IRLS weight
-      sys.add(px, py, c, s, gx, gy, d, w);
+    for (std::size_t i0 = 0; i0 < n; i0 += kDistanceBatch) {
+      const std::size_t m = n - i0 < kDistanceBatch ? n - i0 : kDistanceBatch;
+      sample_distance_batch(map, points + i0, m, t.x, t.y, c, s, outlier, &batch);
+      for (std::size_t j = 0; j < m; ++j) {
+        if (!batch.use[j]) continue;
+        // On the distance field the residual is d itself and the line normal its gradient.
+        const float d = batch.d[j];
+        const double w = d <= o.huber_m ? 1.0 : static_cast<double>(o.huber_m) / d;  // Huber IRLS weight
+        sys.add_jacobian(batch.gx[j], batch.gy[j], batch.jt[j], d, w);
+      }
     }
     if (sys.used < 3) break;
     Eigen::Vector3d dx;
