@@ -31,19 +31,10 @@ RefineResult refine_pose(const GlobalMap& map, const Point2f* points, std::size_
     for (std::size_t i0 = 0; i0 < n; i0 += kDistanceBatch) {
       const std::size_t m = n - i0 < kDistanceBatch ? n - i0 : kDistanceBatch;
       sample_distance_batch(map, points + i0, m, t.x, t.y, c, s, clip, &batch);
-      // The inliers' indices first (no branch on which end-points fit: that is data), then their
-      // terms in end-point order, as a loop with a `continue` summed them.
-      static_assert(kDistanceBatch <= 256, "uint8 indices");
-      std::uint8_t used[kDistanceBatch];
-      std::size_t k = 0;
       for (std::size_t j = 0; j < m; ++j) {
-        used[k] = static_cast<std::uint8_t>(j);
-        k += batch.use[j];
-      }
-      inl += k;
-      for (std::size_t q = 0; q < k; ++q) {
-        const std::size_t j = used[q];
+        if (!batch.use[j]) continue;
         const float d = batch.d[j];
+        ++inl;
         sq += static_cast<double>(d) * d;
         // On the distance field: residual d, normal ∇d.
         if (!last) sys.add_jacobian(batch.gx[j], batch.gy[j], batch.jt[j], d, wd);
