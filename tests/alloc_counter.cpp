@@ -4,6 +4,18 @@
 #include <cstdlib>
 #include <new>
 
+// Under a sanitizer the counter must not replace malloc (the sanitizer's allocator is what checks
+// the heap). GCC says so by __SANITIZE_ADDRESS__ / __SANITIZE_THREAD__; clang only through
+// __has_feature (a clang ASan build replaced malloc with __libc_malloc and ran the heap-counting
+// tests without ASan's heap checks).
+#if defined(__SANITIZE_ADDRESS__) || defined(__SANITIZE_THREAD__)
+#define MMLFW_UNDER_SANITIZER 1
+#elif defined(__has_feature)
+#if __has_feature(address_sanitizer) || __has_feature(thread_sanitizer)
+#define MMLFW_UNDER_SANITIZER 1
+#endif
+#endif
+
 extern "C" {
 void* __libc_malloc(size_t);
 void* __libc_calloc(size_t, size_t);
@@ -37,7 +49,7 @@ long AllocCounter::end() {
 }
 long AllocCounter::bytes() { return g_bytes.load(); }
 bool AllocCounter::available() {
-#if defined(__SANITIZE_ADDRESS__) || defined(__SANITIZE_THREAD__)
+#if defined(MMLFW_UNDER_SANITIZER)
   return false;
 #else
   return true;
@@ -45,7 +57,7 @@ bool AllocCounter::available() {
 }
 }  // namespace mmlfw_test
 
-#if !defined(__SANITIZE_ADDRESS__) && !defined(__SANITIZE_THREAD__)
+#if !defined(MMLFW_UNDER_SANITIZER)
 extern "C" {
 void* malloc(size_t n) {
   note(n);
