@@ -70,7 +70,10 @@ TEST(FragmentBordersTest, GrahamScanMatchesABruteForceHullOnRandomClouds) {
   std::uniform_real_distribution<float> u(-5.0f, 5.0f);
   for (int trial = 0; trial < 20; ++trial) {
     std::vector<Point2f> p(200);
-    for (auto& q : p) q = Point2f(u(rng), u(rng));
+    for (auto& q : p) {  // one draw per statement (argument order is unspecified)
+      const float y = u(rng);
+      q = Point2f(u(rng), y);
+    }
     std::vector<Point2f> scratch(p.size()), hull(p.size());
     const std::size_t m = convex_hull(p.data(), p.size(), scratch.data(), hull.data(), hull.size());
     ASSERT_GE(m, 3u);

@@ -1,8 +1,10 @@
 // ACO (Eq. 3.13–3.14) and LM on a small synthetic loop with a known answer: 12 fragments on a
 // circle, every adjacent edge measured with a bias (drift) so that the chain misses the start, and
-// a precise closure measurement. Both optimisers must pull the loop shut and lower W.
+// a precise closure measurement. Both optimisers must pull the loop shut and lower W. And the
+// sampled options of an edge (Eq. 3.10) are the same for one seed on every target.
 #include <gtest/gtest.h>
 
+#include <Eigen/Cholesky>
 #include <cmath>
 #include <vector>
 
@@ -175,6 +177,33 @@ TEST(LoopLmTest, NothingToDoWhenTheLoopIsAlreadyShut) {
   ASSERT_TRUE(lm.solve(loop.problem, values.data(), &rep).is_ok());
   EXPECT_LT(rep.initial_cost, 1e-6);
   for (std::uint32_t i = 0; i < SyntheticLoop::kEdges; ++i) EXPECT_NEAR(values[i].x, loop.truth[i].x, 1e-6);
+}
+
+// The options of an edge are a function of the seed alone, on every compiler and target: each
+// option k > 0 is μ + L·(x, y, z) with z, y, x drawn in that order (Eq. 3.10). A constructor taking
+// three draws as arguments left their order to the compiler (x86-64 GCC drew z first, aarch64 GCC
+// x first), so the same seed gave different edges, and loop corrections, on the robot's computer.
+TEST(SampledEdgeTest, OptionsFollowTheDrawOrderOnEveryTarget) {
+  Mat3 cov;
+  cov << 0.04, 0.01, 0.002, 0.01, 0.09, -0.003, 0.002, -0.003, 0.0025;
+  const Se2d mean(1.0, -2.0, 0.3);
+  constexpr std::uint32_t kCount = 5;
+  Se2d options[kCount];
+  double costs[kCount];
+  SampledEdge edge;
+  RandomStream rng(2012, 7);
+  ASSERT_TRUE(init_sampled_edge(0, 1, mean, cov, options, costs, kCount, rng, &edge).is_ok());
+  const Mat3 l = cov.llt().matrixL();
+  RandomStream replay(2012, 7);
+  for (std::uint32_t k = 1; k < kCount; ++k) {
+    const double gz = replay.gaussian();
+    const double gy = replay.gaussian();
+    const double gx = replay.gaussian();
+    const Vec3 t = Vec3(mean.x, mean.y, mean.theta) + l * Vec3(gx, gy, gz);
+    EXPECT_NEAR(options[k].x, t(0), 1e-12) << k;
+    EXPECT_NEAR(options[k].y, t(1), 1e-12) << k;
+    EXPECT_NEAR(options[k].theta, wrap_angle(t(2)), 1e-12) << k;
+  }
 }
 
 }  // namespace

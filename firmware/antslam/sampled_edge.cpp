@@ -56,7 +56,13 @@ Status init_sampled_edge(std::uint32_t from, std::uint32_t to, const Se2d& mean,
   for (std::uint32_t k = 0; k < count; ++k) {
     Vec3 t(mean.x, mean.y, mean.theta);
     if (k > 0) {  // Eq. 3.10: a draw from N(μ_ij, Σ_ij)
-      const Vec3 z(rng.gaussian(), rng.gaussian(), rng.gaussian());
+      // One draw per statement: the order of a constructor's arguments is unspecified, and the
+      // x86-64 GCC build drew z first while aarch64 and clang drew x first (different edges for one
+      // seed). Kept z, y, x — the order every recorded figure was measured with.
+      const double gz = rng.gaussian();
+      const double gy = rng.gaussian();
+      const double gx = rng.gaussian();
+      const Vec3 z(gx, gy, gz);
       t += l * z;
     }
     options[k] = Se2d(t(0), t(1), wrap_angle(t(2)));

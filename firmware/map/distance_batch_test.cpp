@@ -86,9 +86,13 @@ TEST(DistanceBatchTest, EveryBuildGivesTheScalarSamplersBits) {
     // Every batch length 1..64, points spread a bit beyond the grid on every side.
     const std::size_t n = 1 + static_cast<std::size_t>(trial) % kDistanceBatch;
     std::vector<Point2f> pts(n);
-    for (auto& p : pts) p = Point2f(static_cast<float>(rng.uniform(-2.5, 2.5)), static_cast<float>(rng.uniform(-2.0, 2.0)));
-    const Se2f pose(static_cast<float>(rng.uniform(-0.5, 1.5)), static_cast<float>(rng.uniform(1.2, 2.0)),
-                    static_cast<float>(rng.uniform(-3.1, 3.1)));
+    for (auto& p : pts) {  // one draw per statement: argument order is unspecified (y first, as x86-64 GCC did)
+      const float y = static_cast<float>(rng.uniform(-2.0, 2.0));
+      p = Point2f(static_cast<float>(rng.uniform(-2.5, 2.5)), y);
+    }
+    const float th = static_cast<float>(rng.uniform(-3.1, 3.1));
+    const float py = static_cast<float>(rng.uniform(1.2, 2.0));
+    const Se2f pose(static_cast<float>(rng.uniform(-0.5, 1.5)), py, th);
     expect_batches_equal(t.map, pts, pose, 0.15f);
     if (HasFatalFailure()) return;
     const float c = std::cos(pose.theta), s = std::sin(pose.theta);

@@ -37,7 +37,8 @@ std::vector<Output> drive(MmlLocalizer* loc, const GridWorld& world, const std::
       Se2f d = path[i - 1].between(path[i]);
       d.x *= 1.0f + 0.02f * static_cast<float>(rng.gaussian());
       d.y *= 1.0f + 0.02f * static_cast<float>(rng.gaussian());
-      d.theta = d.theta * (1.0f + 0.02f * static_cast<float>(rng.gaussian())) + 0.002f * static_cast<float>(rng.gaussian());
+      const float scale = 1.0f + 0.02f * static_cast<float>(rng.gaussian());  // one draw per statement
+      d.theta = d.theta * scale + 0.002f * static_cast<float>(rng.gaussian());
       *odom = odom->compose(d);
     }
     mcl::testing::simulate_scan(world.view(), path[i].x, path[i].y, path[i].theta, &scan);

@@ -39,13 +39,14 @@ Tour make_tour(std::uint64_t seed) {
   t.truth = truth_tour();
   t.relative.push_back(t.truth[0]);
   for (std::size_t i = 0; i < t.truth.size(); ++i) {
-    t.absolute.push_back(Se2d(t.truth[i].x + 0.03 * rng.gaussian(), t.truth[i].y + 0.03 * rng.gaussian(),
-                              wrap_angle(t.truth[i].theta + 0.0087 * rng.gaussian())));
+    // One draw per statement (argument order is unspecified): θ, y, x as x86-64 GCC drew them.
+    const double at = 0.0087 * rng.gaussian(), ay = 0.03 * rng.gaussian(), ax = 0.03 * rng.gaussian();
+    t.absolute.push_back(Se2d(t.truth[i].x + ax, t.truth[i].y + ay, wrap_angle(t.truth[i].theta + at)));
     if (i == 0) continue;
     const Se2d u = t.truth[i - 1].between(t.truth[i]);
     const double st = 0.002 + 0.01 * std::hypot(u.x, u.y), sr = 0.0009 + 0.01 * std::fabs(u.theta);
-    t.relative.push_back(
-        t.relative.back().compose(Se2d(u.x + st * rng.gaussian(), u.y + st * rng.gaussian(), u.theta + sr * rng.gaussian())));
+    const double rt = sr * rng.gaussian(), ry = st * rng.gaussian(), rx = st * rng.gaussian();
+    t.relative.push_back(t.relative.back().compose(Se2d(u.x + rx, u.y + ry, u.theta + rt)));
   }
   return t;
 }

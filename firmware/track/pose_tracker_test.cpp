@@ -51,7 +51,8 @@ TEST(PoseTrackerTest, TracksWithinProtectionLevel) {
     if (i > 0) {
       Se2f d = path[i - 1].between(path[i]);
       d.x *= 1.0f + 0.05f * static_cast<float>(rng.gaussian());
-      d.theta = d.theta * (1.0f + 0.05f * static_cast<float>(rng.gaussian())) + 0.005f * static_cast<float>(rng.gaussian());
+      const float scale = 1.0f + 0.05f * static_cast<float>(rng.gaussian());  // one draw per statement
+      d.theta = d.theta * scale + 0.005f * static_cast<float>(rng.gaussian());
       odom = odom.compose(d);
     }
     const auto pts = testing::scan_at(room(), path[i], &rng);

@@ -49,7 +49,8 @@ TEST(ProtectionLevelTest, GaussianErrorsExceedAtMostTheRisk) {
   int over_xy = 0, over_th = 0;
   const int n = 200000;
   for (int i = 0; i < n; ++i) {
-    const Eigen::Vector2f z(static_cast<float>(rng.gaussian()), static_cast<float>(rng.gaussian()));
+    const float zy = static_cast<float>(rng.gaussian());  // one draw per statement (argument order is unspecified)
+    const Eigen::Vector2f z(static_cast<float>(rng.gaussian()), zy);
     const Eigen::Vector2f e = l * z;
     over_xy += e.norm() > pl.xy_m;
     over_th += std::fabs(0.05f * static_cast<float>(rng.gaussian())) > pl.theta_rad;

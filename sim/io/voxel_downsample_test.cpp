@@ -33,7 +33,10 @@ TEST(VoxelDownsample, DenseCloudShrinksToOnePointPerVoxel) {
   std::mt19937 g(1);
   std::uniform_real_distribution<float> u(0.0f, 1.0f);
   std::vector<Eigen::Vector3f> in;
-  for (int i = 0; i < 20000; ++i) in.emplace_back(u(g), u(g), u(g));
+  for (int i = 0; i < 20000; ++i) {  // one draw per declarator (argument order is unspecified)
+    const float z = u(g), y = u(g), x = u(g);
+    in.emplace_back(x, y, z);
+  }
   std::vector<Eigen::Vector3f> out;
   std::string err;
   ASSERT_TRUE(voxel_downsample(in, 0.25f, &out, &err)) << err;

@@ -338,10 +338,14 @@ ThreeDRun run_3d(std::size_t trials, int pool_threads, std::uint32_t max_iterati
     const Eigen::Matrix3f r = (Eigen::AngleAxisf(yaw, Eigen::Vector3f::UnitZ()) *
                                Eigen::AngleAxisf(pitch, Eigen::Vector3f::UnitY()) *
                                Eigen::AngleAxisf(roll, Eigen::Vector3f::UnitX())).toRotationMatrix();
-    const P3 t(rt.uniform(-2, 2), rt.uniform(-2, 2), rt.uniform(-0.5f, 0.5f));
+    // One draw per declarator, last coordinate first (as x86-64 GCC evaluated the constructor's
+    // arguments when the figures were measured; the order of arguments is unspecified).
+    const float tz = rt.uniform(-0.5f, 0.5f), ty = rt.uniform(-2, 2), tx = rt.uniform(-2, 2);
+    const P3 t(tx, ty, tz);
     std::vector<P3> a;
     for (const P3& p : aw) {
-      const P3 noisy = p + P3(rt.gaussianf(0, 0.005f), rt.gaussianf(0, 0.005f), rt.gaussianf(0, 0.005f));
+      const float nz = rt.gaussianf(0, 0.005f), ny = rt.gaussianf(0, 0.005f), nx = rt.gaussianf(0, 0.005f);
+      const P3 noisy = p + P3(nx, ny, nz);
       a.push_back(r.transpose() * (noisy - t));
     }
     fw::pransam::MatchParams p;

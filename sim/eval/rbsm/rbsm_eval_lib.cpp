@@ -271,8 +271,11 @@ bool run_pairwise(const CarmenLog& log, const std::vector<CorrectedPose>& refere
       continue;
     }
     const fw::Se2d truth = ra.pose.between(rb.pose);
-    const fw::Se2d guess(truth.x + sigma_xy * noise.gaussian(), truth.y + sigma_xy * noise.gaussian(),
-                         fw::wrap_angle(truth.theta + sigma_theta_deg * M_PI / 180.0 * noise.gaussian()));
+    // One draw per declarator (a constructor's argument order is unspecified): θ, y, x — the
+    // order x86-64 GCC used when the figures were measured.
+    const double gt = noise.gaussian(), gy = noise.gaussian(), gx = noise.gaussian();
+    const fw::Se2d guess(truth.x + sigma_xy * gx, truth.y + sigma_xy * gy,
+                         fw::wrap_angle(truth.theta + sigma_theta_deg * M_PI / 180.0 * gt));
     fw::ScanMatcher* m = inst->matcher();
     m->reset();
     if (inst->rbsm()) inst->rbsm()->forget_tracking();
