@@ -22,6 +22,11 @@ if(MMLFW_SANITIZE STREQUAL "address")
   # (e.g. hal_sim's polymorphic sources used from RTTI-enabled tests) do not emit: link errors otherwise.
   add_compile_options(-fsanitize=address,undefined -fno-sanitize=vptr -fno-omit-frame-pointer -fno-sanitize-recover=undefined)
   add_link_options(-fsanitize=address,undefined)
+  if(CMAKE_CXX_COMPILER_ID STREQUAL "Clang")
+    # clang's UBSan `function` check emits typeinfo for function types into every object, the
+    # -fno-rtti firmware libraries included (symbol_check would report RTTI); GCC has no such check.
+    add_compile_options(-fno-sanitize=function)
+  endif()
 elseif(MMLFW_SANITIZE STREQUAL "fuzzer")
   # libFuzzer targets (tests/fuzz, `fuzz` preset, clang only): every library carries the fuzzer's
   # coverage instrumentation plus ASan+UBSan; only the fuzz executables link libFuzzer's main.
