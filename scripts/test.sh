@@ -50,7 +50,7 @@ build_and_test() {
 }
 release() { build_and_test release "host (release)" -j "$JOBS" --timeout 1200; }
 aarch64() { build_and_test aarch64 "aarch64 cross (tests under qemu-aarch64)" -j "$JOBS" --timeout 1200; }
-# ASan + UBSan: every unit, data and rules test (not hil: the HIL scripts measure the release
+# ASan + UBSan (clang: half GCC's build time): every unit, data and rules test (not hil: the HIL scripts measure the release
 # binaries inside UML; not budget: timing under ASan says nothing about the firmware's budget; not
 # scenario: whole-world behaviour runs of mml-sim — the kidnap into the twin office, the aces
 # transport comparisons, 520 s under ASan — whose drivers and localizer run under ASan in the

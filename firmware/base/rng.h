@@ -2,7 +2,10 @@
 // from (seed, stream index) with SplitMix64, the generator is PCG32 (O'Neill 2014), and all draws
 // use only IEEE-exact operations (+ − × ÷ √ and our own polynomial log), so the same seed gives
 // bit-identical draws on x86-64 and aarch64 (libm's log/sin/cos may differ across platforms, and
-// GCC contracts a*b+c into FMA on aarch64 unless -ffp-contract=off, which toolchain/ sets).
+// GCC contracts a*b+c into FMA on aarch64 unless -ffp-contract=off, which toolchain/ sets) — as
+// long as a caller never takes two draws in one expression, whose order C++ leaves to the compiler
+// (`Vec3(r.gaussian(), r.gaussian(), r.gaussian())` fills x from the third draw with x86-64 GCC and
+// from the first with aarch64 GCC; scripts/check_draw_order.py reports such expressions).
 // Hand-written instead of <random>: std::normal_distribution's algorithm is unspecified and
 // differs between standard libraries.
 #pragma once
