@@ -49,7 +49,26 @@ build_and_test() {
   ctest --preset "$preset" "$@"
 }
 release() { build_and_test release "host (release)" -j "$JOBS" --timeout 1200; }
-aarch64() { build_and_test aarch64 "aarch64 cross (tests under qemu-aarch64)" -j "$JOBS" --timeout 1200; }
+aarch64() { build_and_test aarch64 "aarch64 cross (tests under qemu-aarch64)" -j "$JOBS" --timeout 1200; cross_target; }
+# The robot's CPU computes what the host does: the MML + tracker run of the synthetic room and the
+# ant colony's answer on the synthetic loop (its sampled edges, Eq. 3.10), host build against the
+# aarch64 build under qemu (scripts/check_cross_target.py). Needs the release build (its two test
+# binaries are brought up to date here).
+CROSS_TARGET_CASES="firmware/track/fw_track_test:TrackedLocalizerTest.FixThenTrackEveryScan
+firmware/antslam/fw_antslam_test:AntColonyTest.ClosesASyntheticLoopAndLowersTheCost"
+cross_target() {
+  if [ ! -f build/release/build.ninja ]; then
+    echo "test.sh: NOTE: no release build: the host/aarch64 comparison (scripts/check_cross_target.py) is skipped"
+    return 0
+  fi
+  echo "=== host against aarch64: the same case, the same answer ==="
+  cmake --build --preset release -j "$JOBS" --target fw_track_test fw_antslam_test >/dev/null
+  local c
+  for c in $CROSS_TARGET_CASES; do
+    python3 scripts/check_cross_target.py --host "build/release/${c%%:*}" --cross "build/aarch64/${c%%:*}" \
+      --emulator "qemu-aarch64 -L /usr/aarch64-linux-gnu" --filter "${c#*:}"
+  done
+}
 # ASan + UBSan (clang: half GCC's build time): every unit, data and rules test (not hil: the HIL scripts measure the release
 # binaries inside UML; not budget: timing under ASan says nothing about the firmware's budget; not
 # scenario: whole-world behaviour runs of mml-sim — the kidnap into the twin office, the aces

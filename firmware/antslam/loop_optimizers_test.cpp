@@ -6,6 +6,7 @@
 
 #include <Eigen/Cholesky>
 #include <cmath>
+#include <cstdio>
 #include <vector>
 
 #include "firmware/antslam/ant_colony.h"
@@ -85,6 +86,11 @@ TEST(AntColonyTest, ClosesASyntheticLoopAndLowersTheCost) {
     EXPECT_LT(rep.best_cost, 0.2 * rep.initial_cost);
     EXPECT_NEAR(loop_cost(loop.problem, values.data()), rep.best_cost, 1e-9 * rep.best_cost);
     EXPECT_LT(closure_gap(loop.chain(values)), 0.3 * gap0) << "reverse " << reverse;
+    // The answer, for scripts/check_cross_target.py (host against aarch64): the sampled edges
+    // (Eq. 3.10) and the colony's choices must be the same on every target.
+    for (std::uint32_t i = 0; i < SyntheticLoop::kEdges; ++i) {
+      std::printf("trace aco %d %u %a %a %a\n", reverse ? 1 : 0, i, values[i].x, values[i].y, values[i].theta);
+    }
   }
 }
 

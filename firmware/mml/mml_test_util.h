@@ -3,6 +3,7 @@
 #pragma once
 
 #include <cmath>
+#include <cstdio>
 #include <functional>
 #include <string>
 #include <vector>
@@ -81,6 +82,18 @@ inline std::vector<StepRecord> drive(Localizer* loc, const GridWorld& world, con
     out.push_back(r);
   }
   return out;
+}
+
+// One "trace" line per step of what it published (floats as exact hex): scripts/check_cross_target.py
+// compares the host's run with the robot CPU's (aarch64 under qemu) — statuses and counts exactly,
+// values to within its tolerance (glibc's float sin/cos/atan2 may differ in the last bit by target).
+inline void print_trace(const char* name, const std::vector<StepRecord>& rec) {
+  for (std::size_t i = 0; i < rec.size(); ++i) {
+    const hal::PoseEstimate& e = rec[i].est;
+    std::printf("trace %s %zu %d %d %u %u %u %d %a %a %a %a %a %a\n", name, i, static_cast<int>(e.status),
+                static_cast<int>(e.mode), e.hypothesis_count, e.cluster_count, e.unsupported_steps,
+                static_cast<int>(e.reason), e.x, e.y, e.theta, e.protection_xy_m, e.protection_theta_rad, e.cov[0]);
+  }
 }
 
 // Straight segments through waypoints at `step` metres per scan, turning in place at corners.

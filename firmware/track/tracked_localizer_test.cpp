@@ -64,6 +64,7 @@ TEST(TrackedLocalizerTest, FixThenTrackEveryScan) {
   const int after = static_cast<int>(rec.size()) - t.first;
   EXPECT_GE(t.localized, after * 95 / 100) << "availability after the first fix";
   EXPECT_EQ(rig.loc->tracks_lost(), 0u);
+  mml::testing::print_trace("mml-track", rec);  // scripts/check_cross_target.py
 }
 
 // TrackOptions::confirm_fix_on_past_scans: MML's fix is confirmed on the recovery_steps scans the
