@@ -86,7 +86,7 @@ inline std::vector<StepRecord> drive(Localizer* loc, const GridWorld& world, con
 
 // One "trace" line per step of what it published (floats as exact hex): scripts/check_cross_target.py
 // compares the host's run with the robot CPU's (aarch64 under qemu) — statuses and counts exactly,
-// values to within its tolerance (glibc's float sin/cos/atan2 may differ in the last bit by target).
+// values to within its tolerance (glibc's atan2f differs in the last bit between x86-64 and aarch64).
 inline void print_trace(const char* name, const std::vector<StepRecord>& rec) {
   for (std::size_t i = 0; i < rec.size(); ++i) {
     const hal::PoseEstimate& e = rec[i].est;
