@@ -495,9 +495,7 @@ TEST(Matcher3DTest, RecoversKnownTransformBetweenOverlappingTexturedClouds) {
   std::vector<P3> a;
   RandomStream rng(46, 0);
   for (std::size_t i = 0; i < a_world.size(); ++i) {
-    // One draw per declarator (argument order is unspecified), last coordinate first.
-    const float nz = rng.gaussianf(0, 0.005f), ny = rng.gaussianf(0, 0.005f), nx = rng.gaussianf(0, 0.005f);
-    const P3 noisy = a_world[i] + P3(nx, ny, nz);
+    const P3 noisy = a_world[i] + sim::pransam_scenes::gaussian3f(rng, 0.005f);
     a.push_back(r.transpose() * (noisy - t));
   }
   StartupArena arena;

@@ -5,6 +5,7 @@
 #include <cmath>
 
 #include "firmware/base/rng.h"
+#include "sim/eval/pransam_scenes.h"
 #include "sim/io/datasets.h"
 #include "sim/io/voxel_downsample.h"
 
@@ -12,14 +13,9 @@ namespace sim::pransam_eval {
 
 namespace {
 
-// Three draws, last coordinate first. One draw per declarator because a constructor's argument
-// order is unspecified (x86-64 GCC drew the last argument first, aarch64 and clang the first): the
-// order here is x86-64 GCC's, with which every recorded figure was measured.
-Eigen::Vector3f gaussian3f(fw::RandomStream& r, float sigma) {
-  const float z = r.gaussianf(0, sigma), y = r.gaussianf(0, sigma), x = r.gaussianf(0, sigma);
-  return Eigen::Vector3f(x, y, z);
-}
+using pransam_scenes::gaussian3f;
 
+// Uniform in [lo, hi) in each coordinate, last coordinate first (as gaussian3f, pransam_scenes.h).
 Eigen::Vector3f uniform3f(fw::RandomStream& r, float lo, float hi) {
   const float z = r.uniform(lo, hi), y = r.uniform(lo, hi), x = r.uniform(lo, hi);
   return Eigen::Vector3f(x, y, z);

@@ -344,8 +344,7 @@ ThreeDRun run_3d(std::size_t trials, int pool_threads, std::uint32_t max_iterati
     const P3 t(tx, ty, tz);
     std::vector<P3> a;
     for (const P3& p : aw) {
-      const float nz = rt.gaussianf(0, 0.005f), ny = rt.gaussianf(0, 0.005f), nx = rt.gaussianf(0, 0.005f);
-      const P3 noisy = p + P3(nx, ny, nz);
+      const P3 noisy = p + pransam_scenes::gaussian3f(rt, 0.005f);
       a.push_back(r.transpose() * (noisy - t));
     }
     fw::pransam::MatchParams p;
