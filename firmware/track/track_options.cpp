@@ -80,6 +80,7 @@ Status TrackOptions::validate() const {
   FW_RETURN_IF_ERROR(check_count("cross_check_steps", cross_check_steps, 0, 1000000));
   FW_RETURN_IF_ERROR(check_count("odometry_window", odometry_window, 0, 32));
   FW_RETURN_IF_ERROR(check_count("recovery_steps", recovery_steps, 0, 10000));
+  FW_RETURN_IF_ERROR(check_count("past_scans_per_step", past_scans_per_step, 2, 64));  // 1 never catches up
   FW_RETURN_IF_ERROR(check_range("alias_max_shift_m", alias_max_shift_m, 0.0f, 50.0f));
   FW_RETURN_IF_ERROR(check_range("alias_step_m", alias_step_m, 0.05f, 10.0f));
   FW_RETURN_IF_ERROR(check_range("alias_min_separation_m", alias_min_separation_m, 0.01f, 10.0f));

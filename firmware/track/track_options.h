@@ -238,13 +238,21 @@ struct TrackOptions {
   // already has instead of data it waits for. Otherwise (a scan contradicts, an alias, too few scans
   // since the last reset) the track starts on the fix's scan and confirms forward as above. A carry
   // between those scans is invisible to the wheels, so the carried-back poses miss the map there and
-  // the replay fails: forward confirmation. Off by default (measured 2026-11-27, README "MML's fix
-  // confirmed on the scans before it"): 0.5–0.8 m less travel to the first fix on intel, fr079, aces,
-  // but in the 420-run kidnap stress one run (intel seed 13, carry 4658 → 6330) is `localized` 15.1 m
-  // off for one scan — the carry whose first scan still fits the old place (README), which forward
-  // confirmation's different track history happened to miss. Until that weakness is closed, the
-  // earlier fix is not worth a wrong `localized`. true = confirm on the past scans first.
-  bool confirm_fix_on_past_scans = false;
+  // the replay fails: forward confirmation. On by default since 2026-11-28 (README "MML's fix
+  // confirmed on the scans before it"): 0.5–0.8 m less travel to the first fix on intel, fr079, aces.
+  // It was off while one run of the 420-run kidnap stress (intel seed 13, carry 4658 → 6330) was
+  // `localized` 15.1 m off for one scan — a carry whose first scan still fits the old place; the
+  // tracker's weakness, not the replay's, closed by confidence_cap_needs_a_pinned_axis (that run
+  // replayed in localize_data_test.cpp); the same 420 runs with both: 0 integrity failures.
+  // false = forward confirmation only.
+  bool confirm_fix_on_past_scans = true;
+  // ... at most this many scans per step (≥ 2): the replay runs in the sensor context, whose every
+  // step must end within one scan period, and recovery_steps + 1 tracker steps in one scan period
+  // missed the 75 Hz deadline (bench.sh realtime: intel 14.0 ms, fr079 20.3 ms on the fix's scan).
+  // The scans that arrive meanwhile join the replay, so it reaches the present after
+  // ⌈(recovery_steps + 1 − past_scans_per_step) / (past_scans_per_step − 1)⌉ further scans (3: two;
+  // forward confirmation needs recovery_steps), not `localized` until then.
+  std::uint32_t past_scans_per_step = 3;
   // Protection level (protection_level.h): integrity risk per `localized` step and alert limits.
   float integrity_risk = 1e-3f;
   float alert_limit_m = 0.5f;             // PL beyond → not `localized` (the product's 0.5 m bound)

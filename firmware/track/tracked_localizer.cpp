@@ -30,6 +30,7 @@ void TrackedLocalizer::reset() {
   cross_check_left_ = 0;
   unconfirmed_ = false;
   history_.clear();
+  replay_lag_ = 0;
 }
 
 // End-points within the tracker's range, evenly subsampled to at most align.max_points (beam order
@@ -86,6 +87,14 @@ Status TrackedLocalizer::step(const hal::LaserScan& scan, const hal::Odometry& o
     for (std::size_t k = 0; k < n; ++k) r.pts[k] = pts_[k];
     r.n = n;
     r.wheel = wheel;
+  }
+  if (replay_lag_ > 0) {  // MML's fix is being confirmed on the scans before it: this one joins them
+    ++replay_lag_;
+    *out = hal::PoseEstimate();
+    out->timestamp_ns = scan.timestamp_ns;
+    out->scan_id = scan.scan_id;
+    replay_past_scans(wheel, n, out);
+    return Status::ok();
   }
   if (tracker_.active()) {
     const TrackStep ts = tracker_.step(pts_, n, wheel);
@@ -153,12 +162,30 @@ bool TrackedLocalizer::start_from_fix(const hal::PoseEstimate& g, const Se2f& wh
   Eigen::Matrix3f cov;
   for (int r = 0; r < 3; ++r)
     for (int c = 0; c < 3; ++c) cov(r, c) = g.cov[r * 3 + c];
-  const bool confirm = tracker_.options().confirm_fix;
-  if (confirm && tracker_.options().confirm_fix_on_past_scans &&
-      confirm_on_past_scans(Se2f(g.x, g.y, g.theta), cov, wheel, n, out)) {
-    return true;
+  const Se2f fix(g.x, g.y, g.theta);
+  const TrackOptions& o = tracker_.options();
+  const std::size_t k = o.recovery_steps;
+  if (o.confirm_fix && o.confirm_fix_on_past_scans && k > 0 && history_.size() >= k + 1) {
+    // TrackOptions::confirm_fix_on_past_scans. The tracker starts recovery_steps scans back, at MML's
+    // pose carried back by the wheels (pose_{t−k} = fix ⊕ (wheel_t ⊖ wheel_{t−k})), as it would
+    // start on a fix there (MML's covariance, confirmation pending), and steps through the
+    // remembered scans, this one and those that arrive meanwhile with their odometry.
+    const RememberedScan& r0 = history_[history_.size() - 1 - k];
+    replay_fix_ = fix;
+    replay_fix_wheel_ = wheel;
+    replay_cov_ = cov;
+    replay_lag_ = static_cast<std::uint32_t>(k + 1);
+    replay_first_ = true;
+    tracker_.start(fix.compose(wheel.between(r0.wheel)), cov, r0.wheel, /*confirm=*/true);
+    return replay_past_scans(wheel, n, out);
   }
-  tracker_.start(Se2f(g.x, g.y, g.theta), cov, wheel, confirm);
+  return start_forward(fix, cov, wheel, n, out);
+}
+
+bool TrackedLocalizer::start_forward(const Se2f& fix, const Eigen::Matrix3f& cov, const Se2f& wheel, std::size_t n,
+                                     hal::PoseEstimate* out) {
+  const bool confirm = tracker_.options().confirm_fix;
+  tracker_.start(fix, cov, wheel, confirm);
   const TrackStep ts = tracker_.step(pts_, n, wheel, /*predict=*/false);
   // The scan must support MML's pose; with confirm_fix every test but the hysteresis must pass
   // (the scan is consistent, unique, within the alert limits), and the track then recovers.
@@ -179,32 +206,42 @@ bool TrackedLocalizer::start_from_fix(const hal::PoseEstimate& g, const Se2f& wh
   return false;
 }
 
-// TrackOptions::confirm_fix_on_past_scans. The tracker starts recovery_steps scans back, at MML's pose
-// carried back by the wheels (pose_{t−k} = fix ⊕ (wheel_t ⊖ wheel_{t−k})), as it would start on a fix
-// there (MML's covariance, confirmation pending), and steps through the remembered scans and this
-// one with their odometry. Nothing is published on the way; only the end counts.
-bool TrackedLocalizer::confirm_on_past_scans(const Se2f& fix, const Eigen::Matrix3f& cov, const Se2f& wheel,
-                                             std::size_t n, hal::PoseEstimate* out) {
-  // history_ ends with this scan; the k before it are replayed first.
-  const std::size_t k = tracker_.options().recovery_steps;
-  if (k == 0 || history_.size() < k + 1) return false;
-  const std::size_t first = history_.size() - 1 - k;
-  const RememberedScan& r0 = history_[first];
-  tracker_.start(fix.compose(wheel.between(r0.wheel)), cov, r0.wheel, /*confirm=*/true);
-  TrackStep ts = tracker_.step(r0.pts, r0.n, r0.wheel, /*predict=*/false);
-  for (std::size_t j = first + 1; j < first + k && !ts.lost; ++j) {
-    ts = tracker_.step(history_[j].pts, history_[j].n, history_[j].wheel);
+// Nothing is published `localized` on the way; only the end on the newest scan counts. While the
+// replay lags, the estimate is the replayed pose carried to this scan by the wheels, not `localized`.
+bool TrackedLocalizer::replay_past_scans(const Se2f& wheel, std::size_t n, hal::PoseEstimate* out) {
+  TrackStep ts;
+  Se2f replayed_wheel = wheel;
+  for (std::uint32_t b = 0; b < tracker_.options().past_scans_per_step && replay_lag_ > 0; ++b) {
+    const RememberedScan& r = history_[history_.size() - replay_lag_];
+    ts = tracker_.step(r.pts, r.n, r.wheel, /*predict=*/!replay_first_);
+    replayed_wheel = r.wheel;
+    replay_first_ = false;
+    --replay_lag_;
+    if (ts.lost) break;
   }
-  if (!ts.lost) ts = tracker_.step(pts_, n, wheel);
-  if (ts.lost || ts.status != hal::LocalizationStatus::kLocalized) {
-    tracker_.stop();
-    return false;
+  if (!ts.lost && replay_lag_ > 0) {
+    publish_track(ts, out);
+    const Se2f now = ts.pose.compose(replayed_wheel.between(wheel));
+    out->x = now.x;
+    out->y = now.y;
+    out->theta = now.theta;
+    out->status = hal::LocalizationStatus::kAmbiguous;
+    out->reason = hal::StatusReason::kTrackRecovering;
+    out->protection_xy_m = out->protection_theta_rad = 0.0f;
+    return true;
   }
-  ++fixes_;
-  ++fixes_on_past_scans_;
-  unconfirmed_ = false;
-  publish_track(ts, out);
-  return true;
+  const bool confirmed = !ts.lost && replay_lag_ == 0 && ts.status == hal::LocalizationStatus::kLocalized;
+  replay_lag_ = 0;
+  if (confirmed) {
+    ++fixes_;
+    ++fixes_on_past_scans_;
+    unconfirmed_ = false;
+    publish_track(ts, out);
+    return true;
+  }
+  // Forward confirmation from MML's fix, carried to this scan by the wheels.
+  tracker_.stop();
+  return start_forward(replay_fix_.compose(replay_fix_wheel_.between(wheel)), replay_cov_, wheel, n, out);
 }
 
 Status TrackedLocalizer::cross_check(const hal::LaserScan& scan, const hal::Odometry& odom, const Se2f& wheel,

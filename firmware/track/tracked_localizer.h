@@ -74,10 +74,14 @@ class TrackedLocalizer final : public Localizer {
   void await_mml_confirmation();
   // MML's fix in `g` → tracker started and confirmed on this scan; false (tracker reset) if not.
   bool start_from_fix(const hal::PoseEstimate& g, const Se2f& wheel, std::size_t n, hal::PoseEstimate* out);
-  // The fix confirmed on the recovery_steps scans before it, then this one: true when the track ends
-  // `localized` on this scan (published in `out`); false with the tracker stopped otherwise.
-  bool confirm_on_past_scans(const Se2f& fix, const Eigen::Matrix3f& cov, const Se2f& wheel, std::size_t n,
-                             hal::PoseEstimate* out);
+  // The fix started on the scan it was isolated on: true when the tracker accepts it (published in
+  // `out`); false with the tracker stopped and `out` saying the fix was rejected.
+  bool start_forward(const Se2f& fix, const Eigen::Matrix3f& cov, const Se2f& wheel, std::size_t n,
+                     hal::PoseEstimate* out);
+  // TrackOptions::confirm_fix_on_past_scans: the replay of the remembered scans, at most
+  // past_scans_per_step per call. true while it catches up or once the track is `localized` on the
+  // newest scan; when it ends otherwise, forward confirmation from the fix (start_forward's result).
+  bool replay_past_scans(const Se2f& wheel, std::size_t n, hal::PoseEstimate* out);
   Status cross_check(const hal::LaserScan& scan, const hal::Odometry& odom, const Se2f& wheel, std::size_t n,
                      const TrackStep& ts, hal::PoseEstimate* out);
   mml::MmlLocalizer* mml_ = nullptr;
@@ -91,6 +95,12 @@ class TrackedLocalizer final : public Localizer {
     Se2f wheel;
   };
   RingBuffer<RememberedScan, kFixHistoryScans + 1> history_;
+  // The replay in progress: the newest replay_lag_ scans of history_ are still to be stepped (0 =
+  // none); MML's fix, the wheels at its scan and its covariance, for forward confirmation.
+  std::uint32_t replay_lag_ = 0;
+  bool replay_first_ = false;
+  Se2f replay_fix_, replay_fix_wheel_;
+  Eigen::Matrix3f replay_cov_ = Eigen::Matrix3f::Zero();
   std::uint32_t fixes_ = 0, fix_rejections_ = 0, tracks_lost_ = 0, cross_check_switches_ = 0;
   std::uint32_t cross_check_left_ = 0;  // scans the background search still runs (0 = idle)
   std::uint32_t confirmations_ = 0, cross_check_conflicts_ = 0, fixes_on_past_scans_ = 0;

@@ -89,10 +89,24 @@ TEST(TrackedLocalizerTest, FixIsConfirmedOnTheScansBeforeIt) {
   EXPECT_EQ(fwd.loc->fixes_on_past_scans(), 0u);
   EXPECT_GE(past.loc->fixes_on_past_scans(), 1u) << "no fix was confirmed on the scans before it";
   // MML's steps do not depend on the tracker, so MML fixes on the same scan in both runs; the
-  // forward confirmation needs recovery_steps more scans (a scan earlier at most for the hysteresis).
+  // forward confirmation needs recovery_steps more scans (a scan earlier at most for the hysteresis),
+  // the replay catch_up (past_scans_per_step scans per step, the new ones joining it).
   const int k = static_cast<int>(TrackOptions().recovery_steps);
-  EXPECT_LE(tp.first, tf.first - (k - 1)) << "forward " << tf.first << ", on past scans " << tp.first;
+  const int b = static_cast<int>(TrackOptions().past_scans_per_step);
+  const int catch_up = (k + 1 - b + (b - 2)) / (b - 1);  // ⌈(k + 1 − b) / (b − 1)⌉
+  ASSERT_LT(catch_up, k - 1) << "the replay would be no earlier than forward confirmation";
+  EXPECT_LE(tp.first, tf.first - (k - 1) + catch_up) << "forward " << tf.first << ", on past scans " << tp.first;
   EXPECT_EQ(rp[static_cast<std::size_t>(tp.first)].est.mode, hal::LocalizationMode::kTracking);
+  // All at once (past_scans_per_step > recovery_steps): `localized` on the fix's own scan.
+  TrackOptions at_once = on_past_scans;
+  at_once.past_scans_per_step = static_cast<std::uint32_t>(k + 1);
+  Rig all;
+  ASSERT_TRUE(all.init(room_map().map, at_once).is_ok());
+  const auto ra = mml::testing::drive(all.loc.get(), room(), path, 1);
+  const Tally ta = tally(ra);
+  ASSERT_GE(ta.first, 0);
+  EXPECT_EQ(ta.wrong, 0);
+  EXPECT_EQ(ta.first + catch_up, tp.first) << "the catch-up is not the stated number of scans";
 }
 
 // More scans of confirmation than the history holds is a configuration error, named as such.
@@ -107,6 +121,13 @@ TEST(TrackedLocalizerTest, RecoveryStepsBeyondTheScanHistoryIsRefused) {
   o.confirm_fix_on_past_scans = false;
   Rig rig2;
   EXPECT_TRUE(rig2.init(room_map().map, o).is_ok()) << "forward confirmation keeps no history";
+  // One scan per step would never catch up with the scans that keep arriving.
+  TrackOptions one;
+  one.past_scans_per_step = 1;
+  Rig rig3;
+  const Status st3 = rig3.init(room_map().map, one);
+  ASSERT_FALSE(st3.is_ok());
+  EXPECT_NE(std::string(st3.message()).find("past_scans_per_step"), std::string::npos) << st3.message();
 }
 
 // Kidnap half way (the truth jumps, the odometry does not): never `localized` at a wrong pose, the

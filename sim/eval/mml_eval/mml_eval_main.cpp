@@ -50,7 +50,7 @@ const char kUsage[] =
     "                [--fix-steps 200] [--mcl-trials 3] [--mcl-datasets intel,fr079] [--kidnap-runs 2]\n"
     "                [--kidnap-datasets intel,fr079,aces] [--no-unknown] [--seed 1] [--threads 2] [--out DIR]\n"
     "                [--no-pool] [--global ref|live|live-deadline] [--odom-noise TT,TR,RR,RT]\n"
-    "                [--odom-adapt] [--fit-drop-rms] [--no-confirm-fix] [--confirm-on-past-scans]\n"
+    "                [--odom-adapt] [--fit-drop-rms] [--no-confirm-fix] [--no-confirm-on-past-scans]\n"
     "                [--no-cover-unfused] [--confidence-cap-pred-pl]\n"
     "       mml-eval --log LOG.clf[.gz] --map MAP.yaml|MAP.mmap --reference POSES.txt|CORRECTED.log[.gz]\n"
     "                [--relations R] [--name NAME] [--synthetic-odometry]   (any building by path)\n"
@@ -64,8 +64,8 @@ const char kUsage[] =
     "0.2,0.2,0.2,0.2). --odom-adapt: the tracker's wheel-noise self-calibration (off by default;\n"
     "firmware/track/track_options.h says why). --fit-drop-rms: the residual (F) form of the fit-drop test\n"
     "(off by default, same header). --no-confirm-fix: MML's fix `localized` on its first consistent scan\n"
-    "(TrackOptions::confirm_fix). --confirm-on-past-scans: MML's fix confirmed on the scans before it first\n"
-    "(TrackOptions::confirm_fix_on_past_scans, off by default). --no-cover-unfused: the PL of a\n"
+    "(TrackOptions::confirm_fix). --no-confirm-on-past-scans: MML's fix confirmed forward only, not on the\n"
+    "scans before it first (TrackOptions::confirm_fix_on_past_scans, on by default). --no-cover-unfused: the PL of a\n"
     "scan not fused (standing robot) leaves out the update the scan would make\n"
     "(TrackOptions::cover_unfused_update). --confidence-cap-pred-pl: the scan's confidence extent capped at\n"
     "the prediction's PL alone (TrackOptions::confidence_cap_with_update). --cap-unpinned-scans: that cap\n"
@@ -147,7 +147,7 @@ static int run_main(int argc, char** argv) {
     else if (a == "--no-keep-contested") lp.keep_support_across_contested_steps = false;
     else if (a == "--fit-drop-rms") { lp.track.fit_drop_rms = true; localize = true; }
     else if (a == "--no-confirm-fix") { lp.track.confirm_fix = false; localize = true; }
-    else if (a == "--confirm-on-past-scans") { lp.track.confirm_fix_on_past_scans = true; localize = true; }
+    else if (a == "--no-confirm-on-past-scans") { lp.track.confirm_fix_on_past_scans = false; localize = true; }
     else if (a == "--no-cover-unfused") { lp.track.cover_unfused_update = false; localize = true; }
     else if (a == "--confidence-cap-pred-pl") { lp.track.confidence_cap_with_update = false; localize = true; }
     else if (a == "--cap-unpinned-scans") { lp.track.confidence_cap_needs_a_pinned_axis = false; localize = true; }
