@@ -295,6 +295,7 @@ void PoseTracker::judge_scan(const Point2f* points, std::size_t n, bool odom_jum
     const float n1 = static_cast<float>(fit_cells_), n2 = static_cast<float>(a.independent);
     const float pooled = (p1 * n1 + p2 * n2) / (n1 + n2);
     const float se = std::sqrt(pooled * (1.0f - pooled) * (1.0f / n1 + 1.0f / n2));
+    if (se > 0.0f) w->fit_drop_z = (p1 - p2) / se;
     if (se > 0.0f && p1 - p2 > o.fit_drop_z * se) {
       w->v = ScanVerdict::kContradicting;
       out->fit_drop = true;
@@ -379,7 +380,8 @@ void PoseTracker::check_aliases(const Point2f* points, std::size_t n, StepWork* 
     // Is the rival a place the robot could be (track_options.h, alias_rival_must_be_credible)? Both
     // exemptions below rest on a track that was right at the last scan, so they hold only on a
     // trusted track — no contradicting scan since the last `recovery_steps` unique consistent scans
-    // (aliased scans neither break nor restore that trust) (mit-killian kidnap
+    // (aliased scans neither break nor restore that trust), and no drop of the fit on this scan at
+    // alias_credible_z (alias_trust_needs_steady_fit: mit-killian carry 3914 → 3828) (mit-killian kidnap
     // 15955 → 16341: 47 m along the same corridor, seen as a heading fault, then 35 aliased scans
     // along the corridor and `localized` 45 m off without this). Not credible is a rival at the
     // fix's heading that is either (a) joined to the fix by poses that fit as well — one mode with
@@ -388,7 +390,7 @@ void PoseTracker::check_aliases(const Point2f* points, std::size_t n, StepWork* 
     // the last scan does not reach at the integrity risk (the bound the innovation test trusts). A
     // turned rival always is: walls that fit as well turned are a scan that does not pin the heading
     // here (intel kidnap 6735 → 7812: a place fitting 5–10° turned).
-    const bool trusted = !contradicted_;
+    const bool trusted = !contradicted_ && !(o.alias_trust_needs_steady_fit && w->fit_drop_z >= o.alias_credible_z);
     const bool same_heading = std::fabs(wrap_angle(u.rival.theta - a.pose.theta)) < o.alias_min_separation_rad;
     const bool beyond_prediction = std::hypot(u.rival.x - w->pred.x, u.rival.y - w->pred.y) > w->pred_pl.xy_m;
     // Neither exemption covers a rival that fits better at alias_credible_z (track_options.h): the

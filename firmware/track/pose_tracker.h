@@ -117,6 +117,7 @@ class PoseTracker {
     Eigen::Matrix3f p_post = Eigen::Matrix3f::Zero();  // posterior covariance if fused
     Eigen::Vector3f e = Eigen::Vector3f::Zero();     // scan fix − prediction
     Eigen::Vector3f unfused = Eigen::Vector3f::Zero();  // the update a scan not fused would make
+    float fit_drop_z = 0.0f;  // the fit-drop test's statistic against the previous scan (0 = not tested)
   };
   struct Update {
     bool fuse = false;

@@ -223,6 +223,14 @@ struct TrackOptions {
   // always count (intel kidnap: rivals 5–10° turned), and so do rivals that fit better than the fix at
   // alias_credible_z. false = every alias beyond the alert limits waits.
   bool alias_rival_must_be_credible = true;
+  // Both exemptions rest on a track that was right at the last scan. A scan whose fit fell from the
+  // last scan's at alias_credible_z (the fit-drop test's statistic, one-sided 5 %) does not carry that
+  // trust: doubt, not proof, as for the rival above. Its rivals then count, and an alias beyond the
+  // alert limits waits for MML (mit-killian, seed 13, carries from scans 3912–3916 back to 3828, 11 m
+  // along the same corridor: inliers 177 → 127 of 177, z 2.7 < fit_drop_z, the rival 1.8 m along the
+  // corridor not credible, `localized` 11.5 m off five unique scans later; localize_data_test.cpp).
+  // false = only a contradiction (contradicted_) withdraws the trust.
+  bool alias_trust_needs_steady_fit = true;
   // A track started from MML's fix is `localized` only after recovery_steps unique consistent scans,
   // as after a fault, and rules out no alias rival until then (check_aliases). One scan can be fit
   // at a wrong local minimum next to MML's pose; consecutive scans from moving poses rarely all are
