@@ -117,8 +117,7 @@ TEST(LocalizeData, IntelCarryWhoseFirstScanFitsTheOldPlaceIsNotLocalized) {
     ASSERT_TRUE(loc) << err;
     TrialOptions opt;
     opt.max_steps = 0;
-    opt.kidnap_after_fix_steps = 60;  // as the kidnap runs of localize_eval.cpp
-    opt.kidnap_at_step = 200;
+    opt.kidnap_at_step = 76;  // 60 steps after the first fix when MML's fix was confirmed on its own scan
     opt.kidnap_target = [](std::size_t) -> std::size_t { return 6325; };  // the first step after it: 6330
     opt.kidnap_steps_after = 8;
     const TrialResult t = run_trial(*loc, ds, 4383, opt);
