@@ -72,7 +72,8 @@ class TrackedLocalizer final : public Localizer {
   std::size_t scan_points(const hal::LaserScan& scan);
   void publish_track(const TrackStep& ts, hal::PoseEstimate* out) const;
   void await_mml_confirmation();
-  // MML's fix in `g` → tracker started and confirmed on this scan; false (tracker reset) if not.
+  // MML's fix in `g` → tracker started on it: true when accepted on this scan or while its replay
+  // on the scans before it catches up (replay_past_scans); false (tracker reset) if rejected.
   bool start_from_fix(const hal::PoseEstimate& g, const Se2f& wheel, std::size_t n, hal::PoseEstimate* out);
   // The fix started on the scan it was isolated on: true when the tracker accepts it (published in
   // `out`); false with the tracker stopped and `out` saying the fix was rejected.
