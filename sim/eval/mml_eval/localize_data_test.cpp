@@ -98,6 +98,35 @@ TEST(LocalizeData, Fr101KidnapRunKeepsOdometryContinuous) {
     if (s.status == hal::LocalizationStatus::kSearching) EXPECT_TRUE(std::isnan(s.err_m));
 }
 
+// A carried trial of mml-track (MML config 3, seed 13): started at scan `start`, carried at step `at`
+// to scan `target` (the dataset's stepping picks the first scan after it) and run `steps_after` steps
+// there. Empty when the localizer cannot be built (reported as a failure).
+TrialResult carried_trial(const LoadedDataset& ds, const fw::track::TrackOptions& to, std::size_t start, std::size_t at,
+                          std::size_t target, std::size_t steps_after) {
+  std::string err;
+  auto loc = OwnedLocalizer::make_track(ds.map, ds.image, mml_track_config(3, 13), to, 1, &err);
+  if (!loc) {
+    ADD_FAILURE() << err;
+    return TrialResult();
+  }
+  TrialOptions opt;
+  opt.max_steps = 0;
+  opt.kidnap_at_step = at;
+  opt.kidnap_target = [target](std::size_t) { return target; };
+  opt.kidnap_steps_after = steps_after;
+  return run_trial(*loc, ds, start, opt);
+}
+
+// Steps from the carry on that are `localized` off by more than the integrity bounds (0.5 m, 5°).
+std::size_t wrong_after_carry(const TrialResult& t) {
+  std::size_t wrong = 0;
+  for (std::size_t i = t.kidnap_step; i < t.steps.size(); ++i) {
+    const StepLog& st = t.steps[i];
+    if (st.status == hal::LocalizationStatus::kLocalized && (st.err_m > 0.5 || st.err_rad > 0.0873)) ++wrong;
+  }
+  return wrong;
+}
+
 // The carry of the 420-run kidnap stress that once ended `localized` 15 m off (intel, seed 13, trial 7:
 // started at scan 4383, carried 60 steps after its first fix from scan 4658 to 6325, MML's fix confirmed on the
 // scans before it): its first carried scan still fit the old place roughly and left the position open
@@ -113,27 +142,16 @@ TEST(LocalizeData, IntelCarryWhoseFirstScanFitsTheOldPlaceIsNotLocalized) {
     fw::track::TrackOptions to;
     to.confirm_fix_on_past_scans = true;
     to.confidence_cap_needs_a_pinned_axis = rule;
-    auto loc = OwnedLocalizer::make_track(ds.map, ds.image, mml_track_config(3, 13), to, 1, &err);
-    ASSERT_TRUE(loc) << err;
-    TrialOptions opt;
-    opt.max_steps = 0;
-    opt.kidnap_at_step = 76;  // 60 steps after the first fix when MML's fix was confirmed on its own scan
-    opt.kidnap_target = [](std::size_t) -> std::size_t { return 6325; };  // the first step after it: 6330
-    opt.kidnap_steps_after = 8;
-    const TrialResult t = run_trial(*loc, ds, 4383, opt);
+    // Step 76: 60 steps after the first fix when MML's fix was confirmed on its own scan.
+    const TrialResult t = carried_trial(ds, to, 4383, 76, 6325, 8);  // the first step after it: 6330
     ASSERT_EQ(t.kidnap_step, 76u);
     ASSERT_EQ(t.steps[76].scan, 6330u);
     ASSERT_EQ(t.steps[75].status, hal::LocalizationStatus::kLocalized) << "the track before the carry changed";
-    std::size_t wrong = 0;
-    for (std::size_t i = 76; i < t.steps.size(); ++i) {
-      const StepLog& st = t.steps[i];
-      if (st.status == hal::LocalizationStatus::kLocalized && (st.err_m > 0.5 || st.err_rad > 0.0873)) ++wrong;
-    }
+    const std::size_t wrong = wrong_after_carry(t);
     if (rule) EXPECT_EQ(wrong, 0u);
     else EXPECT_GE(wrong, 1u) << "the replay no longer reaches the carried scan that fits the old place";
   }
 }
-
 
 // A carry along a corridor whose first scan fits the old place a little worse (the kidnap stress of
 // 2026-11-28): mit-killian, seed 13, started at scan 3605, carried 157–159 steps later from scans
@@ -156,21 +174,10 @@ TEST(LocalizeData, MitKillianCarryAlongTheCorridorIsNotLocalized) {
         fw::track::TrackOptions to;
         to.confirm_fix_on_past_scans = past_scans;
         to.alias_trust_needs_steady_fit = rule;
-        auto loc = OwnedLocalizer::make_track(ds.map, ds.image, mml_track_config(3, 13), to, 1, &err);
-        ASSERT_TRUE(loc) << err;
-        TrialOptions opt;
-        opt.max_steps = 0;
-        opt.kidnap_at_step = at;
-        opt.kidnap_target = [](std::size_t) -> std::size_t { return 3826; };  // the first step after it: 3828
-        opt.kidnap_steps_after = 40;
-        const TrialResult t = run_trial(*loc, ds, 3605, opt);
+        const TrialResult t = carried_trial(ds, to, 3605, at, 3826, 40);  // the first step after it: 3828
         ASSERT_EQ(t.steps[t.kidnap_step].scan, 3828u);
         ASSERT_EQ(t.steps[t.kidnap_step - 1].status, hal::LocalizationStatus::kLocalized) << "the track before the carry changed";
-        std::size_t wrong = 0;
-        for (std::size_t i = t.kidnap_step; i < t.steps.size(); ++i) {
-          const StepLog& st = t.steps[i];
-          if (st.status == hal::LocalizationStatus::kLocalized && (st.err_m > 0.5 || st.err_rad > 0.0873)) ++wrong;
-        }
+        const std::size_t wrong = wrong_after_carry(t);
         const std::string what = "carried at step " + std::to_string(at) + " from scan " +
                                  std::to_string(t.steps[t.kidnap_step - 1].scan) +
                                  (past_scans ? " (fix confirmed on past scans)" : " (forward confirmation)");
