@@ -64,7 +64,8 @@ bool parse_baud(const char* v, unsigned long* out) {
 constexpr const char* kKeys[] = {"laser",     "odometry",  "output",  "can_fd",           "localizer",
                                  "mml_preset", "map",       "workers", "cores",            "realtime",
                                  "arena_mib", "step_deadline_ms", "health_period_ms", "laser_timeout_ms", "seed",
-                                 "log_level", "global_context", "global_period_scans", "odom_noise"};
+                                 "log_level", "global_context", "global_period_scans", "odom_noise",
+                                 "odom_noise_per_step"};
 constexpr int kNumKeys = static_cast<int>(sizeof(kKeys) / sizeof(kKeys[0]));
 
 // The config path as shown in messages: at most kShownPath characters, the end kept (the file
@@ -111,25 +112,38 @@ Status check_backend_arg(const char* name, int line, const char* key, const char
   return Status::ok();
 }
 
-// "TT, TR, RR, RT": the tracker's odometry noise model (track_options.h), four numbers in 0..10.
-Status parse_odom_noise(const char* name, int line, const char* key, char* v, float out[4]) {
+// `count` comma-separated numbers, number i in 0..hi[i]; `names` lists them for the messages.
+Status parse_number_list(const char* name, int line, const char* key, char* v, float* out, int count,
+                         const float* hi, const char* names) {
   int commas = 0;
   for (const char* c = v; *c; ++c) commas += *c == ',';
-  if (commas != 3) return CFG_ERR("'%s' is not four numbers TT, TR, RR, RT", v);
+  if (commas != count - 1) return CFG_ERR("'%s' is not %d numbers %s", v, count, names);
   char* tok = v;
-  for (int i = 0; i < 4; ++i) {
+  for (int i = 0; i < count; ++i) {
     char* comma = std::strchr(tok, ',');
     if (comma != nullptr) *comma = '\0';
     char* pe = nullptr;
     const double d = std::strtod(tok, &pe);
     while (pe != nullptr && (*pe == ' ' || *pe == '\t')) ++pe;
-    if (pe == tok || *pe || !std::isfinite(d) || d < 0.0 || d > 10.0) {
-      return CFG_ERR("number %d '%s' is not in 0..10 (TT, TR, RR, RT)", i + 1, tok);
+    if (pe == tok || *pe || !std::isfinite(d) || d < 0.0 || d > hi[i]) {
+      return CFG_ERR("number %d '%s' is not in 0..%g (%s)", i + 1, tok, static_cast<double>(hi[i]), names);
     }
     out[i] = static_cast<float>(d);
     tok = comma != nullptr ? comma + 1 : nullptr;
   }
   return Status::ok();
+}
+
+// "TT, TR, RR, RT": the tracker's odometry noise model (track_options.h), four numbers in 0..10.
+Status parse_odom_noise(const char* name, int line, const char* key, char* v, float out[4]) {
+  static const float kHi[4] = {10.0f, 10.0f, 10.0f, 10.0f};
+  return parse_number_list(name, line, key, v, out, 4, kHi, "TT, TR, RR, RT");
+}
+
+// "M, DEG": the tracker's per-step odometry noise (TrackOptions::odom_trans_per_step_m, the other in degrees).
+Status parse_odom_noise_per_step(const char* name, int line, const char* key, char* v, float out[2]) {
+  static const float kHi[2] = {1.0f, 28.0f};
+  return parse_number_list(name, line, key, v, out, 2, kHi, "M, DEG");
 }
 
 }  // namespace
@@ -260,6 +274,8 @@ Status parse_app_config(const char* path, const char* text, std::size_t len, App
       out->seed = static_cast<std::uint64_t>(x);
     } else if (!std::strcmp(key, "odom_noise")) {
       FW_RETURN_IF_ERROR(parse_odom_noise(name, line, key, v, out->odom_noise));
+    } else if (!std::strcmp(key, "odom_noise_per_step")) {
+      FW_RETURN_IF_ERROR(parse_odom_noise_per_step(name, line, key, v, out->odom_noise_per_step));
     } else if (!std::strcmp(key, "log_level")) {
       static const char* const kLevels[] = {"debug", "info", "warning", "error"};
       int lvl = -1;

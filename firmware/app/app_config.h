@@ -63,6 +63,10 @@ struct AppConfig {
   // per scan interval. Set it from your robot: a model tighter than the wheels makes right tracks
   // fail the innovation and odometry-consistency tests (availability).
   float odom_noise[4] = {0.2f, 0.2f, 0.2f, 0.2f};
+  // Per-step odometry noise (TrackOptions::odom_trans_per_step_m / _rot_per_step_rad): σ in metres
+  // (on x and y) and degrees per scan interval that does not follow the motion, added in quadrature
+  // to the model above. 0, 0 (default) for wheels whose error follows the motion.
+  float odom_noise_per_step[2] = {0.0f, 0.0f};
 };
 
 // Parses `text` (len bytes); `path` is used in messages (abbreviated to its last 96 characters).

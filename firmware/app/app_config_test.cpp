@@ -168,8 +168,8 @@ TEST(AppConfig, OdomNoiseKey) {
     const char* value;
     const char* must_contain;
   } cases[] = {
-      {"0.1, 0.2, 0.3", "line 3: key 'odom_noise': '0.1, 0.2, 0.3' is not four numbers"},
-      {"0.1,0.2,0.3,0.4,0.5", "is not four numbers"},
+      {"0.1, 0.2, 0.3", "line 3: key 'odom_noise': '0.1, 0.2, 0.3' is not 4 numbers TT, TR, RR, RT"},
+      {"0.1,0.2,0.3,0.4,0.5", "is not 4 numbers TT, TR, RR, RT"},
       {"0.1,x,0.3,0.4", "number 2 'x' is not in 0..10"},
       {"-1,0,0,0", "number 1 '-1' is not in 0..10"},
       {"0.1,0.2,0.3,11", "number 4 '11' is not in 0..10"},
@@ -177,6 +177,34 @@ TEST(AppConfig, OdomNoiseKey) {
   };
   for (const Case& k : cases) {
     const std::string text = std::string("laser = socketcan:vcan0\nlocalizer = odom\nodom_noise = ") + k.value + "\n";
+    const Status s = parse(text, &c);
+    ASSERT_FALSE(s.is_ok()) << k.value;
+    EXPECT_NE(std::strstr(s.message(), k.must_contain), nullptr) << s.message();
+  }
+}
+
+// odom_noise_per_step: σ per scan step that does not follow the motion (metres, degrees; default 0, 0).
+TEST(AppConfig, OdomNoisePerStepKey) {
+  AppConfig c;
+  ASSERT_TRUE(parse("laser = socketcan:vcan0\nlocalizer = odom\n", &c).is_ok());
+  EXPECT_FLOAT_EQ(c.odom_noise_per_step[0], 0.0f);
+  EXPECT_FLOAT_EQ(c.odom_noise_per_step[1], 0.0f);
+  ASSERT_TRUE(parse("laser = socketcan:vcan0\nlocalizer = odom\nodom_noise_per_step = 0.04, 4\n", &c).is_ok());
+  EXPECT_FLOAT_EQ(c.odom_noise_per_step[0], 0.04f);
+  EXPECT_FLOAT_EQ(c.odom_noise_per_step[1], 4.0f);
+  struct Case {
+    const char* value;
+    const char* must_contain;
+  } cases[] = {
+      {"0.04", "line 3: key 'odom_noise_per_step': '0.04' is not 2 numbers M, DEG"},
+      {"0.04,4,1", "is not 2 numbers"},
+      {"2,4", "number 1 '2' is not in 0..1 (M, DEG)"},
+      {"0.04,30", "number 2 '30' is not in 0..28"},
+      {"0.04,-1", "number 2 '-1'"},
+      {"inf,1", "number 1 'inf'"},
+  };
+  for (const Case& k : cases) {
+    const std::string text = std::string("laser = socketcan:vcan0\nlocalizer = odom\nodom_noise_per_step = ") + k.value + "\n";
     const Status s = parse(text, &c);
     ASSERT_FALSE(s.is_ok()) << k.value;
     EXPECT_NE(std::strstr(s.message(), k.must_contain), nullptr) << s.message();

@@ -244,6 +244,8 @@ int build_localizer(const Args& a, Startup* su) {
   su->track.odom_trans_per_rad = c.odom_noise[1];
   su->track.odom_rot_per_rad = c.odom_noise[2];
   su->track.odom_rot_per_m = c.odom_noise[3];
+  su->track.odom_trans_per_step_m = c.odom_noise_per_step[0];
+  su->track.odom_rot_per_step_rad = c.odom_noise_per_step[1] * 0.017453292f;
   sys.track = &su->track;
   su->live = fw::track::live_global_schedule(c.global_period_scans);
   su->global_ctx = fw::track::global_context_for(c.global_period_scans);

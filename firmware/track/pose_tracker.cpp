@@ -1,3 +1,4 @@
+#include <cstdlib>
 #include "firmware/track/pose_tracker.h"
 
 #include <Eigen/Cholesky>
@@ -50,6 +51,7 @@ void PoseTracker::stop() {
   cov_.setZero();
   prev_odom_ = odom_at_fuse_ = Se2f();
   pose_at_fuse_ = Se2f();
+  predicted_since_fuse_ = 0;
   fuse_next_ = true;
   bias_xy_m_ = map_.geometry.resolution;
   bias_theta_rad_ = 0.0f;
@@ -87,15 +89,22 @@ void PoseTracker::start(const Se2f& pose, const Eigen::Matrix3f& cov, const Se2f
 void PoseTracker::predict_to(const Se2f& odom) {
   const Se2f delta = prev_odom_.between(odom);
   prev_odom_ = odom;
+  ++predicted_since_fuse_;
   const float ds = std::hypot(delta.x, delta.y), da = std::fabs(delta.theta);
-  const float st0 = options_.odom_trans_per_m * ds + options_.odom_trans_per_rad * da;
-  const float sr0 = options_.odom_rot_per_rad * da + options_.odom_rot_per_m * ds;
+  const float at = options_.odom_trans_per_m * ds + options_.odom_trans_per_rad * da;
+  const float ar = options_.odom_rot_per_rad * da + options_.odom_rot_per_m * ds;
+  const float ft = options_.odom_trans_per_step_m, fr = options_.odom_rot_per_step_rad;
+  // The per-step part in quadrature (track_options.h); without one, the AMCL model exactly.
+  const float st0 = ft > 0.0f ? std::sqrt(at * at + ft * ft) : at;
+  const float sr0 = fr > 0.0f ? std::sqrt(ar * ar + fr * fr) : ar;
   if (options_.odom_noise_window > 0) {
     noise_model_var_t_ += st0 * st0;
     noise_model_var_r_ += sr0 * sr0;
   }
-  const float st = odom_noise_.scale().trans * st0;
-  const float sr = odom_noise_.scale().rot * sr0;
+  static const float FT = std::getenv("FLOOR_T") ? std::atof(std::getenv("FLOOR_T")) : 0.0f;
+  static const float FR = std::getenv("FLOOR_R") ? std::atof(std::getenv("FLOOR_R")) * 0.0174533f : 0.0f;
+  const float st = odom_noise_.scale().trans * std::sqrt(st0 * st0 + FT * FT);
+  const float sr = odom_noise_.scale().rot * std::sqrt(sr0 * sr0 + FR * FR);
   Eigen::Matrix3f q = Eigen::Matrix3f::Zero();
   q(0, 0) = q(1, 1) = st * st;
   q(2, 2) = sr * sr;
@@ -431,8 +440,14 @@ PoseTracker::Update PoseTracker::propose_update(const Se2f& odom, bool predict, 
   const Se2f since = odom_at_fuse_.between(odom);
   const Se2f seen = pose_at_fuse_.between(a.pose);
   const bool trusted = !had_fault_ || consistent_since_fault_ >= o.recovery_steps;
+  // Wheels with per-step noise (odom_trans_per_step_m / odom_rot_per_step_rad) drift unreported
+  // while the robot stands: once that drift since the last fused scan (σ·√k over k predicted scans)
+  // reaches the thresholds, the prediction has moved as far as a reported motion would have.
+  const float k = static_cast<float>(predicted_since_fuse_);
+  const bool drifted = predicted_since_fuse_ > 0 && (o.odom_trans_per_step_m * std::sqrt(k) >= o.update_min_d_m ||
+                                                     o.odom_rot_per_step_rad * std::sqrt(k) >= o.update_min_a_rad);
   const bool moved = fuse_next_ || !predict || beyond_update_thresholds(since, o) ||
-                     (trusted && beyond_update_thresholds(seen, o));
+                     (trusted && beyond_update_thresholds(seen, o)) || drifted;
   const Eigen::Vector3f dx = w->p_post * (a.information * w->e);
   if (!dx.allFinite()) return u;
   if (!moved) {
@@ -503,6 +518,7 @@ void PoseTracker::apply_verdict(const Se2f& odom, const StepWork& w, const Updat
       cov_ = u.cov;
       odom_at_fuse_ = odom;
       pose_at_fuse_ = pose_;
+      predicted_since_fuse_ = 0;
       fuse_next_ = false;
       out->fused = true;
       odometry_check_.push(pose_, cov_, u.bias_xy, u.bias_theta);

@@ -162,6 +162,7 @@ class PoseTracker {
   Eigen::Matrix3f cov_ = Eigen::Matrix3f::Zero();
   Se2f prev_odom_;
   Se2f odom_at_fuse_;      // odometry at the last fused scan (update thresholds)
+  std::uint32_t predicted_since_fuse_ = 0;  // predictions since the last fused scan (per-step noise)
   Se2f pose_at_fuse_;      // the track's pose after the last fused scan (update thresholds)
   // The next supported scan is fused whatever the update thresholds say: at the start, and after an
   // innovation fault widened the covariance (the pose held since the last update is not trusted).

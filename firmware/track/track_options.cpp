@@ -55,6 +55,8 @@ Status TrackOptions::validate() const {
   FW_RETURN_IF_ERROR(check_range("odom_trans_per_rad", odom_trans_per_rad, 0.0f, 10.0f));
   FW_RETURN_IF_ERROR(check_range("odom_rot_per_rad", odom_rot_per_rad, 0.0f, 10.0f));
   FW_RETURN_IF_ERROR(check_range("odom_rot_per_m", odom_rot_per_m, 0.0f, 10.0f));
+  FW_RETURN_IF_ERROR(check_range("odom_trans_per_step_m", odom_trans_per_step_m, 0.0f, 1.0f));
+  FW_RETURN_IF_ERROR(check_range("odom_rot_per_step_rad", odom_rot_per_step_rad, 0.0f, 0.5f));
   if (odom_noise_window > 128 || (odom_noise_window > 0 && (odom_noise_min_samples < 2 ||
                                                             odom_noise_min_samples > odom_noise_window))) {
     return Status::error(Errc::kInvalidArgument,

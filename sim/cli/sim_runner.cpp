@@ -131,6 +131,27 @@ bool check_sources(SimConfig* cfg, std::string* err) {
 
 // The configuration as the run uses it: a dataset resolved to its log, reference and map, the
 // output folder created, the localizer named, the source checked.
+// The product's tracker is given the simulated wheels' noise, as a deployment writes its robot's
+// odometry spec into the config (odom_noise_per_step, track_options.h): a world's odometry errs by
+// σ per scan step whatever the motion (Sec. 5.7.1), and so does --odom-noise on a log. An explicit
+// --opt odom_noise_per_step wins (0,0: the AMCL model alone).
+void tell_tracker_the_wheels(SimConfig* cfg) {
+  if (cfg->localizer != "mml-track" || cfg->localizer_options.count("odom_noise_per_step") > 0) return;
+  const bool world = !cfg->world.empty() || cfg->custom_world != nullptr;
+  double m = 0.0, deg = 0.0;
+  if (world) {
+    m = cfg->synthetic.odometry.sigma_trans;
+    deg = cfg->synthetic.odometry.sigma_rot_deg;
+  } else if (cfg->log_odom_noise) {
+    m = cfg->log_odom_sigma_m;
+    deg = cfg->log_odom_sigma_deg;
+  }
+  if (!(m > 0.0 || deg > 0.0)) return;
+  char v[64];
+  std::snprintf(v, sizeof(v), "%g,%g", std::min(m, 1.0), std::min(deg, 28.0));  // the option's ranges
+  cfg->localizer_options["odom_noise_per_step"] = v;
+}
+
 bool complete_config(const SimConfig& cfg_in, SimConfig* cfg, std::string* err) {
   *cfg = cfg_in;
   if (!cfg->dataset.empty()) {
@@ -142,6 +163,7 @@ bool complete_config(const SimConfig& cfg_in, SimConfig* cfg, std::string* err) 
   }
   if (!create_output_dir(cfg->out_dir, err)) return false;
   if (cfg->localizer.empty()) cfg->localizer = default_localizer();
+  tell_tracker_the_wheels(cfg);
   return check_sources(cfg, err);
 }
 
@@ -614,6 +636,12 @@ bool run_simulation(const SimConfig& cfg_in, SimResult* out, std::string* err) {
   const auto load_start = std::chrono::steady_clock::now();
   SimConfig cfg;
   if (!complete_config(cfg_in, &cfg, err)) return false;
+  if (cfg.progress && cfg_in.localizer_options.count("odom_noise_per_step") == 0 &&
+      cfg.localizer_options.count("odom_noise_per_step") > 0) {
+    std::fprintf(stderr, "mml-sim: mml-track is given the simulated wheels' noise per scan step: odom_noise_per_step=%s "
+                 "(--opt odom_noise_per_step=0,0 for the AMCL model alone)\n",
+                 cfg.localizer_options.at("odom_noise_per_step").c_str());
+  }
   SimSummary& sum = out->summary;
   sum.localizer = cfg.localizer;
   SimSource src;

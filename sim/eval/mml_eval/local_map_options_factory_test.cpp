@@ -114,4 +114,36 @@ TEST(LocalMapOptionsFactory, OdomNoiseReachesTheTracker) {
   }
 }
 
+// odom_noise_per_step (mml-sim --opt, mml-eval --odom-noise-per-step, mmlfw's config key): metres
+// and degrees per scan step reach the tracker (0 by default); malformed values are refused.
+TEST(LocalMapOptionsFactory, OdomNoisePerStepReachesTheTracker) {
+  SmallOffice so;
+  ASSERT_TRUE(so.load()) << so.err;
+  sim::LocalizerContext ctx;
+  ctx.global_map = &so.map;
+  ctx.map_image = &so.image;
+  std::string err;
+  auto plain = sim::mmleval::make_track_localizer(ctx, &err);
+  ASSERT_NE(plain, nullptr) << err;
+  const fw::track::TrackOptions& d =
+      static_cast<sim::mmleval::OwnedLocalizer*>(plain.get())->tracked()->tracker().options();
+  EXPECT_EQ(d.odom_trans_per_step_m, 0.0f);
+  EXPECT_EQ(d.odom_rot_per_step_rad, 0.0f);
+  ctx.options = {{"odom_noise_per_step", "0.04,4"}};
+  auto loc = sim::mmleval::make_track_localizer(ctx, &err);
+  ASSERT_NE(loc, nullptr) << err;
+  const fw::track::TrackOptions& o =
+      static_cast<sim::mmleval::OwnedLocalizer*>(loc.get())->tracked()->tracker().options();
+  EXPECT_FLOAT_EQ(o.odom_trans_per_step_m, 0.04f);
+  EXPECT_NEAR(o.odom_rot_per_step_rad, 4.0f * 3.14159265f / 180.0f, 1e-6f);
+  for (const char* bad : {"0.04", "0.04,4,1", "x,4", "2,4", "0.04,29", "0.04,-1", "0.04,4,"}) {
+    ctx.options = {{"odom_noise_per_step", bad}};
+    EXPECT_EQ(sim::mmleval::make_track_localizer(ctx, &err), nullptr) << bad;
+    EXPECT_NE(err.find(std::string("odom_noise_per_step='") + bad + "'"), std::string::npos) << err;
+    fw::track::TrackOptions untouched;
+    EXPECT_FALSE(sim::mmleval::set_odom_noise_per_step(bad, &untouched)) << bad;
+    EXPECT_EQ(untouched.odom_trans_per_step_m, 0.0f) << bad;
+  }
+}
+
 }  // namespace

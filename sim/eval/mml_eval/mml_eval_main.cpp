@@ -50,7 +50,7 @@ const char kUsage[] =
     "                [--fix-steps 200] [--mcl-trials 3] [--mcl-datasets intel,fr079] [--kidnap-runs 2]\n"
     "                [--kidnap-datasets intel,fr079,aces] [--no-unknown] [--seed 1] [--threads 2] [--out DIR]\n"
     "                [--no-pool] [--global ref|live|live-deadline] [--odom-noise TT,TR,RR,RT]\n"
-    "                [--odom-adapt] [--fit-drop-rms] [--no-confirm-fix] [--no-confirm-on-past-scans]\n"
+    "                [--odom-noise-per-step M,DEG] [--odom-adapt] [--fit-drop-rms] [--no-confirm-fix] [--no-confirm-on-past-scans]\n"
     "                [--no-steady-fit-trust]\n"
     "                [--no-cover-unfused] [--confidence-cap-pred-pl]\n"
     "       mml-eval --log LOG.clf[.gz] --map MAP.yaml|MAP.mmap --reference POSES.txt|CORRECTED.log[.gz]\n"
@@ -62,7 +62,8 @@ const char kUsage[] =
     "Your own building: --log RAW.clf --map MAP.yaml or MAP.mmap (a compiled image: its relation table is\n"
     "used) --reference REF (REF: 'mml-carmen reference' rows or a CARMEN log with one pose per scan of\n"
     "RAW). --odom-noise: the tracker's odometry noise model (mmlfw's config key odom_noise; default\n"
-    "0.2,0.2,0.2,0.2). --odom-adapt: the tracker's wheel-noise self-calibration (off by default;\n"
+    "0.2,0.2,0.2,0.2). --odom-noise-per-step: σ per scan step that does not follow the motion, metres\n"
+    "and degrees (odom_noise_per_step; default 0,0). --odom-adapt: the tracker's wheel-noise self-calibration (off by default;\n"
     "firmware/track/track_options.h says why). --fit-drop-rms: the residual (F) form of the fit-drop test\n"
     "(off by default, same header). --no-confirm-fix: MML's fix `localized` on its first consistent scan\n"
     "(TrackOptions::confirm_fix). --no-confirm-on-past-scans: MML's fix confirmed forward only, not on the\n"
@@ -160,6 +161,13 @@ static int run_main(int argc, char** argv) {
       const std::string v = str();
       if (!sim::mmleval::set_odom_noise(v, &lp.track)) {
         return usage(("--odom-noise: '" + v + "' is not four numbers TT,TR,RR,RT in 0..10").c_str());
+      }
+      localize = true;
+    }
+    else if (a == "--odom-noise-per-step") {
+      const std::string v = str();
+      if (!sim::mmleval::set_odom_noise_per_step(v, &lp.track)) {
+        return usage(("--odom-noise-per-step: '" + v + "' is not M,DEG (metres in 0..1, degrees in 0..28)").c_str());
       }
       localize = true;
     }

@@ -151,21 +151,43 @@ bool set_odom_noise(const std::string& value, fw::track::TrackOptions* to) {
   return true;
 }
 
-// odom_noise=TT,TR,RR,RT → the tracker's odometry noise model.
+bool set_odom_noise_per_step(const std::string& value, fw::track::TrackOptions* to) {
+  const char* p = value.c_str();
+  char* end = nullptr;
+  const double m = std::strtod(p, &end);
+  if (end == p || *end != ',' || !(m >= 0.0 && m <= 1.0)) return false;
+  p = end + 1;
+  const double deg = std::strtod(p, &end);
+  if (end == p || *end != '\0' || !(deg >= 0.0 && deg <= 28.0)) return false;
+  to->odom_trans_per_step_m = static_cast<float>(m);
+  to->odom_rot_per_step_rad = static_cast<float>(deg * 0.017453292519943295);
+  return true;
+}
+
+// odom_noise=TT,TR,RR,RT and odom_noise_per_step=M,DEG → the tracker's odometry noise model.
 static bool parse_odom_noise(const std::map<std::string, std::string>& options, fw::track::TrackOptions* to,
                              std::string* err) {
   const auto it = options.find("odom_noise");
-  if (it == options.end() || set_odom_noise(it->second, to)) return true;
-  *err = "localizer mml-track: option odom_noise='" + it->second + "' (expected four numbers TT,TR,RR,RT in 0..10)";
-  return false;
+  if (it != options.end() && !set_odom_noise(it->second, to)) {
+    *err = "localizer mml-track: option odom_noise='" + it->second + "' (expected four numbers TT,TR,RR,RT in 0..10)";
+    return false;
+  }
+  const auto ps = options.find("odom_noise_per_step");
+  if (ps != options.end() && !set_odom_noise_per_step(ps->second, to)) {
+    *err = "localizer mml-track: option odom_noise_per_step='" + ps->second +
+           "' (expected M,DEG: metres in 0..1 and degrees in 0..28 per scan step)";
+    return false;
+  }
+  return true;
 }
 
 // The product's system (firmware default): MML fix confirmed and tracked with a protection level.
 // Options: config=1..4, correct=0|1, reduce=0|1, pool=0|1, keep=0|1, contested=0|1, rivals=0|1 (MML part); alert=M (alert limit, metres);
-// odom_noise=TT,TR,RR,RT (the tracker's odometry noise model, as mmlfw's config key odom_noise);
+// odom_noise=TT,TR,RR,RT and odom_noise_per_step=M,DEG (the tracker's odometry noise model, as
+// mmlfw's config keys of the same names);
 // odom_adapt=0|1 (wheel-noise self-calibration, TrackOptions::odom_noise_window 64; 0 = default).
 std::unique_ptr<fw::Localizer> make_track_localizer(const LocalizerContext& ctx, std::string* err) {
-  const std::string bad = check_keys("mml-track", ctx.options, {"config", "correct", "reduce", "pool", "keep", "contested", "rivals", "alert", "odom_noise", "odom_adapt"});
+  const std::string bad = check_keys("mml-track", ctx.options, {"config", "correct", "reduce", "pool", "keep", "contested", "rivals", "alert", "odom_noise", "odom_noise_per_step", "odom_adapt"});
   if (!bad.empty()) { *err = bad; return nullptr; }
   if (ctx.global_map == nullptr) { *err = "localizer mml-track: needs a global map"; return nullptr; }
   long config = 3;

@@ -105,6 +105,9 @@ std::unique_ptr<fw::Localizer> make_track_localizer(const LocalizerContext& ctx,
 // "TT,TR,RR,RT" (each in 0..10) → the tracker's odometry noise model (as mmlfw's config key
 // odom_noise); false, `to` unchanged, when malformed.
 bool set_odom_noise(const std::string& value, fw::track::TrackOptions* to);
+// "M,DEG" (metres in 0..1, degrees in 0..28) → the tracker's per-step odometry noise (as mmlfw's
+// config key odom_noise_per_step); false, `to` unchanged, when malformed.
+bool set_odom_noise_per_step(const std::string& value, fw::track::TrackOptions* to);
 std::unique_ptr<fw::Localizer> make_mcl_localizer(const LocalizerContext& ctx, std::string* err);
 std::unique_ptr<fw::Localizer> make_handoff_localizer(const LocalizerContext& ctx, std::string* err);
 
