@@ -82,6 +82,12 @@ UniquenessResult check_pose_uniqueness(const GlobalMap& map, const Point2f* poin
   ro.clip_m = o.clip_m;
   ro.max_shift_m = o.shift_step_m;  // a rival stays near its seed: the seeds cover the line
   for (int a = 0; a < 2; ++a) {
+    // valley_is_one_mode: per direction, the valley is followed outwards from the candidate through
+    // the rivals found in it (each segment an in_same_cost_valley path, each rival within `margin`
+    // of the candidate's cost), so a far rival costs one short path, not one from the candidate;
+    // after a rival outside it, that direction's further rivals all count.
+    Se2f valley_end[2] = {pose, pose};
+    bool valley_open[2] = {true, true};
     for (float step = o.shift_step_m; step <= o.max_shift_m + 1e-4f; step += o.shift_step_m) {
       for (int sign = -1; sign <= 1; sign += 2) {
         const Se2f seed(pose.x + sign * step * axes(0, a), pose.y + sign * step * axes(1, a), pose.theta);
@@ -89,6 +95,18 @@ UniquenessResult check_pose_uniqueness(const GlobalMap& map, const Point2f* poin
         ++r.rivals_tried;
         if (std::hypot(rr.pose.x - pose.x, rr.pose.y - pose.y) < o.min_separation_m) continue;
         const float cost = truncated_scan_cost(map, points, n, rr.pose, o.clip_m);
+        // Only a rival that would break uniqueness is tested for one valley (the path costs a
+        // truncated cost per sample); a better one never is (in_same_cost_valley needs alike costs).
+        if (o.valley_is_one_mode && cost <= r.cost + o.margin) {
+          const int d = sign > 0 ? 1 : 0;
+          if (valley_open[d] && std::fabs(wrap_angle(rr.pose.theta - pose.theta)) < o.min_separation_rad &&
+              in_same_cost_valley(map, points, n, valley_end[d], rr.pose, o.clip_m, o.valley_step_m, o.margin)) {
+            valley_end[d] = rr.pose;
+            ++r.same_valley_rivals;
+            continue;
+          }
+          valley_open[d] = false;
+        }
         if (cost < r.rival_cost) {
           r.rival_cost = cost;
           r.rival = rr.pose;

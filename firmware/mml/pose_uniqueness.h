@@ -28,6 +28,14 @@ struct UniquenessOptions {
   float rotation_step_rad = 0.0f;
   float max_rotation_rad = 0.0f;
   float min_separation_rad = 0.035f;  // a refined rival turned less than this is the candidate
+  // Extension (the tracker's TrackOptions::alias_valley_is_one_mode): a rival at the candidate's
+  // heading (within min_separation_rad, cost within `margin` of the candidate's) joined to the
+  // candidate through the candidate's own cost valley (in_same_cost_valley paths, sampled every
+  // valley_step_m, outwards along each seed direction through the rivals already found in it) is
+  // the scan's indeterminacy along its weak axis, not a second mode: it is not counted
+  // (same_valley_rivals), and `rival` is the best of the others. false = every rival counts.
+  bool valley_is_one_mode = false;
+  float valley_step_m = 0.075f;
 };
 
 struct UniquenessResult {
@@ -37,6 +45,7 @@ struct UniquenessResult {
   Se2f rival;
   std::uint32_t rivals_tried = 0;
   bool rival_turned = false;  // the best rival came from a turned seed
+  std::uint32_t same_valley_rivals = 0;  // rivals left out as one mode (valley_is_one_mode)
 };
 
 // Mean of min(d, clip)² / clip² over the points (robot frame) placed at `pose`; points off the map

@@ -372,6 +372,9 @@ void PoseTracker::check_aliases(const Point2f* points, std::size_t n, StepWork* 
   uo.rotation_step_rad = o.alias_rotation_step_rad;
   uo.max_rotation_rad = o.alias_max_rotation_rad;
   uo.min_separation_rad = o.alias_min_separation_rad;
+  // The exemptions below (and the one-valley rule) rest on a track that was right at the last scan.
+  const bool trusted = !contradicted_ && !(o.alias_trust_needs_steady_fit && w->fit_drop_z >= o.alias_credible_z);
+  uo.valley_is_one_mode = o.alias_valley_is_one_mode && trusted;
   const std::size_t m = subsample_alias_points(points, n);
   const mml::UniquenessResult u = mml::check_pose_uniqueness(map_, alias_points_, m, a.pose, uo);
   out->alias_cost = u.cost;
@@ -399,7 +402,6 @@ void PoseTracker::check_aliases(const Point2f* points, std::size_t n, StepWork* 
     // the last scan does not reach at the integrity risk (the bound the innovation test trusts). A
     // turned rival always is: walls that fit as well turned are a scan that does not pin the heading
     // here (intel kidnap 6735 → 7812: a place fitting 5–10° turned).
-    const bool trusted = !contradicted_ && !(o.alias_trust_needs_steady_fit && w->fit_drop_z >= o.alias_credible_z);
     const bool same_heading = std::fabs(wrap_angle(u.rival.theta - a.pose.theta)) < o.alias_min_separation_rad;
     const bool beyond_prediction = std::hypot(u.rival.x - w->pred.x, u.rival.y - w->pred.y) > w->pred_pl.xy_m;
     // Neither exemption covers a rival that fits better at alias_credible_z (track_options.h): the

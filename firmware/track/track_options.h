@@ -102,7 +102,8 @@ struct TrackOptions {
   float max_odom_step_rad = 1.5f;
   // Scans are fused only after the robot moved this far or turned this much since the last fused
   // scan (LaMa / AMCL update thresholds): standing still neither drifts nor shrinks the covariance
-  // by re-counting the same map error. Every scan is still checked against the map.
+  // by re-counting the same map error (under the α model; wheels with per-step noise drift while
+  // standing, odom_trans_per_step_m). Every scan is still checked against the map.
   float update_min_d_m = 0.05f;
   float update_min_a_rad = 0.05f;
   // Integrity monitor (fault detection on the residuals, RAIM style).
@@ -147,6 +148,16 @@ struct TrackOptions {
   // the error and the status is not `localized` until the scans are unique again for
   // `recovery_steps` scans. The PL is a single-mode bound; this check is what makes it one.
   bool alias_check = true;
+  // One valley, one mode (extension): on a trusted track (no contradiction since the last
+  // recovery_steps unique scans, no fit drop at alias_credible_z), a rival at the fix's heading
+  // joined to the fix by poses that fit as well (mml::in_same_cost_valley: a bare corridor whose
+  // walls fit wherever the robot stands along it) is not a second mode but the scan's weak axis,
+  // which the update leaves to the prediction and the PL covers through the scan's confidence extent
+  // (confidence_extent_xy, capped at the prediction's PL plus the update's shift: the truth is within
+  // the prediction's PL of it, the published pose within the shift). Such a rival does not make the
+  // scan ambiguous; any other rival does (check_pose_uniqueness reports the best of the others).
+  // false = every rival counts (the large office: 56–71 `ambiguous` steps a run in its corridors).
+  bool alias_valley_is_one_mode = true;
   float alias_max_shift_m = 3.0f;
   float alias_step_m = 0.4f;
   float alias_min_separation_m = 0.4f;

@@ -150,6 +150,33 @@ SimConfig small_run(const std::string& out, std::uint64_t seed) {
   return cfg;
 }
 
+// mml-sim hands mml-track the simulated wheels' per-step σ on the axes its α model does not cover
+// on the nominal straight step (0.75 m/s × 0.4 s = 0.3 m): translation 0.2 × 0.3 = 6 cm ≥ 4 cm is
+// covered, rotation 0.2 × 0.3 rad = 3.4° < 4° is not. Nothing for another localizer, a log, or
+// when the option is given.
+TEST(SimRunner, TrackerIsToldTheWheelNoiseItsModelMisses) {
+  SimConfig cfg = small_run("", 1);
+  cfg.localizer = "mml-track";
+  EXPECT_EQ(wheel_noise_beyond_alpha(cfg), "0,4");
+  cfg.localizer_options["odom_noise"] = "0.1,0.2,0.2,0.3";  // TT·0.3 = 3 cm < 4 cm; RT·0.3 = 5.2° ≥ 4°
+  EXPECT_EQ(wheel_noise_beyond_alpha(cfg), "0.04,0");
+  cfg.localizer_options["odom_noise"] = "0.3,0.2,0.2,0.3";  // both covered
+  EXPECT_EQ(wheel_noise_beyond_alpha(cfg), "");
+  cfg.localizer_options.erase("odom_noise");
+  cfg.synthetic.odometry.sigma_rot_deg = 2.0;  // wheels better than the α model on both axes
+  EXPECT_EQ(wheel_noise_beyond_alpha(cfg), "");
+  cfg.synthetic.odometry.sigma_rot_deg = 4.0;
+  cfg.localizer_options["odom_noise_per_step"] = "0,0";
+  EXPECT_EQ(wheel_noise_beyond_alpha(cfg), "");
+  cfg.localizer_options.clear();
+  cfg.localizer = "odom";
+  EXPECT_EQ(wheel_noise_beyond_alpha(cfg), "");
+  cfg.localizer = "mml-track";
+  cfg.world.clear();
+  cfg.log_path = "run.clf";
+  EXPECT_EQ(wheel_noise_beyond_alpha(cfg), "");
+}
+
 TEST(SimRunner, SameSeedGivesIdenticalCsv) {
   const std::string a = temp_dir("a"), b = temp_dir("b"), c = temp_dir("c");
   SimResult r;

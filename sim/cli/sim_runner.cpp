@@ -16,6 +16,7 @@
 #include "firmware/base/arena.h"
 #include "firmware/map/map_image.h"
 #include "firmware/runtime/localization_loop.h"
+#include "firmware/track/track_options.h"
 #include "hal/hal.h"
 #include "hal_linux/linux_clock.h"
 #include "hal_sim/sim_hal.h"
@@ -131,26 +132,39 @@ bool check_sources(SimConfig* cfg, std::string* err) {
 
 // The configuration as the run uses it: a dataset resolved to its log, reference and map, the
 // output folder created, the localizer named, the source checked.
-// The product's tracker is given the simulated wheels' noise, as a deployment writes its robot's
-// odometry spec into the config (odom_noise_per_step, track_options.h): a world's odometry errs by
-// σ per scan step whatever the motion (Sec. 5.7.1), and so does --odom-noise on a log. An explicit
-// --opt odom_noise_per_step wins (0,0: the AMCL model alone).
-void tell_tracker_the_wheels(SimConfig* cfg) {
-  if (cfg->localizer != "mml-track" || cfg->localizer_options.count("odom_noise_per_step") > 0) return;
-  const bool world = !cfg->world.empty() || cfg->custom_world != nullptr;
-  double m = 0.0, deg = 0.0;
-  if (world) {
-    m = cfg->synthetic.odometry.sigma_trans;
-    deg = cfg->synthetic.odometry.sigma_rot_deg;
-  } else if (cfg->log_odom_noise) {
-    m = cfg->log_odom_sigma_m;
-    deg = cfg->log_odom_sigma_deg;
+}  // namespace
+
+// The product's tracker is told what its α model (odom_noise) misses of the simulated wheels, as a
+// deployment configures its robot's odometry: a world's wheels err by σ per scan step whatever the
+// motion (Sec. 5.7.1: 4 cm on x and y, 4° — standing, turning on the spot or driving). Per axis that
+// σ becomes odom_noise_per_step (track_options.h) where the α model gives less on the robot's
+// nominal straight step (route speed × scan period): on the large office's 0.3 m step the default α
+// already give 0.2 × 0.3 m = 6 cm ≥ 4 cm (not counted twice), and 0.2 × 0.3 = 3.4° < 4° of rotation
+// (handed over). An explicit --opt odom_noise_per_step wins (0,0: the α model alone). Not for logs:
+// their wheels are real, --odom-noise only adds to them.
+std::string wheel_noise_beyond_alpha(const SimConfig& c) {
+  const SimConfig* cfg = &c;
+  if (cfg->localizer != "mml-track" || cfg->localizer_options.count("odom_noise_per_step") > 0) return "";
+  if (cfg->world.empty() && cfg->custom_world == nullptr) return "";
+  const fw::track::TrackOptions defaults;
+  double tt = defaults.odom_trans_per_m, tr = 0, rr = 0, rt = defaults.odom_rot_per_m;
+  const auto given = cfg->localizer_options.find("odom_noise");
+  if (given != cfg->localizer_options.end() &&
+      std::sscanf(given->second.c_str(), "%lf,%lf,%lf,%lf", &tt, &tr, &rr, &rt) != 4) {
+    return "";  // malformed: the localizer's factory names it
   }
-  if (!(m > 0.0 || deg > 0.0)) return;
+  const OdometryNoiseOptions& wheels = cfg->synthetic.odometry;
+  const double step_m = cfg->synthetic.route.speed * cfg->synthetic.scan_period_s;
+  const double rot_rad = wheels.sigma_rot_deg * 3.14159265358979 / 180.0;
+  const double m = tt * step_m < wheels.sigma_trans ? wheels.sigma_trans : 0.0;
+  const double deg = rt * step_m < rot_rad ? wheels.sigma_rot_deg : 0.0;
+  if (!(m > 0.0 || deg > 0.0)) return "";
   char v[64];
   std::snprintf(v, sizeof(v), "%g,%g", std::min(m, 1.0), std::min(deg, 28.0));  // the option's ranges
-  cfg->localizer_options["odom_noise_per_step"] = v;
+  return v;
 }
+
+namespace {
 
 bool complete_config(const SimConfig& cfg_in, SimConfig* cfg, std::string* err) {
   *cfg = cfg_in;
@@ -163,7 +177,8 @@ bool complete_config(const SimConfig& cfg_in, SimConfig* cfg, std::string* err) 
   }
   if (!create_output_dir(cfg->out_dir, err)) return false;
   if (cfg->localizer.empty()) cfg->localizer = default_localizer();
-  tell_tracker_the_wheels(cfg);
+  const std::string wheels = wheel_noise_beyond_alpha(*cfg);
+  if (!wheels.empty()) cfg->localizer_options["odom_noise_per_step"] = wheels;
   return check_sources(cfg, err);
 }
 
@@ -638,8 +653,8 @@ bool run_simulation(const SimConfig& cfg_in, SimResult* out, std::string* err) {
   if (!complete_config(cfg_in, &cfg, err)) return false;
   if (cfg.progress && cfg_in.localizer_options.count("odom_noise_per_step") == 0 &&
       cfg.localizer_options.count("odom_noise_per_step") > 0) {
-    std::fprintf(stderr, "mml-sim: mml-track is given the simulated wheels' noise per scan step: odom_noise_per_step=%s "
-                 "(--opt odom_noise_per_step=0,0 for the AMCL model alone)\n",
+    std::fprintf(stderr, "mml-sim: mml-track is given the simulated wheels' noise its odom_noise model misses: "
+                 "odom_noise_per_step=%s (metres, degrees per scan step; --opt odom_noise_per_step=0,0 for the α model alone)\n",
                  cfg.localizer_options.at("odom_noise_per_step").c_str());
   }
   SimSummary& sum = out->summary;

@@ -166,6 +166,11 @@ struct SimResult {
   long last_hypotheses_step = -1;
 };
 
+// What mml-sim hands mml-track as odom_noise_per_step ("M,DEG", or "" for nothing): per axis, the
+// simulated wheels' σ per scan step where the tracker's α model (odom_noise) gives less on the
+// robot's nominal straight step (sim_runner.cpp says why). Worlds only, and not when given.
+std::string wheel_noise_beyond_alpha(const SimConfig& cfg);
+
 // Runs the whole simulation; false with *err naming the bad input (world, log, map, localizer).
 bool run_simulation(const SimConfig& cfg, SimResult* out, std::string* err);
 
