@@ -142,6 +142,36 @@ TEST(PoseUniquenessTest, SameCostValleyOnlyAlongAFeaturelessAxis) {
   EXPECT_FALSE(in_same_cost_valley(rm.map, pts, n, room_pose, Se2f(5.0f, 3.0f, 0.3f), 0.15f, 0.075f, 0.01f));
 }
 
+// UniquenessOptions::valley_is_one_mode: along the plain corridor every rival is the scan's own
+// weak axis (one valley): not unique when every rival counts, unique when the valley is one mode.
+// The periodic corridor's rivals one pillar period away are separate look-alikes: not unique either
+// way, and the rival reported is still the look-alike one period away.
+TEST(PoseUniquenessTest, ValleyRivalsAreOneModeSeparateLookAlikesAreNot) {
+  static GridWorld periodic = periodic_corridor();
+  static testing::OwnedGlobalMap pm(periodic);
+  static GridWorld plain;
+  plain.w = 800; plain.h = 60;
+  plain.occ.assign(plain.w * plain.h, 0);
+  plain.box(0.5f, 0.5f, 39.5f, 2.5f);
+  plain.finish();
+  static testing::OwnedGlobalMap fm(plain);
+  static Point2f pts[1081];
+  UniquenessOptions every, one_mode;
+  one_mode.valley_is_one_mode = true;
+  const Se2f at(18.1f, 1.5f, 0.0f);
+  std::size_t n = scan_points_at(plain, at, pts);
+  const UniquenessResult all = check_pose_uniqueness(fm.map, pts, n, at, every);
+  EXPECT_FALSE(all.unique);
+  EXPECT_EQ(all.same_valley_rivals, 0u);
+  const UniquenessResult valley = check_pose_uniqueness(fm.map, pts, n, at, one_mode);
+  EXPECT_TRUE(valley.unique) << "rival " << valley.rival.x << " cost " << valley.rival_cost << " vs " << valley.cost;
+  EXPECT_GE(valley.same_valley_rivals, 10u) << "0.4 m seeds up to 3 m both ways along the corridor";
+  n = scan_points_at(periodic, at, pts);
+  const UniquenessResult look_alike = check_pose_uniqueness(pm.map, pts, n, at, one_mode);
+  EXPECT_FALSE(look_alike.unique);
+  EXPECT_NEAR(std::fabs(look_alike.rival.x - at.x), 3.0f, 0.2f);
+}
+
 TEST(PoseUniquenessTest, EmptyInputIsHandled) {
   static GridWorld g = mcl::testing::unique_room();
   static testing::OwnedGlobalMap gm(g);

@@ -663,9 +663,9 @@ TEST(PoseTrackerTest, RivalThatFitsBetterIsCredibleBeyondThePrediction) {
 
 // A corridor without pillars: the walls fit wherever the robot stands along it, so the rival is
 // joined to the fix by poses that fit as well (one cost valley, one mode) and is never a place the
-// track could have taken instead — even with a prediction known only to 1.5 m. The scan is still
-// `ambiguous`. (Rivals nearer than 1 m are ignored here so that the best of the equally good rivals
-// lies beyond the alert limit.)
+// track could have taken instead — even with a prediction known only to 1.5 m. With every rival
+// counted (alias_valley_is_one_mode off) the scan is still `ambiguous`. (Rivals nearer than 1 m are
+// ignored here so that the best of the equally good rivals lies beyond the alert limit.)
 TEST(PoseTrackerTest, AliasInTheFixsOwnValleyIsNoDoubt) {
   GridWorld world;
   world.w = 600; world.h = 80;
@@ -679,6 +679,7 @@ TEST(PoseTrackerTest, AliasInTheFixsOwnValleyIsNoDoubt) {
     TrackOptions o;
     o.alias_min_separation_m = 1.0f;
     o.alias_rival_must_be_credible = must_be_credible;
+    o.alias_valley_is_one_mode = false;
     ASSERT_TRUE(t.init(o, map.map).is_ok());
     RandomStream rng(37, 0);
     Eigen::Matrix3f cov = small_cov();
@@ -691,6 +692,60 @@ TEST(PoseTrackerTest, AliasInTheFixsOwnValleyIsNoDoubt) {
     EXPECT_NEAR(s.alias_rival.y, truth.y, 0.05f);
     EXPECT_FALSE(s.alias_rival_credible);
     EXPECT_EQ(s.alias_beyond_alert, !must_be_credible);
+  }
+}
+
+// TrackOptions::alias_valley_is_one_mode: on a trusted track the same corridor's rivals are its weak
+// axis, not a second mode — the scan is supported, and every `localized` pose along the corridor
+// (driven with the wheels 2 % short) is inside its PL, the flat axis left to the wheels (the PL grows
+// with them until it passes the alert limit). On a track that is not trusted (started from a fix, confirmation pending) the rivals
+// count: `ambiguous`.
+TEST(PoseTrackerTest, ValleyRivalIsOneModeOnATrustedTrack) {
+  GridWorld world;
+  world.w = 600; world.h = 80;
+  world.occ.assign(world.w * world.h, 0);
+  world.box(0.5f, 1.0f, 29.5f, 3.0f);
+  world.finish();
+  const OwnedGlobalMap map(world);
+  for (const bool one_mode : {true, false}) {
+    PoseTracker t;
+    TrackOptions o;
+    o.alias_valley_is_one_mode = one_mode;
+    ASSERT_TRUE(t.init(o, map.map).is_ok());
+    RandomStream rng(47, 0);
+    const Se2f start(10.0f, 2.0f, 0.0f);
+    t.start(start, small_cov(), Se2f());
+    int supported = 0, localized = 0;
+    float first_pl = 0.0f, last_pl = 0.0f;
+    for (int i = 1; i <= 40; ++i) {
+      const Se2f truth(start.x + 0.1f * static_cast<float>(i), 2.0f, 0.0f);
+      const Se2f odom(0.098f * static_cast<float>(i), 0.0f, 0.0f);
+      const auto pts = testing::scan_at(world, truth, &rng, 0.01f, 4.0f);
+      const TrackStep s = t.step(pts.data(), pts.size(), odom);
+      ASSERT_FALSE(s.lost) << one_mode << " " << i;
+      supported += s.verdict == ScanVerdict::kSupported;
+      if (i == 1) first_pl = s.pl.xy_m;
+      last_pl = s.pl.xy_m;
+      if (s.status == hal::LocalizationStatus::kLocalized) {
+        ++localized;
+        EXPECT_LE(err_xy(s.pose, truth), s.pl.xy_m) << one_mode << " " << i;
+      }
+    }
+    if (one_mode) {
+      EXPECT_EQ(supported, 40);
+      // `localized` while the wheels alone keep the axis within the alert limit, then beyond it.
+      EXPECT_GE(localized, 5);
+      EXPECT_LT(localized, 40);
+      EXPECT_GT(last_pl, first_pl + 0.1f) << "the corridor's axis is the wheels', and its PL grows with them";
+    } else {
+      EXPECT_EQ(supported, 0) << "every scan has an equally good rival along the corridor";
+      EXPECT_EQ(localized, 0);
+    }
+    PoseTracker u;
+    ASSERT_TRUE(u.init(o, map.map).is_ok());
+    u.start(start, small_cov(), Se2f(), /*confirm=*/true);
+    const auto pts = testing::scan_at(world, start, &rng, 0.01f, 4.0f);
+    EXPECT_EQ(u.step(pts.data(), pts.size(), Se2f(), /*predict=*/false).verdict, ScanVerdict::kAmbiguous) << one_mode;
   }
 }
 
