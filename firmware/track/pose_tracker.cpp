@@ -1,4 +1,3 @@
-#include <cstdlib>
 #include "firmware/track/pose_tracker.h"
 
 #include <Eigen/Cholesky>
@@ -101,10 +100,8 @@ void PoseTracker::predict_to(const Se2f& odom) {
     noise_model_var_t_ += st0 * st0;
     noise_model_var_r_ += sr0 * sr0;
   }
-  static const float FT = std::getenv("FLOOR_T") ? std::atof(std::getenv("FLOOR_T")) : 0.0f;
-  static const float FR = std::getenv("FLOOR_R") ? std::atof(std::getenv("FLOOR_R")) * 0.0174533f : 0.0f;
-  const float st = odom_noise_.scale().trans * std::sqrt(st0 * st0 + FT * FT);
-  const float sr = odom_noise_.scale().rot * std::sqrt(sr0 * sr0 + FR * FR);
+  const float st = odom_noise_.scale().trans * st0;
+  const float sr = odom_noise_.scale().rot * sr0;
   Eigen::Matrix3f q = Eigen::Matrix3f::Zero();
   q(0, 0) = q(1, 1) = st * st;
   q(2, 2) = sr * sr;
