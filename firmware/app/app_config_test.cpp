@@ -5,12 +5,28 @@
 #include <unistd.h>
 
 #include <cstring>
+#include <initializer_list>
 #include <string>
 
 namespace fw {
 namespace {
 
 Status parse(const std::string& s, AppConfig* c) { return parse_app_config("t.conf", s.data(), s.size(), c); }
+
+// A value of `key` (line 3 of a minimal config) and what its refusal must say.
+struct RefusedValue {
+  const char* value;
+  const char* must_contain;
+};
+void expect_refused(const char* key, std::initializer_list<RefusedValue> cases) {
+  for (const RefusedValue& k : cases) {
+    AppConfig c;
+    const std::string text = std::string("laser = socketcan:vcan0\nlocalizer = odom\n") + key + " = " + k.value + "\n";
+    const Status s = parse(text, &c);
+    ASSERT_FALSE(s.is_ok()) << key << " = " << k.value;
+    EXPECT_NE(std::strstr(s.message(), k.must_contain), nullptr) << s.message();
+  }
+}
 
 TEST(AppConfig, ParsesAllKeys) {
   AppConfig c;
@@ -164,23 +180,13 @@ TEST(AppConfig, OdomNoiseKey) {
   EXPECT_FLOAT_EQ(c.odom_noise[1], 0.05f);
   EXPECT_FLOAT_EQ(c.odom_noise[2], 0.3f);
   EXPECT_FLOAT_EQ(c.odom_noise[3], 0.25f);
-  struct Case {
-    const char* value;
-    const char* must_contain;
-  } cases[] = {
-      {"0.1, 0.2, 0.3", "line 3: key 'odom_noise': '0.1, 0.2, 0.3' is not 4 numbers TT, TR, RR, RT"},
-      {"0.1,0.2,0.3,0.4,0.5", "is not 4 numbers TT, TR, RR, RT"},
-      {"0.1,x,0.3,0.4", "number 2 'x' is not in 0..10"},
-      {"-1,0,0,0", "number 1 '-1' is not in 0..10"},
-      {"0.1,0.2,0.3,11", "number 4 '11' is not in 0..10"},
-      {"0.1,0.2,0.3,nan", "number 4 'nan'"},
-  };
-  for (const Case& k : cases) {
-    const std::string text = std::string("laser = socketcan:vcan0\nlocalizer = odom\nodom_noise = ") + k.value + "\n";
-    const Status s = parse(text, &c);
-    ASSERT_FALSE(s.is_ok()) << k.value;
-    EXPECT_NE(std::strstr(s.message(), k.must_contain), nullptr) << s.message();
-  }
+  expect_refused("odom_noise",
+                 {{"0.1, 0.2, 0.3", "line 3: key 'odom_noise': '0.1, 0.2, 0.3' is not 4 numbers TT, TR, RR, RT"},
+                  {"0.1,0.2,0.3,0.4,0.5", "is not 4 numbers TT, TR, RR, RT"},
+                  {"0.1,x,0.3,0.4", "number 2 'x' is not in 0..10"},
+                  {"-1,0,0,0", "number 1 '-1' is not in 0..10"},
+                  {"0.1,0.2,0.3,11", "number 4 '11' is not in 0..10"},
+                  {"0.1,0.2,0.3,nan", "number 4 'nan'"}});
 }
 
 // odom_noise_per_step: σ per scan step that does not follow the motion (metres, degrees; default 0, 0).
@@ -192,23 +198,12 @@ TEST(AppConfig, OdomNoisePerStepKey) {
   ASSERT_TRUE(parse("laser = socketcan:vcan0\nlocalizer = odom\nodom_noise_per_step = 0.04, 4\n", &c).is_ok());
   EXPECT_FLOAT_EQ(c.odom_noise_per_step[0], 0.04f);
   EXPECT_FLOAT_EQ(c.odom_noise_per_step[1], 4.0f);
-  struct Case {
-    const char* value;
-    const char* must_contain;
-  } cases[] = {
-      {"0.04", "line 3: key 'odom_noise_per_step': '0.04' is not 2 numbers M, DEG"},
-      {"0.04,4,1", "is not 2 numbers"},
-      {"2,4", "number 1 '2' is not in 0..1 (M, DEG)"},
-      {"0.04,30", "number 2 '30' is not in 0..28"},
-      {"0.04,-1", "number 2 '-1'"},
-      {"inf,1", "number 1 'inf'"},
-  };
-  for (const Case& k : cases) {
-    const std::string text = std::string("laser = socketcan:vcan0\nlocalizer = odom\nodom_noise_per_step = ") + k.value + "\n";
-    const Status s = parse(text, &c);
-    ASSERT_FALSE(s.is_ok()) << k.value;
-    EXPECT_NE(std::strstr(s.message(), k.must_contain), nullptr) << s.message();
-  }
+  expect_refused("odom_noise_per_step", {{"0.04", "line 3: key 'odom_noise_per_step': '0.04' is not 2 numbers M, DEG"},
+                                         {"0.04,4,1", "is not 2 numbers"},
+                                         {"2,4", "number 1 '2' is not in 0..1 (M, DEG)"},
+                                         {"0.04,30", "number 2 '30' is not in 0..28"},
+                                         {"0.04,-1", "number 2 '-1'"},
+                                         {"inf,1", "number 1 'inf'"}});
 }
 
 // global_context (issue 14): thread by default, inline selectable, anything else named.

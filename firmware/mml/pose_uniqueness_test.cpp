@@ -25,6 +25,16 @@ GridWorld periodic_corridor() {
   return g;
 }
 
+// The same corridor without pillars: its walls fit wherever the robot stands along it.
+GridWorld plain_corridor() {
+  GridWorld g;
+  g.w = 800; g.h = 60;
+  g.occ.assign(g.w * g.h, 0);
+  g.box(0.5f, 0.5f, 39.5f, 2.5f);
+  g.finish();
+  return g;
+}
+
 std::size_t scan_points_at(const GridWorld& g, const Se2f& pose, Point2f* pts) {
   static hal::LaserScan scan;
   mcl::testing::simulate_scan(g.view(), pose.x, pose.y, pose.theta, &scan);
@@ -116,11 +126,7 @@ TEST(PoseUniquenessTest, PeriodicCorridorIsNotUnique) {
 TEST(PoseUniquenessTest, SameCostValleyOnlyAlongAFeaturelessAxis) {
   static GridWorld periodic = periodic_corridor();
   static testing::OwnedGlobalMap pm(periodic);
-  static GridWorld plain;
-  plain.w = 800; plain.h = 60;
-  plain.occ.assign(plain.w * plain.h, 0);
-  plain.box(0.5f, 0.5f, 39.5f, 2.5f);
-  plain.finish();
+  static GridWorld plain = plain_corridor();
   static testing::OwnedGlobalMap fm(plain);
   static GridWorld room = mcl::testing::unique_room();
   static testing::OwnedGlobalMap rm(room);
@@ -149,11 +155,7 @@ TEST(PoseUniquenessTest, SameCostValleyOnlyAlongAFeaturelessAxis) {
 TEST(PoseUniquenessTest, ValleyRivalsAreOneModeSeparateLookAlikesAreNot) {
   static GridWorld periodic = periodic_corridor();
   static testing::OwnedGlobalMap pm(periodic);
-  static GridWorld plain;
-  plain.w = 800; plain.h = 60;
-  plain.occ.assign(plain.w * plain.h, 0);
-  plain.box(0.5f, 0.5f, 39.5f, 2.5f);
-  plain.finish();
+  static GridWorld plain = plain_corridor();
   static testing::OwnedGlobalMap fm(plain);
   static Point2f pts[1081];
   UniquenessOptions every, one_mode;

@@ -14,18 +14,7 @@ namespace {
 
 using testing::GridWorld;
 using testing::OwnedGlobalMap;
-
-// A plain corridor 2 m wide and 30 m long: with a 4 m laser its ends are never seen. `stub` adds a
-// 10 cm stub on one wall at x = 12 m (a door frame): a few end-points that constrain the axis.
-GridWorld plain_corridor(bool stub = false) {
-  GridWorld g;
-  g.w = 600; g.h = 80;
-  g.occ.assign(g.w * g.h, 0);
-  g.box(0.5f, 1.0f, 29.5f, 3.0f);
-  if (stub) g.wall(12.0f, 1.0f, 12.0f, 1.1f);
-  g.finish();
-  return g;
-}
+using testing::plain_corridor;
 
 ConfidenceExtent extent_at(const GridWorld& world, const OwnedGlobalMap& map, const Se2f& pose, float maxr,
                            std::uint32_t seed) {

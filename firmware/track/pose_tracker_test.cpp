@@ -667,11 +667,7 @@ TEST(PoseTrackerTest, RivalThatFitsBetterIsCredibleBeyondThePrediction) {
 // counted (alias_valley_is_one_mode off) the scan is still `ambiguous`. (Rivals nearer than 1 m are
 // ignored here so that the best of the equally good rivals lies beyond the alert limit.)
 TEST(PoseTrackerTest, AliasInTheFixsOwnValleyIsNoDoubt) {
-  GridWorld world;
-  world.w = 600; world.h = 80;
-  world.occ.assign(world.w * world.h, 0);
-  world.box(0.5f, 1.0f, 29.5f, 3.0f);
-  world.finish();
+  const GridWorld world = testing::plain_corridor();
   const OwnedGlobalMap map(world);
   const Se2f truth(15.1f, 2.0f, 0.0f);
   for (const bool must_be_credible : {true, false}) {
@@ -701,11 +697,7 @@ TEST(PoseTrackerTest, AliasInTheFixsOwnValleyIsNoDoubt) {
 // with them until it passes the alert limit). On a track that is not trusted (started from a fix, confirmation pending) the rivals
 // count: `ambiguous`.
 TEST(PoseTrackerTest, ValleyRivalIsOneModeOnATrustedTrack) {
-  GridWorld world;
-  world.w = 600; world.h = 80;
-  world.occ.assign(world.w * world.h, 0);
-  world.box(0.5f, 1.0f, 29.5f, 3.0f);
-  world.finish();
+  const GridWorld world = testing::plain_corridor();
   const OwnedGlobalMap map(world);
   for (const bool one_mode : {true, false}) {
     PoseTracker t;

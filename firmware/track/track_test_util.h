@@ -35,6 +35,18 @@ inline const OwnedGlobalMap& room_map() {
   return m;
 }
 
+// A plain corridor 2 m wide and 30 m long: with a 4 m laser its ends are never seen. `stub` adds a
+// 10 cm stub on one wall at x = 12 m (a door frame): a few end-points that constrain the axis.
+inline GridWorld plain_corridor(bool stub = false) {
+  GridWorld g;
+  g.w = 600; g.h = 80;
+  g.occ.assign(g.w * g.h, 0);
+  g.box(0.5f, 1.0f, 29.5f, 3.0f);
+  if (stub) g.wall(12.0f, 1.0f, 12.0f, 1.1f);
+  g.finish();
+  return g;
+}
+
 // Scan end-points (sensor frame) of a simulated scan at `pose` in `world`, with range noise.
 inline std::vector<Point2f> scan_at(const GridWorld& world, const Se2f& pose, RandomStream* rng, float noise = 0.01f,
                                     float maxr = 8.0f) {

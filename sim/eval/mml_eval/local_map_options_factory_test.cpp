@@ -29,7 +29,18 @@ struct SmallOffice {
     return arena.init_mapped(image.size() + (4u << 20), false, "test map").is_ok() &&
            fw::load_map_image(image.data(), image.size(), arena, &map, "small-office").is_ok();
   }
+  sim::LocalizerContext context() {
+    sim::LocalizerContext ctx;
+    ctx.global_map = &map;
+    ctx.map_image = &image;
+    return ctx;
+  }
 };
+
+// The options the tracker of an mml-track localizer runs with.
+const fw::track::TrackOptions& tracker_options(const std::unique_ptr<fw::Localizer>& loc) {
+  return static_cast<sim::mmleval::OwnedLocalizer*>(loc.get())->tracked()->tracker().options();
+}
 
 TEST(LocalMapOptionsFactory, OptionsReachTheLocalizer) {
   SmallOffice so;
@@ -91,15 +102,12 @@ TEST(LocalMapOptionsFactory, BadValuesAreRefused) {
 TEST(LocalMapOptionsFactory, OdomNoiseReachesTheTracker) {
   SmallOffice so;
   ASSERT_TRUE(so.load()) << so.err;
-  sim::LocalizerContext ctx;
-  ctx.global_map = &so.map;
-  ctx.map_image = &so.image;
+  sim::LocalizerContext ctx = so.context();
   ctx.options = {{"odom_noise", "0.1,0.05,0.3,0.25"}};
   std::string err;
   auto loc = sim::mmleval::make_track_localizer(ctx, &err);
   ASSERT_NE(loc, nullptr) << err;
-  const fw::track::TrackOptions& o =
-      static_cast<sim::mmleval::OwnedLocalizer*>(loc.get())->tracked()->tracker().options();
+  const fw::track::TrackOptions& o = tracker_options(loc);
   EXPECT_FLOAT_EQ(o.odom_trans_per_m, 0.1f);
   EXPECT_FLOAT_EQ(o.odom_trans_per_rad, 0.05f);
   EXPECT_FLOAT_EQ(o.odom_rot_per_rad, 0.3f);
@@ -119,21 +127,17 @@ TEST(LocalMapOptionsFactory, OdomNoiseReachesTheTracker) {
 TEST(LocalMapOptionsFactory, OdomNoisePerStepReachesTheTracker) {
   SmallOffice so;
   ASSERT_TRUE(so.load()) << so.err;
-  sim::LocalizerContext ctx;
-  ctx.global_map = &so.map;
-  ctx.map_image = &so.image;
+  sim::LocalizerContext ctx = so.context();
   std::string err;
   auto plain = sim::mmleval::make_track_localizer(ctx, &err);
   ASSERT_NE(plain, nullptr) << err;
-  const fw::track::TrackOptions& d =
-      static_cast<sim::mmleval::OwnedLocalizer*>(plain.get())->tracked()->tracker().options();
+  const fw::track::TrackOptions& d = tracker_options(plain);
   EXPECT_EQ(d.odom_trans_per_step_m, 0.0f);
   EXPECT_EQ(d.odom_rot_per_step_rad, 0.0f);
   ctx.options = {{"odom_noise_per_step", "0.04,4"}};
   auto loc = sim::mmleval::make_track_localizer(ctx, &err);
   ASSERT_NE(loc, nullptr) << err;
-  const fw::track::TrackOptions& o =
-      static_cast<sim::mmleval::OwnedLocalizer*>(loc.get())->tracked()->tracker().options();
+  const fw::track::TrackOptions& o = tracker_options(loc);
   EXPECT_FLOAT_EQ(o.odom_trans_per_step_m, 0.04f);
   EXPECT_NEAR(o.odom_rot_per_step_rad, 4.0f * 3.14159265f / 180.0f, 1e-6f);
   for (const char* bad : {"0.04", "0.04,4,1", "x,4", "2,4", "0.04,29", "0.04,-1", "0.04,4,"}) {

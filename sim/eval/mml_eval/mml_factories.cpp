@@ -185,9 +185,10 @@ static bool parse_odom_noise(const std::map<std::string, std::string>& options, 
 // Options: config=1..4, correct=0|1, reduce=0|1, pool=0|1, keep=0|1, contested=0|1, rivals=0|1 (MML part); alert=M (alert limit, metres);
 // odom_noise=TT,TR,RR,RT and odom_noise_per_step=M,DEG (the tracker's odometry noise model, as
 // mmlfw's config keys of the same names);
-// odom_adapt=0|1 (wheel-noise self-calibration, TrackOptions::odom_noise_window 64; 0 = default).
+// odom_adapt=0|1 (wheel-noise self-calibration, TrackOptions::odom_noise_window 64; 0 = default);
+// valley=0|1 (TrackOptions::alias_valley_is_one_mode; 0 = default).
 std::unique_ptr<fw::Localizer> make_track_localizer(const LocalizerContext& ctx, std::string* err) {
-  const std::string bad = check_keys("mml-track", ctx.options, {"config", "correct", "reduce", "pool", "keep", "contested", "rivals", "alert", "odom_noise", "odom_noise_per_step", "odom_adapt"});
+  const std::string bad = check_keys("mml-track", ctx.options, {"config", "correct", "reduce", "pool", "keep", "contested", "rivals", "alert", "odom_noise", "odom_noise_per_step", "odom_adapt", "valley"});
   if (!bad.empty()) { *err = bad; return nullptr; }
   if (ctx.global_map == nullptr) { *err = "localizer mml-track: needs a global map"; return nullptr; }
   long config = 3;
@@ -210,6 +211,9 @@ std::unique_ptr<fw::Localizer> make_track_localizer(const LocalizerContext& ctx,
   long adapt = 0;
   if (!parse_int(ctx.options, "odom_adapt", 0, 1, &adapt, "mml-track", err)) return nullptr;
   if (adapt == 1) to.odom_noise_window = 64;
+  long valley = 0;
+  if (!parse_int(ctx.options, "valley", 0, 1, &valley, "mml-track", err)) return nullptr;
+  to.alias_valley_is_one_mode = valley == 1;
   static const std::vector<std::uint8_t> kEmpty;
   return wrap_hooks(OwnedLocalizer::make_track(*ctx.global_map, ctx.map_image ? *ctx.map_image : kEmpty, cfg, to,
                                                ctx.threads, err),
