@@ -142,19 +142,18 @@ bool check_sources(SimConfig* cfg, std::string* err) {
 // already give 0.2 × 0.3 m = 6 cm ≥ 4 cm (not counted twice), and 0.2 × 0.3 = 3.4° < 4° of rotation
 // (handed over). An explicit --opt odom_noise_per_step wins (0,0: the α model alone). Not for logs:
 // their wheels are real, --odom-noise only adds to them.
-std::string wheel_noise_beyond_alpha(const SimConfig& c) {
-  const SimConfig* cfg = &c;
-  if (cfg->localizer != "mml-track" || cfg->localizer_options.count("odom_noise_per_step") > 0) return "";
-  if (cfg->world.empty() && cfg->custom_world == nullptr) return "";
+std::string wheel_noise_beyond_alpha(const SimConfig& cfg) {
+  if (cfg.localizer != "mml-track" || cfg.localizer_options.count("odom_noise_per_step") > 0) return "";
+  if (cfg.world.empty() && cfg.custom_world == nullptr) return "";
   const fw::track::TrackOptions defaults;
   double tt = defaults.odom_trans_per_m, tr = 0, rr = 0, rt = defaults.odom_rot_per_m;
-  const auto given = cfg->localizer_options.find("odom_noise");
-  if (given != cfg->localizer_options.end() &&
+  const auto given = cfg.localizer_options.find("odom_noise");
+  if (given != cfg.localizer_options.end() &&
       std::sscanf(given->second.c_str(), "%lf,%lf,%lf,%lf", &tt, &tr, &rr, &rt) != 4) {
     return "";  // malformed: the localizer's factory names it
   }
-  const OdometryNoiseOptions& wheels = cfg->synthetic.odometry;
-  const double step_m = cfg->synthetic.route.speed * cfg->synthetic.scan_period_s;
+  const OdometryNoiseOptions& wheels = cfg.synthetic.odometry;
+  const double step_m = cfg.synthetic.route.speed * cfg.synthetic.scan_period_s;
   const double rot_rad = wheels.sigma_rot_deg * 3.14159265358979 / 180.0;
   const double m = tt * step_m < wheels.sigma_trans ? wheels.sigma_trans : 0.0;
   const double deg = rt * step_m < rot_rad ? wheels.sigma_rot_deg : 0.0;
