@@ -50,17 +50,20 @@ Status IncrementFusion::update(const Se2d& absolute, bool has_increment, const S
     return Status::error(Errc::kInvalidArgument, "increment fusion: non-finite pose or increment");
   }
   if (!started_) {
-    pose_ = absolute;
-    cov_ = r_;
+    step_.pose = step_.predicted = absolute;
+    step_.cov = step_.predicted_cov = r_;
+    step_.transition.setIdentity();
     last_absolute_ = absolute;
     started_ = true;
     return Status::ok();
   }
   // Predict (Eq. 3.4): without an increment, RBSM's own motion with a wide Q.
   const Se2d u = has_increment ? increment : last_absolute_.between(absolute);
-  const PoseWithCovariance<double> predicted = propagate(
-      pose_.compose(u), pose_.jacobian_compose_first(u), cov_, pose_.jacobian_compose_second(),
-      increment_cov(u, has_increment ? 1.0 : options_.unknown_increment_scale));
+  const Se2d& pose = step_.pose;
+  const Eigen::Matrix<double, 3, 3> transition = pose.jacobian_compose_first(u);
+  const PoseWithCovariance<double> predicted =
+      propagate(pose.compose(u), transition, step_.cov, pose.jacobian_compose_second(),
+                increment_cov(u, has_increment ? 1.0 : options_.unknown_increment_scale));
   last_absolute_ = absolute;
   // Update with RBSM's pose.
   Eigen::Matrix<double, 3, 1> y(absolute.x - predicted.pose.x, absolute.y - predicted.pose.y,
@@ -79,9 +82,12 @@ Status IncrementFusion::update(const Se2d& absolute, bool has_increment, const S
   }
   const Eigen::Matrix<double, 3, 3> k = predicted.cov * s_inv;
   const Eigen::Matrix<double, 3, 1> dx = k * y;
-  pose_ = Se2d(predicted.pose.x + dx(0), predicted.pose.y + dx(1), wrap_angle(predicted.pose.theta + dx(2)));
-  cov_ = (Eigen::Matrix<double, 3, 3>::Identity() - k) * predicted.cov;
-  cov_ = 0.5 * (cov_ + cov_.transpose());
+  step_.transition = transition;
+  step_.predicted = predicted.pose;
+  step_.predicted_cov = predicted.cov;
+  step_.pose = Se2d(predicted.pose.x + dx(0), predicted.pose.y + dx(1), wrap_angle(predicted.pose.theta + dx(2)));
+  const Eigen::Matrix<double, 3, 3> cov = (Eigen::Matrix<double, 3, 3>::Identity() - k) * predicted.cov;
+  step_.cov = 0.5 * (cov + cov.transpose());
   return Status::ok();
 }
 

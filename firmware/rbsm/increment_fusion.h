@@ -32,6 +32,17 @@
 
 namespace fw {
 
+// One scan of the filter as a Rauch–Tung–Striebel smoother needs it (increment_smoother.h): the
+// filtered pose and covariance, the prediction into this scan (before RBSM's pose was fused) and
+// that prediction's state transition J_x = ∂(x ⊕ u)/∂x.
+struct FusionStep {
+  Se2d pose;
+  Eigen::Matrix<double, 3, 3> cov = Eigen::Matrix<double, 3, 3>::Zero();
+  Se2d predicted;
+  Eigen::Matrix<double, 3, 3> predicted_cov = Eigen::Matrix<double, 3, 3>::Zero();
+  Eigen::Matrix<double, 3, 3> transition = Eigen::Matrix<double, 3, 3>::Identity();
+};
+
 struct IncrementFusionOptions {
   // Relative matcher's error per increment (PL-ICP laser-to-laser): a floor and a share of the motion.
   double relative_sigma_m = 0.002;
@@ -56,8 +67,9 @@ class IncrementFusion {
   // Errors for non-finite input (the state is left unchanged).
   Status update(const Se2d& absolute, bool has_increment, const Se2d& increment);
 
-  const Se2d& pose() const { return pose_; }
-  const Eigen::Matrix<double, 3, 3>& covariance() const { return cov_; }
+  const Se2d& pose() const { return step_.pose; }
+  const Eigen::Matrix<double, 3, 3>& covariance() const { return step_.cov; }
+  const FusionStep& step() const { return step_; }  // the last update, for the smoother
   std::uint32_t gated_updates() const { return gated_; }  // updates down-weighted at the gate
 
  private:
@@ -67,9 +79,8 @@ class IncrementFusion {
   Eigen::Matrix<double, 3, 3> r_ = Eigen::Matrix<double, 3, 3>::Zero();
   bool initialized_ = false;
   bool started_ = false;
-  Se2d pose_;
   Se2d last_absolute_;
-  Eigen::Matrix<double, 3, 3> cov_ = Eigen::Matrix<double, 3, 3>::Zero();
+  FusionStep step_;
   std::uint32_t gated_ = 0;
 };
 

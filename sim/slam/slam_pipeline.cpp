@@ -136,7 +136,7 @@ bool run_slam(const CarmenLog& log, const SlamConfig& config, SlamRun* out, std:
     }
     std::vector<fw::Se2d> fused;
     std::uint32_t gated = 0;
-    if (!fuse_increments(odo.poses, icp.poses, mc.fusion, &fused, &gated, error)) return false;
+    if (!fuse_increments(odo.poses, icp.poses, mc.fusion, mc.fusion_smooth, &fused, &gated, error)) return false;
     odo.poses = std::move(fused);
   }
   const double front_s = seconds_since(t0);

@@ -9,6 +9,7 @@
 #include <ctime>
 
 #include "firmware/base/rng.h"
+#include "firmware/rbsm/increment_smoother.h"
 #include "sim/io/datasets.h"
 
 namespace sim {
@@ -173,8 +174,8 @@ bool run_scan_matching_odometry(const CarmenLog& log, MatcherKind kind, const Ma
 }
 
 bool fuse_increments(const std::vector<fw::Se2d>& absolute, const std::vector<fw::Se2d>& relative,
-                     const fw::IncrementFusionOptions& options, std::vector<fw::Se2d>* out, uint32_t* gated,
-                     std::string* error) {
+                     const fw::IncrementFusionOptions& options, bool smooth, std::vector<fw::Se2d>* out,
+                     uint32_t* gated, std::string* error) {
   if (absolute.size() != relative.size()) {
     *error = "fuse_increments: " + std::to_string(absolute.size()) + " RBSM poses but " +
              std::to_string(relative.size()) + " PL-ICP poses";
@@ -186,7 +187,8 @@ bool fuse_increments(const std::vector<fw::Se2d>& absolute, const std::vector<fw
     *error = std::string("fuse_increments: ") + init.message();
     return false;
   }
-  out->clear();
+  std::vector<fw::FusionStep> steps;
+  steps.reserve(absolute.size());
   for (size_t i = 0; i < absolute.size(); ++i) {
     const fw::Se2d u = i == 0 ? fw::Se2d() : relative[i - 1].between(relative[i]);
     const fw::Status st = fusion.update(absolute[i], i > 0, u);
@@ -194,9 +196,18 @@ bool fuse_increments(const std::vector<fw::Se2d>& absolute, const std::vector<fw
       *error = "fuse_increments: scan " + std::to_string(i) + ": " + st.message();
       return false;
     }
-    out->push_back(fusion.pose());
+    steps.push_back(fusion.step());
   }
   *gated = fusion.gated_updates();
+  if (smooth) {
+    const fw::Status st = fw::smooth_fusion_steps(steps.data(), steps.size());
+    if (!st.is_ok()) {
+      *error = std::string("fuse_increments: ") + st.message();
+      return false;
+    }
+  }
+  out->clear();
+  for (const fw::FusionStep& s : steps) out->push_back(s.pose);
   return true;
 }
 

@@ -36,6 +36,7 @@ struct MatcherConfig {
   fw::PlIcpOptions plicp;
   fw::ScanMatchingOdometryOptions front;
   fw::IncrementFusionOptions fusion;  // RBSM ⊕ PL-ICP increments (extension, fuse_increments)
+  bool fusion_smooth = true;          // and the fused chain smoothed backwards (fw::smooth_fusion_steps)
   int workers = 1;  // >1: RBSM sampling/weighting over a fw::WorkerPool
 };
 // 5 cm cells, 1024-cell (51 m) scrolling window, 1000 particles, points up to 15 m, at least 3
@@ -80,11 +81,13 @@ bool run_scan_matching_odometry(const CarmenLog& log, MatcherKind kind, const Ma
                                 const std::function<void(size_t, size_t)>& progress = {});
 
 // RBSM's poses (`absolute`) fused with the increments of PL-ICP's poses (`relative`, same scans) by
-// fw::IncrementFusion (an extension of Alg. 1, issue 15): one pose per scan in *out; *gated:
-// updates down-weighted at the gate. False (with *error) when the lengths differ or a pose is not finite.
+// fw::IncrementFusion (an extension of Alg. 1, issue 15), then, when `smooth`, smoothed over the whole
+// log by fw::smooth_fusion_steps (offline use: every scan hears the later ones): one pose per scan in
+// *out; *gated: updates down-weighted at the gate. False (with *error) when the lengths differ or a
+// pose is not finite.
 bool fuse_increments(const std::vector<fw::Se2d>& absolute, const std::vector<fw::Se2d>& relative,
-                     const fw::IncrementFusionOptions& options, std::vector<fw::Se2d>* out, uint32_t* gated,
-                     std::string* error);
+                     const fw::IncrementFusionOptions& options, bool smooth, std::vector<fw::Se2d>* out,
+                     uint32_t* gated, std::string* error);
 
 // Mean of scan_cpu_ms: CPU per scan including the map update (the throughput figure).
 double cpu_ms_per_scan(const OdometryRun& run);

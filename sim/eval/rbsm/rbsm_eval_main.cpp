@@ -16,7 +16,7 @@
 //     shrink, accept_ratio, min_iterations, max_iterations, sigma_xy2, sigma_psi2, hill_climbing, mahalanobis,
 //     min_translation, min_rotation_deg, icp_max_corr, refine (0: pure Alg. 1 with prior=0), prior (odometry motion prior, 0/1), prior_xy (its σ in m), refine_radius, refine_iterations,
 //     refine_gate, refine_eigen, refine_score_loss, chain_refined, plicp_max_corr, plicp_kf_dist, plicp_kf_deg, plicp_trim,
-//     fuse_abs_xy, fuse_abs_deg (RBSM's σ in the fusion), fuse_rel_xy, fuse_rel_per_m, fuse_rel_deg, fuse_gate); --no-maps skips the PNGs.
+//     fuse_abs_xy, fuse_abs_deg (RBSM's σ in the fusion), fuse_rel_xy, fuse_rel_per_m, fuse_rel_deg, fuse_gate, fuse_smooth (0: the filter alone)); --no-maps skips the PNGs.
 //     consecutive corrected-scan pairs, guess perturbed by N(0, 10 cm, 6°): mean/p95/max errors.
 #include <algorithm>
 #include <cmath>
@@ -196,6 +196,7 @@ bool apply_front_and_icp_setting(const std::string& key, double v, sim::MatcherC
   else if (key == "fuse_rel_per_m") cfg->fusion.relative_sigma_per_m = v;
   else if (key == "fuse_rel_deg") cfg->fusion.relative_sigma_rad = v * M_PI / 180.0;
   else if (key == "fuse_gate") cfg->fusion.gate_chi2 = v;
+  else if (key == "fuse_smooth") cfg->fusion_smooth = v != 0;
   else return false;
   return true;
 }
@@ -351,7 +352,7 @@ int run_rbsm_seed(const EvalArgs& a, const OdometryInput& in, sim::MatcherConfig
   if (!in.pl_icp.empty()) {
     std::vector<fw::Se2d> fused;
     uint32_t gated = 0;
-    if (!sim::fuse_increments(run.poses, in.pl_icp, cfg->fusion, &fused, &gated, err)) {
+    if (!sim::fuse_increments(run.poses, in.pl_icp, cfg->fusion, cfg->fusion_smooth, &fused, &gated, err)) {
       std::fprintf(stderr, "mml-rbsm-eval: %s\n", err->c_str());
       return 1;
     }
@@ -459,7 +460,7 @@ int run_fuse(int argc, char** argv) {
   for (const auto& p : rb) a.push_back(p.pose);
   for (const auto& p : pl) b.push_back(p.pose);
   uint32_t gated = 0;
-  if (!sim::fuse_increments(a, b, cfg.fusion, &fused, &gated, &err)) {
+  if (!sim::fuse_increments(a, b, cfg.fusion, cfg.fusion_smooth, &fused, &gated, &err)) {
     std::fprintf(stderr, "mml-rbsm-eval fuse: %s\n", err.c_str());
     return 1;
   }
