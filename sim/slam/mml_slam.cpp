@@ -36,8 +36,10 @@ const char* kHelp =
     "  --optimizer aco|lm    loop optimiser (default aco: the ant colony of Eq. 3.13-3.14)\n"
     "  --edge-model sensor|motion  edge covariance: from poses weighted by the sensor model (Eq. 3.9, default)\n"
     "                        or the front end's propagated motion covariance (Eq. 3.4; closures: --closure-sigma)\n"
-    "  --front fused|rbsm    front end: RBSM fused with PL-ICP's laser-to-laser increments (default;\n"
-    "                        fw::IncrementFusion, an extension: firmware/rbsm/README.md) or RBSM alone (the dissertation's)\n"
+    "  --front fused|fused-filter|rbsm  front end: RBSM fused with PL-ICP's laser-to-laser increments and\n"
+    "                        smoothed backwards (default; fw::IncrementFusion + fw::smooth_fusion_steps, an\n"
+    "                        extension: firmware/rbsm/README.md), the same without the backward pass, or RBSM\n"
+    "                        alone (the dissertation's)\n"
     "  --traversal off|on|tracked  fragment borders, convex hulls and EXPLORE -> TRAVERSAL (Sec. 3.4): a\n"
     "                        revisited fragment is traversed, not mapped again (tracked: the scan is also fitted\n"
     "                        on the fragment every keyframe step); off (default, measured better on the logs):\n"
@@ -144,9 +146,9 @@ Parsed parse_run_option(const std::string& a, const std::string& v, SlamArgs* o)
     cfg.slam.traversal_tracking = v == "tracked";
     if (!cfg.slam.traversal && v != "off") return failed("--traversal: '" + v + "' is not off, on or tracked");
   } else if (a == "--front") {
-    if (v == "rbsm") cfg.fuse_front = false;
-    else if (v == "fused") cfg.fuse_front = true;
-    else return failed("--front: '" + v + "' is not rbsm or fused");
+    cfg.fuse_front = v == "fused" || v == "fused-filter";
+    cfg.front.fusion_smooth = v == "fused";
+    if (!cfg.fuse_front && v != "rbsm") return failed("--front: '" + v + "' is not fused, fused-filter or rbsm");
   } else if (a == "--ants") {
     if (!parse_u64(v, 1, 1024, &u)) return failed("--ants: '" + v + "' is not an integer in 1..1024");
     cfg.slam.aco.ants = static_cast<std::uint32_t>(u);

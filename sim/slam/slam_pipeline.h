@@ -20,7 +20,8 @@ namespace sim {
 struct SlamConfig {
   MatcherConfig front = default_matcher_config();  // RBSM front end
   // RBSM's poses fused with PL-ICP's laser-to-laser increments (fw::IncrementFusion, front.fusion;
-  // an extension, issue 15) before the back end; false = RBSM alone (the dissertation's front end).
+  // an extension, issue 15) and smoothed backwards when front.fusion_smooth (the default) before the
+  // back end; false = RBSM alone (the dissertation's front end).
   // On by default: better AntSLAM maps on all five logs of bench_slam (README, AntSLAM section).
   bool fuse_front = true;
   fw::antslam::AntSlamOptions slam = fw::antslam::default_antslam_options();
