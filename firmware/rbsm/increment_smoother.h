@@ -15,7 +15,7 @@
 //
 // Offline (mml-slam's front end, mml-rbsm-eval) the steps are the whole log. Onboard the caller
 // keeps the last L steps in a fixed array and smooths them after each scan, reading the pose of
-// scan t−L (a fixed-lag smoother: L scans of latency, 160 bytes per scan). No heap; errors as Status.
+// scan t−L (a fixed-lag smoother: L scans of latency, 264 bytes per scan). No heap; errors as Status.
 #pragma once
 
 #include <cstddef>
