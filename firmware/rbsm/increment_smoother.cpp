@@ -1,6 +1,6 @@
 #include "firmware/rbsm/increment_smoother.h"
 
-#include <Eigen/Cholesky>
+#include <Eigen/LU>
 #include <cmath>
 
 namespace fw {
@@ -11,13 +11,16 @@ Status smooth_fusion_steps(FusionStep* steps, std::size_t n) {
   for (std::size_t k = n; k-- > 1;) {
     const FusionStep& next = steps[k];
     FusionStep& s = steps[k - 1];
-    // P̂ is symmetric positive definite when it came from the filter (Q has a floor): Cholesky.
-    const Eigen::LLT<M3> predicted(next.predicted_cov);
-    if (predicted.info() != Eigen::Success) {
+    // P̂ is symmetric positive definite when it came from the filter (Q has a floor): Sylvester's
+    // criterion on its leading minors, then the closed-form 3×3 inverse (no allocation, unlike a
+    // Cholesky factorisation's blocked path in unoptimised builds).
+    const M3& p = next.predicted_cov;
+    const double m1 = p(0, 0), m2 = p(0, 0) * p(1, 1) - p(0, 1) * p(1, 0), m3 = p.determinant();
+    if (!(m1 > 0.0 && m2 > 0.0 && m3 > 0.0)) {
       return Status::error(Errc::kInvalidArgument,
                            "increment smoother: the predicted covariance of step %zu is not positive definite", k);
     }
-    const M3 gain = predicted.solve(next.transition * s.cov).transpose();  // P_k Fᵀ P̂⁻¹ (P_k, P̂ symmetric)
+    const M3 gain = s.cov * next.transition.transpose() * p.inverse();
     if (!gain.allFinite()) {
       return Status::error(Errc::kInvalidArgument, "increment smoother: non-finite gain at step %zu", k);
     }
