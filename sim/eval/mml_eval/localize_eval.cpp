@@ -232,8 +232,9 @@ void run_whole_logs(LocalizeRun& run, const LoadedDataset& ds, OwnedLocalizer& l
 
 // First-fix trials from kidnapped starts, fix_steps long each.
 void run_fix_trials(LocalizeRun& run, const LoadedDataset& ds, OwnedLocalizer& loc, const MetricBounds& b,
-                    const std::vector<std::size_t>& starts, const TrialOptions& fopt, std::vector<TrialResult>* all) {
-  std::vector<TrialResult> fix;
+                    const std::vector<std::size_t>& starts, const TrialOptions& fopt, std::vector<TrialResult>* all,
+                    std::vector<TrialResult>* fix_out) {
+  std::vector<TrialResult>& fix = *fix_out;
   for (std::size_t k = 0; k < starts.size(); ++k) {
     const auto tk = std::chrono::steady_clock::now();
     TrialResult t = run_trial(loc, ds, starts[k], fopt);
@@ -278,9 +279,11 @@ void add_dataset_figures(BenchJson* json, const std::string& D, const SystemSumm
   json->add_int(D + "_trials", static_cast<long long>(s.trials));
 }
 
-// MCL baseline: metres to the first fix on the first fix-trial starts.
+// MCL baseline: metres to the first fix on the first fix-trial starts, and mml-track's figure on the
+// same starts (`fix`: its fix trials, in start order), so the two medians compare like with like.
 bool run_mcl_baseline(LocalizeRun& run, const LoadedDataset& ds, const MetricBounds& b,
-                      const std::vector<std::size_t>& starts, const TrialOptions& fopt, std::string* err) {
+                      const std::vector<std::size_t>& starts, const TrialOptions& fopt,
+                      const std::vector<TrialResult>& fix, std::string* err) {
   const LocalizePlan& plan = run.plan;
   std::string e;
   auto mcl = OwnedLocalizer::make_mcl(ds.map, mcl_baseline_options(plan.mcl_particles, plan.seed), plan.threads, &e);
@@ -296,6 +299,10 @@ bool run_mcl_baseline(LocalizeRun& run, const LoadedDataset& ds, const MetricBou
   run.rows.push_back(ms);
   run.json->add(ds.key + "_mcl_m_to_fix_median", ms.m_to_fix_median);
   run.json->add(ds.key + "_mcl_first_fix_success", ms.first_fix_success);
+  const std::vector<TrialResult> same(fix.begin(), fix.begin() + static_cast<std::ptrdiff_t>(std::min(mt.size(), fix.size())));
+  const SystemSummary paired = summarize(ds.name, "mml-track", same, 0.0, b);
+  run.json->add(ds.key + "_m_to_fix_median_mcl_starts", paired.m_to_fix_median);
+  run.json->add(ds.key + "_first_fix_success_mcl_starts", paired.first_fix_success);
   return true;
 }
 
@@ -389,7 +396,8 @@ bool evaluate_dataset(LocalizeRun& run, const std::string& name, const DatasetFi
   TrialOptions fopt = plan.step_rule;
   fopt.max_steps = plan.fix_steps;
   const std::vector<std::size_t> starts = draw_starts(ds, nfix, plan.seed, fopt);
-  run_fix_trials(run, ds, *loc, b, starts, fopt, &all);
+  std::vector<TrialResult> fix;  // the fix trials alone, in start order (the MCL comparison's)
+  run_fix_trials(run, ds, *loc, b, starts, fopt, &all, &fix);
   SystemSummary s = summarize(ds.name, "mml-track", all, loc->static_bytes() / (1024.0 * 1024.0), b);
   run.rows.push_back(s);
   for (const auto& t : all)
@@ -399,7 +407,7 @@ bool evaluate_dataset(LocalizeRun& run, const std::string& name, const DatasetFi
 
   if (std::find(plan.mcl_datasets.begin(), plan.mcl_datasets.end(), ds.name) != plan.mcl_datasets.end() &&
       plan.mcl_trials > 0) {
-    if (!run_mcl_baseline(run, ds, b, starts, fopt, err)) return false;
+    if (!run_mcl_baseline(run, ds, b, starts, fopt, fix, err)) return false;
   }
   if (std::find(plan.kidnap_datasets.begin(), plan.kidnap_datasets.end(), ds.name) != plan.kidnap_datasets.end() &&
       plan.kidnap_runs > 0) {

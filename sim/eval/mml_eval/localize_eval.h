@@ -36,9 +36,10 @@ struct LocalizePlan {
   std::size_t fix_steps = 200;
   // Per-dataset overrides of the trial counts (name → count), e.g. fewer runs on a slow dataset.
   std::vector<std::pair<std::string, std::size_t>> whole_runs_override, fix_trials_override;
-  // MCL baseline (metres to the first fix) on the first `mcl_trials` fix-trial starts.
+  // MCL baseline (metres to the first fix) on the first `mcl_trials` fix-trial starts; mml-track's
+  // figure on the same starts beside it (D_m_to_fix_median_mcl_starts). 10 = every fix-trial start.
   std::vector<std::string> mcl_datasets = {"intel", "fr079"};
-  std::size_t mcl_trials = 3;
+  std::size_t mcl_trials = 10;
   std::uint32_t mcl_particles = 30000;
   // Kidnaps: `kidnap_runs` per dataset; the robot is carried `kidnap_after_fix` steps after its first
   // fix (at step kidnap_latest_step at the latest) to a random scan ≥ kidnap_min_dist_m away and the

@@ -104,6 +104,25 @@ TEST(LocalizeMetrics, FirstFixOutsideWindowOrWrong) {
   EXPECT_EQ(trial_metrics(wrong_heading, b).integrity_failures, 1u);
 }
 
+// Metres to the first fix count a wrong fix, and a trial without one, as never fixed (+∞) instead of
+// as a fast fix or not at all: the median of {1, 2, 3, wrong at 0, none} is the 3rd of 1 2 3 ∞ ∞ = 3
+// (the old rule: median of {0, 1, 2, 3} = 1.5, flattering the system that fixed wrongly).
+TEST(LocalizeMetrics, MetresToFixCountWrongAndMissingFixesAsNever) {
+  const TrialResult at1 = trial({step(S, 0), step(L, 0.1), step(L, 0.1)});
+  const TrialResult at2 = trial({step(S, 0), step(A, 3.0), step(L, 0.1)});
+  const TrialResult at3 = trial({step(S, 0), step(S, 0), step(A, 1.0), step(L, 0.2)});
+  const TrialResult wrong = trial({step(L, 4.0), step(L, 4.0)});
+  const TrialResult none = trial({step(S, 0), step(A, 2.0), step(S, 0)});
+  EXPECT_DOUBLE_EQ(summarize("d", "sys", {at1, at2, at3, wrong, none}, 0).m_to_fix_median, 3.0);
+  EXPECT_DOUBLE_EQ(summarize("d", "sys", {at1, at2, at3, wrong}, 0).m_to_fix_median, 2.5);
+  EXPECT_DOUBLE_EQ(summarize("d", "sys", {at1, at2, at3}, 0).m_to_fix_median, 2.0);
+  // Half or more never fixed: the median is not reached (NaN), never a finite figure.
+  EXPECT_TRUE(std::isnan(summarize("d", "sys", {at1, wrong, none}, 0).m_to_fix_median));
+  EXPECT_TRUE(std::isnan(summarize("d", "sys", {at1, none}, 0).m_to_fix_median));
+  EXPECT_TRUE(std::isnan(censored_median({})));
+  EXPECT_DOUBLE_EQ(censored_median({5.0, 1.0, std::numeric_limits<double>::infinity()}), 5.0);
+}
+
 TEST(LocalizeMetrics, IntegrityFailuresAndReferenceExclusion) {
   TrialResult t = trial({step(L, 0.1), step(L, 0.7), step(L, 0.2, 7.0), step(A, 5.0), step(L, 0.9), step(L, 0.1)});
   t.steps[4].ref_ok = false;  // unreliable reference: not checked, counted as excluded

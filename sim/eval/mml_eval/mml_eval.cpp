@@ -695,6 +695,14 @@ double percentile(std::vector<double> v, double p) {
   return v[lo] + (v[hi] - v[lo]) * (idx - lo);
 }
 
+double censored_median(std::vector<double> v) {
+  if (v.empty()) return std::numeric_limits<double>::quiet_NaN();
+  std::sort(v.begin(), v.end());  // +∞ (never) sorts last
+  const std::size_t n = v.size();
+  const double m = n % 2 ? v[n / 2] : 0.5 * (v[n / 2 - 1] + v[n / 2]);
+  return std::isfinite(m) ? m : std::numeric_limits<double>::quiet_NaN();
+}
+
 SystemSummary summarize(const std::string& dataset, const std::string& system, const std::vector<TrialResult>& trials,
                         double memory_mib, const MetricBounds& bounds) {
   SystemSummary s;
@@ -758,7 +766,11 @@ SystemSummary summarize(const std::string& dataset, const std::string& system, c
     const TrialMetrics m = trial_metrics(t, bounds);
     s.first_fixes += m.first_fix;
     s.first_fix_successes += m.first_fix_success;
-    if (m.first_fix) m_fix.push_back(m.m_to_fix);
+    // Metres to the first *correct* fix: a trial whose first `localized` within the window is wrong
+    // (or cannot be judged), or that has none, never fixed — +∞ in the sample (a censored
+    // observation). A confidently wrong fix is not a fast fix, and a trial that never fixed is not
+    // left out of the median (both flattered one side of the MCL comparison before 2026-11-29).
+    m_fix.push_back(m.first_fix_success ? m.m_to_fix : std::numeric_limits<double>::infinity());
     s.avail_steps += m.avail_steps;
     avail_loc += m.avail_localized;
     for (std::size_t r = 0; r < hal::kStatusReasonCount; ++r) s.unavailable_by_reason[r] += m.unavailable_by_reason[r];
@@ -785,7 +797,7 @@ SystemSummary summarize(const std::string& dataset, const std::string& system, c
     }
   }
   s.first_fix_success = trials.empty() ? nan : static_cast<double>(s.first_fix_successes) / trials.size();
-  s.m_to_fix_median = percentile(m_fix, 50);
+  s.m_to_fix_median = censored_median(m_fix);
   s.availability = s.avail_steps ? static_cast<double>(avail_loc) / s.avail_steps : nan;
   s.integrity_failure_rate = s.localized_checked ? static_cast<double>(s.integrity_failures) / s.localized_checked : nan;
   s.pl_exceed_rate = s.pl_steps ? static_cast<double>(s.pl_exceed) / s.pl_steps : nan;

@@ -242,6 +242,8 @@ struct SystemSummary {
   // Product metrics (trial_metrics pooled over the trials; NaN where nothing to measure).
   std::size_t first_fixes = 0, first_fix_successes = 0;
   double first_fix_success = 0;      // share of trials
+  // Median metres to the first correct fix over all trials; a trial with a wrong or no first fix
+  // within the window counts as never fixed (+∞); NaN when half or more never fixed.
   double m_to_fix_median = 0;
   double availability = 0;           // pooled avail_localized / avail_steps
   std::size_t avail_steps = 0;
@@ -255,6 +257,10 @@ struct SystemSummary {
   std::size_t kidnaps = 0, kidnaps_detected = 0, kidnap_refixes = 0, kidnap_integrity_failures = 0;
   double kidnap_delay_median = 0, kidnap_refix_m_median = 0, kidnap_refix_success = 0;
 };
+
+// Median of a sample where +∞ stands for "never" (a censored observation); NaN when empty or when
+// the median itself is "never".
+double censored_median(std::vector<double> v);
 
 SystemSummary summarize(const std::string& dataset, const std::string& system, const std::vector<TrialResult>& trials,
                         double memory_mib, const MetricBounds& bounds = MetricBounds());

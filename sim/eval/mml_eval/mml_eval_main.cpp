@@ -11,7 +11,7 @@
 // Localizer product metrics (mml-track; sim/eval/mml_eval/localize_eval.h, README "Localizer product
 // metrics"):
 //   mml-eval --localize [--datasets intel,fr101] [--whole-runs 3] [--steps 0] [--fix-trials 10]
-//            [--fix-steps 200] [--mcl-trials 3] [--mcl-datasets intel,fr079] [--kidnap-runs 2]
+//            [--fix-steps 200] [--mcl-trials 10] [--mcl-datasets intel,fr079] [--kidnap-runs 2]
 //            [--kidnap-datasets intel,fr079,aces] [--no-unknown] [--seed 1] [--threads 2] [--out DIR]
 //            [--no-pool]   (MML best-cluster support not pooled over consistent steps: Eq. 5.17 per step)
 //   --help prints the usage.
@@ -47,7 +47,7 @@ const char kUsage[] =
     "                [--mcl-particles-mit 120000] [--no-handoff] [--no-mcl] [--no-unknown] [--out build/eval/mml]\n"
     "                [--correct] [--reduce] [--no-unique] [--compare-local-map-options]\n"
     "       mml-eval --localize [--datasets intel,fr101] [--whole-runs 3] [--steps 0] [--fix-trials 10]\n"
-    "                [--fix-steps 200] [--mcl-trials 3] [--mcl-datasets intel,fr079] [--kidnap-runs 2]\n"
+    "                [--fix-steps 200] [--mcl-trials 10] [--mcl-datasets intel,fr079] [--kidnap-runs 2]\n"
     "                [--kidnap-datasets intel,fr079,aces] [--no-unknown] [--seed 1] [--threads 2] [--out DIR]\n"
     "                [--no-pool] [--global ref|live|live-deadline] [--odom-noise TT,TR,RR,RT]\n"
     "                [--odom-noise-per-step M,DEG] [--odom-adapt] [--fit-drop-rms] [--no-confirm-fix] [--no-confirm-on-past-scans]\n"
