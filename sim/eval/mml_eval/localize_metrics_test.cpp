@@ -228,6 +228,13 @@ TEST(LocalizeMetrics, KidnapDelayAndRefix) {
   const SystemSummary s = summarize("d", "sys", {t, never}, 0);
   EXPECT_EQ(s.kidnaps, 2u);
   EXPECT_DOUBLE_EQ(s.kidnap_refix_success, 0.5);
+  // The kidnap never detected nor re-fixed stays in the medians as "never": with one of two, the
+  // median is not reached; with one of three, it is the others' figure.
+  EXPECT_TRUE(std::isnan(s.kidnap_delay_median));
+  EXPECT_TRUE(std::isnan(s.kidnap_refix_m_median));
+  const SystemSummary s3 = summarize("d", "sys", {t, t, never}, 0);
+  EXPECT_DOUBLE_EQ(s3.kidnap_delay_median, 2.0);
+  EXPECT_DOUBLE_EQ(s3.kidnap_refix_m_median, 7.0 - 2.5);
 }
 
 // Records the odometry it is given; always "searching".

@@ -792,8 +792,11 @@ SystemSummary summarize(const std::string& dataset, const std::string& system, c
       s.kidnaps_detected += m.kidnap_detected;
       s.kidnap_refixes += m.kidnap_refix;
       s.kidnap_integrity_failures += m.kidnap_integrity_failures;
-      if (m.kidnap_detected) delays.push_back(m.kidnap_delay_steps);
-      if (m.kidnap_refix) refix_m.push_back(m.refix_m);
+      // As the first fix: a kidnap never detected, or never re-fixed correctly within the window,
+      // stays in the sample as "never" (+∞).
+      const double never = std::numeric_limits<double>::infinity();
+      delays.push_back(m.kidnap_detected ? m.kidnap_delay_steps : never);
+      refix_m.push_back(m.kidnap_refix ? m.refix_m : never);
     }
   }
   s.first_fix_success = trials.empty() ? nan : static_cast<double>(s.first_fix_successes) / trials.size();
@@ -803,8 +806,8 @@ SystemSummary summarize(const std::string& dataset, const std::string& system, c
   s.pl_exceed_rate = s.pl_steps ? static_cast<double>(s.pl_exceed) / s.pl_steps : nan;
   s.track_err_median_m = percentile(terr, 50);
   s.track_err_p95_m = percentile(terr, 95);
-  s.kidnap_delay_median = percentile(delays, 50);
-  s.kidnap_refix_m_median = percentile(refix_m, 50);
+  s.kidnap_delay_median = censored_median(delays);
+  s.kidnap_refix_m_median = censored_median(refix_m);
   s.kidnap_refix_success = s.kidnaps ? static_cast<double>(s.kidnap_refixes) / s.kidnaps : nan;
   return s;
 }

@@ -255,6 +255,7 @@ struct SystemSummary {
   double pl_exceed_rate = 0;
   double track_err_median_m = 0, track_err_p95_m = 0;
   std::size_t kidnaps = 0, kidnaps_detected = 0, kidnap_refixes = 0, kidnap_integrity_failures = 0;
+  // Medians with a kidnap never detected / never re-fixed counted as +∞ (censored_median).
   double kidnap_delay_median = 0, kidnap_refix_m_median = 0, kidnap_refix_success = 0;
 };
 
