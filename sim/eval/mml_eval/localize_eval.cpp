@@ -191,7 +191,7 @@ struct LocalizeRun {
   BenchJson* json;
   std::chrono::steady_clock::time_point t_all;
   std::vector<SystemSummary> rows;
-  std::ostringstream notes, refnotes, plnotes;
+  std::ostringstream notes, refnotes, plnotes, mclnotes;
   std::vector<double> track_ms_all;
   std::vector<TrialResult> kidnap_all;
   MetricBounds kidnap_bounds;
@@ -303,6 +303,22 @@ bool run_mcl_baseline(LocalizeRun& run, const LoadedDataset& ds, const MetricBou
   const SystemSummary paired = summarize(ds.name, "mml-track", same, 0.0, b);
   run.json->add(ds.key + "_m_to_fix_median_mcl_starts", paired.m_to_fix_median);
   run.json->add(ds.key + "_first_fix_success_mcl_starts", paired.first_fix_success);
+  // Start by start, for the report: metres to the first fix and whether it was right.
+  auto fix_text = [&](const TrialResult& t) {
+    const TrialMetrics m = trial_metrics(t, b);
+    char buf[64];
+    if (!m.first_fix) std::snprintf(buf, sizeof buf, "none");
+    else std::snprintf(buf, sizeof buf, "%.1f m%s", m.m_to_fix, m.first_fix_success ? "" : " WRONG");
+    return std::string(buf);
+  };
+  char head[256];
+  std::snprintf(head, sizeof head, "- %s: mml-track %.2f m (%zu/%zu right) vs %s %.2f m (%zu/%zu right); per start",
+                ds.name.c_str(), paired.m_to_fix_median, paired.first_fix_successes, same.size(), label.c_str(),
+                ms.m_to_fix_median, ms.first_fix_successes, mt.size());
+  run.mclnotes << head << " (scan: mml-track | " << label << "):";
+  for (std::size_t k = 0; k < same.size(); ++k)
+    run.mclnotes << (k ? "," : "") << " " << starts[k] << ": " << fix_text(same[k]) << " | " << fix_text(mt[k]);
+  run.mclnotes << "\n";
   return true;
 }
 
@@ -497,7 +513,10 @@ void write_localize_report(LocalizeRun& run) {
      << unavailable << "\n## Reference quality\n\n" << run.refnotes.str() << "\n## Integrity failures\n\n"
      << (run.notes.str().empty() ? std::string("none\n") : run.notes.str())
      << "\n## Protection-level exceedances (judged; compare with the reference's scatter at rest above)\n\n"
-     << (run.plnotes.str().empty() ? std::string("none\n") : run.plnotes.str());
+     << (run.plnotes.str().empty() ? std::string("none\n") : run.plnotes.str())
+     << "\n## First fix against MCL on the same starts (median metres to the first right fix; a wrong or "
+        "missing fix counts as never)\n\n"
+     << (run.mclnotes.str().empty() ? std::string("not run\n") : run.mclnotes.str());
   if (plan.verbose)
     std::printf("\n%s\nnot localized after the first fix, by reason:\n%sreference:\n%s\ntotal %.1f s\n", table.c_str(),
                 unavailable.c_str(), run.refnotes.str().c_str(), seconds_since(run.t_all));
@@ -506,7 +525,7 @@ void write_localize_report(LocalizeRun& run) {
 }  // namespace
 
 bool run_localize_evaluation(const LocalizePlan& plan, BenchJson* json, std::string* err) {
-  LocalizeRun run{plan, json, std::chrono::steady_clock::now(), {}, {}, {}, {}, {}, {}, {},
+  LocalizeRun run{plan, json, std::chrono::steady_clock::now(), {}, {}, {}, {}, {}, {}, {}, {},
                   mml_track_config(plan.mml_config, plan.seed)};
   run.mml_cfg.mml.pool_cluster_support = plan.pool_cluster_support;
   run.mml_cfg.mml.keep_support_across_empty_steps = plan.keep_support_across_empty_steps;
