@@ -103,6 +103,12 @@ UniquenessResult check_pose_uniqueness(const GlobalMap& map, const Point2f* poin
               in_same_cost_valley(map, points, n, valley_end[d], rr.pose, o.clip_m, o.valley_step_m, o.margin)) {
             valley_end[d] = rr.pose;
             ++r.same_valley_rivals;
+            const float dx = rr.pose.x - pose.x, dy = rr.pose.y - pose.y, dist = std::hypot(dx, dy);
+            if (dist > r.valley_extent_m) {
+              r.valley_extent_m = dist;
+              r.valley_axis_x = dx / dist;
+              r.valley_axis_y = dy / dist;
+            }
             continue;
           }
           valley_open[d] = false;

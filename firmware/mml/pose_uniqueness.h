@@ -46,6 +46,10 @@ struct UniquenessResult {
   std::uint32_t rivals_tried = 0;
   bool rival_turned = false;  // the best rival came from a turned seed
   std::uint32_t same_valley_rivals = 0;  // rivals left out as one mode (valley_is_one_mode)
+  // The farthest of those rivals from the candidate (valley_extent_m, 0 = none) and the unit
+  // direction towards it: the axis along which the scan fits alike, i.e. says nothing.
+  float valley_extent_m = 0.0f;
+  float valley_axis_x = 0.0f, valley_axis_y = 0.0f;
 };
 
 // Mean of min(d, clip)² / clip² over the points (robot frame) placed at `pose`; points off the map

@@ -82,7 +82,10 @@ TEST(ConfidenceExtentTest, PairedTestPrefersTheTruePose) {
 // Tracking along the corridor with one 10 cm stub: the stub's few end-points give the information
 // matrix a strong axis along the corridor (PL 0.15–0.17 m from the covariance) although the scan
 // cannot reject a 0.5 m shift (the paired test); with the extent the PL covers what the scan leaves
-// open, up to the prediction's own PL (0.24 m here).
+// open, up to the prediction's own PL (0.24 m here). The valley rule (alias_valley_is_one_mode with
+// its information drop, on by default) guards the same corridor another way — the scans' claimed
+// axial information is dropped — so it is off here to test the extent alone; the last case shows
+// the default covering the corridor with the extent off too.
 TEST(ConfidenceExtentTest, ProtectionLevelInACorridorCoversTheExtent) {
   float min_pl_off = 0.0f;
   const GridWorld corridor = plain_corridor(true);
@@ -90,6 +93,7 @@ TEST(ConfidenceExtentTest, ProtectionLevelInACorridorCoversTheExtent) {
   for (const bool on : {false, true}) {
     PoseTracker t;
     TrackOptions o;
+    o.alias_valley_is_one_mode = false;
     o.confidence_extent_xy = on;
     o.align.max_range_m = 4.0f;
     ASSERT_TRUE(t.init(o, map.map).is_ok());
@@ -122,6 +126,28 @@ TEST(ConfidenceExtentTest, ProtectionLevelInACorridorCoversTheExtent) {
       EXPECT_GT(min_pl, min_pl_off + 0.05f);
     }
   }
+  // The defaults with the extent off: the valley rule alone leaves the axis to the wheels.
+  PoseTracker t;
+  TrackOptions o;
+  o.confidence_extent_xy = false;
+  o.align.max_range_m = 4.0f;
+  ASSERT_TRUE(t.init(o, map.map).is_ok());
+  RandomStream rng(11, 0);
+  Se2f truth(10.0f, 2.0f, 0.0f), odom;
+  Eigen::Matrix3f cov = Eigen::Matrix3f::Zero();
+  cov(0, 0) = cov(1, 1) = 0.0025f;
+  cov(2, 2) = 0.0004f;
+  t.start(truth, cov, odom);
+  auto pts = testing::scan_at(corridor, truth, &rng, 0.01f, 4.0f);
+  t.step(pts.data(), pts.size(), odom, false);
+  float min_pl = 1e9f;
+  for (int i = 0; i < 20; ++i) {
+    odom = odom.compose(Se2f(0.2f, 0.0f, 0.0f));
+    truth = truth.compose(Se2f(0.2f, 0.0f, 0.0f));
+    pts = testing::scan_at(corridor, truth, &rng, 0.01f, 4.0f);
+    min_pl = std::fmin(min_pl, t.step(pts.data(), pts.size(), odom).pl.xy_m);
+  }
+  EXPECT_GT(min_pl, min_pl_off + 0.05f) << "the valley rule alone must not leave the corridor over-confident";
 }
 
 }  // namespace

@@ -377,6 +377,10 @@ void PoseTracker::check_aliases(const Point2f* points, std::size_t n, StepWork* 
   out->alias_cost = u.cost;
   out->alias_rival_cost = u.rival_cost;
   out->alias_rival = u.rival;
+  if (uo.valley_is_one_mode && o.alias_valley_drops_information && u.valley_extent_m > 0.0f) {
+    w->valley = true;
+    w->valley_axis = Eigen::Vector2f(u.valley_axis_x, u.valley_axis_y);
+  }
   if (u.rival_cost < u.cost - o.alias_margin &&
       rival_significantly_better(map_, alias_points_, m, a.pose, u.rival, o.alias_clip_m, a.independent, o.alias_z)) {
     w->v = ScanVerdict::kContradicting;  // the scan says the robot is elsewhere
@@ -447,7 +451,28 @@ PoseTracker::Update PoseTracker::propose_update(const Se2f& odom, bool predict, 
                                                      o.odom_rot_per_step_rad * std::sqrt(k) >= o.update_min_a_rad);
   const bool moved = fuse_next_ || !predict || beyond_update_thresholds(since, o) ||
                      (trusted && beyond_update_thresholds(seen, o)) || drifted;
-  const Eigen::Vector3f dx = w->p_post * (a.information * w->e);
+  Eigen::Matrix3f h = a.information;
+  if (w->valley) {
+    // alias_valley_drops_information: no information along the valley's axis (P H P). The axis is
+    // the weak eigenvector of H's position block when the valley runs along it (within 30°): the
+    // rival's refined position is a few centimetres off the line, and a tilted axis would leak the
+    // strong across-corridor information into it (a corridor's 1 cm across, tilted 3°, pins the
+    // axis to 20 cm per scan).
+    const Sym2Eigen eig = sym2_eigen(a.information(0, 0), 0.5f * (a.information(0, 1) + a.information(1, 0)),
+                                     a.information(1, 1));
+    Eigen::Vector2f axis(eig.vmin_x, eig.vmin_y);
+    if (std::fabs(axis.dot(w->valley_axis)) < 0.866f) axis = w->valley_axis;
+    Eigen::Matrix3f proj = Eigen::Matrix3f::Identity();
+    proj.topLeftCorner<2, 2>() -= axis * axis.transpose();
+    const Eigen::Matrix3f hv = proj * a.information * proj;
+    const Eigen::Matrix3d post = (cov_.cast<double>().inverse() + hv.cast<double>()).inverse();
+    if (post.allFinite()) {
+      w->p_post = post.cast<float>();
+      h = hv;
+      out->valley_dropped = true;
+    }
+  }
+  const Eigen::Vector3f dx = w->p_post * (h * w->e);
   if (!dx.allFinite()) return u;
   if (!moved) {
     w->unfused = dx;

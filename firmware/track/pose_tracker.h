@@ -80,6 +80,9 @@ struct TrackStep {
   // The rival of an ambiguous scan is a place the robot could be: turned, or at the fix's heading
   // inside the prediction's protection level and behind a barrier (not in the fix's cost valley).
   bool alias_rival_credible = false;
+  // The fused update left the alias check's one-mode valley axis to the prediction
+  // (TrackOptions::alias_valley_drops_information).
+  bool valley_dropped = false;
   std::uint32_t search_candidates = 0;  // correlative pre-search (0 = not run: prediction tight)
   bool search_moved = false;            // the alignment started from the search's best pose
   OdometryNoiseScale odom_noise;        // wheel-noise self-calibration in use (odometry_noise_estimate.h)
@@ -118,6 +121,10 @@ class PoseTracker {
     Eigen::Vector3f e = Eigen::Vector3f::Zero();     // scan fix − prediction
     Eigen::Vector3f unfused = Eigen::Vector3f::Zero();  // the update a scan not fused would make
     float fit_drop_z = 0.0f;  // the fit-drop test's statistic against the previous scan (0 = not tested)
+    // The alias check's one-mode valley (alias_valley_is_one_mode): the unit axis along which the
+    // scan fits alike; its information along it is dropped before the update.
+    bool valley = false;
+    Eigen::Vector2f valley_axis = Eigen::Vector2f::Zero();
   };
   struct Update {
     bool fuse = false;

@@ -741,6 +741,60 @@ TEST(PoseTrackerTest, ValleyRivalIsOneModeOnATrustedTrack) {
   }
 }
 
+// TrackOptions::alias_valley_drops_information: along a bare corridor the alias check finds rivals
+// in the fix's own cost valley, so the scan says nothing along the axis; what its Hessian claims
+// there (the distance field's cell steps, range noise) is not evidence. With the drop the axis's
+// variance is the wheels' alone and grows as they drive; without it the scans keep shrinking it
+// (mit-killian 2026-11-29: a track 0.31 m off along a corridor under a PL of 0.26–0.28 m).
+TEST(PoseTrackerTest, ValleyAxisIsLeftToTheWheels) {
+  // A corridor narrowing by 0.3 m over 29 m: the sloped wall gives the scan a little information
+  // along the axis, mostly less than a rival 0.4 m along it needs to fit measurably worse.
+  GridWorld world;
+  world.w = 600;
+  world.h = 80;
+  world.occ.assign(world.w * world.h, 0);
+  world.wall(0.5f, 1.0f, 29.5f, 1.0f);
+  world.wall(0.5f, 3.0f, 29.5f, 2.7f);
+  world.wall(0.5f, 1.0f, 0.5f, 3.0f);
+  world.wall(29.5f, 1.0f, 29.5f, 2.7f);
+  world.finish();
+  const OwnedGlobalMap map(world);
+  int shrank_on_valley_scans[2] = {0, 0}, valley_scans[2] = {0, 0};
+  float across[2] = {0.0f, 0.0f};
+  for (const bool drop : {true, false}) {
+    PoseTracker t;
+    TrackOptions o;
+    o.alias_valley_is_one_mode = true;
+    o.alias_valley_drops_information = drop;
+    ASSERT_TRUE(t.init(o, map.map).is_ok());
+    RandomStream rng(47, 0);
+    const Se2f start(10.0f, 2.0f, 0.0f);
+    t.start(start, small_cov(), Se2f());
+    float prev_axis = std::sqrt(small_cov()(0, 0));
+    for (int i = 1; i <= 40; ++i) {
+      const Se2f truth(start.x + 0.1f * static_cast<float>(i), 2.0f, 0.0f);
+      const Se2f odom(0.098f * static_cast<float>(i), 0.0f, 0.0f);
+      const auto pts = testing::scan_at(world, truth, &rng, 0.01f, 4.0f);
+      const TrackStep s = t.step(pts.data(), pts.size(), odom);
+      ASSERT_FALSE(s.lost) << drop << " " << i;
+      if (s.status == hal::LocalizationStatus::kLocalized) EXPECT_LE(err_xy(s.pose, truth), s.pl.xy_m) << drop << " " << i;
+      const float axis = std::sqrt(s.cov(0, 0));
+      EXPECT_FALSE(s.valley_dropped && !drop);
+      // With the drop: the fused scans that dropped the axis; without: every fused scan.
+      if (s.fused && (s.valley_dropped || !drop)) {
+        ++valley_scans[drop];
+        shrank_on_valley_scans[drop] += axis < prev_axis - 1e-4f;
+      }
+      prev_axis = axis;
+      across[drop] = std::sqrt(s.cov(1, 1));
+    }
+  }
+  EXPECT_GE(valley_scans[1], 30) << "most scans of the narrowing corridor fit alike along it";
+  EXPECT_EQ(shrank_on_valley_scans[1], 0) << "with the drop a valley scan never narrows the axis";
+  EXPECT_GE(shrank_on_valley_scans[0], 10) << "without it the scans' weak axial information narrows it";
+  EXPECT_NEAR(across[1], across[0], 0.2f * across[0]) << "across the corridor the scan still pins the pose";
+}
+
 // A track that slid one period along the corridor (or was started there by a wrong fix): the scan
 // fits there except for the one pillar only the true pose explains. The alias check finds the rival
 // at the true pose and it explains the scan better; one pillar is one correlated object (a single

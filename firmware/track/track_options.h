@@ -152,18 +152,23 @@ struct TrackOptions {
   // recovery_steps unique scans, no fit drop at alias_credible_z), a rival at the fix's heading
   // joined to the fix by poses that fit as well (mml::in_same_cost_valley: a bare corridor whose
   // walls fit wherever the robot stands along it) is not a second mode but the scan's weak axis,
-  // which the update leaves to the prediction and the PL covers through the scan's confidence extent
-  // (confidence_extent_xy, capped at the prediction's PL plus the update's shift: the truth is within
-  // the prediction's PL of it, the published pose within the shift). Such a rival does not make the
-  // scan ambiguous; any other rival does (check_pose_uniqueness reports the best of the others).
-  // OFF by default: measured 2026-11-29 it lifts the large office's availability 0.770 → 0.847
-  // (seeds 1–5) and 0.725 → 0.817 (6–15) with 0 wrong, but on mit-killian (whole run, seed 1) it
-  // let a corridor track 0.31 m off along the axis be `localized` under a PL of 0.26–0.28 m (scans
-  // 15992–15993, reference good there): repeated scans with a little curvature along the weak axis
-  // shrink the covariance the PL is built from, so the Gaussian does not cover that axis yet. The
-  // next step is to drop the scan's information along the valley before the update. false = every
-  // rival counts (the large office: 56–71 `ambiguous` steps a run in its corridors).
-  bool alias_valley_is_one_mode = false;
+  // which the update leaves to the prediction (alias_valley_drops_information below) and the PL
+  // covers through the prediction's growth and the scan's confidence extent (capped at the
+  // prediction's PL plus the update's shift). Such a rival does not make the scan ambiguous; any
+  // other rival does (check_pose_uniqueness reports the best of the others).
+  // ON since 2026-11-29 (measured: whole runs of the seven logs, the large office, 560 kidnap runs;
+  // README "Protection level"). First measured without the drop below (off then): it lifted the
+  // large office's availability 0.770 → 0.847, but on mit-killian (whole run, seed 1) let a corridor
+  // track 0.31 m off along the axis be `localized` under a PL of 0.26–0.28 m (scans 15992–15993):
+  // the scans' weak curvature along the axis had shrunk the covariance the PL is built from.
+  // false = every rival counts (the large office: 56–71 `ambiguous` steps a run in its corridors).
+  bool alias_valley_is_one_mode = true;
+  // With the rule above: a scan whose fix has a one-mode valley gives no information along the
+  // valley's axis (its rivals there fit as well, so what its Hessian claims along that axis is the
+  // curvature of a flat floor, not evidence): that axis of H is projected out before the update
+  // (H ← P H P, P = I − v vᵀ on the position), so the pose along it stays on the prediction and its
+  // variance grows with the wheels, as the PL then says. false = the full H (the 2026-11-29 rule).
+  bool alias_valley_drops_information = true;
   float alias_max_shift_m = 3.0f;
   float alias_step_m = 0.4f;
   float alias_min_separation_m = 0.4f;

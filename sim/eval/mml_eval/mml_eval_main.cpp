@@ -51,7 +51,7 @@ const char kUsage[] =
     "                [--kidnap-datasets intel,fr079,aces] [--no-unknown] [--seed 1] [--threads 2] [--out DIR]\n"
     "                [--no-pool] [--global ref|live|live-deadline] [--odom-noise TT,TR,RR,RT]\n"
     "                [--odom-noise-per-step M,DEG] [--odom-adapt] [--fit-drop-rms] [--no-confirm-fix] [--no-confirm-on-past-scans]\n"
-    "                [--no-steady-fit-trust] [--valley-one-mode]\n"
+    "                [--no-steady-fit-trust] [--no-valley-one-mode] [--keep-valley-information]\n"
     "                [--no-cover-unfused] [--confidence-cap-pred-pl]\n"
     "       mml-eval --log LOG.clf[.gz] --map MAP.yaml|MAP.mmap --reference POSES.txt|CORRECTED.log[.gz]\n"
     "                [--relations R] [--name NAME] [--synthetic-odometry]   (any building by path)\n"
@@ -69,8 +69,10 @@ const char kUsage[] =
     "(TrackOptions::confirm_fix). --no-confirm-on-past-scans: MML's fix confirmed forward only, not on the\n"
     "scans before it first (TrackOptions::confirm_fix_on_past_scans, on by default). --no-steady-fit-trust:\n"
     "an alias rival beyond the prediction stays exempt when the fit fell at z 1.645\n"
-    "(TrackOptions::alias_trust_needs_steady_fit). --valley-one-mode: on a trusted track a rival in the fix's own\n"
-    "cost valley does not make the scan ambiguous (TrackOptions::alias_valley_is_one_mode, off by default). --no-cover-unfused: the PL of a\n"
+    "(TrackOptions::alias_trust_needs_steady_fit). --no-valley-one-mode: on a trusted track a rival in the fix's own\n"
+    "cost valley makes the scan ambiguous too (TrackOptions::alias_valley_is_one_mode, on by default; --valley-one-mode\n"
+    "turns it on). --keep-valley-information: such a scan's information along the valley is fused, not dropped\n"
+    "(TrackOptions::alias_valley_drops_information). --no-cover-unfused: the PL of a\n"
     "scan not fused (standing robot) leaves out the update the scan would make\n"
     "(TrackOptions::cover_unfused_update). --confidence-cap-pred-pl: the scan's confidence extent capped at\n"
     "the prediction's PL alone (TrackOptions::confidence_cap_with_update). --cap-unpinned-scans: that cap\n"
@@ -155,6 +157,8 @@ static int run_main(int argc, char** argv) {
     else if (a == "--no-confirm-on-past-scans") { lp.track.confirm_fix_on_past_scans = false; localize = true; }
     else if (a == "--no-steady-fit-trust") { lp.track.alias_trust_needs_steady_fit = false; localize = true; }
     else if (a == "--valley-one-mode") { lp.track.alias_valley_is_one_mode = true; localize = true; }
+    else if (a == "--no-valley-one-mode") { lp.track.alias_valley_is_one_mode = false; localize = true; }
+    else if (a == "--keep-valley-information") { lp.track.alias_valley_drops_information = false; localize = true; }
     else if (a == "--no-cover-unfused") { lp.track.cover_unfused_update = false; localize = true; }
     else if (a == "--confidence-cap-pred-pl") { lp.track.confidence_cap_with_update = false; localize = true; }
     else if (a == "--cap-unpinned-scans") { lp.track.confidence_cap_needs_a_pinned_axis = false; localize = true; }

@@ -211,7 +211,7 @@ std::unique_ptr<fw::Localizer> make_track_localizer(const LocalizerContext& ctx,
   long adapt = 0;
   if (!parse_int(ctx.options, "odom_adapt", 0, 1, &adapt, "mml-track", err)) return nullptr;
   if (adapt == 1) to.odom_noise_window = 64;
-  long valley = 0;
+  long valley = to.alias_valley_is_one_mode ? 1 : 0;  // default: TrackOptions'
   if (!parse_int(ctx.options, "valley", 0, 1, &valley, "mml-track", err)) return nullptr;
   to.alias_valley_is_one_mode = valley == 1;
   static const std::vector<std::uint8_t> kEmpty;
