@@ -83,9 +83,9 @@ TEST(ConfidenceExtentTest, PairedTestPrefersTheTruePose) {
 // matrix a strong axis along the corridor (PL 0.15–0.17 m from the covariance) although the scan
 // cannot reject a 0.5 m shift (the paired test); with the extent the PL covers what the scan leaves
 // open, up to the prediction's own PL (0.24 m here). The valley rule (alias_valley_is_one_mode with
-// its information drop, on by default) guards the same corridor another way — the scans' claimed
-// axial information is dropped — so it is off here to test the extent alone; the last case shows
-// the default covering the corridor with the extent off too.
+// its information drop; off by default for its cost) guards the same corridor another way — the
+// scans' claimed axial information is dropped — so it is off here to test the extent alone; the
+// last case shows it covering the corridor with the extent off.
 TEST(ConfidenceExtentTest, ProtectionLevelInACorridorCoversTheExtent) {
   float min_pl_off = 0.0f;
   const GridWorld corridor = plain_corridor(true);
@@ -126,9 +126,10 @@ TEST(ConfidenceExtentTest, ProtectionLevelInACorridorCoversTheExtent) {
       EXPECT_GT(min_pl, min_pl_off + 0.05f);
     }
   }
-  // The defaults with the extent off: the valley rule alone leaves the axis to the wheels.
+  // The valley rule with the extent off: it alone leaves the axis to the wheels.
   PoseTracker t;
   TrackOptions o;
+  o.alias_valley_is_one_mode = true;
   o.confidence_extent_xy = false;
   o.align.max_range_m = 4.0f;
   ASSERT_TRUE(t.init(o, map.map).is_ok());

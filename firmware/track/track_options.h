@@ -156,14 +156,16 @@ struct TrackOptions {
   // covers through the prediction's growth and the scan's confidence extent (capped at the
   // prediction's PL plus the update's shift). Such a rival does not make the scan ambiguous; any
   // other rival does (check_pose_uniqueness reports the best of the others).
-  // ON since 2026-11-29 (measured: whole runs of the seven logs, the large office, 560 kidnap runs;
-  // README "Protection level"). First measured without the drop below (off then): it lifted the
-  // large office's availability 0.770 → 0.847, but on mit-killian (whole run, seed 1) let a corridor
-  // track 0.31 m off along the axis be `localized` under a PL of 0.26–0.28 m (scans 15992–15993):
-  // the scans' weak curvature along the axis had shrunk the covariance the PL is built from.
+  // OFF by default, for its cost (measured 2026-11-29, README "Protection level"): with the drop
+  // below it is sound on every measurement (mit-killian availability +0.006 with no new PL
+  // exceedance, the large office 0.770 → 0.836, the other six logs identical, 560 kidnap runs 0
+  // wrong), but the valley paths it walks on every corridor scan raise the sensor step's p99 on the
+  // office logs past one LMS scan period (bench_localize: fr079 10.1 → 15.7 ms, mit-killian 9.6 →
+  // 16.3 ms, intel 7.4 → 12.9 ms; target ≤ 13.3 ms). Without the drop it let a mit-killian corridor
+  // track 0.31 m off along the axis be `localized` under a PL of 0.26–0.28 m (scans 15992–15993).
   // false = every rival counts (the large office: 56–71 `ambiguous` steps a run in its corridors).
-  bool alias_valley_is_one_mode = true;
-  // With the rule above: a scan whose fix has a one-mode valley gives no information along the
+  bool alias_valley_is_one_mode = false;
+  // With the rule above (on whenever it is): a scan whose fix has a one-mode valley gives no information along the
   // valley's axis (its rivals there fit as well, so what its Hessian claims along that axis is the
   // curvature of a flat floor, not evidence): that axis of H is projected out before the update
   // (H ← P H P, P = I − v vᵀ on the position), so the pose along it stays on the prediction and its
