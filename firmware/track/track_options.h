@@ -160,16 +160,18 @@ struct TrackOptions {
   // below it is sound on every measurement (mit-killian availability +0.006 with no new PL
   // exceedance, the large office 0.770 → 0.836, the other six logs identical, 560 kidnap runs 0
   // wrong), but the valley paths it walks on every corridor scan raise the sensor step's p99 on the
-  // office logs past one LMS scan period (bench_localize: fr079 10.1 → 15.7 ms, mit-killian 9.6 →
-  // 16.3 ms, intel 7.4 → 12.9 ms; target ≤ 13.3 ms). Without the drop it let a mit-killian corridor
-  // track 0.31 m off along the axis be `localized` under a PL of 0.26–0.28 m (scans 15992–15993).
+  // office logs past one LMS scan period (whole runs side by side: mit-killian 11.2 → 15.4 ms,
+  // fr-clinic 9.8 → 15.2 ms, intel 7.6 → 10.6 ms; target ≤ 13.3 ms). Without the drop it let a
+  // mit-killian corridor track 0.31 m off along the axis be `localized` under a PL of 0.26–0.28 m
+  // (scans 15992–15993).
   // false = every rival counts (the large office: 56–71 `ambiguous` steps a run in its corridors).
   bool alias_valley_is_one_mode = false;
-  // With the rule above (on whenever it is): a scan whose fix has a one-mode valley gives no information along the
-  // valley's axis (its rivals there fit as well, so what its Hessian claims along that axis is the
-  // curvature of a flat floor, not evidence): that axis of H is projected out before the update
-  // (H ← P H P, P = I − v vᵀ on the position), so the pose along it stays on the prediction and its
-  // variance grows with the wheels, as the PL then says. false = the full H (the 2026-11-29 rule).
+  // With the rule above (in effect whenever it is on): a scan whose fix has a one-mode valley gives
+  // no information along the valley's axis (its rivals there fit as well, so what its Hessian
+  // claims along that axis is the curvature of a flat floor, not evidence): that axis of H is
+  // projected out before the update (H ← P H P, P = I − v vᵀ on the position), so the pose along it
+  // stays on the prediction and its variance grows with the wheels, as the PL then says.
+  // false = the full H (the rule as first measured).
   bool alias_valley_drops_information = true;
   float alias_max_shift_m = 3.0f;
   float alias_step_m = 0.4f;
