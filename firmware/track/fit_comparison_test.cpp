@@ -79,60 +79,12 @@ TEST(ConfidenceExtentTest, PairedTestPrefersTheTruePose) {
                                           a.independent, 3.09f));
 }
 
-// Tracking along the corridor with one 10 cm stub: the stub's few end-points give the information
-// matrix a strong axis along the corridor (PL 0.15–0.17 m from the covariance) although the scan
-// cannot reject a 0.5 m shift (the paired test); with the extent the PL covers what the scan leaves
-// open, up to the prediction's own PL (0.24 m here). The valley rule (alias_valley_is_one_mode with
-// its information drop; off by default for its cost) guards the same corridor another way — the
-// scans' claimed axial information is dropped — so it is off here to test the extent alone; the
-// last case shows it covering the corridor with the extent off.
-TEST(ConfidenceExtentTest, ProtectionLevelInACorridorCoversTheExtent) {
-  float min_pl_off = 0.0f;
-  const GridWorld corridor = plain_corridor(true);
-  const OwnedGlobalMap map(corridor);
-  for (const bool on : {false, true}) {
-    PoseTracker t;
-    TrackOptions o;
-    o.alias_valley_is_one_mode = false;
-    o.confidence_extent_xy = on;
-    o.align.max_range_m = 4.0f;
-    ASSERT_TRUE(t.init(o, map.map).is_ok());
-    RandomStream rng(11, 0);
-    Se2f truth(10.0f, 2.0f, 0.0f), odom;
-    Eigen::Matrix3f cov = Eigen::Matrix3f::Zero();
-    cov(0, 0) = cov(1, 1) = 0.0025f;
-    cov(2, 2) = 0.0004f;
-    t.start(truth, cov, odom);
-    auto pts = testing::scan_at(corridor, truth, &rng, 0.01f, 4.0f);
-    t.step(pts.data(), pts.size(), odom, false);
-    float min_pl = 1e9f;
-    for (int i = 0; i < 20; ++i) {
-      odom = odom.compose(Se2f(0.2f, 0.0f, 0.0f));
-      truth = truth.compose(Se2f(0.2f, 0.0f, 0.0f));
-      pts = testing::scan_at(corridor, truth, &rng, 0.01f, 4.0f);
-      const TrackStep s = t.step(pts.data(), pts.size(), odom);
-      min_pl = std::fmin(min_pl, s.pl.xy_m);
-      if (on) {
-        EXPECT_GE(s.confidence_xy_m, 0.45f) << i;
-      } else {
-        EXPECT_EQ(s.confidence_xy_m, 0.0f) << i;
-      }
-    }
-    if (!on) {
-      min_pl_off = min_pl;
-      EXPECT_LT(min_pl, 0.2f) << "the scenario no longer has an over-confident covariance";
-    } else {
-      EXPECT_GT(min_pl, 0.2f) << "the PL must cover the open corridor (bounded by the prediction)";
-      EXPECT_GT(min_pl, min_pl_off + 0.05f);
-    }
-  }
-  // The valley rule with the extent off: it alone leaves the axis to the wheels.
+// 20 steps of 0.2 m along `corridor` from a tight start at x = 10 m; returns the smallest PL and
+// hands every step to `each`.
+template <class EachStep>
+float smallest_pl_along(const GridWorld& corridor, const OwnedGlobalMap& map, const TrackOptions& o, EachStep each) {
   PoseTracker t;
-  TrackOptions o;
-  o.alias_valley_is_one_mode = true;
-  o.confidence_extent_xy = false;
-  o.align.max_range_m = 4.0f;
-  ASSERT_TRUE(t.init(o, map.map).is_ok());
+  EXPECT_TRUE(t.init(o, map.map).is_ok());
   RandomStream rng(11, 0);
   Se2f truth(10.0f, 2.0f, 0.0f), odom;
   Eigen::Matrix3f cov = Eigen::Matrix3f::Zero();
@@ -146,9 +98,42 @@ TEST(ConfidenceExtentTest, ProtectionLevelInACorridorCoversTheExtent) {
     odom = odom.compose(Se2f(0.2f, 0.0f, 0.0f));
     truth = truth.compose(Se2f(0.2f, 0.0f, 0.0f));
     pts = testing::scan_at(corridor, truth, &rng, 0.01f, 4.0f);
-    min_pl = std::fmin(min_pl, t.step(pts.data(), pts.size(), odom).pl.xy_m);
+    const TrackStep s = t.step(pts.data(), pts.size(), odom);
+    min_pl = std::fmin(min_pl, s.pl.xy_m);
+    each(i, s);
   }
-  EXPECT_GT(min_pl, min_pl_off + 0.05f) << "the valley rule alone must not leave the corridor over-confident";
+  return min_pl;
+}
+
+// Tracking along the corridor with one 10 cm stub: the stub's few end-points give the information
+// matrix a strong axis along the corridor (PL 0.15–0.17 m from the covariance) although the scan
+// cannot reject a 0.5 m shift (the paired test); with the extent the PL covers what the scan leaves
+// open, up to the prediction's own PL (0.24 m here). The valley rule (alias_valley_is_one_mode with
+// its information drop; off by default for its cost) guards the same corridor another way — the
+// scans' claimed axial information is dropped — so it is off here to test the extent alone; the
+// last case shows it covering the corridor with the extent off.
+TEST(ConfidenceExtentTest, ProtectionLevelInACorridorCoversTheExtent) {
+  const GridWorld corridor = plain_corridor(true);
+  const OwnedGlobalMap map(corridor);
+  TrackOptions o;
+  o.alias_valley_is_one_mode = false;
+  o.align.max_range_m = 4.0f;
+  o.confidence_extent_xy = false;
+  const float min_pl_off = smallest_pl_along(corridor, map, o, [](int i, const TrackStep& s) {
+    EXPECT_EQ(s.confidence_xy_m, 0.0f) << i;
+  });
+  EXPECT_LT(min_pl_off, 0.2f) << "the scenario no longer has an over-confident covariance";
+  o.confidence_extent_xy = true;
+  const float min_pl_on = smallest_pl_along(corridor, map, o, [](int i, const TrackStep& s) {
+    EXPECT_GE(s.confidence_xy_m, 0.45f) << i;
+  });
+  EXPECT_GT(min_pl_on, 0.2f) << "the PL must cover the open corridor (bounded by the prediction)";
+  EXPECT_GT(min_pl_on, min_pl_off + 0.05f);
+  // The valley rule with the extent off: it alone leaves the axis to the wheels.
+  o.confidence_extent_xy = false;
+  o.alias_valley_is_one_mode = true;
+  const float min_pl_valley = smallest_pl_along(corridor, map, o, [](int, const TrackStep&) {});
+  EXPECT_GT(min_pl_valley, min_pl_off + 0.05f) << "the valley rule alone must not leave the corridor over-confident";
 }
 
 }  // namespace
