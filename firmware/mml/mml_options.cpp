@@ -89,6 +89,7 @@ Status MmlOptions::validate() const {
   }
   FW_RETURN_IF_ERROR(check_range("tau_up", tau_up, 1, kMaxUnknownWindow));
   FW_RETURN_IF_ERROR(check_range("outside_map_contact", outside_map_contact, 0.0, 1.0));
+  FW_RETURN_IF_ERROR(check_range("refine_window", refine_window, 0.0, 1.0));
   FW_RETURN_IF_ERROR(check_positive("contact_distance_m", contact_distance_m));
   FW_RETURN_IF_ERROR(check_range("outside_map_no_match_steps", outside_map_no_match_steps, 0, 100000));
   FW_RETURN_IF_ERROR(check_range("reduction_min_jump", reduction_min_jump, 0.0, 1e6));

@@ -120,6 +120,9 @@ struct MmlOptions {
   float omega_thres_min = 0.60f;   // never ask pRANSAM for less than this (weak matches fool
                                    // the constraints when only one cluster survives)
   float omega_thres_max = 0.95f;
+  // pRANSAM refinement (MatchParams::refine_iterations, on in mml_track_preset): hypotheses rated
+  // at least Ω_thres − refine_window (and MatchParams::refine_min_quality) are refined.
+  float refine_window = 0.2f;
 
   // --- Unknown regions (Sec. 5.6, Eq. 5.37).
   bool detect_unknown = true;

@@ -108,5 +108,82 @@ TEST(ContactFieldTest, MatchNeedingTheDistanceFieldIsRefusedWithoutIt) {
   EXPECT_TRUE(st.is_ok()) << st.message();
 }
 
+// The L of the test above and a wall at x = 5 as segments: the distance to the nearest, and its
+// gradient (what the global map's distance field gives MML; Matcher::set_refine_distance).
+struct SegmentDistance {
+  mutable std::uint64_t calls = 0;
+  static bool sample(const void* ctx, const Point<2>& p, float* d, Point<2>* g) {
+    const SegmentDistance& self = *static_cast<const SegmentDistance*>(ctx);
+    ++self.calls;
+    const Point<2> a[3] = {Point<2>(0, 0), Point<2>(0, 0), Point<2>(5, 0)};
+    const Point<2> b[3] = {Point<2>(4.95f, 0), Point<2>(0, 4.95f), Point<2>(5, 2.97f)};
+    float best = 1e9f;
+    for (int k = 0; k < 3; ++k) {
+      const Point<2> ab = b[k] - a[k];
+      const float t = std::fmin(1.0f, std::fmax(0.0f, (p - a[k]).dot(ab) / ab.squaredNorm()));
+      const Point<2> diff = p - (a[k] + t * ab);
+      const float dist = diff.norm();
+      if (dist < best) {
+        best = dist;
+        *g = dist > 1e-6f ? Point<2>(diff / dist) : Point<2>(0, 0);
+      }
+    }
+    *d = best;
+    return true;
+  }
+};
+
+TEST(ContactFieldTest, RefinementUsesAnExternalDistanceWhenTheFieldKeepsNone) {
+  MatcherOptions o;
+  o.num_workers = 2;
+  o.max_scene_points = 512;
+  o.max_model_points = 1024;
+  o.field.max_cells = 200 * 200;
+  o.field.max_axis = 256;
+  o.field.keep_distance = false;
+  o.collect_capacity = 64;
+  StartupArena arena;
+  ASSERT_TRUE(arena.init_mapped(std::size_t(32) << 20, false, "contact test").is_ok());
+  Matcher<2> m;
+  ASSERT_TRUE(m.init(o, arena, nullptr).is_ok());
+  std::vector<Point<2>> model;
+  for (int i = 0; i < 100; ++i) {
+    model.emplace_back(0.05f * i, 0.0f);
+    model.emplace_back(0.0f, 0.05f * i);
+    model.emplace_back(5.0f, 0.03f * i);
+  }
+  ASSERT_TRUE(m.set_model(model.data(), model.size(), "L").is_ok());
+  SegmentDistance dist;
+  m.set_refine_distance(&SegmentDistance::sample, &dist);
+  // The scene: the model seen from a pose 0.3 m / 10° away, every other point.
+  const float c = std::cos(0.17f), s = std::sin(0.17f);
+  std::vector<Point<2>> scene;
+  for (std::size_t i = 0; i < model.size(); i += 2) {
+    const Point<2> q = model[i] - Point<2>(0.3f, -0.2f);
+    scene.emplace_back(c * q(0) + s * q(1), -s * q(0) + c * q(1));
+  }
+  MatchParams p;
+  p.seed = 5;
+  p.max_iterations = 4000;
+  p.omega_thres = 0.9f;
+  p.refine_iterations = 3;
+  p.refine_min_quality = 0.3f;
+  p.refine_max_points = 16;
+  MatchResult<2> r;
+  const Status st = m.match(scene.data(), scene.size(), p, &r);
+  ASSERT_TRUE(st.is_ok()) << st.message();
+  ASSERT_TRUE(r.found) << r.best.quality;
+  EXPECT_GT(r.stats.refined, 0u);
+  EXPECT_GT(dist.calls, 0u) << "the refinement did not sample the external distance";
+  // refine_max_points: a stride of ceil(150 / 16) = 10 leaves 15 points per Gauss–Newton step.
+  EXPECT_LE(dist.calls, r.stats.refined * p.refine_iterations * 15u);
+  // The scene maps back onto the model: h = the pose the scene was seen from.
+  const Point<2> t = r.best.translation;
+  const float th = std::atan2(r.best.rotation(1, 0), r.best.rotation(0, 0));
+  EXPECT_NEAR(t(0), 0.3f, 0.02f);
+  EXPECT_NEAR(t(1), -0.2f, 0.02f);
+  EXPECT_NEAR(th, 0.17f, 0.01f);
+}
+
 }  // namespace
 }  // namespace fw::pransam

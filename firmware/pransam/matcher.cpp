@@ -286,7 +286,8 @@ template <int D>
 Status Matcher<D>::check_match_input(const Point<D>* scene, std::size_t n, const MatchParams& params) const {
   if (!initialized_) return Status::error(Errc::kNotInitialized, "pransam match: matcher not initialised");
   if (model_ == nullptr) return Status::error(Errc::kNotInitialized, "pransam match: no model set (set_model)");
-  if ((params.refine_iterations > 0 || params.scene_origin_is_sensor) && !field_.has_distance()) {
+  if (((params.refine_iterations > 0 && refine_fn_ == nullptr) || params.scene_origin_is_sensor) &&
+      !field_.has_distance()) {
     return Status::error(Errc::kInvalidArgument,
                          "pransam match: refinement / free-space test need the distance field "
                          "(ContactFieldOptions.keep_distance = false)");

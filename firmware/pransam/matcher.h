@@ -103,6 +103,11 @@ struct MatchParams {
   float free_space_block_radius = 0.0f;
   float refine_min_quality = 0.6f;
   float refine_cutoff = 0.4f;
+  // At most this many scene points (evenly strided) enter the refinement's normal equations; 0 =
+  // all. Three parameters need far fewer points than a local map has, and the refinement of every
+  // hypothesis above refine_min_quality is what costs (MML: a full refinement raised the global
+  // step's p99 7-15x); the refined hypothesis is rated on the whole scene again.
+  std::uint32_t refine_max_points = 0;
 };
 
 struct MatchStats {
@@ -189,6 +194,15 @@ class Matcher {
 
   const MatcherOptions& options() const { return options_; }
   const ContactField<D>& field() const { return field_; }
+  // Optional distance source for the refinement (MatchParams::refine_iterations) in place of the
+  // contact field's float distance: a model that already has a distance field (the global map's)
+  // need not keep a second one (ContactFieldOptions::keep_distance = false saves 4 bytes per cell).
+  // `fn` gives the distance and its gradient at p, false where it is unknown. Start-up only.
+  using DistanceFn = bool (*)(const void* ctx, const Point<D>& p, float* d, Point<D>* grad);
+  void set_refine_distance(DistanceFn fn, const void* ctx) {
+    refine_fn_ = fn;
+    refine_ctx_ = ctx;
+  }
 
  private:
   static constexpr std::size_t kMaxTouched = 1u << 18;  // touched-slot list per table
@@ -250,6 +264,8 @@ class Matcher {
   bool touched_overflow_[2] = {false, false};
   float model_index_extent_ = -1.0f;
   ContactField<D> field_;
+  DistanceFn refine_fn_ = nullptr;
+  const void* refine_ctx_ = nullptr;
   PointIndex<D> index_a_, index_b_;
   const Point<D>* model_ = nullptr;
   std::uint32_t model_n_ = 0;

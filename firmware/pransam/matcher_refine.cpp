@@ -14,16 +14,19 @@ void Matcher<D>::refine(Hypothesis<D>* h) const {
   using MatP = Eigen::Matrix<float, kP, kP>;
   using VecP = Eigen::Matrix<float, kP, 1>;
   const float cutoff = params_.refine_cutoff;
+  const std::uint32_t cap = params_.refine_max_points;
+  const std::uint32_t stride = cap > 0 && scene_n_ > cap ? (scene_n_ + cap - 1) / cap : 1;
   for (std::uint32_t it = 0; it < params_.refine_iterations; ++it) {
     MatP hess = MatP::Zero();
     VecP grad = VecP::Zero();
     int used = 0;
-    for (std::uint32_t i = 0; i < scene_n_; ++i) {
+    for (std::uint32_t i = 0; i < scene_n_; i += stride) {
       const Point<D> q = h->rotation * scene_[i];
       const Point<D> p = q + h->translation;
       float d;
       Point<D> g;
-      if (!field_.distance_gradient(p, &d, &g) || d > cutoff) continue;
+      const bool known = refine_fn_ != nullptr ? refine_fn_(refine_ctx_, p, &d, &g) : field_.distance_gradient(p, &d, &g);
+      if (!known || d > cutoff) continue;
       VecP j;
       if constexpr (D == 2) {
         // Update R ← r(δθ)·R, t ← t + δt, so ∂p/∂δθ = perp(R·a).

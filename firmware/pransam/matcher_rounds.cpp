@@ -53,7 +53,9 @@ void Matcher<D>::run_worker(int w) {
     if (refining && q >= params_.refine_min_quality) {
       refine(&h);
       ++st.stats.refined;
-      q = rate(h, 0.0f, 0, &complete, &st.stats.point_checks);
+      // Collecting, a refined hypothesis below Ω_thres is dropped anyway: the early stop applies.
+      q = rate(h, collect ? thres : 0.0f, 0, &complete, &st.stats.point_checks);
+      if (!complete) { ++st.stats.extrapolation_cut; continue; }
     }
     // Free-space gate: 2-D tests what reaches Ω_thres; the 3-D extension tests from
     // free_space_min_quality whatever would become the best (or be collected).
