@@ -183,6 +183,16 @@ TEST(ContactFieldTest, RefinementUsesAnExternalDistanceWhenTheFieldKeepsNone) {
   EXPECT_NEAR(t(0), 0.3f, 0.02f);
   EXPECT_NEAR(t(1), -0.2f, 0.02f);
   EXPECT_NEAR(th, 0.17f, 0.01f);
+  // refine_max_hypotheses: each of the two workers refines at most its share, ceil(5 / 2) = 3.
+  p.collect_all = true;  // every draw is rated: many refinements
+  p.omega_thres = 0.6f;
+  ASSERT_TRUE(m.match(scene.data(), scene.size(), p, &r).is_ok());
+  const std::uint64_t uncapped = r.stats.refined;
+  ASSERT_GT(uncapped, 6u) << "the cap below would not bind";
+  p.refine_max_hypotheses = 5;
+  ASSERT_TRUE(m.match(scene.data(), scene.size(), p, &r).is_ok());
+  EXPECT_GT(r.stats.refined, 0u);
+  EXPECT_LE(r.stats.refined, 6u);
 }
 
 }  // namespace

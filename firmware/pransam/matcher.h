@@ -108,6 +108,10 @@ struct MatchParams {
   // hypothesis above refine_min_quality is what costs (MML: a full refinement raised the global
   // step's p99 7-15x); the refined hypothesis is rated on the whole scene again.
   std::uint32_t refine_max_points = 0;
+  // At most this many refinements per match (0 = no limit), shared evenly by the workers (each stops
+  // refining after its share, so the result does not depend on scheduling): the bound on what the
+  // refinement can add to a match where hundreds of hypotheses come near the threshold.
+  std::uint32_t refine_max_hypotheses = 0;
 };
 
 struct MatchStats {

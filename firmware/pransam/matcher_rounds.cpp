@@ -18,6 +18,10 @@ void Matcher<D>::run_worker(int w) {
   const bool collect = params_.collect_all;
   const float thres = params_.omega_thres;
   float bound = collect ? thres : round_bound_;
+  const std::uint64_t refine_share =
+      params_.refine_max_hypotheses == 0
+          ? 0
+          : (params_.refine_max_hypotheses + static_cast<std::uint64_t>(num_workers_) - 1) / static_cast<std::uint64_t>(num_workers_);
   for (std::uint32_t it = 0; it < st.batch; ++it) {
     ++st.stats.iterations;
     Triple t;
@@ -46,7 +50,7 @@ void Matcher<D>::run_worker(int w) {
     h.worker = static_cast<std::uint16_t>(w);
     ++st.stats.evaluated;
     bool complete = false;
-    const bool refining = params_.refine_iterations > 0;
+    const bool refining = params_.refine_iterations > 0 && (refine_share == 0 || st.stats.refined < refine_share);
     const float rate_bound = refining && params_.refine_min_quality < bound ? params_.refine_min_quality : bound;
     float q = rate(h, rate_bound, st.rng.uniform_index(scene_n_), &complete, &st.stats.point_checks);
     if (!complete) { ++st.stats.extrapolation_cut; continue; }
