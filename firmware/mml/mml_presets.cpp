@@ -52,8 +52,9 @@ MmlLocalizerConfig fit_contact_field_to_map(MmlLocalizerConfig config, const Glo
   const float sx = map.geometry.size_x() / res + 64.0f, sy = map.geometry.size_y() / res + 64.0f;
   f.max_axis = static_cast<std::uint32_t>(std::max(sx, sy)) + 1;
   f.max_cells = static_cast<std::size_t>(sx + 1) * static_cast<std::size_t>(sy + 1);
-  // MML rates hypotheses by contact only (no pRANSAM refinement or free-space test): the float
-  // distance field would duplicate the map's own, 4 bytes per cell (issue 14).
+  // The contact field keeps no float distance field: it would duplicate the map's own, 4 bytes per
+  // cell (issue 14); pRANSAM's refinement (mml_track_preset) samples the map's field instead
+  // (Matcher::set_refine_distance), and MML uses no free-space test.
   f.keep_distance = false;
   return config;
 }
