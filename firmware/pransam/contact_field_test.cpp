@@ -1,6 +1,7 @@
 // The contact field without its float distance field (keep_distance = false, what MML uses: issue
 // 14) stamps the same contact bytes the EDT path computes, in 2-D and 3-D, and a match that needs
-// the distance field is refused with a status instead of reading memory that was never allocated.
+// the distance field is refused with a status instead of reading memory that was never allocated,
+// unless the caller gives the refinement a distance of its own (as MML gives the global map's).
 #include "firmware/pransam/contact_field.h"
 
 #include <gtest/gtest.h>
@@ -73,26 +74,33 @@ TEST(ContactFieldTest, StampedBytesEqualTheEdtBytes2D) { expect_same_bytes<2>(0.
 TEST(ContactFieldTest, StampedBytesEqualTheEdtBytes2DCoarse) { expect_same_bytes<2>(0.1f, 0.2f, 0.4f, 200, 9.0f, 2); }
 TEST(ContactFieldTest, StampedBytesEqualTheEdtBytes3D) { expect_same_bytes<3>(0.05f, 0.10f, 0.20f, 150, 1.5f, 3); }
 
-TEST(ContactFieldTest, MatchNeedingTheDistanceFieldIsRefusedWithoutIt) {
-  MatcherOptions o;
-  o.num_workers = 2;  // online matching: one worker per relation table
-  o.max_scene_points = 64;
-  o.max_model_points = 1024;
-  o.field.max_cells = 200 * 200;
-  o.field.max_axis = 256;
-  o.field.keep_distance = false;
-  o.collect_capacity = 64;
-  StartupArena arena;
-  ASSERT_TRUE(arena.init_mapped(std::size_t(32) << 20, false, "contact test").is_ok());
-  Matcher<2> m;
-  ASSERT_TRUE(m.init(o, arena, nullptr).is_ok());
-  std::vector<Point<2>> model;
-  for (int i = 0; i < 100; ++i) {
-    model.emplace_back(0.05f * i, 0.0f);
-    model.emplace_back(0.0f, 0.05f * i);
-    model.emplace_back(5.0f, 0.03f * i);
+// A matcher without the float distance field (as MML's), its model an L and a wall at x = 5.
+class NoDistanceMatcherTest : public ::testing::Test {
+ protected:
+  void SetUp() override {
+    MatcherOptions o;
+    o.num_workers = 2;  // online matching: one worker per relation table
+    o.max_scene_points = 512;
+    o.max_model_points = 1024;
+    o.field.max_cells = 200 * 200;
+    o.field.max_axis = 256;
+    o.field.keep_distance = false;
+    o.collect_capacity = 64;
+    ASSERT_TRUE(arena.init_mapped(std::size_t(32) << 20, false, "contact test").is_ok());
+    ASSERT_TRUE(m.init(o, arena, nullptr).is_ok());
+    for (int i = 0; i < 100; ++i) {
+      model.emplace_back(0.05f * i, 0.0f);
+      model.emplace_back(0.0f, 0.05f * i);
+      model.emplace_back(5.0f, 0.03f * i);
+    }
+    ASSERT_TRUE(m.set_model(model.data(), model.size(), "L").is_ok());
   }
-  ASSERT_TRUE(m.set_model(model.data(), model.size(), "L").is_ok());
+  StartupArena arena;
+  Matcher<2> m;
+  std::vector<Point<2>> model;
+};
+
+TEST_F(NoDistanceMatcherTest, MatchNeedingTheDistanceFieldIsRefusedWithoutIt) {
   MatchParams p;
   p.max_iterations = 100;
   MatchResult<2> r;
@@ -108,7 +116,7 @@ TEST(ContactFieldTest, MatchNeedingTheDistanceFieldIsRefusedWithoutIt) {
   EXPECT_TRUE(st.is_ok()) << st.message();
 }
 
-// The L of the test above and a wall at x = 5 as segments: the distance to the nearest, and its
+// The fixture's L and wall as segments: the distance to the nearest, and its
 // gradient (what the global map's distance field gives MML; Matcher::set_refine_distance).
 struct SegmentDistance {
   mutable std::uint64_t calls = 0;
@@ -133,26 +141,7 @@ struct SegmentDistance {
   }
 };
 
-TEST(ContactFieldTest, RefinementUsesAnExternalDistanceWhenTheFieldKeepsNone) {
-  MatcherOptions o;
-  o.num_workers = 2;
-  o.max_scene_points = 512;
-  o.max_model_points = 1024;
-  o.field.max_cells = 200 * 200;
-  o.field.max_axis = 256;
-  o.field.keep_distance = false;
-  o.collect_capacity = 64;
-  StartupArena arena;
-  ASSERT_TRUE(arena.init_mapped(std::size_t(32) << 20, false, "contact test").is_ok());
-  Matcher<2> m;
-  ASSERT_TRUE(m.init(o, arena, nullptr).is_ok());
-  std::vector<Point<2>> model;
-  for (int i = 0; i < 100; ++i) {
-    model.emplace_back(0.05f * i, 0.0f);
-    model.emplace_back(0.0f, 0.05f * i);
-    model.emplace_back(5.0f, 0.03f * i);
-  }
-  ASSERT_TRUE(m.set_model(model.data(), model.size(), "L").is_ok());
+TEST_F(NoDistanceMatcherTest, RefinementUsesAnExternalDistance) {
   SegmentDistance dist;
   m.set_refine_distance(&SegmentDistance::sample, &dist);
   // The scene: the model seen from a pose 0.3 m / 10° away, every other point.
