@@ -5,6 +5,7 @@
 #include "firmware/base/se2.h"
 #include "sim/common/units.h"
 #include "sim/eval/mml_eval/reference_map_check.h"
+#include "sim/eval/mml_eval/unmapped_scan.h"
 
 namespace sim {
 
@@ -39,6 +40,20 @@ std::size_t check_steps_against_map(const fw::GlobalMap& map, const std::vector<
     r.map_err_deg = std::fabs(fw::wrap_angle(static_cast<double>(e.theta) - f.best.theta)) * kRadToDeg;
   }
   return checked;
+}
+
+std::size_t mark_unmapped_steps(const fw::GlobalMap& map, const std::vector<Frame>& frames,
+                                std::vector<StepRecord>* steps) {
+  std::size_t marked = 0;
+  for (StepRecord& r : *steps) {
+    const std::uint32_t k = r.estimate.scan_id;
+    if (!r.has_truth || r.in_unknown || k >= frames.size() || frames[k].scan.scan_id != k) continue;
+    const mmleval::UnmappedScan u = mmleval::unmapped_scan(map, mmleval::carmen_scan_of(frames[k].scan), r.truth);
+    if (!mmleval::in_unmapped_area(u)) continue;
+    r.in_unknown = true;
+    ++marked;
+  }
+  return marked;
 }
 
 }  // namespace sim

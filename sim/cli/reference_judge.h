@@ -20,4 +20,10 @@ namespace sim {
 std::size_t check_steps_against_map(const fw::GlobalMap& map, const std::vector<Frame>& frames,
                                     std::vector<StepRecord>* steps);
 
+// Marks StepRecord::in_unknown (left out of the availability) where the truth's scan is in an
+// unmapped area (sim/eval/mml_eval/unmapped_scan.h, the rule of mml-eval's figures): a log replay has
+// no drawn unknown areas. Returns the number of steps marked.
+std::size_t mark_unmapped_steps(const fw::GlobalMap& map, const std::vector<Frame>& frames,
+                                std::vector<StepRecord>* steps);
+
 }  // namespace sim

@@ -679,7 +679,10 @@ bool run_simulation(const SimConfig& cfg_in, SimResult* out, std::string* err) {
 
   sum.steps = out->steps.size();
   // A log's reference is judged by the map where a step is beyond a limit against it (reference_judge.h).
-  if (!src.log_frames.empty() && src.have_grid) check_steps_against_map(map.global_map, src.log_frames, &out->steps);
+  if (!src.log_frames.empty() && src.have_grid) {
+    check_steps_against_map(map.global_map, src.log_frames, &out->steps);
+    mark_unmapped_steps(map.global_map, src.log_frames, &out->steps);
+  }
   collect_loop_counters(rig, frames.ring_drops(), wall_s, &sum);
   summarize_steps(out->steps, &sum);
   if (cfg.progress) print_run_report(cfg, rig, sum);

@@ -80,7 +80,9 @@ struct StepRecord {
   hal::PoseEstimate estimate;
   bool has_pose = false;   // estimate_has_pose(estimate)
   bool has_truth = false;
-  bool in_unknown = false;  // the truth lies in the world's unknown area (erased from the map)
+  // The truth lies in the world's unknown area (erased from the map), or (log replays) its scan is
+  // in an unmapped area there (reference_judge.h, mark_unmapped_steps).
+  bool in_unknown = false;
   fw::Se2d truth;
   // The truth's own error bound (a log reference between corrected poses; 0 in a simulated world,
   // inf where the reference is extrapolated): an error counts against the localizer only beyond a

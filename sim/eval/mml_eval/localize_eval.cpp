@@ -264,6 +264,9 @@ void add_dataset_figures(BenchJson* json, const std::string& D, const SystemSumm
   json->add(D + "_pl_exceed_xy_rate", s.pl_steps ? static_cast<double>(s.pl_exceed_xy) / s.pl_steps : NAN);
   json->add(D + "_pl_exceed_theta_rate", s.pl_steps ? static_cast<double>(s.pl_exceed_theta) / s.pl_steps : NAN);
   json->add(D + "_availability_steps", static_cast<double>(s.avail_steps));
+  // Left out as unmapped (unmapped_scan.h), and the availability with them counted in.
+  json->add_int(D + "_unmapped_steps_excluded", static_cast<long long>(s.unmapped_steps));
+  json->add(D + "_availability_with_unmapped", s.availability_with_unmapped);
   // Where the availability went: share of the availability steps not `localized`, per reason
   // (hal::StatusReason; names with '-' as '_').
   for (std::size_t r = 1; r < hal::kStatusReasonCount; ++r) {
@@ -491,7 +494,14 @@ std::string unavailability_text(const std::vector<SystemSummary>& rows) {
     if (s.avail_steps == 0) continue;
     const std::string why = reason_list(s.unavailable_by_reason, s.avail_steps);
     t << "- " << s.dataset << " (" << s.system << ", " << s.avail_steps << " steps): "
-      << (why.empty() ? "always localized" : why) << "\n";
+      << (why.empty() ? "always localized" : why);
+    if (s.unmapped_steps > 0) {
+      char buf[160];
+      std::snprintf(buf, sizeof buf, "; %zu steps in unmapped areas left out (%zu of them localized; availability %.3f with them)",
+                    s.unmapped_steps, s.unmapped_localized, s.availability_with_unmapped);
+      t << buf;
+    }
+    t << "\n";
   }
   return t.str();
 }

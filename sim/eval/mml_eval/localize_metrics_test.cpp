@@ -85,6 +85,21 @@ TEST(LocalizeMetrics, AvailabilityExcludesErasedRegion) {
   EXPECT_EQ(m.avail_localized, 2u);
 }
 
+// Steps whose reference scan the map does not describe (unmapped_scan.h) are left out like the
+// erased region, but counted, and so are the `localized` ones among them.
+TEST(LocalizeMetrics, AvailabilityLeavesOutUnmappedStepsAndCountsThem) {
+  TrialResult t = trial({step(L, 0.1), step(S, 0), step(L, 0.1), step(S, 0), step(L, 0.1)});
+  t.steps[1].ref_unmapped = t.steps[2].ref_unmapped = true;
+  const TrialMetrics m = trial_metrics(t, MetricBounds());
+  EXPECT_EQ(m.avail_steps, 2u);
+  EXPECT_EQ(m.avail_localized, 1u);
+  EXPECT_EQ(m.unmapped_steps, 2u);
+  EXPECT_EQ(m.unmapped_localized, 1u);
+  // The first fix is not judged by it: an unmapped first step still starts the count.
+  t.steps[0].ref_unmapped = true;
+  EXPECT_TRUE(trial_metrics(t, MetricBounds()).first_fix);
+}
+
 TEST(LocalizeMetrics, FirstFixOutsideWindowOrWrong) {
   MetricBounds b;
   b.fix_within_steps = 3;

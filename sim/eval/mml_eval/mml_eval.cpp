@@ -1,4 +1,5 @@
 #include "sim/eval/mml_eval/mml_eval.h"
+#include "sim/eval/mml_eval/unmapped_scan.h"
 
 #include "sim/viz/font5x7.h"
 
@@ -581,6 +582,7 @@ TrialResult run_trial(fw::Localizer& loc, const LoadedDataset& ds, std::size_t s
     if (region) {
       st.in_region = st.truth.x >= region[0] && st.truth.x <= region[2] && st.truth.y >= region[1] && st.truth.y <= region[3];
     }
+    st.ref_unmapped = !ds.reference_unreliable(i) && in_unmapped_area(unmapped_scan(ds.map, ds.log.scans[i], ds.reference[i]));
     tr.steps.push_back(st);
     if (std::getenv("MML_EVAL_TRACE")) trace_step(tr.steps.size(), i, est, st);
     if (tally_step(st, ds, opt, &tally, &tr)) break;
@@ -625,6 +627,11 @@ TrialMetrics trial_metrics(const TrialResult& t, const MetricBounds& b) {
   if (first_loc != TrialResult::kNone) {
     for (std::size_t k = first_loc + 1; k < pre; ++k) {
       if (t.steps[k].in_region) continue;
+      if (t.steps[k].ref_unmapped) {
+        ++m.unmapped_steps;
+        m.unmapped_localized += is_loc(t.steps[k]);
+        continue;
+      }
       ++m.avail_steps;
       if (is_loc(t.steps[k])) {
         ++m.avail_localized;
@@ -772,6 +779,8 @@ SystemSummary summarize(const std::string& dataset, const std::string& system, c
     // left out of the median (both flattered one side of the MCL comparison before 2026-11-29).
     m_fix.push_back(m.first_fix_success ? m.m_to_fix : std::numeric_limits<double>::infinity());
     s.avail_steps += m.avail_steps;
+    s.unmapped_steps += m.unmapped_steps;
+    s.unmapped_localized += m.unmapped_localized;
     avail_loc += m.avail_localized;
     for (std::size_t r = 0; r < hal::kStatusReasonCount; ++r) s.unavailable_by_reason[r] += m.unavailable_by_reason[r];
     s.localized_checked += m.localized_steps;
@@ -802,6 +811,9 @@ SystemSummary summarize(const std::string& dataset, const std::string& system, c
   s.first_fix_success = trials.empty() ? nan : static_cast<double>(s.first_fix_successes) / trials.size();
   s.m_to_fix_median = censored_median(m_fix);
   s.availability = s.avail_steps ? static_cast<double>(avail_loc) / s.avail_steps : nan;
+  const std::size_t with_unmapped = s.avail_steps + s.unmapped_steps;
+  s.availability_with_unmapped =
+      with_unmapped ? static_cast<double>(avail_loc + s.unmapped_localized) / static_cast<double>(with_unmapped) : nan;
   s.integrity_failure_rate = s.localized_checked ? static_cast<double>(s.integrity_failures) / s.localized_checked : nan;
   s.pl_exceed_rate = s.pl_steps ? static_cast<double>(s.pl_exceed) / s.pl_steps : nan;
   s.track_err_median_m = percentile(terr, 50);

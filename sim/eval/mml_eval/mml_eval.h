@@ -153,6 +153,9 @@ struct StepLog {
   fw::Se2d estimate, truth;
   fw::Se2d odom;            // odometry fed to the localizer
   bool in_region = false;  // inside the erased region (unknown-area runs)
+  // The reference's scan is in an unmapped area (unmapped_scan.h; a reliable reference only): left
+  // out of the availability like the erased region.
+  bool ref_unmapped = false;
   std::size_t matched_points = 0;  // MML: local map points handed to pRANSAM (0: not matched / not MML)
 };
 
@@ -196,6 +199,9 @@ struct TrialMetrics {
   std::size_t first_fix_index = TrialResult::kNone;  // index in steps
   double m_to_fix = 0;             // NaN when no first fix
   std::size_t avail_steps = 0, avail_localized = 0;  // after the first fix, before a kidnap, outside the erased region
+  // Steps after the first fix left out of avail_steps as unmapped (ref_unmapped), and how many of
+  // them were `localized` (shown beside the availability: never left out silently).
+  std::size_t unmapped_steps = 0, unmapped_localized = 0;
   std::size_t unavailable_by_reason[hal::kStatusReasonCount] = {};  // avail_steps not `localized`, by reason
   std::size_t localized_steps = 0;      // `localized` with a reliable reference (error-checked)
   std::size_t integrity_failures = 0;   // of those: error beyond the bounds
@@ -247,6 +253,8 @@ struct SystemSummary {
   double m_to_fix_median = 0;
   double availability = 0;           // pooled avail_localized / avail_steps
   std::size_t avail_steps = 0;
+  std::size_t unmapped_steps = 0, unmapped_localized = 0;  // pooled TrialMetrics::unmapped_*
+  double availability_with_unmapped = 0;  // the unmapped steps counted in: (avail + unmapped localized) / (both steps)
   std::size_t unavailable_by_reason[hal::kStatusReasonCount] = {};  // pooled: where the availability went
   std::size_t localized_checked = 0, integrity_failures = 0, excluded_ref_steps = 0, excluded_map_steps = 0,
               excluded_bound_steps = 0, integrity_failures_raw = 0, pl_steps_raw = 0, pl_exceed_raw = 0;

@@ -1,0 +1,86 @@
+// The unmapped-area rule (unmapped_scan.h) on a corridor whose map knows only its west half: a scan
+// the map describes is not unmapped, one taken in the unknown half is, and the rule is judged at the
+// pose it is given (the truth), not at an estimate.
+#include "sim/eval/mml_eval/unmapped_scan.h"
+
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <limits>
+
+#include "firmware/baselines/mcl/mcl_test_world.h"
+#include "firmware/mml/mml_test_util.h"
+#include "sim/eval/mml_eval/reference_map_check.h"
+
+namespace sim::mmleval {
+namespace {
+
+using fw::mcl::testing::GridWorld;
+
+// 20 × 4 m, a 2 m wide corridor closed at both ends; `known_to_m` < 20: the map's cells east of it
+// are unknown (no wall, no free space), as a map built from part of a log.
+GridWorld corridor(float known_to_m) {
+  GridWorld g;
+  g.w = 400;
+  g.h = 80;
+  g.occ.assign(g.w * g.h, 0);
+  g.box(0.2f, 1.0f, 19.8f, 3.0f);
+  for (std::uint32_t y = 0; y < g.h; ++y)
+    for (std::uint32_t x = 0; x < g.w; ++x)
+      if ((static_cast<float>(x) + 0.5f) * g.res > known_to_m) g.occ[y * g.w + x] = fw::kCellUnknown;
+  g.finish();
+  return g;
+}
+
+CarmenScan scan_at(const GridWorld& world, double x, double y, double th) {
+  static hal::LaserScan s;
+  fw::mcl::testing::simulate_scan(world.view(), static_cast<float>(x), static_cast<float>(y), static_cast<float>(th), &s);
+  return carmen_scan_of(s);
+}
+
+TEST(UnmappedScan, AScanTheMapDescribesIsNotUnmapped) {
+  const GridWorld world = corridor(20.0f);
+  const fw::mml::testing::OwnedGlobalMap full(world);
+  const fw::Se2d truth(5.0, 2.0, 0.0);
+  const UnmappedScan u = unmapped_scan(full.map, scan_at(world, truth.x, truth.y, truth.theta), truth);
+  EXPECT_GT(u.points, 100u);
+  EXPECT_EQ(u.unmapped, 0u);
+  EXPECT_FALSE(in_unmapped_area(u));
+}
+
+TEST(UnmappedScan, ScanInTheUnknownHalfIsUnmappedAndOneLookingIntoItIsNot) {
+  const GridWorld world = corridor(20.0f);
+  const GridWorld half = corridor(10.0f);
+  const fw::mml::testing::OwnedGlobalMap map(half);
+  // Deep in the unknown half: every end-point on unknown cells far from the known walls.
+  const fw::Se2d east(15.0, 2.0, 0.0);
+  const UnmappedScan ue = unmapped_scan(map.map, scan_at(world, east.x, east.y, east.theta), east);
+  EXPECT_GT(ue.fraction(), 0.9);
+  EXPECT_TRUE(in_unmapped_area(ue));
+  // In the known half looking east: the end-points beyond 10.3 m are unmapped, the rest are not,
+  // and most of the scan is still described (the tracker's test asks for more than half).
+  const fw::Se2d west(6.0, 2.0, 0.0);
+  const UnmappedScan uw = unmapped_scan(map.map, scan_at(world, west.x, west.y, west.theta), west);
+  EXPECT_GT(uw.unmapped, 0u);
+  EXPECT_LT(uw.fraction(), 0.5);
+  EXPECT_FALSE(in_unmapped_area(uw));
+}
+
+TEST(UnmappedScan, InvalidBeamsAreNotCountedAndAnEmptyScanIsNotUnmapped) {
+  const GridWorld world = corridor(20.0f);
+  const GridWorld half = corridor(10.0f);
+  const fw::mml::testing::OwnedGlobalMap map(half);
+  CarmenScan s = scan_at(world, 15.0, 2.0, 0.0);
+  const std::size_t valid = unmapped_scan(map.map, s, fw::Se2d(15.0, 2.0, 0.0)).points;
+  s.ranges[0] = std::numeric_limits<float>::quiet_NaN();
+  s.ranges[1] = -1.0f;
+  s.ranges[2] = s.max_range;  // no return
+  EXPECT_EQ(unmapped_scan(map.map, s, fw::Se2d(15.0, 2.0, 0.0)).points, valid - 3);
+  for (float& r : s.ranges) r = std::numeric_limits<float>::quiet_NaN();
+  const UnmappedScan none = unmapped_scan(map.map, s, fw::Se2d(15.0, 2.0, 0.0));
+  EXPECT_EQ(none.points, 0u);
+  EXPECT_FALSE(in_unmapped_area(none));
+}
+
+}  // namespace
+}  // namespace sim::mmleval
