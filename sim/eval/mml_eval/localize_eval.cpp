@@ -267,6 +267,8 @@ void add_dataset_figures(BenchJson* json, const std::string& D, const SystemSumm
   // Left out as unmapped (unmapped_scan.h), and the availability with them counted in.
   json->add_int(D + "_unmapped_steps_excluded", static_cast<long long>(s.unmapped_steps));
   json->add(D + "_availability_with_unmapped", s.availability_with_unmapped);
+  // Shown only: availability steps where the map explains less than half of the scan at the reference.
+  json->add(D + "_ref_off_map_share", s.avail_steps ? static_cast<double>(s.off_map_steps) / s.avail_steps : NAN);
   // Where the availability went: share of the availability steps not `localized`, per reason
   // (hal::StatusReason; names with '-' as '_').
   for (std::size_t r = 1; r < hal::kStatusReasonCount; ++r) {
@@ -499,6 +501,12 @@ std::string unavailability_text(const std::vector<SystemSummary>& rows) {
       char buf[160];
       std::snprintf(buf, sizeof buf, "; %zu steps in unmapped areas left out (%zu of them localized; availability %.3f with them)",
                     s.unmapped_steps, s.unmapped_localized, s.availability_with_unmapped);
+      t << buf;
+    }
+    if (s.off_map_steps > 0) {
+      char buf[200];
+      std::snprintf(buf, sizeof buf, "; at %zu steps (%.4f) the map explains less than half of the scan at the reference (%zu localized there)",
+                    s.off_map_steps, static_cast<double>(s.off_map_steps) / static_cast<double>(s.avail_steps), s.off_map_localized);
       t << buf;
     }
     t << "\n";

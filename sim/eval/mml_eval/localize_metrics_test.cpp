@@ -95,6 +95,12 @@ TEST(LocalizeMetrics, AvailabilityLeavesOutUnmappedStepsAndCountsThem) {
   EXPECT_EQ(m.avail_localized, 1u);
   EXPECT_EQ(m.unmapped_steps, 2u);
   EXPECT_EQ(m.unmapped_localized, 1u);
+  // Steps where the map does not explain the scan at the reference are shown, not left out.
+  t.steps[3].ref_off_map = t.steps[4].ref_off_map = true;
+  const TrialMetrics o = trial_metrics(t, MetricBounds());
+  EXPECT_EQ(o.avail_steps, 2u);
+  EXPECT_EQ(o.off_map_steps, 2u);
+  EXPECT_EQ(o.off_map_localized, 1u);
   // The first fix is not judged by it: an unmapped first step still starts the count.
   t.steps[0].ref_unmapped = true;
   EXPECT_TRUE(trial_metrics(t, MetricBounds()).first_fix);

@@ -582,7 +582,11 @@ TrialResult run_trial(fw::Localizer& loc, const LoadedDataset& ds, std::size_t s
     if (region) {
       st.in_region = st.truth.x >= region[0] && st.truth.x <= region[2] && st.truth.y >= region[1] && st.truth.y <= region[3];
     }
-    st.ref_unmapped = !ds.reference_unreliable(i) && in_unmapped_area(unmapped_scan(ds.map, ds.log.scans[i], ds.reference[i]));
+    if (!ds.reference_unreliable(i)) {
+      const UnmappedScan u = unmapped_scan(ds.map, ds.log.scans[i], ds.reference[i]);
+      st.ref_unmapped = in_unmapped_area(u);
+      st.ref_off_map = reference_off_map(u);
+    }
     tr.steps.push_back(st);
     if (std::getenv("MML_EVAL_TRACE")) trace_step(tr.steps.size(), i, est, st);
     if (tally_step(st, ds, opt, &tally, &tr)) break;
@@ -633,6 +637,8 @@ TrialMetrics trial_metrics(const TrialResult& t, const MetricBounds& b) {
         continue;
       }
       ++m.avail_steps;
+      m.off_map_steps += t.steps[k].ref_off_map;
+      m.off_map_localized += t.steps[k].ref_off_map && is_loc(t.steps[k]);
       if (is_loc(t.steps[k])) {
         ++m.avail_localized;
       } else {
@@ -781,6 +787,8 @@ SystemSummary summarize(const std::string& dataset, const std::string& system, c
     s.avail_steps += m.avail_steps;
     s.unmapped_steps += m.unmapped_steps;
     s.unmapped_localized += m.unmapped_localized;
+    s.off_map_steps += m.off_map_steps;
+    s.off_map_localized += m.off_map_localized;
     avail_loc += m.avail_localized;
     for (std::size_t r = 0; r < hal::kStatusReasonCount; ++r) s.unavailable_by_reason[r] += m.unavailable_by_reason[r];
     s.localized_checked += m.localized_steps;

@@ -156,6 +156,9 @@ struct StepLog {
   // The reference's scan is in an unmapped area (unmapped_scan.h; a reliable reference only): left
   // out of the availability like the erased region.
   bool ref_unmapped = false;
+  // The map explains less than half of the scan at the reference (unmapped_scan.h,
+  // reference_off_map): shown beside the availability, never used to leave a step out.
+  bool ref_off_map = false;
   std::size_t matched_points = 0;  // MML: local map points handed to pRANSAM (0: not matched / not MML)
 };
 
@@ -202,6 +205,7 @@ struct TrialMetrics {
   // Steps after the first fix left out of avail_steps as unmapped (ref_unmapped), and how many of
   // them were `localized` (shown beside the availability: never left out silently).
   std::size_t unmapped_steps = 0, unmapped_localized = 0;
+  std::size_t off_map_steps = 0, off_map_localized = 0;  // availability steps with ref_off_map, and `localized`
   std::size_t unavailable_by_reason[hal::kStatusReasonCount] = {};  // avail_steps not `localized`, by reason
   std::size_t localized_steps = 0;      // `localized` with a reliable reference (error-checked)
   std::size_t integrity_failures = 0;   // of those: error beyond the bounds
@@ -254,6 +258,7 @@ struct SystemSummary {
   double availability = 0;           // pooled avail_localized / avail_steps
   std::size_t avail_steps = 0;
   std::size_t unmapped_steps = 0, unmapped_localized = 0;  // pooled TrialMetrics::unmapped_*
+  std::size_t off_map_steps = 0, off_map_localized = 0;   // pooled TrialMetrics::off_map_*
   double availability_with_unmapped = 0;  // the unmapped steps counted in: (avail + unmapped localized) / (both steps)
   std::size_t unavailable_by_reason[hal::kStatusReasonCount] = {};  // pooled: where the availability went
   std::size_t localized_checked = 0, integrity_failures = 0, excluded_ref_steps = 0, excluded_map_steps = 0,

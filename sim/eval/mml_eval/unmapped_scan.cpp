@@ -18,7 +18,10 @@ UnmappedScan unmapped_scan(const fw::GlobalMap& map, const CarmenScan& scan, con
     const double px = r * std::cos(a), py = r * std::sin(a);
     const float wx = static_cast<float>(pose.x + c * px - s * py), wy = static_cast<float>(pose.y + s * px + c * py);
     ++u.points;
-    if (map.distance_at(wx, wy, INFINITY) <= opt.wall_m) continue;  // a mapped wall explains it
+    if (map.distance_at(wx, wy, INFINITY) <= opt.wall_m) {  // a mapped wall explains it
+      ++u.explained;
+      continue;
+    }
     std::int32_t cx = 0, cy = 0;
     if (!map.geometry.world_to_cell(wx, wy, &cx, &cy) || map.cell(cx, cy) == fw::kCellUnknown) ++u.unmapped;
   }
@@ -27,6 +30,10 @@ UnmappedScan unmapped_scan(const fw::GlobalMap& map, const CarmenScan& scan, con
 
 bool in_unmapped_area(const UnmappedScan& u, const UnmappedScanOptions& opt) {
   return u.points > 0 && u.fraction() > opt.max_fraction;
+}
+
+bool reference_off_map(const UnmappedScan& u, const UnmappedScanOptions& opt) {
+  return u.points > 0 && !in_unmapped_area(u, opt) && u.explained_fraction() < opt.max_fraction;
 }
 
 }  // namespace sim::mmleval

@@ -82,5 +82,24 @@ TEST(UnmappedScan, InvalidBeamsAreNotCountedAndAnEmptyScanIsNotUnmapped) {
   EXPECT_FALSE(in_unmapped_area(none));
 }
 
+// A reference far from where the scan was taken: the map is known there but explains little of it
+// (reference_off_map); at the truth, or where the map is unknown, it is not "off the map".
+TEST(UnmappedScan, AReferenceTheMapDoesNotExplainIsOffTheMap) {
+  const GridWorld world = corridor(20.0f);
+  const fw::mml::testing::OwnedGlobalMap full(world);
+  const CarmenScan s = scan_at(world, 5.0, 2.0, 0.0);
+  const UnmappedScan at_truth = unmapped_scan(full.map, s, fw::Se2d(5.0, 2.0, 0.0));
+  EXPECT_GT(at_truth.explained_fraction(), 0.95);
+  EXPECT_FALSE(reference_off_map(at_truth));
+  const UnmappedScan turned = unmapped_scan(full.map, s, fw::Se2d(5.0, 2.0, 0.6));  // 34° off
+  EXPECT_LT(turned.explained_fraction(), 0.5);
+  EXPECT_TRUE(reference_off_map(turned));
+  const GridWorld half = corridor(10.0f);
+  const fw::mml::testing::OwnedGlobalMap map(half);
+  const UnmappedScan unknown = unmapped_scan(map.map, scan_at(world, 15.0, 2.0, 0.0), fw::Se2d(15.0, 2.0, 0.0));
+  EXPECT_TRUE(in_unmapped_area(unknown));
+  EXPECT_FALSE(reference_off_map(unknown));  // unmapped, not contradicted
+}
+
 }  // namespace
 }  // namespace sim::mmleval
