@@ -7,30 +7,15 @@
 
 #include <cmath>
 
-#include "firmware/baselines/mcl/mcl_test_world.h"
 #include "firmware/mml/mml_test_util.h"
+#include "sim/eval/mml_eval/corridor_test_world.h"
 
 namespace sim::mmleval {
 namespace {
 
-using fw::mcl::testing::GridWorld;
-
-// 20 × 4 m: a 2 m wide corridor with no feature along it, closed far beyond the laser's 8 m.
-GridWorld corridor() {
-  GridWorld g;
-  g.w = 400;
-  g.h = 80;
-  g.occ.assign(g.w * g.h, 0);
-  g.box(0.2f, 1.0f, 19.8f, 3.0f);
-  g.finish();
-  return g;
-}
-
-CarmenScan scan_at(const GridWorld& g, double x, double y, double th) {
-  static hal::LaserScan s;
-  fw::mcl::testing::simulate_scan(g.view(), static_cast<float>(x), static_cast<float>(y), static_cast<float>(th), &s);
-  return carmen_scan_of(s);
-}
+using testing::corridor;
+using testing::GridWorld;
+using testing::scan_at;
 
 TEST(ReferenceMapCheck, KeepsAReferenceTheMapAgreesWith) {
   const GridWorld g = corridor();

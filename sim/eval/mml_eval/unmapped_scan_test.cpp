@@ -8,35 +8,15 @@
 #include <cmath>
 #include <limits>
 
-#include "firmware/baselines/mcl/mcl_test_world.h"
 #include "firmware/mml/mml_test_util.h"
-#include "sim/eval/mml_eval/reference_map_check.h"
+#include "sim/eval/mml_eval/corridor_test_world.h"
 
 namespace sim::mmleval {
 namespace {
 
-using fw::mcl::testing::GridWorld;
-
-// 20 × 4 m, a 2 m wide corridor closed at both ends; `known_to_m` < 20: the map's cells east of it
-// are unknown (no wall, no free space), as a map built from part of a log.
-GridWorld corridor(float known_to_m) {
-  GridWorld g;
-  g.w = 400;
-  g.h = 80;
-  g.occ.assign(g.w * g.h, 0);
-  g.box(0.2f, 1.0f, 19.8f, 3.0f);
-  for (std::uint32_t y = 0; y < g.h; ++y)
-    for (std::uint32_t x = 0; x < g.w; ++x)
-      if ((static_cast<float>(x) + 0.5f) * g.res > known_to_m) g.occ[y * g.w + x] = fw::kCellUnknown;
-  g.finish();
-  return g;
-}
-
-CarmenScan scan_at(const GridWorld& world, double x, double y, double th) {
-  static hal::LaserScan s;
-  fw::mcl::testing::simulate_scan(world.view(), static_cast<float>(x), static_cast<float>(y), static_cast<float>(th), &s);
-  return carmen_scan_of(s);
-}
+using testing::corridor;
+using testing::GridWorld;
+using testing::scan_at;
 
 TEST(UnmappedScan, AScanTheMapDescribesIsNotUnmapped) {
   const GridWorld world = corridor(20.0f);
