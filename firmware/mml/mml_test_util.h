@@ -115,6 +115,31 @@ inline std::vector<Se2f> waypoint_path(const std::vector<std::pair<float, float>
   return path;
 }
 
+// The right part of the building (x > 6 m) is missing from the global map, and it is a different
+// layout from anything mapped.
+struct UnknownWorld {
+  GridWorld world = mcl::testing::unique_room();
+  GridWorld mapped;
+  UnknownWorld() {
+    mapped = world;
+    for (std::uint32_t y = 0; y < mapped.h; ++y)
+      for (std::uint32_t x = 0; x < mapped.w; ++x)
+        if (x * mapped.res > 6.0f) mapped.occ[y * mapped.w + x] = 255;
+    mapped.finish();
+    for (std::uint32_t y = 0; y < world.h; ++y)
+      for (std::uint32_t x = 0; x < world.w; ++x)
+        if (x * world.res > 6.5f && world.occ[y * world.w + x] == 100) world.occ[y * world.w + x] = 0;
+    world.wall(6.6f, 0.2f, 11.8f, 0.2f);
+    world.wall(11.8f, 0.2f, 11.8f, 7.8f);
+    world.wall(11.8f, 7.8f, 6.6f, 7.8f);
+    world.wall(6.6f, 7.8f, 6.6f, 4.5f);  // doorway 1.2 m < y < 4.5 m into the unmapped part
+    world.wall(8.0f, 5.5f, 10.5f, 3.5f);
+    world.wall(9.0f, 7.8f, 9.0f, 6.0f);
+    world.box(10.0f, 1.0f, 11.0f, 1.6f);
+    world.finish();
+  }
+};
+
 }  // namespace testing
 }  // namespace mml
 }  // namespace fw

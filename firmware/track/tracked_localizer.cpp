@@ -4,6 +4,7 @@
 
 #include "firmware/scan/scan_points.h"
 #include "firmware/track/fit_comparison.h"
+#include "firmware/track/scan_alignment.h"
 
 namespace fw {
 namespace track {
@@ -31,6 +32,8 @@ void TrackedLocalizer::reset() {
   unconfirmed_ = false;
   history_.clear();
   replay_lag_ = 0;
+  have_lost_pose_ = false;
+  dr_pose_ = dr_wheel_ = Se2f();
 }
 
 // End-points within the tracker's range, evenly subsampled to at most align.max_points (beam order
@@ -125,6 +128,9 @@ Status TrackedLocalizer::step(const hal::LaserScan& scan, const hal::Odometry& o
       ++tracks_lost_;
       cross_check_left_ = 0;
       global_.reset();
+      have_lost_pose_ = true;
+      dr_pose_ = ts.pose;
+      dr_wheel_ = wheel;
       hal::PoseEstimate g;
       FW_RETURN_IF_ERROR(global_.step(scan, odom, &g));
       out->status = ts.verdict == ScanVerdict::kOutsideMap ? hal::LocalizationStatus::kOutsideMap
@@ -141,11 +147,19 @@ Status TrackedLocalizer::step(const hal::LaserScan& scan, const hal::Odometry& o
   // local map (a lost track and every cross-check reset it first), so a job on this scan would be
   // thrown away, and on the 2-core board it would share the cores with the confirming step, the
   // sensor context's longest (aces replay: 10.5 ms, which stretched that global step to 16 ms).
+  if (have_lost_pose_) {  // the wheels carry the last track's pose on (outside_by_dead_reckoning)
+    dr_pose_ = dr_pose_.compose(dr_wheel_.between(wheel));
+    dr_wheel_ = wheel;
+  }
   const bool delayed = global_.results_delayed();
   const Status got = delayed ? global_.collect(scan, odom, out) : global_.step(scan, odom, out);
   if (!delayed) FW_RETURN_IF_ERROR(got);
   out->mode = hal::LocalizationMode::kGlobal;
   out->protection_xy_m = out->protection_theta_rad = 0.0f;
+  if (got.is_ok() && out->status == hal::LocalizationStatus::kSearching && outside_by_dead_reckoning(n)) {
+    out->status = hal::LocalizationStatus::kOutsideMap;
+    out->reason = hal::StatusReason::kOutsideMap;
+  }
   if (got.is_ok() && out->status == hal::LocalizationStatus::kLocalized) {
     const hal::PoseEstimate g = *out;
     if (start_from_fix(g, wheel, n, out) || !delayed) return Status::ok();
@@ -155,6 +169,22 @@ Status TrackedLocalizer::step(const hal::LaserScan& scan, const hal::Odometry& o
     FW_RETURN_IF_ERROR(global_.offer(scan, odom, &unused));
   }
   return got;
+}
+
+// While MML searches it has no pose it trusts, so "outside the map" needs another source
+// (mml_track_preset turns MML's own unknown-region rules off: they said `outside-map` at 937 steps of
+// a fr-clinic whole run, inside its mapped corridors). After a track is given up, the wheels carry
+// its last pose on; this scan at that dead-reckoned pose is judged by the tracker's outside-map test
+// (more than outside_map_fraction of the end-points on unknown space, far from every wall), else the
+// answer is `searching`. After a fault the robot may have been carried anywhere and the dead-reckoned
+// pose means little, but the test only chooses between two statuses that are not `localized`; on a
+// track given up outside the map (ScanVerdict::kOutsideMap) it is where the robot went.
+bool TrackedLocalizer::outside_by_dead_reckoning(std::size_t n) const {
+  if (!have_lost_pose_ || n == 0) return false;
+  ScanAlignOptions at_pose = tracker_.options().align;
+  at_pose.iterations = 0;  // the statistics at the pose itself, no fit
+  const ScanAlignment a = align_scan(tracker_.map(), pts_, n, dr_pose_, at_pose);
+  return a.unknown_fraction() > tracker_.options().outside_map_fraction;
 }
 
 bool TrackedLocalizer::start_from_fix(const hal::PoseEstimate& g, const Se2f& wheel, std::size_t n,

@@ -83,6 +83,10 @@ class TrackedLocalizer final : public Localizer {
   // past_scans_per_step per call. true while it catches up or once the track is `localized` on the
   // newest scan; when it ends otherwise, forward confirmation from the fix (start_forward's result).
   bool replay_past_scans(const Se2f& wheel, std::size_t n, hal::PoseEstimate* out);
+  // MML is searching: is the robot outside the map? After a track was given up, by the tracker's
+  // outside-map test on this scan at the track's last pose carried by the wheels.
+  bool outside_by_dead_reckoning(std::size_t n) const;
+
   Status cross_check(const hal::LaserScan& scan, const hal::Odometry& odom, const Se2f& wheel, std::size_t n,
                      const TrackStep& ts, hal::PoseEstimate* out);
   mml::MmlLocalizer* mml_ = nullptr;
@@ -106,6 +110,10 @@ class TrackedLocalizer final : public Localizer {
   std::uint32_t cross_check_left_ = 0;  // scans the background search still runs (0 = idle)
   std::uint32_t confirmations_ = 0, cross_check_conflicts_ = 0, fixes_on_past_scans_ = 0;
   bool unconfirmed_ = false;
+  // Dead reckoning since the last track was given up (reset() clears it): its last pose carried by
+  // the wheels, for outside_by_dead_reckoning().
+  bool have_lost_pose_ = false;
+  Se2f dr_pose_, dr_wheel_;
 };
 
 }  // namespace track

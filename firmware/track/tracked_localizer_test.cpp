@@ -3,6 +3,8 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <cstdio>
+#include <cstdlib>
 #include <memory>
 
 #include "firmware/track/track_test_util.h"
@@ -279,6 +281,95 @@ TEST(TrackedLocalizerTest, HeadingOnlyFaultRecoversWithoutWaitingForMml) {
 }
 
 // Same input and seed ⇒ same output; reset() ⇒ the same run again, bit for bit.
+// `outside-map` in mml-track comes from scans, not from MML's search (mml_track_preset turns MML's
+// unknown-region rules off): after the track is given up in an unmapped corridor off the mapped room,
+// from this scan at the track's last pose carried by the wheels; back in the room the status is not
+// `outside-map`; started in the corridor, with no track to carry, it never is (nothing says where the
+// robot is: `searching`). No `localized` pose is ever wrong.
+struct RoomAndCorridor {
+  GridWorld world, mapped;  // the room with a 12 m corridor east of its door; the map knows the room only
+  RoomAndCorridor() {
+    for (GridWorld* g : {&world, &mapped}) {
+      g->w = 480;
+      g->h = 160;
+      g->occ.assign(g->w * g->h, 0);
+      g->wall(0.2f, 0.2f, 11.8f, 0.2f);
+      g->wall(0.2f, 7.8f, 11.8f, 7.8f);
+      g->wall(0.2f, 0.2f, 0.2f, 7.8f);
+      g->wall(11.8f, 0.2f, 11.8f, 3.4f);  // the door: 3.4 m < y < 4.6 m
+      g->wall(11.8f, 4.6f, 11.8f, 7.8f);
+      g->wall(3.0f, 0.2f, 3.0f, 3.0f);
+      g->wall(7.0f, 7.8f, 7.0f, 5.0f);
+      g->box(8.5f, 1.5f, 9.5f, 2.2f);
+      g->wall(5.0f, 4.0f, 6.5f, 4.0f);
+      g->wall(11.8f, 3.4f, 23.5f, 3.4f);
+      g->wall(11.8f, 4.6f, 23.5f, 4.6f);
+      g->wall(23.5f, 3.4f, 23.5f, 4.6f);
+    }
+    for (std::uint32_t y = 0; y < mapped.h; ++y)
+      for (std::uint32_t x = 0; x < mapped.w; ++x)
+        if ((static_cast<float>(x) + 0.5f) * mapped.res > 12.0f) mapped.occ[y * mapped.w + x] = 255;
+    world.finish();
+    mapped.finish();
+  }
+};
+
+struct UnknownRun {
+  std::vector<mml::testing::StepRecord> rec;
+  std::uint32_t tracks_lost = 0;
+};
+
+UnknownRun drive_room_and_corridor(const std::vector<Se2f>& path) {
+  static RoomAndCorridor rc;
+  static OwnedGlobalMap gm(rc.mapped);
+  mml::MmlLocalizerConfig c = testing::small_mml_config();
+  c.mml.detect_unknown = false;  // as mml_track_preset
+  auto arena = std::make_unique<StartupArena>();
+  auto mml = std::make_unique<mml::MmlLocalizer>();
+  auto loc = std::make_unique<TrackedLocalizer>();
+  UnknownRun r;
+  EXPECT_TRUE(arena->init_mapped(192u << 20, false, "track-test").is_ok());
+  EXPECT_TRUE(mml->init(c, gm.map, nullptr, 0, *arena, nullptr).is_ok());
+  EXPECT_TRUE(loc->init(TrackOptions(), gm.map, mml.get()).is_ok());
+  r.rec = mml::testing::drive(loc.get(), rc.world, path, 3);
+  r.tracks_lost = loc->tracks_lost();
+  return r;
+}
+
+TEST(TrackedLocalizerTest, OutsideMapComesFromTheScanAtTheDeadReckonedPose) {
+  const auto path = mml::testing::waypoint_path({{1.5f, 1.5f}, {1.5f, 6.5f}, {4.5f, 6.5f}, {4.5f, 2.0f}, {10.5f, 4.0f},
+                                                 {20.0f, 4.0f}, {10.5f, 4.0f}, {10.5f, 6.5f}, {4.5f, 6.5f}},
+                                                0.1f);
+  const UnknownRun run = drive_room_and_corridor(path);
+  EXPECT_EQ(tally(run.rec).wrong, 0);
+  EXPECT_GE(run.tracks_lost, 1u);
+  int outside_corridor = 0, steps_corridor = 0, outside_room = 0;
+  bool been_out = false;
+  for (std::size_t i = 0; i < run.rec.size(); ++i) {
+    const auto& r = run.rec[i];
+    const bool outside = r.est.status == hal::LocalizationStatus::kOutsideMap;
+    if (std::getenv("TRACK_TRACE")) {
+      std::printf("%3zu %-11s %-18s truth (%.2f %.2f %.1f) est (%.2f %.2f %.1f)\n", i, hal::status_name(r.est.status),
+                  hal::reason_name(r.est.reason), r.truth.x, r.truth.y, r.truth.theta * 57.3f, r.est.x, r.est.y,
+                  r.est.theta * 57.3f);
+    }
+    if (r.truth.x > 15.0f) {
+      been_out = true;
+      ++steps_corridor;
+      outside_corridor += outside;
+    }
+    if (been_out && r.truth.x < 10.0f) outside_room += outside;
+  }
+  EXPECT_GT(outside_corridor, steps_corridor / 2) << "of " << steps_corridor;
+  EXPECT_EQ(outside_room, 0);
+  // Started in the corridor: nothing to carry, never `outside-map` (and never `localized`).
+  const UnknownRun cold = drive_room_and_corridor(mml::testing::waypoint_path({{22.0f, 4.0f}, {14.0f, 4.0f}}, 0.1f));
+  for (std::size_t i = 0; i < cold.rec.size(); ++i) {
+    EXPECT_NE(cold.rec[i].est.status, hal::LocalizationStatus::kOutsideMap) << i;
+    EXPECT_NE(cold.rec[i].est.status, hal::LocalizationStatus::kLocalized) << i;
+  }
+}
+
 TEST(TrackedLocalizerTest, DeterministicAndResettable) {
   Rig a, b;
   ASSERT_TRUE(a.init(room_map().map).is_ok());

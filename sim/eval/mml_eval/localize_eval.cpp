@@ -268,6 +268,9 @@ void add_dataset_figures(BenchJson* json, const std::string& D, const SystemSumm
   json->add_int(D + "_unmapped_steps_excluded", static_cast<long long>(s.unmapped_steps));
   json->add(D + "_availability_with_unmapped", s.availability_with_unmapped);
   // Shown only: availability steps where the map explains less than half of the scan at the reference.
+  // `outside-map` published where the map covers the reference's scan (unmapped_scan.h): a false one.
+  json->add_int(D + "_outside_map_steps", static_cast<long long>(s.outside_map_steps));
+  json->add_int(D + "_outside_map_false_steps", static_cast<long long>(s.outside_map_false_steps));
   json->add(D + "_ref_off_map_share", s.avail_steps ? static_cast<double>(s.off_map_steps) / s.avail_steps : NAN);
   // Where the availability went: share of the availability steps not `localized`, per reason
   // (hal::StatusReason; names with '-' as '_').
@@ -480,11 +483,16 @@ bool run_unknown_area(LocalizeRun& run, std::string* err) {
   json->add("unknown_area_in_region_localized_fraction",
             in_region ? static_cast<double>(in_region_loc) / in_region : NAN);
   json->add("unknown_area_availability_outside_region", us.availability);
+  // How often the robot in the erased region is told it is outside the map, and how often it is told
+  // so elsewhere (outside the region, where the map covers the reference's scan).
+  json->add("unknown_area_in_region_outside_map_fraction", us.outside_map_in_region);
+  json->add_int("unknown_area_outside_map_false_steps", static_cast<long long>(us.outside_map_false_steps));
   write_plots(plan, ds, "mml-track_unknown", ut, region);
   if (plan.verbose)
-    std::printf("unknown area (%s, 8 x 8 m erased): %zu in-region steps, %zu localized there (%zu wrong); integrity "
-                "failures %zu; done in %.1f s\n",
-                ds.name.c_str(), in_region, in_region_loc, in_region_wrong, us.integrity_failures, seconds_since(t0));
+    std::printf("unknown area (%s, 8 x 8 m erased): %zu in-region steps, %zu localized there (%zu wrong), %.3f of them "
+                "outside-map; %zu outside-map steps elsewhere; integrity failures %zu; done in %.1f s\n",
+                ds.name.c_str(), in_region, in_region_loc, in_region_wrong, us.outside_map_in_region,
+                us.outside_map_false_steps, us.integrity_failures, seconds_since(t0));
   return true;
 }
 

@@ -753,6 +753,10 @@ SystemSummary summarize(const std::string& dataset, const std::string& system, c
         ++region_n;
         region_out += st.status == hal::LocalizationStatus::kOutsideMap;
       }
+      if (st.status == hal::LocalizationStatus::kOutsideMap) {
+        ++s.outside_map_steps;
+        s.outside_map_false_steps += !st.in_region && !st.ref_unmapped;
+      }
     }
   }
   const double n = trials.empty() ? 1.0 : static_cast<double>(trials.size());

@@ -246,6 +246,9 @@ struct SystemSummary {
   double step_ms_p50 = 0, step_ms_p99 = 0, step_ms_mean = 0;
   double memory_mib = 0;
   double outside_map_in_region = 0;  // unknown-area runs: fraction of in-region steps reporting outside-map
+  // Steps published `outside-map`, and of them those neither in the erased region nor unmapped at the
+  // reference (unmapped_scan.h): an `outside-map` the map contradicts.
+  std::size_t outside_map_steps = 0, outside_map_false_steps = 0;
   double tracking_err_median_m = 0;  // steps in tracking mode (hand-off)
   double tracking_step_ms_p50 = 0, tracking_step_ms_p99 = 0;
   double matched_points_mean = 0;    // MML: mean local map points matched per matching step (NaN: none)
