@@ -86,7 +86,6 @@ class TrackedLocalizer final : public Localizer {
   // MML is searching: is the robot outside the map? After a track was given up, by the tracker's
   // outside-map test on this scan at the track's last pose carried by the wheels.
   bool outside_by_dead_reckoning(std::size_t n) const;
-
   Status cross_check(const hal::LaserScan& scan, const hal::Odometry& odom, const Se2f& wheel, std::size_t n,
                      const TrackStep& ts, hal::PoseEstimate* out);
   mml::MmlLocalizer* mml_ = nullptr;
