@@ -21,9 +21,10 @@ struct Rig {
   StartupArena arena;
   std::unique_ptr<mml::MmlLocalizer> mml = std::make_unique<mml::MmlLocalizer>();
   std::unique_ptr<TrackedLocalizer> loc = std::make_unique<TrackedLocalizer>();
-  Status init(const GlobalMap& map, const TrackOptions& options = TrackOptions()) {
+  Status init(const GlobalMap& map, const TrackOptions& options = TrackOptions(),
+              const mml::MmlLocalizerConfig& mml_config = testing::small_mml_config()) {
     FW_RETURN_IF_ERROR(arena.init_mapped(192u << 20, false, "track-test"));
-    FW_RETURN_IF_ERROR(mml->init(testing::small_mml_config(), map, nullptr, 0, arena, nullptr));
+    FW_RETURN_IF_ERROR(mml->init(mml_config, map, nullptr, 0, arena, nullptr));
     return loc->init(options, map, mml.get());
   }
 };
@@ -280,7 +281,6 @@ TEST(TrackedLocalizerTest, HeadingOnlyFaultRecoversWithoutWaitingForMml) {
   EXPECT_GT(r.localized_after, 0) << "never localized again after the jump";
 }
 
-// Same input and seed ⇒ same output; reset() ⇒ the same run again, bit for bit.
 // `outside-map` in mml-track comes from scans, not from MML's search (mml_track_preset turns MML's
 // unknown-region rules off): after the track is given up in an unmapped corridor off the mapped room,
 // from this scan at the track's last pose carried by the wheels; back in the room the status is not
@@ -324,15 +324,11 @@ UnknownRun drive_room_and_corridor(const std::vector<Se2f>& path) {
   static OwnedGlobalMap gm(rc.mapped);
   mml::MmlLocalizerConfig c = testing::small_mml_config();
   c.mml.detect_unknown = false;  // as mml_track_preset
-  auto arena = std::make_unique<StartupArena>();
-  auto mml = std::make_unique<mml::MmlLocalizer>();
-  auto loc = std::make_unique<TrackedLocalizer>();
+  Rig rig;
   UnknownRun r;
-  EXPECT_TRUE(arena->init_mapped(192u << 20, false, "track-test").is_ok());
-  EXPECT_TRUE(mml->init(c, gm.map, nullptr, 0, *arena, nullptr).is_ok());
-  EXPECT_TRUE(loc->init(TrackOptions(), gm.map, mml.get()).is_ok());
-  r.rec = mml::testing::drive(loc.get(), rc.world, path, 3);
-  r.tracks_lost = loc->tracks_lost();
+  EXPECT_TRUE(rig.init(gm.map, TrackOptions(), c).is_ok());
+  r.rec = mml::testing::drive(rig.loc.get(), rc.world, path, 3);
+  r.tracks_lost = rig.loc->tracks_lost();
   return r;
 }
 
@@ -370,6 +366,7 @@ TEST(TrackedLocalizerTest, OutsideMapComesFromTheScanAtTheDeadReckonedPose) {
   }
 }
 
+// Same input and seed ⇒ same output; reset() ⇒ the same run again, bit for bit.
 TEST(TrackedLocalizerTest, DeterministicAndResettable) {
   Rig a, b;
   ASSERT_TRUE(a.init(room_map().map).is_ok());

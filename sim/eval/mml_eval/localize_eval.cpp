@@ -267,10 +267,10 @@ void add_dataset_figures(BenchJson* json, const std::string& D, const SystemSumm
   // Left out as unmapped (unmapped_scan.h), and the availability with them counted in.
   json->add_int(D + "_unmapped_steps_excluded", static_cast<long long>(s.unmapped_steps));
   json->add(D + "_availability_with_unmapped", s.availability_with_unmapped);
-  // Shown only: availability steps where the map explains less than half of the scan at the reference.
   // `outside-map` published where the map covers the reference's scan (unmapped_scan.h): a false one.
   json->add_int(D + "_outside_map_steps", static_cast<long long>(s.outside_map_steps));
   json->add_int(D + "_outside_map_false_steps", static_cast<long long>(s.outside_map_false_steps));
+  // Shown only: availability steps where the map explains less than half of the scan at the reference.
   json->add(D + "_ref_off_map_share", s.avail_steps ? static_cast<double>(s.off_map_steps) / s.avail_steps : NAN);
   // Where the availability went: share of the availability steps not `localized`, per reason
   // (hal::StatusReason; names with '-' as '_').
