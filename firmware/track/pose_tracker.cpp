@@ -8,6 +8,7 @@
 #include "firmware/base/sym2_eigen.h"
 #include "firmware/map/distance_sample.h"
 #include "firmware/mml/pose_uniqueness.h"
+#include "firmware/track/dead_reckoning.h"
 #include "firmware/track/fit_comparison.h"
 
 namespace fw {
@@ -89,22 +90,12 @@ void PoseTracker::predict_to(const Se2f& odom) {
   const Se2f delta = prev_odom_.between(odom);
   prev_odom_ = odom;
   ++predicted_since_fuse_;
-  const float ds = std::hypot(delta.x, delta.y), da = std::fabs(delta.theta);
-  const float at = options_.odom_trans_per_m * ds + options_.odom_trans_per_rad * da;
-  const float ar = options_.odom_rot_per_rad * da + options_.odom_rot_per_m * ds;
-  const float ft = options_.odom_trans_per_step_m, fr = options_.odom_rot_per_step_rad;
-  // The per-step part in quadrature (track_options.h); without one, the AMCL model exactly.
-  const float st0 = ft > 0.0f ? std::sqrt(at * at + ft * ft) : at;
-  const float sr0 = fr > 0.0f ? std::sqrt(ar * ar + fr * fr) : ar;
+  float st0 = 0.0f, sr0 = 0.0f;
+  const Eigen::Matrix3f q = odometry_increment_noise(delta, options_, odom_noise_.scale(), &st0, &sr0);
   if (options_.odom_noise_window > 0) {
     noise_model_var_t_ += st0 * st0;
     noise_model_var_r_ += sr0 * sr0;
   }
-  const float st = odom_noise_.scale().trans * st0;
-  const float sr = odom_noise_.scale().rot * sr0;
-  Eigen::Matrix3f q = Eigen::Matrix3f::Zero();
-  q(0, 0) = q(1, 1) = st * st;
-  q(2, 2) = sr * sr;
   const Eigen::Matrix3f f = pose_.jacobian_compose_first(delta);
   const Eigen::Matrix3f g = pose_.jacobian_compose_second();
   pose_ = pose_.compose(delta);
@@ -119,6 +110,16 @@ float f_test_z(float f, float d1, float d2) {
   const float a1 = 2.0f / (9.0f * d1), a2 = 2.0f / (9.0f * d2);
   const float c = std::cbrt(f);
   return ((1.0f - a2) * c - (1.0f - a1)) / std::sqrt(a2 * c * c + a1);
+}
+// The fit-drop test's statistic (judge_scan): the previous scan's inlier fraction p1 over its n1
+// correlation cells against this alignment's, z = (p1 − p2) / se with the pooled proportion (0 when
+// se is 0).
+float fit_drop_statistic(float p1, std::uint32_t cells1, const ScanAlignment& a) {
+  const float p2 = a.inlier_fraction();
+  const float n1 = static_cast<float>(cells1), n2 = static_cast<float>(a.independent);
+  const float pooled = (p1 * n1 + p2 * n2) / (n1 + n2);
+  const float se = std::sqrt(pooled * (1.0f - pooled) * (1.0f / n1 + 1.0f / n2));
+  return se > 0.0f ? (p1 - p2) / se : 0.0f;
 }
 bool outside_bound(const Eigen::Vector3f& e, const ProtectionLevel& pl) {
   return std::hypot(e(0), e(1)) > pl.xy_m || std::fabs(e(2)) > pl.theta_rad;
@@ -267,6 +268,11 @@ void PoseTracker::judge_scan(const Point2f* points, std::size_t n, bool odom_jum
   }
   if (a.points > 0 && a.unknown_fraction() > o.outside_map_fraction) {
     w->v = ScanVerdict::kOutsideMap;
+    if (a.inliers + a.contradicting >= o.min_points) {
+      out->known_part_contradicts = a.inlier_fraction() < o.min_inlier_fraction ||
+                                    (o.fit_drop_z > 0.0f && fit_cells_ >= 2 && a.independent >= 2 &&
+                                     fit_drop_statistic(fit_fraction_, fit_cells_, a) > o.fit_drop_z);
+    }
     return;
   }
   if (a.inliers + a.contradicting < o.min_points) {
@@ -297,12 +303,9 @@ void PoseTracker::judge_scan(const Point2f* points, std::size_t n, bool odom_jum
   // recovery_steps consistent scans, and no alias rival is ruled out meanwhile (contradicted_); as
   // a large fault it waited for MML after every such scan (fr-campus availability 0.49 → 0.36).
   if (o.fit_drop_z > 0.0f && fit_cells_ >= 2 && a.independent >= 2) {
-    const float p1 = fit_fraction_, p2 = a.inlier_fraction();
     const float n1 = static_cast<float>(fit_cells_), n2 = static_cast<float>(a.independent);
-    const float pooled = (p1 * n1 + p2 * n2) / (n1 + n2);
-    const float se = std::sqrt(pooled * (1.0f - pooled) * (1.0f / n1 + 1.0f / n2));
-    if (se > 0.0f) w->fit_drop_z = (p1 - p2) / se;
-    if (se > 0.0f && p1 - p2 > o.fit_drop_z * se) {
+    w->fit_drop_z = fit_drop_statistic(fit_fraction_, fit_cells_, a);
+    if (w->fit_drop_z > o.fit_drop_z) {
       w->v = ScanVerdict::kContradicting;
       out->fit_drop = true;
       return;

@@ -63,6 +63,11 @@ struct TrackStep {
   bool unexplained = false;
   // The scan fits the map significantly worse than the previous one (TrackOptions::fit_drop_z).
   bool fit_drop = false;
+  // An outside-map scan whose end-points on the map contradict the pose by the tracker's fit tests
+  // (inlier fraction below min_inlier_fraction, or a fit drop against the previous scan): a robot
+  // that drove out of the map still sees the mapped walls behind it where the map has them; one
+  // carried away from a place near the map's edge does not (tracked_localizer.h).
+  bool known_part_contradicts = false;
   // A fault in heading only, recovered by the track (TrackOptions::heading_fault_local_recovery).
   bool heading_fault = false;
   // The alias check found a rival that fits this scan as well as the fix and lies beyond the alert
@@ -108,6 +113,8 @@ class PoseTracker {
   const TrackStep& last() const { return last_; }
   const TrackOptions& options() const { return options_; }
   const GlobalMap& map() const { return map_; }
+  // The wheel-noise self-calibration in use (scale 1 when off or still learning).
+  const OdometryNoiseScale& odometry_noise_scale() const { return odom_noise_.scale(); }
 
  private:
   // Working state of one step() between its stages (pose_tracker.cpp).

@@ -20,6 +20,7 @@ Status TrackedLocalizer::init(const TrackOptions& options, const GlobalMap& map,
   FW_RETURN_IF_ERROR(tracker_.init(options, map));
   FW_RETURN_IF_ERROR(global_.init(global, schedule));
   mml_ = global;
+  k_ = ProtectionFactors::for_risk(options.integrity_risk);
   reset();
   return Status::ok();
 }
@@ -28,12 +29,15 @@ void TrackedLocalizer::reset() {
   tracker_.reset();
   global_.restart();
   fixes_ = fix_rejections_ = tracks_lost_ = cross_check_switches_ = confirmations_ = cross_check_conflicts_ = fixes_on_past_scans_ = 0;
+  fixes_refused_by_wheels_ = 0;
   cross_check_left_ = 0;
   unconfirmed_ = false;
   history_.clear();
   replay_lag_ = 0;
-  have_lost_pose_ = false;
-  dr_pose_ = dr_wheel_ = Se2f();
+  dead_reckoning_.clear();
+  left_map_cleanly_ = true;
+  have_previous_scan_ = false;
+  previous_n_ = 0;
 }
 
 // End-points within the tracker's range, evenly subsampled to at most align.max_points (beam order
@@ -84,6 +88,7 @@ Status TrackedLocalizer::step(const hal::LaserScan& scan, const hal::Odometry& o
   global_.tick();
   const Se2f wheel(odom.x, odom.y, odom.theta);
   const std::size_t n = scan_points(scan);
+  const RememberPreviousScan remember{this, n, wheel};  // for the next step's continuity test
   if (tracker_.options().confirm_fix_on_past_scans) {
     history_.push_overwrite(RememberedScan());
     RememberedScan& r = history_[history_.size() - 1];
@@ -105,6 +110,16 @@ Status TrackedLocalizer::step(const hal::LaserScan& scan, const hal::Odometry& o
     out->timestamp_ns = scan.timestamp_ns;
     out->scan_id = scan.scan_id;
     publish_track(ts, out);
+    // Since the last supported scan, did the scans leave the map as a robot driving out of it
+    // would (TrackStep::known_part_contradicts)?
+    if (ts.verdict == ScanVerdict::kSupported) left_map_cleanly_ = true;
+    if (ts.known_part_contradicts || ts.large_fault) left_map_cleanly_ = false;
+    if (ts.verdict == ScanVerdict::kOutsideMap && have_previous_scan_ &&
+        continuity_.explained_fraction(previous_pts_, previous_n_, pts_, n, previous_wheel_.between(wheel),
+                                       tracker_.options().align.outlier_m) <
+            tracker_.options().min_explained_fraction) {
+      left_map_cleanly_ = false;  // the scan is not what the robot saw a scan ago: it may have been carried
+    }
     if (ts.large_fault && !ts.lost && tracker_.options().cross_check_steps > 0) {
       // The robot may have been carried anywhere (a kidnap into a twin corridor fits every local
       // test): the pose needs MML's word again, from a local map that starts after the fault.
@@ -128,9 +143,15 @@ Status TrackedLocalizer::step(const hal::LaserScan& scan, const hal::Odometry& o
       ++tracks_lost_;
       cross_check_left_ = 0;
       global_.reset();
-      have_lost_pose_ = true;
-      dr_pose_ = ts.pose;
-      dr_wheel_ = wheel;
+      // Given up outside the map, having left it cleanly, the robot is where the wheels carry it
+      // (dead_reckoning.h). After a contradiction, or an exit whose scans contradicted the map
+      // where they saw it or did not continue the scan before them, it may have been carried
+      // anywhere, and the chain binds nothing (aces kidnaps 3501 → 922 and 1129 → 4609, seed 19:
+      // the first scans after the carry were 63 % and 53 % unknown at the old pose; in the
+      // first the end-points on the map fitted 0.59, a fit drop, in the second 0.79, but the scan
+      // was unlike the one before it; bound by the wheels, both right re-fixes came late or never).
+      const bool binding = ts.verdict == ScanVerdict::kOutsideMap && left_map_cleanly_;
+      dead_reckoning_.start(ts.pose, ts.cov, wheel, binding);
       hal::PoseEstimate g;
       FW_RETURN_IF_ERROR(global_.step(scan, odom, &g));
       out->status = ts.verdict == ScanVerdict::kOutsideMap ? hal::LocalizationStatus::kOutsideMap
@@ -147,20 +168,41 @@ Status TrackedLocalizer::step(const hal::LaserScan& scan, const hal::Odometry& o
   // local map (a lost track and every cross-check reset it first), so a job on this scan would be
   // thrown away, and on the 2-core board it would share the cores with the confirming step, the
   // sensor context's longest (aces replay: 10.5 ms, which stretched that global step to 16 ms).
-  if (have_lost_pose_) {  // the wheels carry the last track's pose on (outside_by_dead_reckoning)
-    dr_pose_ = dr_pose_.compose(dr_wheel_.between(wheel));
-    dr_wheel_ = wheel;
-  }
+  // The wheels carry the last track's pose on; this scan judged there (dead_reckoning.h).
+  dead_reckoning_.advance(wheel, tracker_.options(), tracker_.odometry_noise_scale());
+  const DeadReckoningVerdict dr = dead_reckoning_.judge(tracker_.map(), pts_, n, tracker_.options());
+  // Back on the map by the wheels, and the scan fits there: MML's local map starts again, so it
+  // holds only scans the map may explain (its scans of an unmapped wing match only by accident,
+  // and they kept it from re-fixing in the mapped room after it).
+  if (dead_reckoning_.reentered()) global_.reset();
   const bool delayed = global_.results_delayed();
   const Status got = delayed ? global_.collect(scan, odom, out) : global_.step(scan, odom, out);
   if (!delayed) FW_RETURN_IF_ERROR(got);
   out->mode = hal::LocalizationMode::kGlobal;
   out->protection_xy_m = out->protection_theta_rad = 0.0f;
-  if (got.is_ok() && out->status == hal::LocalizationStatus::kSearching && outside_by_dead_reckoning(n)) {
+  // While MML searches it has no pose it trusts, so "outside the map" needs another source
+  // (mml_track_preset turns MML's own unknown-region rules off: they said `outside-map` at 937 steps
+  // of a fr-clinic whole run, inside its mapped corridors): the tracker's outside-map test on this
+  // scan at the dead-reckoned pose, else `searching`. After a fault the robot may have been carried
+  // anywhere and that pose means little, but the test only chooses between two statuses that are not
+  // `localized`; on a track given up outside the map it is where the robot went.
+  // A chain that binds (the track was given up outside the map) says so over MML's `ambiguous` too:
+  // MML's candidates are places on the map, and the wheels, unrefuted, put the robot off it.
+  const bool mml_unsure = out->status == hal::LocalizationStatus::kSearching ||
+                          (out->status == hal::LocalizationStatus::kAmbiguous && dead_reckoning_.binding());
+  if (got.is_ok() && mml_unsure && dr == DeadReckoningVerdict::kOutside) {
     out->status = hal::LocalizationStatus::kOutsideMap;
     out->reason = hal::StatusReason::kOutsideMap;
   }
-  if (got.is_ok() && out->status == hal::LocalizationStatus::kLocalized) {
+  if (got.is_ok() && out->status == hal::LocalizationStatus::kLocalized &&
+      !dead_reckoning_.admits(Se2f(out->x, out->y, out->theta), k_, tracker_.options())) {
+    // The wheels rule MML's fix out and no scan has refuted them: MML sees only the map, and an
+    // unmapped place can resemble a mapped one (dead_reckoning.h).
+    ++fixes_refused_by_wheels_;
+    const bool outside = dr == DeadReckoningVerdict::kOutside;
+    out->status = outside ? hal::LocalizationStatus::kOutsideMap : hal::LocalizationStatus::kAmbiguous;
+    out->reason = outside ? hal::StatusReason::kOutsideMap : hal::StatusReason::kFixRejected;
+  } else if (got.is_ok() && out->status == hal::LocalizationStatus::kLocalized) {
     const hal::PoseEstimate g = *out;
     if (start_from_fix(g, wheel, n, out) || !delayed) return Status::ok();
   }
@@ -171,22 +213,6 @@ Status TrackedLocalizer::step(const hal::LaserScan& scan, const hal::Odometry& o
   return got;
 }
 
-// While MML searches it has no pose it trusts, so "outside the map" needs another source
-// (mml_track_preset turns MML's own unknown-region rules off: they said `outside-map` at 937 steps of
-// a fr-clinic whole run, inside its mapped corridors). After a track is given up, the wheels carry
-// its last pose on; this scan at that dead-reckoned pose is judged by the tracker's outside-map test
-// (more than outside_map_fraction of the end-points on unknown space, far from every wall), else the
-// answer is `searching`. After a fault the robot may have been carried anywhere and the dead-reckoned
-// pose means little, but the test only chooses between two statuses that are not `localized`; on a
-// track given up outside the map (ScanVerdict::kOutsideMap) it is where the robot went.
-bool TrackedLocalizer::outside_by_dead_reckoning(std::size_t n) const {
-  if (!have_lost_pose_ || n == 0) return false;
-  ScanAlignOptions at_pose = tracker_.options().align;
-  at_pose.iterations = 0;  // the statistics at the pose itself, no fit
-  const ScanAlignment a = align_scan(tracker_.map(), pts_, n, dr_pose_, at_pose);
-  return a.unknown_fraction() > tracker_.options().outside_map_fraction;
-}
-
 bool TrackedLocalizer::start_from_fix(const hal::PoseEstimate& g, const Se2f& wheel, std::size_t n,
                                       hal::PoseEstimate* out) {
   Eigen::Matrix3f cov;
@@ -195,6 +221,7 @@ bool TrackedLocalizer::start_from_fix(const hal::PoseEstimate& g, const Se2f& wh
   const Se2f fix(g.x, g.y, g.theta);
   const TrackOptions& o = tracker_.options();
   const std::size_t k = o.recovery_steps;
+  left_map_cleanly_ = true;  // a new track: no scan of it has contradicted it yet
   if (o.confirm_fix && o.confirm_fix_on_past_scans && k > 0 && history_.size() >= k + 1) {
     // TrackOptions::confirm_fix_on_past_scans. The tracker starts recovery_steps scans back, at MML's
     // pose carried back by the wheels (pose_{t−k} = fix ⊕ (wheel_t ⊖ wheel_{t−k})), as it would

@@ -18,6 +18,12 @@
 // there) an alias whose equally good rival lies beyond the alert limits is treated the same way, once
 // per episode: the track may already follow the wrong one of two look-alikes — when that rival is a
 // place the robot could be (TrackOptions::alias_rival_must_be_credible).
+// Leaving the map (extension): a track given up outside the map, having left it as a driving robot
+// would (no contradiction where its scans saw the map, each scan continuing the one before it,
+// scan_continuity.h), leaves the robot where the wheels carry it (dead_reckoning.h); MML's fixes
+// outside that pose's protection level are refused until the scans refute the wheels (an unmapped
+// wing can look like a mapped room turned round), and MML's local map restarts when the scan fits
+// the map again at that pose (the robot came back).
 // PoseEstimate.mode says which one is active; protection_xy_m / protection_theta_rad are set on
 // every `localized` pose. Never allocates in step(); both parts live in static storage.
 #pragma once
@@ -26,9 +32,11 @@
 
 #include "firmware/base/ring_buffer.h"
 #include "firmware/mml/mml_localizer.h"
+#include "firmware/track/dead_reckoning.h"
 #include "firmware/runtime/localizer.h"
 #include "firmware/track/global_context.h"
 #include "firmware/track/pose_tracker.h"
+#include "firmware/track/scan_continuity.h"
 
 namespace fw {
 namespace track {
@@ -59,6 +67,10 @@ class TrackedLocalizer final : public Localizer {
   // Fixes confirmed on the scans before them (TrackOptions::confirm_fix_on_past_scans), of fixes().
   std::uint32_t fixes_on_past_scans() const { return fixes_on_past_scans_; }
   std::uint32_t tracks_lost() const { return tracks_lost_; }
+  // MML fixes refused because the wheels, carrying a track given up outside the map, rule them out
+  // (dead_reckoning.h); counted once per scan.
+  std::uint32_t fixes_refused_by_wheels() const { return fixes_refused_by_wheels_; }
+  const DeadReckoning& dead_reckoning() const { return dead_reckoning_; }
   std::uint32_t cross_check_switches() const { return cross_check_switches_; }  // tracks replaced by MML
   // MML isolated a pose outside a track that had seen no large fault, and the scan did not prefer
   // MML's pose significantly: neither is published `localized` until MML isolates the tracked pose.
@@ -83,9 +95,6 @@ class TrackedLocalizer final : public Localizer {
   // past_scans_per_step per call. true while it catches up or once the track is `localized` on the
   // newest scan; when it ends otherwise, forward confirmation from the fix (start_forward's result).
   bool replay_past_scans(const Se2f& wheel, std::size_t n, hal::PoseEstimate* out);
-  // MML is searching: is the robot outside the map? After a track was given up, by the tracker's
-  // outside-map test on this scan at the track's last pose carried by the wheels.
-  bool outside_by_dead_reckoning(std::size_t n) const;
   Status cross_check(const hal::LaserScan& scan, const hal::Odometry& odom, const Se2f& wheel, std::size_t n,
                      const TrackStep& ts, hal::PoseEstimate* out);
   mml::MmlLocalizer* mml_ = nullptr;
@@ -109,10 +118,32 @@ class TrackedLocalizer final : public Localizer {
   std::uint32_t cross_check_left_ = 0;  // scans the background search still runs (0 = idle)
   std::uint32_t confirmations_ = 0, cross_check_conflicts_ = 0, fixes_on_past_scans_ = 0;
   bool unconfirmed_ = false;
-  // Dead reckoning since the last track was given up (reset() clears it): its last pose carried by
-  // the wheels, for outside_by_dead_reckoning().
-  bool have_lost_pose_ = false;
-  Se2f dr_pose_, dr_wheel_;
+  // Since the last track was given up (reset() clears it): its last pose carried by the wheels, for
+  // the outside-map status while MML searches and, after a track given up outside the map, as the
+  // rival MML's fixes must agree with (dead_reckoning.h).
+  DeadReckoning dead_reckoning_;
+  // No scan since the track's last supported one contradicted it where it saw the map, or was
+  // unlike the scan before it (scan_continuity.h).
+  bool left_map_cleanly_ = true;
+  // The previous scan's end-points and wheels, for the continuity test; copied when a step ends.
+  struct RememberPreviousScan {
+    TrackedLocalizer* self;
+    std::size_t n;
+    Se2f wheel;
+    ~RememberPreviousScan() {
+      for (std::size_t k = 0; k < n; ++k) self->previous_pts_[k] = self->pts_[k];
+      self->previous_n_ = n;
+      self->previous_wheel_ = wheel;
+      self->have_previous_scan_ = true;
+    }
+  };
+  ScanContinuity continuity_;
+  Point2f previous_pts_[hal::LaserScan::kMaxBeams];
+  std::size_t previous_n_ = 0;
+  Se2f previous_wheel_;
+  bool have_previous_scan_ = false;
+  ProtectionFactors k_;
+  std::uint32_t fixes_refused_by_wheels_ = 0;
 };
 
 }  // namespace track
