@@ -69,10 +69,9 @@ DeadReckoningVerdict DeadReckoning::judge(const GlobalMap& map, const Point2f* p
   const bool outside = here.unknown_fraction() > o.outside_map_fraction;
   if (!binding_) return outside ? DeadReckoningVerdict::kOutside : DeadReckoningVerdict::kSaysNothing;
   // The part of the scan on the map, fitted from the carried pose (the wheels' drift is no
-  // contradiction), by the tracker's fit tests (pose_tracker.cpp, judge_scan). Off the map too:
-  // a robot that drove out still sees the mapped walls behind it where the map has them; one
-  // carried away while its old place was at the map's edge does not (aces kidnap: the scan at the
-  // old pose was mostly unknown, the map's walls in it contradicted).
+  // contradiction), by the tracker's fit tests (pose_tracker.cpp, judge_scan). Off the map too: a
+  // robot where the wheels say sees the mapped walls where the map has them, so a scan mostly off
+  // the map whose end-points on it contradict the carried pose refutes the wheels as well.
   const ScanAlignment a = align_scan(map, pts, n, pose_, o.align);
   const bool informative = a.inliers + a.contradicting >= o.min_points;
   const bool contradicts =

@@ -332,6 +332,14 @@ UnknownRun drive_room_and_corridor(const std::vector<Se2f>& path) {
   return r;
 }
 
+// TRACK_TRACE=1: one line per step (status, reason, truth, estimate).
+void trace_step(std::size_t i, const mml::testing::StepRecord& r) {
+  if (!std::getenv("TRACK_TRACE")) return;
+  std::printf("%3zu %-11s %-18s truth (%.2f %.2f %.1f) est (%.2f %.2f %.1f)\n", i, hal::status_name(r.est.status),
+              hal::reason_name(r.est.reason), r.truth.x, r.truth.y, r.truth.theta * 57.3f, r.est.x, r.est.y,
+              r.est.theta * 57.3f);
+}
+
 TEST(TrackedLocalizerTest, OutsideMapComesFromTheScanAtTheDeadReckonedPose) {
   const auto path = mml::testing::waypoint_path({{1.5f, 1.5f}, {1.5f, 6.5f}, {4.5f, 6.5f}, {4.5f, 2.0f}, {10.5f, 4.0f},
                                                  {20.0f, 4.0f}, {10.5f, 4.0f}, {10.5f, 6.5f}, {4.5f, 6.5f}},
@@ -344,11 +352,7 @@ TEST(TrackedLocalizerTest, OutsideMapComesFromTheScanAtTheDeadReckonedPose) {
   for (std::size_t i = 0; i < run.rec.size(); ++i) {
     const auto& r = run.rec[i];
     const bool outside = r.est.status == hal::LocalizationStatus::kOutsideMap;
-    if (std::getenv("TRACK_TRACE")) {
-      std::printf("%3zu %-11s %-18s truth (%.2f %.2f %.1f) est (%.2f %.2f %.1f)\n", i, hal::status_name(r.est.status),
-                  hal::reason_name(r.est.reason), r.truth.x, r.truth.y, r.truth.theta * 57.3f, r.est.x, r.est.y,
-                  r.est.theta * 57.3f);
-    }
+    trace_step(i, r);
     if (r.truth.x > 15.0f) {
       been_out = true;
       ++steps_corridor;
@@ -390,11 +394,7 @@ TEST(TrackedLocalizerTest, LookAlikeWingBeyondTheMapIsNeverLocalized) {
   bool been_in_wing = false;
   for (std::size_t i = 0; i < rec.size(); ++i) {
     const auto& r = rec[i];
-    if (std::getenv("TRACK_TRACE")) {
-      std::printf("%3zu %-11s %-18s truth (%.2f %.2f %.1f) est (%.2f %.2f %.1f)\n", i, hal::status_name(r.est.status),
-                  hal::reason_name(r.est.reason), r.truth.x, r.truth.y, r.truth.theta * 57.3f, r.est.x, r.est.y,
-                  r.est.theta * 57.3f);
-    }
+    trace_step(i, r);
     if (r.truth.x > 7.5f) {
       been_in_wing = true;
       ++wing;
