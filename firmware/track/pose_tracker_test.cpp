@@ -566,6 +566,40 @@ TEST(PoseTrackerTest, ConfidenceCapIncludesTheUpdatesShift) {
   EXPECT_GT(pl[1], err[1]);
 }
 
+// A scan that is not fused leaves the pose on the prediction, and the prediction carries the bound
+// the last scan published, confidence-extent excess included. Driving along a corridor whose only
+// feature along its axis is a 10 cm stub, the scans pin the axis by their information but the
+// paired test leaves it open (excess > 0); when the robot stops, the scans are no longer fused, and
+// the PL must not fall back to the covariance's (fr079 scans 2155–2182: 0.18 → 0.11 m at the stop
+// while the error against the reference was 0.11–0.15 m).
+TEST(PoseTrackerTest, StandingStillKeepsTheConfidenceExcess) {
+  const GridWorld world = testing::plain_corridor(/*stub=*/true);
+  const OwnedGlobalMap map(world);
+  PoseTracker t;
+  ASSERT_TRUE(t.init(TrackOptions(), map.map).is_ok());
+  RandomStream rng(17, 0);
+  Se2f truth(10.5f, 2.0f, 0.0f), odom;
+  t.start(truth, small_cov(), odom);
+  const auto first = testing::scan_at(world, truth, &rng, 0.01f, 4.0f);
+  t.step(first.data(), first.size(), odom, false);
+  TrackStep moving;
+  for (int i = 0; i < 10; ++i) {
+    truth = truth.compose(Se2f(0.1f, 0.0f, 0.0f));
+    odom = odom.compose(Se2f(0.1f, 0.0f, 0.0f));
+    const auto pts = testing::scan_at(world, truth, &rng, 0.01f, 4.0f);
+    moving = t.step(pts.data(), pts.size(), odom);
+    ASSERT_FALSE(moving.lost) << i;
+  }
+  const float cov_only = protection_level(moving.cov, ProtectionFactors::for_risk(TrackOptions().integrity_risk), 0.0f, 0.0f).xy_m;
+  ASSERT_GT(moving.pl.xy_m, cov_only + 0.05f) << "the corridor's axis must leave an excess";
+  for (int i = 0; i < 20; ++i) {
+    const auto pts = testing::scan_at(world, truth, &rng, 0.01f, 4.0f);
+    const TrackStep s = t.step(pts.data(), pts.size(), odom);
+    ASSERT_FALSE(s.fused) << i;
+    EXPECT_GE(s.pl.xy_m, 0.95f * moving.pl.xy_m) << "standing step " << i << ": PL " << moving.pl.xy_m << " -> " << s.pl.xy_m;
+  }
+}
+
 // Ambiguity along a weak axis: the protection level describes one Gaussian mode and cannot cover an
 // alias one period away, so the alias check keeps the status from `localized` (still tracked).
 // Without the check the same scans would be published `localized`.
