@@ -36,8 +36,6 @@ void TrackedLocalizer::reset() {
   replay_lag_ = 0;
   dead_reckoning_.clear();
   left_map_cleanly_ = true;
-  have_previous_scan_ = false;
-  previous_n_ = 0;
 }
 
 // End-points within the tracker's range, evenly subsampled to at most align.max_points (beam order
@@ -88,8 +86,7 @@ Status TrackedLocalizer::step(const hal::LaserScan& scan, const hal::Odometry& o
   global_.tick();
   const Se2f wheel(odom.x, odom.y, odom.theta);
   const std::size_t n = scan_points(scan);
-  const RememberPreviousScan remember{this, n, wheel};  // for the next step's continuity test
-  if (tracker_.options().confirm_fix_on_past_scans) {
+  {  // the continuity test reads the previous scan, the replay of confirm_fix_on_past_scans all of them
     history_.push_overwrite(RememberedScan());
     RememberedScan& r = history_[history_.size() - 1];
     for (std::size_t k = 0; k < n; ++k) r.pts[k] = pts_[k];
@@ -114,8 +111,9 @@ Status TrackedLocalizer::step(const hal::LaserScan& scan, const hal::Odometry& o
     // would (TrackStep::known_part_contradicts)?
     if (ts.verdict == ScanVerdict::kSupported) left_map_cleanly_ = true;
     if (ts.known_part_contradicts || ts.large_fault) left_map_cleanly_ = false;
-    if (ts.verdict == ScanVerdict::kOutsideMap && have_previous_scan_ &&
-        continuity_.explained_fraction(previous_pts_, previous_n_, pts_, n, previous_wheel_.between(wheel),
+    const RememberedScan* previous = history_.size() >= 2 ? &history_[history_.size() - 2] : nullptr;
+    if (ts.verdict == ScanVerdict::kOutsideMap && previous != nullptr &&
+        continuity_.explained_fraction(previous->pts, previous->n, pts_, n, previous->wheel.between(wheel),
                                        tracker_.options().align.outlier_m) <
             tracker_.options().min_explained_fraction) {
       left_map_cleanly_ = false;  // the scan is not what the robot saw a scan ago: it may have been carried

@@ -101,7 +101,8 @@ class TrackedLocalizer final : public Localizer {
   GlobalContext global_;
   PoseTracker tracker_;
   Point2f pts_[hal::LaserScan::kMaxBeams];
-  // The last scans as the tracker uses them, this step's the newest (only with confirm_fix_on_past_scans).
+  // The last scans as the tracker uses them, this step's the newest: the previous one for the
+  // continuity test (scan_continuity.h), all of them for confirm_fix_on_past_scans.
   struct RememberedScan {
     Point2f pts[hal::LaserScan::kMaxBeams];
     std::size_t n = 0;
@@ -125,23 +126,7 @@ class TrackedLocalizer final : public Localizer {
   // No scan since the track's last supported one contradicted it where it saw the map, or was
   // unlike the scan before it (scan_continuity.h).
   bool left_map_cleanly_ = true;
-  // The previous scan's end-points and wheels, for the continuity test; copied when a step ends.
-  struct RememberPreviousScan {
-    TrackedLocalizer* self;
-    std::size_t n;
-    Se2f wheel;
-    ~RememberPreviousScan() {
-      for (std::size_t k = 0; k < n; ++k) self->previous_pts_[k] = self->pts_[k];
-      self->previous_n_ = n;
-      self->previous_wheel_ = wheel;
-      self->have_previous_scan_ = true;
-    }
-  };
   ScanContinuity continuity_;
-  Point2f previous_pts_[hal::LaserScan::kMaxBeams];
-  std::size_t previous_n_ = 0;
-  Se2f previous_wheel_;
-  bool have_previous_scan_ = false;
   ProtectionFactors k_;
   std::uint32_t fixes_refused_by_wheels_ = 0;
 };
