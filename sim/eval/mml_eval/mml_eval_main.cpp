@@ -70,7 +70,7 @@ const char kUsage[] =
     "scans before it first (TrackOptions::confirm_fix_on_past_scans, on by default). --no-steady-fit-trust:\n"
     "an alias rival beyond the prediction stays exempt when the fit fell at z 1.645\n"
     "(TrackOptions::alias_trust_needs_steady_fit). --valley-one-mode: on a trusted track a rival in the fix's own\n"
-    "cost valley does not make the scan ambiguous (TrackOptions::alias_valley_is_one_mode, off by default;\n"
+    "cost valley does not make the scan ambiguous (TrackOptions::alias_valley_is_one_mode, on by default;\n"
     "--no-valley-one-mode turns it off). --keep-valley-information: with it, such a scan's information along the\n"
     "valley is fused, not dropped (TrackOptions::alias_valley_drops_information). --no-cover-unfused: the PL of a\n"
     "scan not fused (standing robot) leaves out the update the scan would make\n"

@@ -186,7 +186,7 @@ static bool parse_odom_noise(const std::map<std::string, std::string>& options, 
 // odom_noise=TT,TR,RR,RT and odom_noise_per_step=M,DEG (the tracker's odometry noise model, as
 // mmlfw's config keys of the same names);
 // odom_adapt=0|1 (wheel-noise self-calibration, TrackOptions::odom_noise_window 64; 0 = default);
-// valley=0|1 (TrackOptions::alias_valley_is_one_mode; 0 = default).
+// valley=0|1 (TrackOptions::alias_valley_is_one_mode; default 1, as TrackOptions).
 std::unique_ptr<fw::Localizer> make_track_localizer(const LocalizerContext& ctx, std::string* err) {
   const std::string bad = check_keys("mml-track", ctx.options, {"config", "correct", "reduce", "pool", "keep", "contested", "rivals", "alert", "odom_noise", "odom_noise_per_step", "odom_adapt", "valley"});
   if (!bad.empty()) { *err = bad; return nullptr; }
