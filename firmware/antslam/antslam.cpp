@@ -85,6 +85,7 @@ Status AntSlamOptions::validate() const {
   }
   FW_RETURN_IF_ERROR(aco.validate());
   FW_RETURN_IF_ERROR(edge_fit.validate());
+  FW_RETURN_IF_ERROR(graph.validate());
   return lm.validate();
 }
 
@@ -125,6 +126,7 @@ std::size_t AntSlam::required_arena_bytes(const AntSlamOptions& o) {
   b += o.max_loop_steps * (sizeof(LoopStep) + sizeof(Se2d));
   b += AntColony::required_arena_bytes(o.aco, o.max_loop_steps, o.samples_per_edge);
   b += LoopLm::required_arena_bytes(o.max_loop_steps);
+  b += GraphRefine::required_arena_bytes(o.max_fragments);
   // pRANSAM: measured by the caller's arena (init reports capacity errors); a generous bound.
   b += 64u << 20;
   return b + 64 * 40;
@@ -177,6 +179,7 @@ Status AntSlam::init(const AntSlamOptions& options, StartupArena& arena, WorkerP
 #undef FW_ANTSLAM_ALLOC
   FW_RETURN_IF_ERROR(aco_.init(options.aco, options.max_loop_steps, options.samples_per_edge, arena, pool));
   FW_RETURN_IF_ERROR(lm_.init(options.lm, options.max_loop_steps, arena));
+  FW_RETURN_IF_ERROR(graph_.init(options.graph, options.max_fragments, arena));
   FW_RETURN_IF_ERROR(matcher_.init(sized_matcher(options), arena, pool));
   edge_rng_.reseed(options.seed, 0xED6E);
   num_scans_ = num_fragments_ = num_edges_ = num_closures_ = 0;
@@ -335,8 +338,27 @@ Status AntSlam::add_scan(const Se2d& pose, const Point2f* points, std::size_t co
 
 Status AntSlam::finish() {
   if (!initialized_) return Status::error(Errc::kNotInitialized, "antslam: init() not called");
-  if (num_fragments_ == 0 || traversing_) return Status::ok();  // a traversed fragment's loop was tried when it ended
-  return close_loop(active_);
+  if (num_fragments_ == 0) return Status::ok();
+  if (!traversing_) FW_RETURN_IF_ERROR(close_loop(active_));  // a traversed fragment's loop was tried when it ended
+  return options_.final_refinement ? refine_whole_graph() : Status::ok();
+}
+
+Status AntSlam::refine_whole_graph() {
+  if (!initialized_) return Status::error(Errc::kNotInitialized, "antslam: init() not called");
+  const std::uint64_t t0 = now();
+  GraphRefineReport rep;
+  FW_RETURN_IF_ERROR(graph_.refine(edges_, num_edges_, world_, num_fragments_, &rep));
+  // Every edge takes the transform between its refined frames; the entry edges rebuild world_.
+  for (std::uint32_t k = 0; k < num_edges_; ++k) {
+    edges_[k].value = world_[edges_[k].from].between(world_[edges_[k].to]);
+  }
+  recompute_world();
+  stats_.graph_initial_cost = rep.initial_cost;
+  stats_.graph_final_cost = rep.final_cost;
+  stats_.graph_iterations = rep.iterations;
+  stats_.graph_cg_iterations = rep.cg_iterations;
+  stats_.graph_ns = now() - t0;
+  return Status::ok();
 }
 
 bool AntSlam::keyframe_due() const {

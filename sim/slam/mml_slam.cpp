@@ -34,6 +34,9 @@ const char* kHelp =
     "                        between its consecutive GMapping-corrected poses)\n"
     "options:\n"
     "  --optimizer aco|lm    loop optimiser (default aco: the ant colony of Eq. 3.13-3.14)\n"
+    "  --final-refine on|off  at the end of the run, refine every fragment frame against every edge at once\n"
+    "                        (Gauss-Newton on the whole graph, frozen loops included; an extension of Alg. 3,\n"
+    "                        fw::antslam::GraphRefine; default: AntSlamOptions::final_refinement)\n"
     "  --edge-model sensor|motion  edge covariance: from poses weighted by the sensor model (Eq. 3.9, default)\n"
     "                        or the front end's propagated motion covariance (Eq. 3.4; closures: --closure-sigma)\n"
     "  --front fused|fused-filter|rbsm  front end: RBSM fused with PL-ICP's laser-to-laser increments and\n"
@@ -137,6 +140,9 @@ Parsed parse_run_option(const std::string& a, const std::string& v, SlamArgs* o)
     if (v == "aco") cfg.slam.optimizer = fw::antslam::LoopOptimizer::kAntColony;
     else if (v == "lm") cfg.slam.optimizer = fw::antslam::LoopOptimizer::kLevenbergMarquardt;
     else return failed("--optimizer: '" + v + "' is not aco or lm");
+  } else if (a == "--final-refine") {
+    cfg.slam.final_refinement = v == "on";
+    if (!cfg.slam.final_refinement && v != "off") return failed("--final-refine: '" + v + "' is not on or off");
   } else if (a == "--edge-model") {
     if (v == "sensor") cfg.slam.edge_model = fw::antslam::EdgeModel::kSensorModel;
     else if (v == "motion") cfg.slam.edge_model = fw::antslam::EdgeModel::kMotionModel;
@@ -310,6 +316,11 @@ void print_summary(const sim::CarmenLog& log, const sim::SlamConfig& cfg, const 
   std::printf("mml-slam: front end %.1f s + AntSLAM %.1f s (pRANSAM %.0f ms, %s %.0f ms) for %.0f s of log\n", run.frontend_s,
               run.backend_s, run.matcher_ms,
               cfg.slam.optimizer == fw::antslam::LoopOptimizer::kAntColony ? "ant colony" : "LM", run.optimizer_ms, log_s);
+  if (cfg.slam.final_refinement) {
+    std::printf("mml-slam: final refinement of the whole graph: W %.1f -> %.1f in %u Gauss-Newton steps (%u CG iterations), %.1f ms\n",
+                run.stats.graph_initial_cost, run.stats.graph_final_cost, run.stats.graph_iterations,
+                run.stats.graph_cg_iterations, 1e-6 * static_cast<double>(run.stats.graph_ns));
+  }
   if (verbose) {
     for (const auto& c : run.closures) {
       std::printf("loop %u -> %u: %u edges, quality %.2f, chi2 %.1f, open %.3f m, W %.1f -> %.1f\n", c.from, c.to,
@@ -365,6 +376,10 @@ int run(int argc, char** argv) {
     const auto ms = sim::evaluate_relations(rel, sim::make_trajectory(log, run.poses));
     std::printf("relations, front end alone: %s\nrelations, AntSLAM:          %s\n", sim::to_string(mf).c_str(),
                 sim::to_string(ms).c_str());
+    if (!run.alg3_poses.empty()) {
+      const auto ma = sim::evaluate_relations(rel, sim::make_trajectory(log, run.alg3_poses));
+      std::printf("relations, AntSLAM before the final refinement (Alg. 3 as published): %s\n", sim::to_string(ma).c_str());
+    }
   }
   return write_outputs(o, log, run);
 }

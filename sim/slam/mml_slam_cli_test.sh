@@ -18,6 +18,7 @@ expect 2 "--front: 'bogus' is not fused, fused-filter or rbsm" --log /nonexisten
 expect 2 "--optimizer: 'x' is not aco or lm" --log /nonexistent --optimizer x
 expect 2 "--edge-model: 'y' is not sensor or motion" --log /nonexistent --edge-model y
 expect 2 "--traversal: 'z' is not off, on or tracked" --log /nonexistent --traversal z
+expect 2 "--final-refine: 'maybe' is not on or off" --log /nonexistent --final-refine maybe
 expect 2 "--ants: '0' is not an integer in 1..1024" --log /nonexistent --ants 0
 expect 2 "unknown option '--bogus'" --log /nonexistent --front fused-filter --bogus 1
 # Every accepted front end gets as far as the log, which names itself.

@@ -43,6 +43,9 @@ bool run_slam_backend(const CarmenLog& log, const std::vector<fw::Se2d>& fronten
     return false;
   }
   fw::antslam::AntSlamOptions o = config.slam;
+  // The final refinement is run below by hand, after Alg. 3's poses are read (SlamRun::alg3_poses).
+  const bool refine = o.final_refinement;
+  o.final_refinement = false;
   if (o.max_scans < n) o.max_scans = static_cast<std::uint32_t>(n);
   // Enough fragments for the distance the front end travelled (a long log must not run out).
   double travelled = 0;
@@ -81,6 +84,12 @@ bool run_slam_backend(const CarmenLog& log, const std::vector<fw::Se2d>& fronten
     if (config.progress && (i % 500 == 0)) config.progress(i, n, "antslam");
   }
   if (st.is_ok()) st = slam->finish();
+  out->alg3_poses.clear();
+  if (st.is_ok() && refine) {
+    out->alg3_poses.resize(n);
+    for (std::size_t i = 0; i < n; ++i) out->alg3_poses[i] = slam->scan_pose(static_cast<std::uint32_t>(i));
+    st = slam->refine_whole_graph();
+  }
   if (pool) pool->stop();
   if (!st.is_ok()) {
     *error = log.path + ": antslam: " + st.message();

@@ -45,6 +45,9 @@ struct SlamEdgeInfo {
 struct SlamRun {
   std::vector<fw::Se2d> frontend;  // RBSM poses (one per scan)
   std::vector<fw::Se2d> poses;     // AntSLAM corrected (one per scan)
+  // With AntSlamOptions::final_refinement: the poses before it (Alg. 3 as published: loops
+  // corrected and frozen, nothing after); empty without it (then `poses` are those).
+  std::vector<fw::Se2d> alg3_poses;
   std::vector<SlamFragmentInfo> fragments;
   std::vector<SlamEdgeInfo> edges;
   std::vector<fw::antslam::ClosureRecord> closures;
