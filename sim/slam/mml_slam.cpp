@@ -36,7 +36,7 @@ const char* kHelp =
     "  --optimizer aco|lm    loop optimiser (default aco: the ant colony of Eq. 3.13-3.14)\n"
     "  --final-refine on|off  at the end of the run, refine every fragment frame against every edge at once\n"
     "                        (Gauss-Newton on the whole graph, frozen loops included; an extension of Alg. 3,\n"
-    "                        fw::antslam::GraphRefine; default: AntSlamOptions::final_refinement)\n"
+    "                        fw::antslam::GraphRefine; default on; off = Alg. 3 as published)\n"
     "  --edge-model sensor|motion  edge covariance: from poses weighted by the sensor model (Eq. 3.9, default)\n"
     "                        or the front end's propagated motion covariance (Eq. 3.4; closures: --closure-sigma)\n"
     "  --front fused|fused-filter|rbsm  front end: RBSM fused with PL-ICP's laser-to-laser increments and\n"
