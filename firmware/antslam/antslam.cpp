@@ -126,7 +126,7 @@ std::size_t AntSlam::required_arena_bytes(const AntSlamOptions& o) {
   b += o.max_loop_steps * (sizeof(LoopStep) + sizeof(Se2d));
   b += AntColony::required_arena_bytes(o.aco, o.max_loop_steps, o.samples_per_edge);
   b += LoopLm::required_arena_bytes(o.max_loop_steps);
-  b += GraphRefine::required_arena_bytes(o.max_fragments);
+  b += GraphRefine::required_arena_bytes(o.max_fragments, max_edges(o));
   // pRANSAM: measured by the caller's arena (init reports capacity errors); a generous bound.
   b += 64u << 20;
   return b + 64 * 40;
@@ -179,7 +179,7 @@ Status AntSlam::init(const AntSlamOptions& options, StartupArena& arena, WorkerP
 #undef FW_ANTSLAM_ALLOC
   FW_RETURN_IF_ERROR(aco_.init(options.aco, options.max_loop_steps, options.samples_per_edge, arena, pool));
   FW_RETURN_IF_ERROR(lm_.init(options.lm, options.max_loop_steps, arena));
-  FW_RETURN_IF_ERROR(graph_.init(options.graph, options.max_fragments, arena));
+  FW_RETURN_IF_ERROR(graph_.init(options.graph, options.max_fragments, max_edges_, arena));
   FW_RETURN_IF_ERROR(matcher_.init(sized_matcher(options), arena, pool));
   edge_rng_.reseed(options.seed, 0xED6E);
   num_scans_ = num_fragments_ = num_edges_ = num_closures_ = 0;

@@ -52,39 +52,42 @@ double graph_cost(const SampledEdge* edges, std::uint32_t num_edges, const Se2d*
   return w;
 }
 
-std::size_t GraphRefine::required_arena_bytes(std::uint32_t max_nodes) {
-  return static_cast<std::size_t>(max_nodes) * (5 * sizeof(Vec3) + sizeof(Mat3) + sizeof(Se2d)) + 7 * 64;
+std::size_t GraphRefine::required_arena_bytes(std::uint32_t max_nodes, std::uint32_t max_edges) {
+  return static_cast<std::size_t>(max_nodes) * (5 * sizeof(Vec3) + sizeof(Mat3) + sizeof(Se2d)) +
+         static_cast<std::size_t>(max_edges) * 2 * sizeof(Mat3) + 8 * 64;
 }
 
-Status GraphRefine::init(const GraphRefineOptions& options, std::uint32_t max_nodes, StartupArena& arena) {
+Status GraphRefine::init(const GraphRefineOptions& options, std::uint32_t max_nodes, std::uint32_t max_edges,
+                         StartupArena& arena) {
   FW_RETURN_IF_ERROR(options.validate());
   options_ = options;
   max_nodes_ = max_nodes;
-#define FW_GRAPH_ALLOC(ptr, T, what)                     \
-  do {                                                   \
-    auto r_ = arena.allocate_array<T>(max_nodes, what);  \
-    if (!r_) return r_.status();                         \
-    ptr = *r_;                                           \
+  max_edges_ = max_edges;
+#define FW_GRAPH_ALLOC(ptr, T, count, what)          \
+  do {                                               \
+    auto r_ = arena.allocate_array<T>(count, what);  \
+    if (!r_) return r_.status();                     \
+    ptr = *r_;                                       \
   } while (0)
-  FW_GRAPH_ALLOC(g_, Vec3, "graph refine gradient");
-  FW_GRAPH_ALLOC(x_, Vec3, "graph refine step");
-  FW_GRAPH_ALLOC(p_, Vec3, "graph refine direction");
-  FW_GRAPH_ALLOC(q_, Vec3, "graph refine product");
-  FW_GRAPH_ALLOC(z_, Vec3, "graph refine preconditioned");
-  FW_GRAPH_ALLOC(dinv_, Mat3, "graph refine preconditioner");
-  FW_GRAPH_ALLOC(trial_, Se2d, "graph refine trial");
+  FW_GRAPH_ALLOC(g_, Vec3, max_nodes, "graph refine gradient");
+  FW_GRAPH_ALLOC(x_, Vec3, max_nodes, "graph refine step");
+  FW_GRAPH_ALLOC(p_, Vec3, max_nodes, "graph refine direction");
+  FW_GRAPH_ALLOC(q_, Vec3, max_nodes, "graph refine product");
+  FW_GRAPH_ALLOC(z_, Vec3, max_nodes, "graph refine preconditioned");
+  FW_GRAPH_ALLOC(dinv_, Mat3, max_nodes, "graph refine preconditioner");
+  FW_GRAPH_ALLOC(trial_, Se2d, max_nodes, "graph refine trial");
+  FW_GRAPH_ALLOC(jac_, Mat3, static_cast<std::size_t>(max_edges) * 2, "graph refine jacobians");
 #undef FW_GRAPH_ALLOC
   return Status::ok();
 }
 
-void GraphRefine::apply_h(const SampledEdge* edges, std::uint32_t num_edges, const Se2d* poses, const Vec3* v,
-                          Vec3* out, std::uint32_t n) const {
+void GraphRefine::apply_h(const SampledEdge* edges, std::uint32_t num_edges, const Vec3* v, Vec3* out,
+                          std::uint32_t n) const {
   for (std::uint32_t i = 0; i < n; ++i) out[i].setZero();
   for (std::uint32_t k = 0; k < num_edges; ++k) {
     const SampledEdge& e = edges[k];
-    Vec3 r;
-    Mat3 a, b;
-    linearise(e, poses, &r, &a, &b);
+    const Mat3& a = jac_[2 * k];
+    const Mat3& b = jac_[2 * k + 1];
     const Vec3 w = e.info * (a * v[e.from] + b * v[e.to]);
     out[e.from] += a.transpose() * w;
     out[e.to] += b.transpose() * w;
@@ -98,6 +101,9 @@ Status GraphRefine::refine(const SampledEdge* edges, std::uint32_t num_edges, Se
   if (n > max_nodes_) {
     return Status::error(Errc::kCapacityExceeded, "graph refine: %u frames, capacity %u", n, max_nodes_);
   }
+  if (num_edges > max_edges_) {
+    return Status::error(Errc::kCapacityExceeded, "graph refine: %u edges, capacity %u", num_edges, max_edges_);
+  }
   for (std::uint32_t k = 0; k < num_edges; ++k) {
     if (edges[k].from >= n || edges[k].to >= n) {
       return Status::error(Errc::kInvalidArgument, "graph refine: edge %u joins frame %u and %u of %u", k,
@@ -109,7 +115,8 @@ Status GraphRefine::refine(const SampledEdge* edges, std::uint32_t num_edges, Se
   rep.initial_cost = rep.final_cost = cost;
   if (!std::isfinite(cost)) return Status::error(Errc::kInvalidArgument, "graph refine: the start cost is not finite");
   for (std::uint32_t it = 0; it < options_.max_iterations && n > 1; ++it) {
-    // Gradient g = Σ Jᵀ Ω r and the diagonal blocks of H = Σ Jᵀ Ω J.
+    // Gradient g = Σ Jᵀ Ω r and the diagonal blocks of H = Σ Jᵀ Ω J; the Jacobians are kept for
+    // the conjugate-gradient products of this step.
     for (std::uint32_t i = 0; i < n; ++i) {
       g_[i].setZero();
       dinv_[i].setZero();
@@ -117,7 +124,8 @@ Status GraphRefine::refine(const SampledEdge* edges, std::uint32_t num_edges, Se
     for (std::uint32_t k = 0; k < num_edges; ++k) {
       const SampledEdge& e = edges[k];
       Vec3 r;
-      Mat3 a, b;
+      Mat3& a = jac_[2 * k];
+      Mat3& b = jac_[2 * k + 1];
       linearise(e, poses, &r, &a, &b);
       const Vec3 w = e.info * r;
       g_[e.from] += a.transpose() * w;
@@ -143,7 +151,7 @@ Status GraphRefine::refine(const SampledEdge* edges, std::uint32_t num_edges, Se
     double rz = dot(g_, z_, n);
     std::uint32_t cg = 0;
     while (cg < options_.max_cg_iterations && std::sqrt(dot(g_, g_, n)) > options_.cg_relative_tolerance * g_norm) {
-      apply_h(edges, num_edges, poses, p_, q_, n);
+      apply_h(edges, num_edges, p_, q_, n);
       const double pq = dot(p_, q_, n);
       if (!(pq > 0.0)) break;  // H not positive along p: stop with what is solved
       const double alpha = rz / pq;

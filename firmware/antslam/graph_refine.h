@@ -38,19 +38,21 @@ double graph_cost(const SampledEdge* edges, std::uint32_t num_edges, const Se2d*
 
 class GraphRefine {
  public:
-  static std::size_t required_arena_bytes(std::uint32_t max_nodes);
-  Status init(const GraphRefineOptions& options, std::uint32_t max_nodes, StartupArena& arena);
+  static std::size_t required_arena_bytes(std::uint32_t max_nodes, std::uint32_t max_edges);
+  Status init(const GraphRefineOptions& options, std::uint32_t max_nodes, std::uint32_t max_edges,
+              StartupArena& arena);
   // poses: in the start, out the minimum (poses[0] unchanged). Every edge's from/to < num_nodes.
   // A step that does not lower W is not taken (the start is returned when none does).
   Status refine(const SampledEdge* edges, std::uint32_t num_edges, Se2d* poses, std::uint32_t num_nodes,
                 GraphRefineReport* report);
 
  private:
-  // H v for the current linearisation (edges' Jacobians recomputed on the fly).
-  void apply_h(const SampledEdge* edges, std::uint32_t num_edges, const Se2d* poses, const Eigen::Vector3d* v,
-               Eigen::Vector3d* out, std::uint32_t n) const;
+  // H v for the current linearisation (the edges' Jacobians kept in jac_ by the Gauss–Newton step).
+  void apply_h(const SampledEdge* edges, std::uint32_t num_edges, const Eigen::Vector3d* v, Eigen::Vector3d* out,
+               std::uint32_t n) const;
   GraphRefineOptions options_;
-  std::uint32_t max_nodes_ = 0;
+  std::uint32_t max_nodes_ = 0, max_edges_ = 0;
+  Eigen::Matrix3d* jac_ = nullptr;  // per edge: ∂r/∂P_from, ∂r/∂P_to at the current linearisation
   Eigen::Vector3d* g_ = nullptr;   // gradient, then CG residual
   Eigen::Vector3d* x_ = nullptr;   // CG solution (δ)
   Eigen::Vector3d* p_ = nullptr;   // CG direction

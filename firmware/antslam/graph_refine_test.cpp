@@ -113,7 +113,7 @@ TEST(GraphRefineTest, FindsTheConsistentFramesFromAPerturbedStart) {
   for (std::uint32_t i = 1; i < kFrames; ++i) p[i] = Se2d(p[i].x + 0.3 * std::sin(i), p[i].y - 0.2, p[i].theta + 0.05);
   Arena a;
   GraphRefine g;
-  ASSERT_TRUE(g.init(GraphRefineOptions(), kFrames, a.arena).is_ok());
+  ASSERT_TRUE(g.init(GraphRefineOptions(), kFrames, kFrames, a.arena).is_ok());
   GraphRefineReport rep;
   ASSERT_TRUE(g.refine(r.edges.data(), kFrames, p.data(), kFrames, &rep).is_ok());
   EXPECT_GT(rep.initial_cost, 100.0);
@@ -134,7 +134,7 @@ TEST(GraphRefineTest, SpreadsTheClosureErrorLikeTheDenseSolution) {
   const std::vector<Se2d> want = dense_solution(r, p);
   Arena a;
   GraphRefine g;
-  ASSERT_TRUE(g.init(GraphRefineOptions(), kFrames, a.arena).is_ok());
+  ASSERT_TRUE(g.init(GraphRefineOptions(), kFrames, kFrames, a.arena).is_ok());
   GraphRefineReport rep;
   const bool count = mmlfw_test::AllocCounter::available();
   if (count) mmlfw_test::AllocCounter::begin();
@@ -167,7 +167,7 @@ TEST(GraphRefineTest, RefusesEdgesBeyondItsFramesAndNeverRaisesTheCost) {
   std::vector<Se2d> p = r.chained();
   GraphRefineReport rep;
   EXPECT_FALSE(g.refine(r.edges.data(), kFrames, p.data(), kFrames, &rep).is_ok());  // before init
-  ASSERT_TRUE(g.init(GraphRefineOptions(), kFrames, a.arena).is_ok());
+  ASSERT_TRUE(g.init(GraphRefineOptions(), kFrames, kFrames, a.arena).is_ok());
   const Status few = g.refine(r.edges.data(), kFrames, p.data(), kFrames - 1, &rep);
   ASSERT_FALSE(few.is_ok());
   EXPECT_NE(std::string(few.message()).find("edge 10"), std::string::npos) << few.message();
@@ -175,7 +175,7 @@ TEST(GraphRefineTest, RefusesEdgesBeyondItsFramesAndNeverRaisesTheCost) {
   GraphRefineOptions bad;
   bad.max_iterations = 0;
   GraphRefine g2;
-  EXPECT_FALSE(g2.init(bad, kFrames, a.arena).is_ok());
+  EXPECT_FALSE(g2.init(bad, kFrames, kFrames, a.arena).is_ok());
   // Already at the minimum: nothing moves, W stays.
   std::vector<Se2d> q = r.truth;
   Ring exact(false);
