@@ -86,6 +86,12 @@ Status AntSlamOptions::validate() const {
   FW_RETURN_IF_ERROR(aco.validate());
   FW_RETURN_IF_ERROR(edge_fit.validate());
   FW_RETURN_IF_ERROR(graph.validate());
+  if ((pair_closures && pair_isolation) || gate_isolation) {
+    FW_RETURN_IF_ERROR(isolation.validate());
+    if (isolation_max_points < 16 || isolation_field_cells < 1024) {
+      return Status::error(Errc::kInvalidArgument, "antslam: isolation_max_points >= 16 and isolation_field_cells >= 1024");
+    }
+  }
   return lm.validate();
 }
 
@@ -109,6 +115,16 @@ pransam::MatcherOptions sized_matcher(const AntSlamOptions& o) {
 }
 std::uint32_t max_edges(const AntSlamOptions& o) { return o.max_fragments + o.max_closures; }
 using FragmentStateStorage = AntSlam::FragmentState;
+
+bool uses_isolation(const AntSlamOptions& o) { return (o.pair_closures && o.pair_isolation) || o.gate_isolation; }
+
+// The isolation model's field: the matcher's contact parameters, with distances (fit_on_field).
+pransam::ContactFieldOptions isolation_field_options(const AntSlamOptions& o) {
+  pransam::ContactFieldOptions f = o.matcher.field;
+  f.keep_distance = true;
+  f.max_cells = o.isolation_field_cells;
+  return f;
+}
 }  // namespace
 
 std::size_t AntSlam::required_arena_bytes(const AntSlamOptions& o) {
@@ -127,6 +143,10 @@ std::size_t AntSlam::required_arena_bytes(const AntSlamOptions& o) {
   b += AntColony::required_arena_bytes(o.aco, o.max_loop_steps, o.samples_per_edge);
   b += LoopLm::required_arena_bytes(o.max_loop_steps);
   b += GraphRefine::required_arena_bytes(o.max_fragments, max_edges(o));
+  if (uses_isolation(o)) {
+    b += o.isolation_max_points * sizeof(Point2f) + 2 * o.max_points_per_fragment * (sizeof(Point2f) + sizeof(CellSample));
+    b += pransam::ContactField<2>::arena_bytes(isolation_field_options(o)) + 64 * 4;
+  }
   // pRANSAM: measured by the caller's arena (init reports capacity errors); a generous bound.
   b += 64u << 20;
   return b + 64 * 40;
@@ -176,14 +196,23 @@ Status AntSlam::init(const AntSlamOptions& options, StartupArena& arena, WorkerP
   FW_ANTSLAM_ALLOC(queue_, std::uint32_t, f, "antslam bfs queue");
   FW_ANTSLAM_ALLOC(steps_, LoopStep, options.max_loop_steps, "antslam loop steps");
   FW_ANTSLAM_ALLOC(values_, Se2d, options.max_loop_steps, "antslam loop values");
-#undef FW_ANTSLAM_ALLOC
   FW_RETURN_IF_ERROR(aco_.init(options.aco, options.max_loop_steps, options.samples_per_edge, arena, pool));
   FW_RETURN_IF_ERROR(lm_.init(options.lm, options.max_loop_steps, arena));
   FW_RETURN_IF_ERROR(graph_.init(options.graph, options.max_fragments, max_edges_, arena));
+  if (uses_isolation(options)) {
+    FW_ANTSLAM_ALLOC(iso_model_, Point2f, options.isolation_max_points, "antslam isolation model");
+    FW_ANTSLAM_ALLOC(iso_scene_, Point2f, 2 * static_cast<std::size_t>(options.max_points_per_fragment),
+                     "antslam isolation scene");
+    FW_ANTSLAM_ALLOC(iso_cells_, CellSample, 2 * static_cast<std::size_t>(options.max_points_per_fragment),
+                     "antslam isolation cells");
+    FW_RETURN_IF_ERROR(iso_field_.init(isolation_field_options(options), arena));
+  }
   FW_RETURN_IF_ERROR(matcher_.init(sized_matcher(options), arena, pool));
+#undef FW_ANTSLAM_ALLOC
   edge_rng_.reseed(options.seed, 0xED6E);
   num_scans_ = num_fragments_ = num_edges_ = num_closures_ = 0;
   active_ = pending_parent_ = 0;
+  pending_.clear();
   traversing_ = false;
   model_of_ = kNoEdge;
   stats_ = AntSlamStats{};
@@ -738,47 +767,197 @@ Se2d AntSlam::freeze_loop(std::uint32_t n) {
   return xc;
 }
 
-// Candidate c for a: match, gate against the prediction, correct and freeze the loop, add the
-// closing edge. `closed` tells whether the loop was closed; errors only from the optimiser / edges.
-Status AntSlam::try_closure(std::uint32_t a, std::uint32_t c, bool* closed) {
+// Candidate c for a: match and gate against the prediction; closes the loop when it passes, else
+// records the closure in gated[] for the pair test. Errors only from the optimiser / edges.
+Status AntSlam::try_closure(std::uint32_t a, std::uint32_t c, bool* closed, ClosureCandidate* gated,
+                            std::uint32_t* num_gated) {
   const Point2f* scene = points_ + static_cast<std::size_t>(a) * options_.max_points_per_fragment;
   const std::uint32_t n = build_path(c, a);
   Se2d x;
   Mat3 cov = Mat3::Zero();
   compound_path(n, &x, &cov);
-  Se2d h;
-  float quality = 0.0f;
-  if (!match_closure(a, c, x, &h, &quality)) return Status::ok();
-  const Mat3 cov_h = closure_cov(scene, num_points_[a], h);
-  const Vec3 dh = se2_difference(h, x);
-  const double chi2 = dh.dot((cov + cov_h).inverse() * dh);
-  if (!(chi2 <= options_.closure_gate_chi2)) {
-    ++stats_.rejected_gate;
+  ClosureCandidate k;
+  k.a = a;
+  k.c = c;
+  if (!match_closure(a, c, x, &k.h, &k.quality)) return Status::ok();
+  k.cov_h = closure_cov(scene, num_points_[a], k.h);
+  k.dh = se2_difference(k.h, x);
+  const double chi2 = k.dh.dot((cov + k.cov_h).inverse() * k.dh);
+  k.gate_chi2 = static_cast<float>(chi2);
+  k.heading_chi2 = static_cast<float>(k.dh(2) * k.dh(2) / (cov(2, 2) + k.cov_h(2, 2)));
+  bool pass = chi2 <= options_.closure_gate_chi2;
+  if (pass && options_.gate_isolation) {
+    // Isolated among the rivals the gate admits too (a rival the prediction rules out is no alias).
+    float z = 0.0f;
+    IsolationPrior prior;
+    prior.mean = x;
+    prior.info = (cov + k.cov_h).inverse();
+    prior.gate = options_.closure_gate_chi2;
+    pass = closure_isolated(nullptr, k, Se2d(), &z, &prior);
+    shortest_paths(a);  // closure_isolated() rooted the BFS at c
+    if (!pass) ++stats_.gated_not_isolated;
+  }
+  if (!pass) {
+    if (!(chi2 <= options_.closure_gate_chi2)) ++stats_.rejected_gate;
+    if (*num_gated < kMaxCandidates) gated[(*num_gated)++] = k;
     return Status::ok();
   }
+  return close_with(a, k, build_path(c, a), closed);
+}
+
+// Corrects the loop c → a (the first n steps_) with the closure k, freezes it and adds the closing edge.
+Status AntSlam::close_with(std::uint32_t a, const ClosureCandidate& k, std::uint32_t n, bool* closed,
+                           const ClosureRecord* pair) {
   double w0 = 0, w1 = 0;
-  FW_RETURN_IF_ERROR(optimize_loop(n, h, cov_h, &w0, &w1));
+  FW_RETURN_IF_ERROR(optimize_loop(n, k.h, k.cov_h, &w0, &w1));
   const Se2d xc = freeze_loop(n);
   std::uint32_t ei = 0;
-  FW_RETURN_IF_ERROR(add_edge(c, a, h, cov_h, cov_h, &ei));
+  FW_RETURN_IF_ERROR(add_edge(k.c, a, k.h, k.cov_h, k.cov_h, &ei));
   edges_[ei].closure = true;
   edges_[ei].value = xc;  // consistent with the corrected chain
   edges_[ei].frozen = true;
-  closures_[num_closures_++] = ClosureRecord{c,
+  closures_[num_closures_++] = ClosureRecord{k.c,
                                              a,
                                              n,
-                                             quality,
-                                             static_cast<float>(chi2),
-                                             static_cast<float>(std::hypot(dh(0), dh(1))),
+                                             k.quality,
+                                             k.gate_chi2,
+                                             static_cast<float>(std::hypot(k.dh(0), k.dh(1))),
                                              static_cast<float>(w0),
                                              static_cast<float>(w1)};
+  if (pair != nullptr) {
+    ClosureRecord& r = closures_[num_closures_ - 1];
+    r.pair_with = pair->pair_with;
+    r.pair_chi2 = pair->pair_chi2;
+    r.isolation_z = pair->isolation_z;
+  }
   ++stats_.loops;
   recompute_world();
   last_closed_ = true;
-  last_closure_c_ = c;
-  last_closure_cov_ = cov_h;
+  last_closure_c_ = k.c;
+  last_closure_cov_ = k.cov_h;
   *closed = true;
   return Status::ok();
+}
+
+bool AntSlam::chain(std::uint32_t from, std::uint32_t to, std::uint32_t max_steps, Se2d* x, Mat3* cov) {
+  *x = Se2d();
+  *cov = Mat3::Zero();
+  if (from == to) return true;
+  if (hops_[from] == kNoHops || hops_[from] > max_steps) return false;
+  const std::uint32_t n = build_path(from, to);
+  if (n == 0) return false;
+  compound_path(n, x, cov);
+  return true;
+}
+
+Status AntSlam::try_pair_closure(std::uint32_t a, const ClosureCandidate* gated, std::uint32_t num_gated,
+                                 bool* closed) {
+  constexpr std::uint32_t kRing = ClosureCandidateRing::kCapacity;
+  // Chains a_p → a of every pending closure (BFS rooted at a, as close_loop left it).
+  Se2d aa[kRing];
+  Mat3 cov_aa[kRing];
+  bool aa_ok[kRing];
+  for (std::uint32_t i = 0; i < pending_.size(); ++i) {
+    aa_ok[i] = pending_[i].a != a && pending_[i].heading_chi2 <= options_.closure_gate_chi2 &&
+               chain(pending_[i].a, a, options_.pair_window + 1, &aa[i], &cov_aa[i]);
+  }
+  // Each gated candidate q: its best cycle with a pending p (BFS rooted at q.c for the chain c_p → c).
+  double best[kMaxCandidates];
+  std::uint32_t partner[kMaxCandidates];
+  std::uint32_t num_paired = 0, first = kMaxCandidates;
+  for (std::uint32_t j = 0; j < num_gated; ++j) {
+    best[j] = options_.closure_gate_chi2 + 1.0;
+    if (!(gated[j].heading_chi2 <= options_.closure_gate_chi2)) continue;  // turned: no drift explains it
+    shortest_paths(gated[j].c);
+    for (std::uint32_t i = 0; i < pending_.size(); ++i) {
+      if (!aa_ok[i]) continue;
+      Se2d cc;
+      Mat3 cov_cc;
+      if (!chain(pending_[i].c, gated[j].c, options_.pair_max_hops, &cc, &cov_cc)) continue;
+      const double chi2 = pair_cycle_chi2(pending_[i], gated[j], cc, cov_cc, aa[i], cov_aa[i]);
+      if (chi2 < best[j]) {
+        best[j] = chi2;
+        partner[j] = i;
+      }
+    }
+    if (best[j] <= options_.closure_gate_chi2) {
+      ++num_paired;
+      if (first == kMaxCandidates || best[j] < best[first]) first = j;
+    }
+  }
+  if (num_paired == 0) {
+    shortest_paths(a);
+    return Status::ok();
+  }
+  // Every paired candidate must agree with the chosen one (the same correction of the revisit).
+  shortest_paths(gated[first].c);
+  for (std::uint32_t j = 0; j < num_gated; ++j) {
+    if (j == first || !(best[j] <= options_.closure_gate_chi2)) continue;
+    Se2d cc;
+    Mat3 cov_cc;
+    const bool near = chain(gated[j].c, gated[first].c, options_.pair_max_hops, &cc, &cov_cc);
+    if (!near || !(pair_cycle_chi2(gated[j], gated[first], cc, cov_cc, Se2d(), Mat3::Zero()) <=
+                   options_.closure_gate_chi2)) {
+      shortest_paths(a);
+      return Status::ok();  // two different corrections: ambiguous
+    }
+  }
+  ClosureRecord rec;
+  rec.pair_with = pending_[partner[first]].a + 1;
+  rec.pair_chi2 = static_cast<float>(best[first]);
+  if (options_.pair_isolation &&
+      !closure_isolated(&pending_[partner[first]], gated[first], aa[partner[first]], &rec.isolation_z)) {
+    ++stats_.pairs_not_isolated;
+    shortest_paths(a);
+    return Status::ok();
+  }
+  shortest_paths(a);
+  const std::uint32_t n = build_path(gated[first].c, a);
+  if (n == 0) return Status::ok();
+  FW_RETURN_IF_ERROR(close_with(a, gated[first], n, closed, &rec));
+  ++stats_.pair_loops;
+  return Status::ok();
+}
+
+bool AntSlam::closure_isolated(const ClosureCandidate* p, const ClosureCandidate& q, const Se2d& aa, float* z,
+                            const IsolationPrior* prior) {
+  // Scene: q.a's points and (a pair) p.a's moved into F_q.a.
+  const std::size_t cap = options_.max_points_per_fragment;
+  std::size_t ns = 0;
+  const Point2f* qa = points_ + static_cast<std::size_t>(q.a) * cap;
+  for (std::uint32_t i = 0; i < num_points_[q.a]; ++i) iso_scene_[ns++] = qa[i];
+  if (p != nullptr) {
+    const Se2d to_q = aa.inverse();
+    const Point2f* pa = points_ + static_cast<std::size_t>(p->a) * cap;
+    for (std::uint32_t i = 0; i < num_points_[p->a]; ++i) {
+      iso_scene_[ns++] = to_q.transform_point(pa[i].cast<double>()).cast<float>();
+    }
+  }
+  // Model: the old fragments within isolation.hops of q.c, in F_q.c, thinned evenly to capacity.
+  shortest_paths(q.c);
+  std::size_t total = 0;
+  for (std::uint32_t f = 0; f < num_fragments_; ++f) {
+    if (hops_[f] <= options_.isolation.hops && f + options_.min_fragment_gap <= q.a) total += num_points_[f];
+  }
+  const std::size_t stride = total > options_.isolation_max_points ? (total + options_.isolation_max_points - 1) / options_.isolation_max_points : 1;
+  std::size_t nm = 0, k = 0;
+  for (std::uint32_t f = 0; f < num_fragments_; ++f) {
+    if (!(hops_[f] <= options_.isolation.hops && f + options_.min_fragment_gap <= q.a)) continue;
+    Se2d cf;
+    Mat3 cov;
+    if (!chain(f, q.c, options_.isolation.hops, &cf, &cov)) continue;
+    const Se2d to_c = cf.inverse();  // F_f in F_q.c
+    const Point2f* fp = points_ + static_cast<std::size_t>(f) * cap;
+    for (std::uint32_t i = 0; i < num_points_[f]; ++i, ++k) {
+      if (k % stride == 0 && nm < options_.isolation_max_points) iso_model_[nm++] = to_c.transform_point(fp[i].cast<double>()).cast<float>();
+    }
+  }
+  *z = 0.0f;
+  if (!iso_field_.build(iso_model_, nm, "antslam isolation model").is_ok()) return false;  // too large: not shown isolated
+  const IsolationResult r =
+      check_closure_isolation(iso_field_, iso_scene_, ns, q.h, options_.isolation, iso_cells_, prior);
+  *z = r.rival_z;
+  return r.isolated;
 }
 
 Status AntSlam::close_loop(std::uint32_t a) {
@@ -788,11 +967,20 @@ Status AntSlam::close_loop(std::uint32_t a) {
   // Candidates, nearest (Mahalanobis) first.
   std::uint32_t cand[kMaxCandidates];
   const std::uint32_t num_cand = find_candidates(a, cand);
-  for (std::uint32_t k = 0; k < num_cand; ++k) {
-    bool closed = false;
-    FW_RETURN_IF_ERROR(try_closure(a, cand[k], &closed));
-    if (closed) return Status::ok();  // one loop per fragment
+  ClosureCandidate gated[kMaxCandidates];
+  std::uint32_t num_gated = 0;
+  bool closed = false;
+  for (std::uint32_t k = 0; k < num_cand && !closed; ++k) {
+    FW_RETURN_IF_ERROR(try_closure(a, cand[k], &closed, gated, &num_gated));  // one loop per fragment
   }
+  if (!options_.pair_closures) return Status::ok();
+  pending_.expire(a, options_.pair_window);
+  if (!closed && num_gated > 0) FW_RETURN_IF_ERROR(try_pair_closure(a, gated, num_gated, &closed));
+  if (closed) {
+    pending_.clear();  // the revisit is corrected; later closures are gated against the new prediction
+    return Status::ok();
+  }
+  for (std::uint32_t k = 0; k < num_gated; ++k) pending_.push(gated[k]);
   return Status::ok();
 }
 

@@ -23,6 +23,13 @@
 // Mahalanobis distance to x pass the gates. The loop L is then corrected by the ant colony
 // (Eq. 3.13–3.14, ant_colony.h) or Levenberg–Marquardt (loop_lm.h) — options.optimizer — and its
 // edges, with the new closing edge, are frozen ("corrected loops are frozen").
+// Closures in pairs (AntSlamOptions::pair_closures, an extension; closure_pairs.h,
+// closure_isolation.h): a closure that fails the gate is kept for the next pair_window fragments;
+// when one of the current fragment's gated-out closures forms a consistent cycle with one of them
+// (through the two short chains between them) and both fragments' points fit nowhere else on the
+// old map around the candidate as well, the loop is closed with it after all — the front end's
+// drift model cannot tell a true closure after a long drifting loop from a corridor's alias, two
+// agreeing and isolated closures can.
 // At the end of the run (finish(), AntSlamOptions::final_refinement, an extension) the whole graph —
 // every adjacent and closing edge, frozen or not — is refined once by least squares (graph_refine.h),
 // so a late closure's error is not left on the one or two edges its loop still had free.
@@ -47,6 +54,8 @@
 #include <cstdint>
 
 #include "firmware/antslam/ant_colony.h"
+#include "firmware/antslam/closure_isolation.h"
+#include "firmware/antslam/closure_pairs.h"
 #include "firmware/antslam/edge_fit.h"
 #include "firmware/antslam/field_fit.h"
 #include "firmware/antslam/fragment_borders.h"
@@ -108,6 +117,28 @@ struct AntSlamOptions {
   float refine_cutoff_start = 0.5f, refine_cutoff_end = 0.15f;
   float prefer_prediction_margin = -1.0f;  // < 0: always pRANSAM's h (measured on intel: preferring
                                            // the prediction, 0.02, made the long relations worse)
+  // Closures confirmed in pairs (closure_pairs.h, an extension of Alg. 3): a closure gated out
+  // against the prediction is closed after all when it forms a consistent cycle (closure_gate_chi2)
+  // with a gated-out closure of one of the last pair_window active fragments, the candidate
+  // fragments at most pair_max_hops apart, and both closures pass the gate in heading alone. The front end's drift model cannot tell a true closure
+  // after a long, drifting loop from a corridor's alias; two closures of successive fragments that
+  // agree through the short chains between them can.
+  bool pair_closures = true;
+  std::uint32_t pair_window = 2;
+  std::uint32_t pair_max_hops = 4;
+  // A pair-confirmed closure must also be isolated on the old map around its candidate
+  // (closure_isolation.h): no rival pose of both fragments' points fits as well. The model is the
+  // old fragments within isolation.hops of the candidate, at most isolation_max_points points
+  // (thinned evenly beyond), on a field of at most isolation_field_cells cells.
+  bool pair_isolation = true;
+  // Closures that pass the gate must be isolated too, among the rivals the gate also admits
+  // (a rival the prediction rules out is no alias); one that is not waits for a pair like a gated-out
+  // one. Measured (README, AntSLAM section): Alg. 3's gate alone accepted five alias closures 4–21 m
+  // off on mit-killian seed 3; with this test none, on every log and seed checked.
+  bool gate_isolation = true;
+  IsolationOptions isolation;
+  std::uint32_t isolation_max_points = 16384;
+  std::size_t isolation_field_cells = std::size_t(1) << 21;
   pransam::MatcherOptions matcher;       // sizes taken from max_points_per_fragment in validate()
   pransam::MatchParams match;
 
@@ -148,6 +179,9 @@ struct AntSlamStats {
   std::uint32_t sensor_fits = 0;       // edges whose Σ came from the sensor model (Eq. 3.9)
   std::uint32_t motion_fallbacks = 0;  // edges that kept the Eq. 3.4 Σ (no fit possible: too few points)
   std::uint32_t loops = 0;             // loops closed and corrected
+  std::uint32_t pair_loops = 0;        // of them, closed by a consistent pair (closure_pairs.h)
+  std::uint32_t pairs_not_isolated = 0;  // consistent pairs refused: a rival fits as well (closure_isolation.h)
+  std::uint32_t gated_not_isolated = 0;  // closures within the gate refused: a rival within the gate fits as well
   std::uint32_t dropped_points = 0;    // points beyond a fragment's capacity
   std::uint32_t borders = 0;           // borders cut (each stored on both sides)
   std::uint32_t no_border = 0;         // a fragment left where Eq. 3.7 found no point on one side
@@ -172,6 +206,8 @@ struct ClosureRecord {
   float gate_chi2 = 0;       // (h − x)ᵀ(Σ_x + Σ_h)⁻¹(h − x)
   float shift_m = 0;         // |h − x| (translation): how far the loop was open
   float cost_before = 0, cost_after = 0;  // W of the loop (Eq. 3.13) before/after the optimiser
+  std::uint32_t pair_with = 0;  // closed by a consistent pair (closure_pairs.h): the other fragment + 1; 0: by the gate
+  float pair_chi2 = 0, isolation_z = 0;  // the pair's cycle χ² and the isolation test's z (closure_isolation.h)
 };
 
 class AntSlam {
@@ -262,7 +298,23 @@ class AntSlam {
   // Steps of close_loop() (antslam.cpp).
   std::uint32_t find_candidates(std::uint32_t a, std::uint32_t* cand);
   bool candidate_distance(std::uint32_t c, std::uint32_t a, std::uint32_t n, double* m) const;
-  Status try_closure(std::uint32_t a, std::uint32_t c, bool* closed);
+  // Matches c against a; closes the loop when the closure passes the gate, else appends it to
+  // gated[] (capacity kMaxCandidates) for the pair test.
+  Status try_closure(std::uint32_t a, std::uint32_t c, bool* closed, ClosureCandidate* gated, std::uint32_t* num_gated);
+  // `pair`: the record's pair fields (nullptr: closed by the gate).
+  Status close_with(std::uint32_t a, const ClosureCandidate& k, std::uint32_t n, bool* closed,
+                    const ClosureRecord* pair = nullptr);
+  // closure_pairs.h: closes a's loop with one of its gated-out candidates that forms a consistent
+  // cycle with a pending one of the last pair_window fragments (and agrees with every other such).
+  Status try_pair_closure(std::uint32_t a, const ClosureCandidate* gated, std::uint32_t num_gated, bool* closed);
+  // F_to in F_from along the current BFS tree (rooted at `to`), with its Eq. 3.4 covariance; false
+  // when not connected or more than max_steps apart.
+  bool chain(std::uint32_t from, std::uint32_t to, std::uint32_t max_steps, Se2d* x, Mat3* cov);
+  // closure_isolation.h for the pair p, q (aa = F_q.a in F_p.a; p nullptr: q alone): both fragments'
+  // points against the old fragments around q.c, rivals limited by `prior` when given. Leaves the
+  // BFS tree rooted at q.c.
+  bool closure_isolated(const ClosureCandidate* p, const ClosureCandidate& q, const Se2d& aa, float* z,
+                     const IsolationPrior* prior = nullptr);
   bool match_closure(std::uint32_t a, std::uint32_t c, const Se2d& x, Se2d* h, float* quality);
   Se2d refine_hypothesis(const Point2f* scene, std::uint32_t n, const Se2d& h, const Se2d& x);
   Mat3 closure_cov(const Point2f* scene, std::uint32_t n, const Se2d& h);
@@ -337,6 +389,11 @@ class AntSlam {
   std::uint32_t* queue_ = nullptr;
   LoopStep* steps_ = nullptr;
   Se2d* values_ = nullptr;
+  ClosureCandidateRing pending_;  // gated-out closures of the last pair_window fragments
+  pransam::ContactField<2> iso_field_;  // the old map around a pair's candidate
+  Point2f* iso_model_ = nullptr;        // isolation_max_points
+  Point2f* iso_scene_ = nullptr;        // 2 × max_points_per_fragment
+  CellSample* iso_cells_ = nullptr;     // 2 × max_points_per_fragment
 };
 
 }  // namespace fw::antslam

@@ -37,6 +37,13 @@ const char* kHelp =
     "  --final-refine on|off  at the end of the run, refine every fragment frame against every edge at once\n"
     "                        (Gauss-Newton on the whole graph, frozen loops included; an extension of Alg. 3,\n"
     "                        fw::antslam::GraphRefine; default on; off = Alg. 3 as published)\n"
+    "  --pair-closures on|off  a loop closure outside the drift gate is still closed when it agrees with one of\n"
+    "                        the last two fragments' through the short chains between them (an extension of\n"
+    "                        Alg. 3, firmware/antslam/closure_pairs.h; default on; off = the gate alone)\n"
+    "  --pair-isolation on|off  such a pair is closed only when both fragments' points fit nowhere else on the old\n"
+    "                        map around the candidate as well (firmware/antslam/closure_isolation.h; default on)\n"
+    "  --gate-isolation on|off  a closure within the gate must be isolated too, among the rivals the gate also\n"
+    "                        admits; if not, it waits for a pair (default on; off = Alg. 3's gate alone)\n"
     "  --edge-model sensor|motion  edge covariance: from poses weighted by the sensor model (Eq. 3.9, default)\n"
     "                        or the front end's propagated motion covariance (Eq. 3.4; closures: --closure-sigma)\n"
     "  --front fused|fused-filter|rbsm  front end: RBSM fused with PL-ICP's laser-to-laser increments and\n"
@@ -143,6 +150,15 @@ Parsed parse_run_option(const std::string& a, const std::string& v, SlamArgs* o)
   } else if (a == "--final-refine") {
     cfg.slam.final_refinement = v == "on";
     if (!cfg.slam.final_refinement && v != "off") return failed("--final-refine: '" + v + "' is not on or off");
+  } else if (a == "--pair-closures") {
+    cfg.slam.pair_closures = v == "on";
+    if (!cfg.slam.pair_closures && v != "off") return failed("--pair-closures: '" + v + "' is not on or off");
+  } else if (a == "--pair-isolation") {
+    cfg.slam.pair_isolation = v == "on";
+    if (!cfg.slam.pair_isolation && v != "off") return failed("--pair-isolation: '" + v + "' is not on or off");
+  } else if (a == "--gate-isolation") {
+    cfg.slam.gate_isolation = v == "on";
+    if (!cfg.slam.gate_isolation && v != "off") return failed("--gate-isolation: '" + v + "' is not on or off");
   } else if (a == "--edge-model") {
     if (v == "sensor") cfg.slam.edge_model = fw::antslam::EdgeModel::kSensorModel;
     else if (v == "motion") cfg.slam.edge_model = fw::antslam::EdgeModel::kMotionModel;
@@ -302,9 +318,11 @@ std::optional<int> load_inputs(SlamArgs* o, sim::CarmenLog* log, std::vector<sim
 // The summary lines on stdout: loops, edge covariances, time, and with --verbose every closed loop.
 void print_summary(const sim::CarmenLog& log, const sim::SlamConfig& cfg, const sim::SlamRun& run, bool verbose) {
   const double log_s = log.scans.size() > 1 ? log.scans[run.poses.size() - 1].ipc_timestamp - log.scans[0].ipc_timestamp : 0;
-  std::printf("mml-slam: %zu scans, %zu fragments, %u loops closed (%u candidates: %u below quality, %u outside the gate)\n",
-              run.poses.size(), run.fragments.size(), run.stats.loops, run.stats.candidates, run.stats.rejected_quality,
-              run.stats.rejected_gate);
+  std::printf("mml-slam: %zu scans, %zu fragments, %u loops closed, %u of them by a consistent pair (%u candidates: %u below "
+              "quality, %u outside the gate, %u within it but not isolated; %u consistent pairs not isolated)\n",
+              run.poses.size(), run.fragments.size(), run.stats.loops, run.stats.pair_loops, run.stats.candidates,
+              run.stats.rejected_quality, run.stats.rejected_gate, run.stats.gated_not_isolated,
+              run.stats.pairs_not_isolated);
   if (cfg.slam.edge_model == fw::antslam::EdgeModel::kSensorModel) {
     std::printf("mml-slam: edge covariances from the sensor model (Eq. 3.9): %u, fallback (too few points: Eq. 3.4, or closure-sigma for a closure): %u\n",
                 run.stats.sensor_fits, run.stats.motion_fallbacks);
@@ -323,8 +341,13 @@ void print_summary(const sim::CarmenLog& log, const sim::SlamConfig& cfg, const 
   }
   if (verbose) {
     for (const auto& c : run.closures) {
-      std::printf("loop %u -> %u: %u edges, quality %.2f, chi2 %.1f, open %.3f m, W %.1f -> %.1f\n", c.from, c.to,
+      std::printf("loop %u -> %u: %u edges, quality %.2f, chi2 %.1f, open %.3f m, W %.1f -> %.1f", c.from, c.to,
                   c.path_edges, c.quality, c.gate_chi2, c.shift_m, c.cost_before, c.cost_after);
+      if (c.pair_with > 0) {
+        std::printf(", beyond the gate: paired with fragment %u (cycle chi2 %.1f)", c.pair_with - 1, c.pair_chi2);
+        if (cfg.slam.pair_isolation) std::printf(", isolated (z %.1f)", c.isolation_z);
+      }
+      std::printf("\n");
     }
   }
 }

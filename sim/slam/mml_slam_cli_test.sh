@@ -19,6 +19,9 @@ expect 2 "--optimizer: 'x' is not aco or lm" --log /nonexistent --optimizer x
 expect 2 "--edge-model: 'y' is not sensor or motion" --log /nonexistent --edge-model y
 expect 2 "--traversal: 'z' is not off, on or tracked" --log /nonexistent --traversal z
 expect 2 "--final-refine: 'maybe' is not on or off" --log /nonexistent --final-refine maybe
+expect 2 "--pair-closures: 'yes' is not on or off" --log /nonexistent --pair-closures yes
+expect 2 "--pair-isolation: '1' is not on or off" --log /nonexistent --pair-isolation 1
+expect 2 "--gate-isolation: 'no' is not on or off" --log /nonexistent --gate-isolation no
 expect 2 "--ants: '0' is not an integer in 1..1024" --log /nonexistent --ants 0
 expect 2 "unknown option '--bogus'" --log /nonexistent --front fused-filter --bogus 1
 # Every accepted front end gets as far as the log, which names itself.
