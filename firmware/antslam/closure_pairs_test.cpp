@@ -2,6 +2,7 @@
 // (closure_isolation.h).
 #include "firmware/antslam/closure_isolation.h"
 #include "firmware/antslam/closure_pairs.h"
+#include "firmware/antslam/field_test_util.h"
 
 #include <gtest/gtest.h>
 
@@ -10,6 +11,9 @@
 
 namespace fw::antslam {
 namespace closure_pairs_test {  // named: the tests are built as one unity source
+
+using field_test::Field;
+using field_test::wall;
 
 ClosureCandidate closure(std::uint32_t a, std::uint32_t c, const Se2d& h, double sigma = 0.05) {
   ClosureCandidate k;
@@ -78,16 +82,6 @@ TEST(ClosurePairsTest, RingKeepsTheLastFragmentsOnly) {
   EXPECT_EQ(ring.size(), 0u);
 }
 
-// Points every 5 cm along the segment a → b.
-void wall(float ax, float ay, float bx, float by, std::vector<Point2f>* out) {
-  const float len = std::hypot(bx - ax, by - ay);
-  const int n = static_cast<int>(len / 0.05f);
-  for (int i = 0; i <= n; ++i) {
-    const float t = static_cast<float>(i) / static_cast<float>(n);
-    out->emplace_back(ax + t * (bx - ax), ay + t * (by - ay));
-  }
-}
-
 // A corridor 2 m wide from x = 0 to 40 m with 1 m door openings in its walls: every 4 m (periodic),
 // or at irregular places.
 std::vector<Point2f> corridor(const std::vector<float>& doors) {
@@ -121,19 +115,6 @@ std::vector<Point2f> scene_of(const std::vector<Point2f>& model, float x0, float
   }
   return s;
 }
-
-struct Field {
-  std::vector<unsigned char> block;
-  StartupArena arena;
-  pransam::ContactField<2> field;
-  explicit Field(const std::vector<Point2f>& model) {
-    pransam::ContactFieldOptions o;
-    block.resize(pransam::ContactField<2>::arena_bytes(o) + 4096);
-    EXPECT_TRUE(arena.init(block.data(), block.size(), "test").is_ok());
-    EXPECT_TRUE(field.init(o, arena).is_ok());
-    EXPECT_TRUE(field.build(model.data(), model.size(), "model").is_ok());
-  }
-};
 
 IsolationResult isolation_of(const std::vector<Point2f>& model, const Se2d& pose, const Se2d& h) {
   const Field f(model);

@@ -1,5 +1,6 @@
 // Eq. 3.9 edge covariances (edge_fit.h): the data decide the shape of Σ.
 #include "firmware/antslam/edge_fit.h"
+#include "firmware/antslam/field_test_util.h"
 
 #include <gtest/gtest.h>
 
@@ -9,29 +10,8 @@
 namespace fw::antslam {
 namespace {
 
-// Points every 5 cm along the segment a → b.
-void wall(float ax, float ay, float bx, float by, std::vector<Point2f>* out) {
-  const float len = std::hypot(bx - ax, by - ay);
-  const int n = static_cast<int>(len / 0.05f);
-  for (int i = 0; i <= n; ++i) {
-    const float t = static_cast<float>(i) / static_cast<float>(n);
-    out->emplace_back(ax + t * (bx - ax), ay + t * (by - ay));
-  }
-}
-
-struct Field {
-  std::vector<unsigned char> block;
-  StartupArena arena;
-  pransam::ContactField<2> field;
-  explicit Field(const std::vector<Point2f>& model, bool keep_distance = true) {
-    pransam::ContactFieldOptions o;
-    o.keep_distance = keep_distance;
-    block.resize(pransam::ContactField<2>::arena_bytes(o) + 4096);
-    EXPECT_TRUE(arena.init(block.data(), block.size(), "test").is_ok());
-    EXPECT_TRUE(field.init(o, arena).is_ok());
-    EXPECT_TRUE(field.build(model.data(), model.size(), "model").is_ok());
-  }
-};
+using field_test::Field;
+using field_test::wall;
 
 // The scene: the model's points seen from `pose` (moved into the pose's frame).
 std::vector<Point2f> seen_from(const std::vector<Point2f>& model, const Se2d& pose) {
