@@ -772,7 +772,7 @@ Se2d AntSlam::freeze_loop(std::uint32_t n) {
 Status AntSlam::try_closure(std::uint32_t a, std::uint32_t c, bool* closed, ClosureCandidate* gated,
                             std::uint32_t* num_gated) {
   const Point2f* scene = points_ + static_cast<std::size_t>(a) * options_.max_points_per_fragment;
-  const std::uint32_t n = build_path(c, a);
+  std::uint32_t n = build_path(c, a);
   Se2d x;
   Mat3 cov = Mat3::Zero();
   compound_path(n, &x, &cov);
@@ -794,7 +794,8 @@ Status AntSlam::try_closure(std::uint32_t a, std::uint32_t c, bool* closed, Clos
     prior.info = (cov + k.cov_h).inverse();
     prior.gate = options_.closure_gate_chi2;
     pass = closure_isolated(nullptr, k, Se2d(), &z, &prior);
-    shortest_paths(a);  // closure_isolated() rooted the BFS at c
+    shortest_paths(a);  // closure_isolated() rooted the BFS at c and reused steps_
+    n = build_path(c, a);
     if (!pass) ++stats_.gated_not_isolated;
   }
   if (!pass) {
@@ -802,7 +803,7 @@ Status AntSlam::try_closure(std::uint32_t a, std::uint32_t c, bool* closed, Clos
     if (*num_gated < kMaxCandidates) gated[(*num_gated)++] = k;
     return Status::ok();
   }
-  return close_with(a, k, build_path(c, a), closed);
+  return close_with(a, k, n, closed);
 }
 
 // Corrects the loop c → a (the first n steps_) with the closure k, freezes it and adds the closing edge.
@@ -920,7 +921,7 @@ Status AntSlam::try_pair_closure(std::uint32_t a, const ClosureCandidate* gated,
 }
 
 bool AntSlam::closure_isolated(const ClosureCandidate* p, const ClosureCandidate& q, const Se2d& aa, float* z,
-                            const IsolationPrior* prior) {
+                               const IsolationPrior* prior) {
   // Scene: q.a's points and (a pair) p.a's moved into F_q.a.
   const std::size_t cap = options_.max_points_per_fragment;
   std::size_t ns = 0;
@@ -939,7 +940,8 @@ bool AntSlam::closure_isolated(const ClosureCandidate* p, const ClosureCandidate
   for (std::uint32_t f = 0; f < num_fragments_; ++f) {
     if (hops_[f] <= options_.isolation.hops && f + options_.min_fragment_gap <= q.a) total += num_points_[f];
   }
-  const std::size_t stride = total > options_.isolation_max_points ? (total + options_.isolation_max_points - 1) / options_.isolation_max_points : 1;
+  const std::size_t cap_m = options_.isolation_max_points;
+  const std::size_t stride = total > cap_m ? (total + cap_m - 1) / cap_m : 1;
   std::size_t nm = 0, k = 0;
   for (std::uint32_t f = 0; f < num_fragments_; ++f) {
     if (!(hops_[f] <= options_.isolation.hops && f + options_.min_fragment_gap <= q.a)) continue;
@@ -949,11 +951,12 @@ bool AntSlam::closure_isolated(const ClosureCandidate* p, const ClosureCandidate
     const Se2d to_c = cf.inverse();  // F_f in F_q.c
     const Point2f* fp = points_ + static_cast<std::size_t>(f) * cap;
     for (std::uint32_t i = 0; i < num_points_[f]; ++i, ++k) {
-      if (k % stride == 0 && nm < options_.isolation_max_points) iso_model_[nm++] = to_c.transform_point(fp[i].cast<double>()).cast<float>();
+      if (k % stride == 0 && nm < cap_m) iso_model_[nm++] = to_c.transform_point(fp[i].cast<double>()).cast<float>();
     }
   }
   *z = 0.0f;
-  if (!iso_field_.build(iso_model_, nm, "antslam isolation model").is_ok()) return false;  // too large: not shown isolated
+  // A model too large for the field is not shown isolated.
+  if (!iso_field_.build(iso_model_, nm, "antslam isolation model").is_ok()) return false;
   const IsolationResult r =
       check_closure_isolation(iso_field_, iso_scene_, ns, q.h, options_.isolation, iso_cells_, prior);
   *z = r.rival_z;

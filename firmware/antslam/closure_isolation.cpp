@@ -7,21 +7,27 @@ namespace fw::antslam {
 
 namespace {
 
-Point2f place(const Se2d& pose, const Point2f& p) {
-  const double c = std::cos(pose.theta), s = std::sin(pose.theta);
-  return Point2f(static_cast<float>(pose.x + c * p(0) - s * p(1)), static_cast<float>(pose.y + s * p(0) + c * p(1)));
-}
+// Se2::transform_point with the rotation computed once per pose, not once per point: the scene is
+// placed at two poses for every rival.
+struct Placement {
+  explicit Placement(const Se2d& pose) : x(pose.x), y(pose.y), c(std::cos(pose.theta)), s(std::sin(pose.theta)) {}
+  Point2f operator()(const Point2f& p) const {
+    return Point2f(static_cast<float>(x + c * p(0) - s * p(1)), static_cast<float>(y + s * p(0) + c * p(1)));
+  }
+  double x, y, c, s;
+};
 
 // z of mean(contact at a − contact at b) over the correlation cells of the points at a (the points of
 // one cell are averaged first: neighbouring end-points are not independent).
 float paired_z(const pransam::ContactField<2>& field, const Point2f* scene, std::size_t n, const Se2d& a, const Se2d& b,
                float cell_m, CellSample* cells) {
+  const Placement at_a(a), at_b(b);
   for (std::size_t i = 0; i < n; ++i) {
-    const Point2f q = place(a, scene[i]);
+    const Point2f q = at_a(scene[i]);
     const auto cx = static_cast<std::uint32_t>(static_cast<std::int32_t>(std::floor(q(0) / cell_m)) & 0xffff);
     const auto cy = static_cast<std::uint32_t>(static_cast<std::int32_t>(std::floor(q(1) / cell_m)) & 0xffff);
     cells[i].key = (cx << 16) | cy;
-    cells[i].d = (static_cast<float>(field.contact(q)) - static_cast<float>(field.contact(place(b, scene[i])))) / 255.0f;
+    cells[i].d = (static_cast<float>(field.contact(q)) - static_cast<float>(field.contact(at_b(scene[i])))) / 255.0f;
   }
   std::sort(cells, cells + n, [](const CellSample& l, const CellSample& r) { return l.key < r.key; });
   double s1 = 0.0, s2 = 0.0;
@@ -64,9 +70,10 @@ IsolationResult check_closure_isolation(const pransam::ContactField<2>& field, c
   r.rival_z = 1e6f;
   if (n < 3) return r;
   // Principal axes of the scene's extent at the closure.
+  const Placement at_h(fh.pose);
   double mx = 0, my = 0;
   for (std::size_t i = 0; i < n; ++i) {
-    const Point2f q = place(fh.pose, scene[i]);
+    const Point2f q = at_h(scene[i]);
     mx += q(0);
     my += q(1);
   }
@@ -74,7 +81,7 @@ IsolationResult check_closure_isolation(const pransam::ContactField<2>& field, c
   my /= static_cast<double>(n);
   double sxx = 0, sxy = 0, syy = 0;
   for (std::size_t i = 0; i < n; ++i) {
-    const Point2f q = place(fh.pose, scene[i]);
+    const Point2f q = at_h(scene[i]);
     sxx += (q(0) - mx) * (q(0) - mx);
     sxy += (q(0) - mx) * (q(1) - my);
     syy += (q(1) - my) * (q(1) - my);

@@ -4,20 +4,14 @@ namespace fw::antslam {
 
 double pair_cycle_chi2(const ClosureCandidate& p, const ClosureCandidate& q, const Se2d& cc, const Mat3& cov_cc,
                        const Se2d& aa, const Mat3& cov_aa) {
-  // Through the closures: F_a' in F_a = h_a⁻¹ ⊕ T(c → c') ⊕ h_a'.
+  // Through the closures: F_a' in F_a = h_a⁻¹ ⊕ T(c → c') ⊕ h_a' (Eq. 3.4 compounding).
   const Mat3 ji = p.h.jacobian_inverse();
-  Se2d x = p.h.inverse();
-  Mat3 cov = ji * p.cov_h * ji.transpose();
-  Mat3 j1 = x.jacobian_compose_first(cc), j2 = x.jacobian_compose_second();
-  cov = j1 * cov * j1.transpose() + j2 * cov_cc * j2.transpose();
-  x = x.compose(cc);
-  j1 = x.jacobian_compose_first(q.h);
-  j2 = x.jacobian_compose_second();
-  cov = j1 * cov * j1.transpose() + j2 * q.cov_h * j2.transpose();
-  x = x.compose(q.h);
+  PoseWithCovariance<double> x{p.h.inverse(), ji * p.cov_h * ji.transpose()};
+  x = compose_with_covariance(x, PoseWithCovariance<double>{cc, cov_cc});
+  x = compose_with_covariance(x, PoseWithCovariance<double>{q.h, q.cov_h});
   // Against the chain a → a' (independent measurements: the covariances add).
-  const Vec3 d = se2_difference(x, aa);
-  const Mat3 s = cov + cov_aa;
+  const Vec3 d = se2_difference(x.pose, aa);
+  const Mat3 s = x.cov + cov_aa;
   return d.dot(s.inverse() * d);
 }
 

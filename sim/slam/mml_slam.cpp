@@ -138,6 +138,13 @@ Parsed parse_file_option(const std::string& a, const std::string& v, SlamArgs* o
   return Parsed::kOk;
 }
 
+// An on|off switch.
+Parsed parse_on_off(const std::string& a, const std::string& v, bool* flag) {
+  if (v != "on" && v != "off") return failed(a + ": '" + v + "' is not on or off");
+  *flag = v == "on";
+  return Parsed::kOk;
+}
+
 // The "options" of the help text: optimiser, colony size, fragments, seed, threads, map raster.
 Parsed parse_run_option(const std::string& a, const std::string& v, SlamArgs* o) {
   sim::SlamConfig& cfg = o->cfg;
@@ -148,17 +155,13 @@ Parsed parse_run_option(const std::string& a, const std::string& v, SlamArgs* o)
     else if (v == "lm") cfg.slam.optimizer = fw::antslam::LoopOptimizer::kLevenbergMarquardt;
     else return failed("--optimizer: '" + v + "' is not aco or lm");
   } else if (a == "--final-refine") {
-    cfg.slam.final_refinement = v == "on";
-    if (!cfg.slam.final_refinement && v != "off") return failed("--final-refine: '" + v + "' is not on or off");
+    return parse_on_off(a, v, &cfg.slam.final_refinement);
   } else if (a == "--pair-closures") {
-    cfg.slam.pair_closures = v == "on";
-    if (!cfg.slam.pair_closures && v != "off") return failed("--pair-closures: '" + v + "' is not on or off");
+    return parse_on_off(a, v, &cfg.slam.pair_closures);
   } else if (a == "--pair-isolation") {
-    cfg.slam.pair_isolation = v == "on";
-    if (!cfg.slam.pair_isolation && v != "off") return failed("--pair-isolation: '" + v + "' is not on or off");
+    return parse_on_off(a, v, &cfg.slam.pair_isolation);
   } else if (a == "--gate-isolation") {
-    cfg.slam.gate_isolation = v == "on";
-    if (!cfg.slam.gate_isolation && v != "off") return failed("--gate-isolation: '" + v + "' is not on or off");
+    return parse_on_off(a, v, &cfg.slam.gate_isolation);
   } else if (a == "--edge-model") {
     if (v == "sensor") cfg.slam.edge_model = fw::antslam::EdgeModel::kSensorModel;
     else if (v == "motion") cfg.slam.edge_model = fw::antslam::EdgeModel::kMotionModel;
