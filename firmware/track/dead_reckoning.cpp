@@ -26,16 +26,18 @@ Eigen::Matrix3f odometry_increment_noise(const Se2f& delta, const TrackOptions& 
 }
 
 void DeadReckoning::clear() {
-  active_ = binding_ = false;
+  active_ = binding_ = trusted_ = false;
   pose_ = wheel_ = Se2f();
   cov_.setZero();
   contradicting_ = 0;
   outside_ = reentered_ = false;
 }
 
-void DeadReckoning::start(const Se2f& pose, const Eigen::Matrix3f& cov, const Se2f& wheel, bool binding) {
+void DeadReckoning::start(const Se2f& pose, const Eigen::Matrix3f& cov, const Se2f& wheel, bool binding,
+                          bool trusted) {
   active_ = true;
   binding_ = binding;
+  trusted_ = trusted;
   pose_ = pose;
   wheel_ = wheel;
   cov_ = cov;
@@ -78,7 +80,7 @@ DeadReckoningVerdict DeadReckoning::judge(const GlobalMap& map, const Point2f* p
       informative && (a.inlier_fraction() < o.min_inlier_fraction ||
                       (!outside && static_cast<float>(a.inliers) < o.min_explained_fraction * static_cast<float>(a.points)));
   contradicting_ = contradicts ? contradicting_ + 1 : 0;
-  if (contradicting_ >= o.max_faulty_steps) binding_ = false;  // the scans refute the wheels
+  if (contradicting_ >= o.max_faulty_steps) binding_ = trusted_ = false;  // the scans refute the wheels
   if (outside) {
     outside_ = true;
     return DeadReckoningVerdict::kOutside;

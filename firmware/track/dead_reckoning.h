@@ -44,7 +44,9 @@ class DeadReckoning {
   void clear();
   // From the track's last pose and covariance; `binding` = its fixes must agree (a track given up
   // outside the map). A non-binding chain only carries the pose (the outside-map status).
-  void start(const Se2f& pose, const Eigen::Matrix3f& cov, const Se2f& wheel, bool binding);
+  // `trusted` = the track was left as a driving robot leaves it (no sign of a carry since its last
+  // supported scan): only then does the carried pose say where the robot is (outside-map).
+  void start(const Se2f& pose, const Eigen::Matrix3f& cov, const Se2f& wheel, bool binding, bool trusted);
   // Carries the pose to the wheel pose `wheel` and grows the covariance.
   void advance(const Se2f& wheel, const TrackOptions& o, const OdometryNoiseScale& scale);
   // The scan (sensor-frame end-points) at the carried pose; a chain refuted max_faulty_steps scans
@@ -57,6 +59,9 @@ class DeadReckoning {
 
   bool active() const { return active_; }
   bool binding() const { return binding_; }
+  // The carried pose is where the robot is as far as the wheels know: started trusted and not
+  // refuted by the scans since (a binding chain refuted stops binding and is no longer trusted).
+  bool trusted() const { return active_ && trusted_; }
   const Se2f& pose() const { return pose_; }
   const Eigen::Matrix3f& cov() const { return cov_; }
   ProtectionLevel bound(const ProtectionFactors& k) const { return protection_level(cov_, k, 0.0f, 0.0f); }
@@ -66,7 +71,7 @@ class DeadReckoning {
   bool reentered() const { return reentered_; }
 
  private:
-  bool active_ = false, binding_ = false;
+  bool active_ = false, binding_ = false, trusted_ = false;
   Se2f pose_, wheel_;
   Eigen::Matrix3f cov_ = Eigen::Matrix3f::Zero();
   std::uint32_t contradicting_ = 0;

@@ -25,7 +25,7 @@ TEST(DeadReckoningTest, CarriesThePoseAndGrowsTheCovarianceByTheOdometryModel) {
   DeadReckoning dr;
   EXPECT_FALSE(dr.active());
   const Se2f start(1.0f, 2.0f, 0.5f), wheel0(10.0f, -3.0f, 1.0f);
-  dr.start(start, dr_cov(0.05f, 0.01f), wheel0, true);
+  dr.start(start, dr_cov(0.05f, 0.01f), wheel0, true, true);
   Se2f wheel = wheel0, truth = start;
   float var_theta = 0.01f * 0.01f;
   for (int i = 0; i < 40; ++i) {
@@ -43,7 +43,7 @@ TEST(DeadReckoningTest, CarriesThePoseAndGrowsTheCovarianceByTheOdometryModel) {
   EXPECT_GT(dr.cov()(0, 0) + dr.cov()(1, 1), 2.0f * 0.05f * 0.05f + 40 * 2 * 0.02f * 0.02f);
   // A self-calibrated scale of 0.5 grows the heading variance by a quarter of that.
   DeadReckoning half;
-  half.start(Se2f(), Eigen::Matrix3f::Zero(), Se2f(), true);
+  half.start(Se2f(), Eigen::Matrix3f::Zero(), Se2f(), true, true);
   OdometryNoiseScale s;
   s.trans = s.rot = 0.5f;
   half.advance(Se2f(1.0f, 0.0f, 0.0f), o, s);
@@ -56,7 +56,7 @@ TEST(DeadReckoningTest, AdmitsOnlyFixesWithinItsProtectionLevel) {
   const TrackOptions o;
   const ProtectionFactors k = ProtectionFactors::for_risk(o.integrity_risk);
   DeadReckoning dr;
-  dr.start(Se2f(5.0f, 2.0f, 0.0f), dr_cov(0.1f, 0.02f), Se2f(), true);
+  dr.start(Se2f(5.0f, 2.0f, 0.0f), dr_cov(0.1f, 0.02f), Se2f(), true, true);
   const ProtectionLevel pl = dr.bound(k);
   EXPECT_NEAR(pl.xy_m, k.k_xy * 0.1f, 1e-4f);
   EXPECT_TRUE(dr.admits(Se2f(5.0f + pl.xy_m + 0.4f, 2.0f, 0.0f), k, o));
@@ -65,10 +65,14 @@ TEST(DeadReckoningTest, AdmitsOnlyFixesWithinItsProtectionLevel) {
   EXPECT_FALSE(dr.admits(Se2f(5.0f, 2.0f, pl.theta_rad + 0.1f), k, o));
   EXPECT_FALSE(dr.admits(Se2f(6.2f, 6.1f, 3.1f), k, o));  // the mapped room turned round
   DeadReckoning loose;
-  loose.start(Se2f(5.0f, 2.0f, 0.0f), dr_cov(0.1f, 0.02f), Se2f(), false);
+  loose.start(Se2f(5.0f, 2.0f, 0.0f), dr_cov(0.1f, 0.02f), Se2f(), false, true);
   EXPECT_TRUE(loose.admits(Se2f(6.2f, 6.1f, 3.1f), k, o));
+  EXPECT_TRUE(loose.trusted());
+  loose.start(Se2f(5.0f, 2.0f, 0.0f), dr_cov(0.1f, 0.02f), Se2f(), false, false);  // after a carry
+  EXPECT_FALSE(loose.trusted());
   loose.clear();
   EXPECT_FALSE(loose.active());
+  EXPECT_FALSE(loose.trusted());
   EXPECT_TRUE(loose.admits(Se2f(6.2f, 6.1f, 3.1f), k, o));
 }
 
@@ -85,23 +89,24 @@ TEST(DeadReckoningTest, ScansAtTheCarriedPoseJudgeIt) {
   const auto wing_scan = testing::scan_at(uw.world, in_wing, &rng);
   DeadReckoning dr;
   EXPECT_EQ(dr.judge(gm.map, room_scan.data(), room_scan.size(), o), DeadReckoningVerdict::kSaysNothing);  // inactive
-  dr.start(in_wing, dr_cov(0.1f, 0.02f), Se2f(), true);
+  dr.start(in_wing, dr_cov(0.1f, 0.02f), Se2f(), true, true);
   EXPECT_EQ(dr.judge(gm.map, wing_scan.data(), wing_scan.size(), o), DeadReckoningVerdict::kOutside);
-  dr.start(in_room, dr_cov(0.1f, 0.02f), Se2f(), true);
+  dr.start(in_room, dr_cov(0.1f, 0.02f), Se2f(), true, true);
   EXPECT_EQ(dr.judge(gm.map, room_scan.data(), room_scan.size(), o), DeadReckoningVerdict::kFits);
-  dr.start(Se2f(2.6f, 3.4f, 0.3f), dr_cov(0.1f, 0.02f), Se2f(), true);  // the wheels' drift is no contradiction
+  dr.start(Se2f(2.6f, 3.4f, 0.3f), dr_cov(0.1f, 0.02f), Se2f(), true, true);  // the wheels' drift is no contradiction
   EXPECT_EQ(dr.judge(gm.map, room_scan.data(), room_scan.size(), o), DeadReckoningVerdict::kFits);
-  dr.start(wrong, dr_cov(0.1f, 0.02f), Se2f(), true);
+  dr.start(wrong, dr_cov(0.1f, 0.02f), Se2f(), true, true);
   for (std::uint32_t i = 1; i < o.max_faulty_steps; ++i) {
     EXPECT_EQ(dr.judge(gm.map, room_scan.data(), room_scan.size(), o), DeadReckoningVerdict::kContradicts);
     EXPECT_TRUE(dr.binding()) << i;
   }
   EXPECT_EQ(dr.judge(gm.map, room_scan.data(), room_scan.size(), o), DeadReckoningVerdict::kContradicts);
   EXPECT_FALSE(dr.binding());
-  EXPECT_TRUE(dr.active());  // still carried, for the outside-map status
+  EXPECT_FALSE(dr.trusted());  // refuted: its pose no longer says where the robot is (outside-map)
+  EXPECT_TRUE(dr.active());  // still carried
   EXPECT_EQ(dr.contradicting_steps(), o.max_faulty_steps);
   // One scan that is not a contradiction restarts the count.
-  dr.start(wrong, dr_cov(0.1f, 0.02f), Se2f(), true);
+  dr.start(wrong, dr_cov(0.1f, 0.02f), Se2f(), true, true);
   for (std::uint32_t i = 1; i < o.max_faulty_steps; ++i) dr.judge(gm.map, room_scan.data(), room_scan.size(), o);
   dr.judge(gm.map, room_scan.data(), 0, o);
   EXPECT_EQ(dr.judge(gm.map, room_scan.data(), room_scan.size(), o), DeadReckoningVerdict::kContradicts);

@@ -118,6 +118,13 @@ Status TrackedLocalizer::step(const hal::LaserScan& scan, const hal::Odometry& o
             tracker_.options().min_explained_fraction) {
       left_map_cleanly_ = false;  // the scan is not what the robot saw a scan ago: it may have been carried
     }
+    if (out->status == hal::LocalizationStatus::kOutsideMap && !left_map_cleanly_ &&
+        tracker_.options().outside_map_needs_clean_exit) {
+      // Mostly unknown at the tracked pose, but not as a robot driving out sees it: the pose is
+      // contradicted (a carry puts the old pose's scan on unknown cells), not the map left.
+      out->status = hal::LocalizationStatus::kAmbiguous;
+      out->reason = hal::StatusReason::kTrackFault;
+    }
     if (ts.large_fault && !ts.lost && tracker_.options().cross_check_steps > 0) {
       // The robot may have been carried anywhere (a kidnap into a twin corridor fits every local
       // test): the pose needs MML's word again, from a local map that starts after the fault.
@@ -149,11 +156,12 @@ Status TrackedLocalizer::step(const hal::LaserScan& scan, const hal::Odometry& o
       // first the end-points on the map fitted 0.59, a fit drop, in the second 0.79, but the scan
       // was unlike the one before it; bound by the wheels, both right re-fixes came late or never).
       const bool binding = ts.verdict == ScanVerdict::kOutsideMap && left_map_cleanly_;
-      dead_reckoning_.start(ts.pose, ts.cov, wheel, binding);
+      dead_reckoning_.start(ts.pose, ts.cov, wheel, binding, left_map_cleanly_);
       hal::PoseEstimate g;
       FW_RETURN_IF_ERROR(global_.step(scan, odom, &g));
-      out->status = ts.verdict == ScanVerdict::kOutsideMap ? hal::LocalizationStatus::kOutsideMap
-                                                           : hal::LocalizationStatus::kSearching;
+      const bool outside = ts.verdict == ScanVerdict::kOutsideMap &&
+                           (left_map_cleanly_ || !tracker_.options().outside_map_needs_clean_exit);
+      out->status = outside ? hal::LocalizationStatus::kOutsideMap : hal::LocalizationStatus::kSearching;
       out->reason = hal::reason_of_status(out->status);
       out->mode = hal::LocalizationMode::kGlobal;
       out->protection_xy_m = out->protection_theta_rad = 0.0f;
@@ -181,14 +189,19 @@ Status TrackedLocalizer::step(const hal::LaserScan& scan, const hal::Odometry& o
   // While MML searches it has no pose it trusts, so "outside the map" needs another source
   // (mml_track_preset turns MML's own unknown-region rules off: they said `outside-map` at 937 steps
   // of a fr-clinic whole run, inside its mapped corridors): the tracker's outside-map test on this
-  // scan at the dead-reckoned pose, else `searching`. After a fault the robot may have been carried
-  // anywhere and that pose means little, but the test only chooses between two statuses that are not
-  // `localized`; on a track given up outside the map it is where the robot went.
-  // A chain that binds (the track was given up outside the map) says so over MML's `ambiguous` too:
-  // MML's candidates are places on the map, and the wheels, unrefuted, put the robot off it.
+  // scan at the dead-reckoned pose, else `searching` — but only from a pose the wheels carried from
+  // a track left cleanly (TrackOptions::outside_map_needs_clean_exit, DeadReckoning::trusted): a
+  // robot that drove off the map is where the wheels say; after a contradiction of the kind a carry
+  // makes (a large fault, the known part of the scan contradicting the pose, a scan that does not
+  // continue the one before it) the robot may be anywhere, that pose means nothing, and a scan
+  // unknown there is no evidence of unmapped space (the large office kidnap of scripts/run.sh: 82
+  // `outside-map` steps in a building mapped wall to wall).
+  // A chain that binds says so over MML's `ambiguous` too: MML's candidates are places on the map,
+  // and the wheels, unrefuted, put the robot off it.
   const bool mml_unsure = out->status == hal::LocalizationStatus::kSearching ||
                           (out->status == hal::LocalizationStatus::kAmbiguous && dead_reckoning_.binding());
-  if (got.is_ok() && mml_unsure && dr == DeadReckoningVerdict::kOutside) {
+  const bool pose_speaks = dead_reckoning_.trusted() || !tracker_.options().outside_map_needs_clean_exit;
+  if (got.is_ok() && mml_unsure && pose_speaks && dr == DeadReckoningVerdict::kOutside) {
     out->status = hal::LocalizationStatus::kOutsideMap;
     out->reason = hal::StatusReason::kOutsideMap;
   }

@@ -179,6 +179,11 @@ TEST(TrackedLocalizerTest, KidnapIsDetectedAndRefixed) {
   EXPECT_EQ(steps_to_drop, 0) << "the first scan after the kidnap must drop the status";
   EXPECT_GE(rig.loc->tracks_lost(), 1u);
   EXPECT_GE(t2.first, 0) << "not found again after the kidnap";
+  // The room is mapped wall to wall: after the carry, nothing is `outside-map`
+  // (TrackOptions::outside_map_needs_clean_exit — the wheels' pose of a carried robot says nothing).
+  int outside = 0;
+  for (const auto& r : rec2) outside += r.est.status == hal::LocalizationStatus::kOutsideMap;
+  EXPECT_EQ(outside, 0) << "outside-map steps after the kidnap";
 }
 
 // The wheels turn 20° more than the robot did (a slip, a bump; four times the 5° alert limit) on a

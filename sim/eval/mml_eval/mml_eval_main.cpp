@@ -77,6 +77,8 @@ const char kUsage[] =
     "(TrackOptions::cover_unfused_update). --confidence-cap-pred-pl: the scan's confidence extent capped at\n"
     "the prediction's PL alone (TrackOptions::confidence_cap_with_update). --cap-unpinned-scans: that cap\n"
     "also for a scan open to the alert limit along both axes (TrackOptions::confidence_cap_needs_a_pinned_axis).\n"
+    "--outside-map-any-pose: after a lost track, `outside-map` from the scan at any dead-reckoned pose, also\n"
+    "after a kidnap or divergence (TrackOptions::outside_map_needs_clean_exit, on by default).\n"
     "Definitions of every figure: sim/eval/mml_eval/README.md.\n";
 int usage(const char* msg) {
   std::fprintf(stderr, "mml-eval: %s\n%s", msg, kUsage);
@@ -163,6 +165,7 @@ static int run_main(int argc, char** argv) {
     else if (a == "--confidence-cap-pred-pl") { lp.track.confidence_cap_with_update = false; localize = true; }
     else if (a == "--cap-unpinned-scans") { lp.track.confidence_cap_needs_a_pinned_axis = false; localize = true; }
     else if (a == "--odom-adapt") { lp.track.odom_noise_window = 64; localize = true; }
+    else if (a == "--outside-map-any-pose") { lp.track.outside_map_needs_clean_exit = false; localize = true; }
     else if (a == "--odom-noise") {
       const std::string v = str();
       if (!sim::mmleval::set_odom_noise(v, &lp.track)) {
