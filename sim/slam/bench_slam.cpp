@@ -4,7 +4,11 @@
 // front end and loops (D_slam_lm_*), each also before the final refinement of the whole graph (Alg. 3
 // as published: D_slam_alg3_*, D_slam_lm_alg3_*), RBSM alone (D_rbsm_*) and raw odometry (D_odom_*); mapping
 // time against the log's duration; time in the loop optimisers; and slam_deterministic (an intel
-// prefix twice with the same seed, once with 1 and once with 2 workers: identical poses).
+// prefix twice with the same seed, once with 1 and once with 2 workers: identical poses). Where the
+// data set has corrected poses (intel, fr079, aces, mit-killian), the whole-trajectory check too:
+// D_slam_ate_m, D_slam_lm_ate_m, D_front_ate_m (and _ate_max_m), the RMS residual of the rigid
+// alignment of the corrected poses onto the trajectory (sim/slam/selfmap.h) — a loop closed on a
+// look-alike place bends the whole trajectory while most relations stay small.
 // Localization in the self-built maps (intel, fr079, aces; D_selfmap_*, D_refmap_*): after the ant
 // colony the map is written (as mml-slam --map) with a reference moved into its frame
 // (sim/slam/selfmap.h: least-squares rigid alignment of the public reference to the AntSLAM
@@ -120,9 +124,21 @@ bool selfmap_localization(const sim::CarmenLog& log, const sim::EvalDataset& d, 
 // One front end (cfg.fuse_front) with both back ends: the ant colony on it, then LM on the same front
 // end and loops. Keys P slam_trans_err_m, slam_lm_*, front_trans_err_m (and rbsm_trans_err_m for the
 // default), times, fragments, loops.
+// The whole-trajectory check (sim/slam/selfmap.h): each trajectory's RMS and largest residual after
+// the rigid alignment of the corrected poses onto it, P{what}_ate_m / _ate_max_m.
+bool add_ate(const std::vector<fw::Se2d>& reference, const std::vector<fw::Se2d>& poses, const std::string& key,
+             sim::BenchJson* json, double* rms, std::string* err) {
+  sim::RigidAlignment2d a;
+  if (!sim::align_rigid_2d(reference, poses, &a, err)) return false;
+  json->add(key + "_ate_m", a.rms_m);
+  json->add(key + "_ate_max_m", a.max_m);
+  *rms = a.rms_m;
+  return true;
+}
+
 bool run_front_and_back(const std::string& ds, const sim::CarmenLog& log, const std::vector<sim::Relation>& rel,
                         const sim::SlamConfig& cfg, const std::string& p, sim::BenchJson* json, sim::SlamRun* aco,
-                        std::string* err) {
+                        std::string* err, const std::vector<fw::Se2d>* reference = nullptr) {
   const auto t0 = std::chrono::steady_clock::now();
   if (!sim::run_slam(log, cfg, aco, err)) {
     std::fprintf(stderr, "bench_slam: %s: %s\n", ds.c_str(), err->c_str());
@@ -148,6 +164,18 @@ bool run_front_and_back(const std::string& ds, const sim::CarmenLog& log, const 
   json->add(p + "slam_lm_trans_err_m", m_lm.trans_mean);
   json->add(p + "slam_lm_rot_err_deg", m_lm.rot_mean_deg);
   json->add(p + "front_trans_err_m", m_front.trans_mean);
+  if (reference != nullptr) {
+    double a_aco = 0, a_lm = 0, a_front = 0;
+    if (!add_ate(*reference, aco->poses, p + "slam", json, &a_aco, err) ||
+        !add_ate(*reference, lm.poses, p + "slam_lm", json, &a_lm, err) ||
+        !add_ate(*reference, aco->frontend, p + "front", json, &a_front, err)) {
+      std::fprintf(stderr, "bench_slam: %s: whole-trajectory check: %s\n", ds.c_str(), err->c_str());
+      return false;
+    }
+    std::printf("%s, front end %s, whole trajectory against the corrected poses (aligned RMS): front %.3f m, ACO %.3f m, "
+                "LM %.3f m\n",
+                ds.c_str(), cfg.fuse_front ? "fused" : "rbsm", a_front, a_aco, a_lm);
+  }
   // Alg. 3 as published (loops corrected and frozen, no final refinement of the whole graph).
   if (!aco->alg3_poses.empty() && !lm.alg3_poses.empty()) {
     const auto a_aco = sim::evaluate_relations(rel, sim::make_trajectory(log, aco->alg3_poses));
@@ -205,11 +233,20 @@ static int run_main(int argc, char** argv) {
       all_ok = false;
       continue;
     }
+    // The whole-trajectory check where the data set has corrected poses (all but fr-clinic).
+    std::vector<fw::Se2d> reference;
+    const bool has_reference = !d.corrected_poses.empty();
+    if (has_reference && !sim::reference_at_every_scan_of(log, d, &reference, &err)) {
+      std::fprintf(stderr, "bench_slam: %s: %s\n", ds.c_str(), err.c_str());
+      all_ok = false;
+      continue;
+    }
+    const std::vector<fw::Se2d>* ref = has_reference ? &reference : nullptr;
     sim::SlamConfig cfg;
     cfg.workers = 1;
     cfg.slam.aco.stall_iterations = kAcoStall;
     sim::SlamRun aco;
-    if (!run_front_and_back(ds, log, rel, cfg, key + "_", &json, &aco, &err)) {
+    if (!run_front_and_back(ds, log, rel, cfg, key + "_", &json, &aco, &err, ref)) {
       all_ok = false;
       continue;
     }
@@ -219,7 +256,7 @@ static int run_main(int argc, char** argv) {
     other.fuse_front = !cfg.fuse_front;
     sim::SlamRun other_run;
     if (!run_front_and_back(ds, log, rel, other, key + (other.fuse_front ? "_fusedfront_" : "_rbsmfront_"), &json,
-                            &other_run, &err)) {
+                            &other_run, &err, ref)) {
       all_ok = false;
       continue;
     }

@@ -12,6 +12,7 @@
 #include "sim/common/cli_main.h"
 #include "sim/io/datasets.h"
 #include "sim/io/reference_trajectory.h"
+#include "sim/slam/selfmap.h"
 #include "sim/slam/slam_pipeline.h"
 
 namespace {
@@ -31,7 +32,8 @@ const char* kHelp =
     "  --svg FILE.svg        picture of fragments, edges and closed loops (FILE.png: a PNG)\n"
     "  --relations FILE      print the relations metric (Kuemmerle et al. 2009) of the front end and AntSLAM\n"
     "                        (default with --dataset: the data set's relations; mit-killian: relations\n"
-    "                        between its consecutive GMapping-corrected poses)\n"
+    "                        between its consecutive GMapping-corrected poses); with --dataset also the whole\n"
+    "                        trajectory against the data set's corrected poses (RMS after a rigid alignment)\n"
     "options:\n"
     "  --optimizer aco|lm    loop optimiser (default aco: the ant colony of Eq. 3.13-3.14)\n"
     "  --final-refine on|off  at the end of the run, refine every fragment frame against every edge at once\n"
@@ -295,7 +297,9 @@ std::string missing_output_dir(const SlamArgs& o) {
 }
 
 // The log and the relations to score against. Set: the exit code of a failure already reported.
-std::optional<int> load_inputs(SlamArgs* o, sim::CarmenLog* log, std::vector<sim::Relation>* rel) {
+// *reference: the data set's corrected poses at every scan (--dataset with corrected poses; else empty).
+std::optional<int> load_inputs(SlamArgs* o, sim::CarmenLog* log, std::vector<sim::Relation>* rel,
+                               std::vector<fw::Se2d>* reference) {
   std::string err;
   sim::EvalDataset ds;
   std::string ds_relations;
@@ -315,6 +319,9 @@ std::optional<int> load_inputs(SlamArgs* o, sim::CarmenLog* log, std::vector<sim
     return fail("--relations: " + err);
   }
   if (log->scans.empty()) return fail(o->log_path + ": no laser scans in the log");
+  if (!o->dataset.empty() && !ds.corrected_poses.empty() && !sim::reference_at_every_scan_of(*log, ds, reference, &err)) {
+    return fail("--dataset: " + err);
+  }
   return std::nullopt;
 }
 
@@ -379,7 +386,8 @@ int run(int argc, char** argv) {
   if (const std::optional<int> exit_code = parse_args(argc, argv, &o)) return *exit_code;
   sim::CarmenLog log;
   std::vector<sim::Relation> rel;
-  if (const std::optional<int> exit_code = load_inputs(&o, &log, &rel)) return *exit_code;
+  std::vector<fw::Se2d> reference;
+  if (const std::optional<int> exit_code = load_inputs(&o, &log, &rel, &reference)) return *exit_code;
   const auto t0 = std::chrono::steady_clock::now();
   if (!o.quiet) {
     o.cfg.progress = [t0](std::size_t done, std::size_t total, const char* phase) {
@@ -406,6 +414,17 @@ int run(int argc, char** argv) {
       const auto ma = sim::evaluate_relations(rel, sim::make_trajectory(log, run.alg3_poses));
       std::printf("relations, AntSLAM before the final refinement (Alg. 3 as published): %s\n", sim::to_string(ma).c_str());
     }
+  }
+  if (!reference.empty()) {
+    // Whole trajectory (sim/slam/selfmap.h): a loop closed on a look-alike bends it all.
+    sim::RigidAlignment2d af, as;
+    if (!sim::align_rigid_2d(reference, run.frontend, &af, &err) || !sim::align_rigid_2d(reference, run.poses, &as, &err)) {
+      std::fprintf(stderr, "mml-slam: whole-trajectory check: %s\n", err.c_str());
+      return 1;
+    }
+    std::printf("whole trajectory against the corrected poses (rigid alignment, %zu scans): front end RMS %.3f m (max "
+                "%.3f m), AntSLAM RMS %.3f m (max %.3f m)\n",
+                as.pairs, af.rms_m, af.max_m, as.rms_m, as.max_m);
   }
   return write_outputs(o, log, run);
 }

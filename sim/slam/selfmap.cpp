@@ -59,19 +59,28 @@ bool align_rigid_2d(const std::vector<fw::Se2d>& from, const std::vector<fw::Se2
   return true;
 }
 
-bool write_selfmap(const CarmenLog& log, const EvalDataset& d, const std::vector<fw::Se2d>& poses,
-                   const std::string& dir, const std::string& name, SelfMapFiles* out, std::string* error) {
+bool reference_at_every_scan_of(const CarmenLog& log, const EvalDataset& d, std::vector<fw::Se2d>* out,
+                                std::string* error) {
   if (d.corrected_poses.empty()) {
     *error = d.name + ": no public corrected poses (no reference to align)";
     return false;
   }
   std::vector<CorrectedPose> cp;
   if (!read_corrected_poses(d.corrected_poses, &cp, error)) return false;
-  const std::vector<fw::Se2d> ref = reference_at_every_scan(log, cp);
-  if (ref.size() != log.scans.size()) {
+  *out = reference_at_every_scan(log, cp);
+  if (out->size() != log.scans.size()) {
     *error = d.corrected_poses + ": no reference at every scan of " + log.path;
     return false;
   }
+  return true;
+}
+
+bool write_selfmap(const CarmenLog& log, const EvalDataset& d, const std::vector<fw::Se2d>& poses,
+                   const std::string& dir, const std::string& name, SelfMapFiles* out, std::string* error) {
+  std::vector<fw::Se2d> ref;
+  if (!reference_at_every_scan_of(log, d, &ref, error)) return false;
+  std::vector<CorrectedPose> cp;  // the rows written below, moved into the map's frame
+  if (!read_corrected_poses(d.corrected_poses, &cp, error)) return false;
   // Reference (all scans the SLAM run covers) → AntSLAM trajectory.
   if (!align_rigid_2d(ref, poses, &out->alignment, error)) {
     *error = d.name + ": " + *error;

@@ -38,6 +38,15 @@ struct RigidAlignment2d {
 bool align_rigid_2d(const std::vector<fw::Se2d>& from, const std::vector<fw::Se2d>& to, RigidAlignment2d* out,
                     std::string* error);
 
+// The data set's public corrected poses at every scan of `log` (reference_at_every_scan): the
+// reference of the self-built map (write_selfmap) and of the whole-trajectory check of bench_slam
+// and mml-slam (D_slam_ate_m: align_rigid_2d of this onto a SLAM trajectory, its RMS residual). The
+// relations metric scores pairs of nearby scans; a loop closed on a look-alike place bends the whole
+// trajectory while most relations stay small, which the aligned residual shows. Fails when the data
+// set has no corrected poses or they do not cover every scan.
+bool reference_at_every_scan_of(const CarmenLog& log, const EvalDataset& dataset, std::vector<fw::Se2d>* out,
+                                std::string* error);
+
 struct SelfMapFiles {
   std::string map_yaml;   // ROS map of the SLAM poses (as mml-slam --map), the reference map's parameters
   std::string reference;  // "flaser_index ipc logger x y theta" rows: the data set's corrected poses moved by T
