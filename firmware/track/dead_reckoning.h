@@ -44,8 +44,8 @@ class DeadReckoning {
   void clear();
   // From the track's last pose and covariance; `binding` = its fixes must agree (a track given up
   // outside the map). A non-binding chain only carries the pose (the outside-map status).
-  // `trusted` = the track was left as a driving robot leaves it (no sign of a carry since its last
-  // supported scan): only then does the carried pose say where the robot is (outside-map).
+  // `trusted` = no scan of the track showed a sign of a carry (TrackedLocalizer: a scan that did not
+  // continue the one before it): only then does the carried pose say where the robot is (outside-map).
   void start(const Se2f& pose, const Eigen::Matrix3f& cov, const Se2f& wheel, bool binding, bool trusted);
   // Carries the pose to the wheel pose `wheel` and grows the covariance.
   void advance(const Se2f& wheel, const TrackOptions& o, const OdometryNoiseScale& scale);

@@ -136,12 +136,13 @@ struct TrackOptions {
   float outside_map_fraction = 0.5f;      // end-points in unknown space beyond this: outside the map
   std::uint32_t max_faulty_steps = 5;     // consecutive contradicting scans → back to global mode
   std::uint32_t max_outside_steps = 5;    // consecutive outside-map scans → back to global mode
-  // After a track is given up, `outside-map` is said from the scan at the dead-reckoned pose only
-  // while that pose binds (the robot drove off the map cleanly: dead_reckoning.h). A track given up
-  // after a contradiction (a kidnap, a divergence) leaves a pose that may be anywhere, so a scan
-  // "mostly unknown" there says nothing about the robot: `searching`. Off: any carried pose decides
-  // (before 2026-12-01; the large office kidnap of scripts/run.sh said `outside-map` at 82 steps of a
-  // building mapped wall to wall).
+  // `outside-map` is said from the scan at the tracked or dead-reckoned pose only if no scan of the
+  // track since MML last vouched for it failed to continue the scan before it (scan_continuity.h: a
+  // carried robot does not see what it saw a scan ago; one driving into unmapped space does). After
+  // such a scan the pose may be anywhere, so "mostly unknown there" says nothing about the robot:
+  // `ambiguous` (track-fault) while tracked, `searching` once the track is given up. Off: any pose
+  // decides (before 2026-12-01; the large office kidnap of scripts/run.sh said `outside-map` at 82
+  // steps of a building mapped wall to wall).
   bool outside_map_needs_clean_exit = true;
   // After a contradicting scan, this many consecutive consistent scans before `localized` again
   // (hysteresis: a fault seen is evidence that the odometry or the fit may be wrong unseen too).

@@ -36,6 +36,7 @@ void TrackedLocalizer::reset() {
   replay_lag_ = 0;
   dead_reckoning_.clear();
   left_map_cleanly_ = true;
+  carry_seen_ = false;
 }
 
 // End-points within the tracker's range, evenly subsampled to at most align.max_points (beam order
@@ -112,16 +113,20 @@ Status TrackedLocalizer::step(const hal::LaserScan& scan, const hal::Odometry& o
     if (ts.verdict == ScanVerdict::kSupported) left_map_cleanly_ = true;
     if (ts.known_part_contradicts || ts.large_fault) left_map_cleanly_ = false;
     const RememberedScan* previous = history_.size() >= 2 ? &history_[history_.size() - 2] : nullptr;
-    if (ts.verdict == ScanVerdict::kOutsideMap && previous != nullptr &&
+    // Does a scan the map does not support continue the one before it? (Supported scans need no
+    // such test: the map vouches for them.)
+    if (ts.verdict != ScanVerdict::kSupported && previous != nullptr &&
         continuity_.explained_fraction(previous->pts, previous->n, pts_, n, previous->wheel.between(wheel),
                                        tracker_.options().align.outlier_m) <
             tracker_.options().min_explained_fraction) {
-      left_map_cleanly_ = false;  // the scan is not what the robot saw a scan ago: it may have been carried
+      // The scan is not what the robot saw a scan ago: it may have been carried.
+      carry_seen_ = true;
+      if (ts.verdict == ScanVerdict::kOutsideMap) left_map_cleanly_ = false;
     }
-    if (out->status == hal::LocalizationStatus::kOutsideMap && !left_map_cleanly_ &&
+    if (out->status == hal::LocalizationStatus::kOutsideMap && carry_seen_ &&
         tracker_.options().outside_map_needs_clean_exit) {
-      // Mostly unknown at the tracked pose, but not as a robot driving out sees it: the pose is
-      // contradicted (a carry puts the old pose's scan on unknown cells), not the map left.
+      // Mostly unknown at the tracked pose, but the robot may have been carried: the old pose's
+      // scan on unknown cells says the pose is wrong, not that the map was left.
       out->status = hal::LocalizationStatus::kAmbiguous;
       out->reason = hal::StatusReason::kTrackFault;
     }
@@ -156,11 +161,11 @@ Status TrackedLocalizer::step(const hal::LaserScan& scan, const hal::Odometry& o
       // first the end-points on the map fitted 0.59, a fit drop, in the second 0.79, but the scan
       // was unlike the one before it; bound by the wheels, both right re-fixes came late or never).
       const bool binding = ts.verdict == ScanVerdict::kOutsideMap && left_map_cleanly_;
-      dead_reckoning_.start(ts.pose, ts.cov, wheel, binding, left_map_cleanly_);
+      dead_reckoning_.start(ts.pose, ts.cov, wheel, binding, !carry_seen_);
       hal::PoseEstimate g;
       FW_RETURN_IF_ERROR(global_.step(scan, odom, &g));
       const bool outside = ts.verdict == ScanVerdict::kOutsideMap &&
-                           (left_map_cleanly_ || !tracker_.options().outside_map_needs_clean_exit);
+                           (!carry_seen_ || !tracker_.options().outside_map_needs_clean_exit);
       out->status = outside ? hal::LocalizationStatus::kOutsideMap : hal::LocalizationStatus::kSearching;
       out->reason = hal::reason_of_status(out->status);
       out->mode = hal::LocalizationMode::kGlobal;
@@ -190,12 +195,12 @@ Status TrackedLocalizer::step(const hal::LaserScan& scan, const hal::Odometry& o
   // (mml_track_preset turns MML's own unknown-region rules off: they said `outside-map` at 937 steps
   // of a fr-clinic whole run, inside its mapped corridors): the tracker's outside-map test on this
   // scan at the dead-reckoned pose, else `searching` — but only from a pose the wheels carried from
-  // a track left cleanly (TrackOptions::outside_map_needs_clean_exit, DeadReckoning::trusted): a
-  // robot that drove off the map is where the wheels say; after a contradiction of the kind a carry
-  // makes (a large fault, the known part of the scan contradicting the pose, a scan that does not
-  // continue the one before it) the robot may be anywhere, that pose means nothing, and a scan
-  // unknown there is no evidence of unmapped space (the large office kidnap of scripts/run.sh: 82
-  // `outside-map` steps in a building mapped wall to wall).
+  // a track that saw no sign of a carry (TrackOptions::outside_map_needs_clean_exit,
+  // DeadReckoning::trusted, carry_seen_): a robot that drove off the map is where the wheels say
+  // (its entry into unmapped space may well be a large fault: intel's erased region); after a scan
+  // that did not continue the one before it the robot may be anywhere, that pose means nothing, and
+  // a scan unknown there is no evidence of unmapped space (the large office kidnap of
+  // scripts/run.sh: 82 `outside-map` steps in a building mapped wall to wall).
   // A chain that binds says so over MML's `ambiguous` too: MML's candidates are places on the map,
   // and the wheels, unrefuted, put the robot off it.
   const bool mml_unsure = out->status == hal::LocalizationStatus::kSearching ||
@@ -233,6 +238,7 @@ bool TrackedLocalizer::start_from_fix(const hal::PoseEstimate& g, const Se2f& wh
   const TrackOptions& o = tracker_.options();
   const std::size_t k = o.recovery_steps;
   left_map_cleanly_ = true;  // a new track: no scan of it has contradicted it yet
+  carry_seen_ = false;
   if (o.confirm_fix && o.confirm_fix_on_past_scans && k > 0 && history_.size() >= k + 1) {
     // TrackOptions::confirm_fix_on_past_scans. The tracker starts recovery_steps scans back, at MML's
     // pose carried back by the wheels (pose_{t−k} = fix ⊕ (wheel_t ⊖ wheel_{t−k})), as it would
@@ -335,6 +341,7 @@ Status TrackedLocalizer::cross_check(const hal::LaserScan& scan, const hal::Odom
   if (d <= ts.pl.xy_m && dth <= ts.pl.theta_rad) {  // MML isolates the tracked pose
     if (unconfirmed_) {
       unconfirmed_ = false;
+      carry_seen_ = false;  // MML has isolated the tracked pose: wherever the robot was carried, it is here
       ++confirmations_;
       out->status = ts.status;  // the tracker's own verdict on this scan stands again
       out->reason = ts.reason;

@@ -126,6 +126,11 @@ class TrackedLocalizer final : public Localizer {
   // No scan since the track's last supported one contradicted it where it saw the map, or was
   // unlike the scan before it (scan_continuity.h).
   bool left_map_cleanly_ = true;
+  // A scan of this track that did not continue the one before it (scan_continuity.h): the robot
+  // may have been carried, so the track's pose (and the wheels' from it) says nothing about where
+  // the robot is until MML confirms it or a new track starts (TrackOptions::outside_map_needs_clean_exit).
+  // A robot driving into unmapped space sees what it saw a scan ago; a carried one does not.
+  bool carry_seen_ = false;
   ScanContinuity continuity_;
   ProtectionFactors k_;
   std::uint32_t fixes_refused_by_wheels_ = 0;
