@@ -77,6 +77,35 @@ void TrackedLocalizer::await_mml_confirmation() {
   cross_check_left_ = tracker_.options().cross_check_steps;
 }
 
+// Since the track's last supported scan: did the scans leave the map as a robot driving out of it
+// would (left_map_cleanly_, for the wheels' binding), and did any show a sign of a carry
+// (carry_seen_, for the outside-map status)? An `outside-map` of the track after such a sign is
+// published as a contradicted track instead.
+void TrackedLocalizer::note_how_the_map_was_left(const TrackStep& ts, const Se2f& wheel, std::size_t n,
+                                                 hal::PoseEstimate* out) {
+  // A driving robot's exit: no known part contradicted (TrackStep::known_part_contradicts).
+  if (ts.verdict == ScanVerdict::kSupported) left_map_cleanly_ = true;
+  if (ts.known_part_contradicts || ts.large_fault) left_map_cleanly_ = false;
+  const RememberedScan* previous = history_.size() >= 2 ? &history_[history_.size() - 2] : nullptr;
+  // Does a scan the map does not support continue the one before it? (Supported scans need no
+  // such test: the map vouches for them.)
+  if (ts.verdict != ScanVerdict::kSupported && previous != nullptr &&
+      continuity_.explained_fraction(previous->pts, previous->n, pts_, n, previous->wheel.between(wheel),
+                                     tracker_.options().align.outlier_m) <
+          tracker_.options().min_explained_fraction) {
+    // The scan is not what the robot saw a scan ago: it may have been carried.
+    carry_seen_ = true;
+    if (ts.verdict == ScanVerdict::kOutsideMap) left_map_cleanly_ = false;
+  }
+  if (out->status == hal::LocalizationStatus::kOutsideMap && carry_seen_ &&
+      tracker_.options().outside_map_needs_clean_exit) {
+    // Mostly unknown at the tracked pose, but the robot may have been carried: the old pose's
+    // scan on unknown cells says the pose is wrong, not that the map was left.
+    out->status = hal::LocalizationStatus::kAmbiguous;
+    out->reason = hal::StatusReason::kTrackFault;
+  }
+}
+
 Status TrackedLocalizer::step(const hal::LaserScan& scan, const hal::Odometry& odom, hal::PoseEstimate* out) {
   const hal::CompleteReasonOnExit reason_on_exit{out};  // every estimate says why it is not `localized`
   if (mml_ == nullptr) return Status::error(Errc::kNotInitialized, "TrackedLocalizer: step() before init()");
@@ -108,28 +137,7 @@ Status TrackedLocalizer::step(const hal::LaserScan& scan, const hal::Odometry& o
     out->timestamp_ns = scan.timestamp_ns;
     out->scan_id = scan.scan_id;
     publish_track(ts, out);
-    // Since the last supported scan, did the scans leave the map as a robot driving out of it
-    // would (TrackStep::known_part_contradicts)?
-    if (ts.verdict == ScanVerdict::kSupported) left_map_cleanly_ = true;
-    if (ts.known_part_contradicts || ts.large_fault) left_map_cleanly_ = false;
-    const RememberedScan* previous = history_.size() >= 2 ? &history_[history_.size() - 2] : nullptr;
-    // Does a scan the map does not support continue the one before it? (Supported scans need no
-    // such test: the map vouches for them.)
-    if (ts.verdict != ScanVerdict::kSupported && previous != nullptr &&
-        continuity_.explained_fraction(previous->pts, previous->n, pts_, n, previous->wheel.between(wheel),
-                                       tracker_.options().align.outlier_m) <
-            tracker_.options().min_explained_fraction) {
-      // The scan is not what the robot saw a scan ago: it may have been carried.
-      carry_seen_ = true;
-      if (ts.verdict == ScanVerdict::kOutsideMap) left_map_cleanly_ = false;
-    }
-    if (out->status == hal::LocalizationStatus::kOutsideMap && carry_seen_ &&
-        tracker_.options().outside_map_needs_clean_exit) {
-      // Mostly unknown at the tracked pose, but the robot may have been carried: the old pose's
-      // scan on unknown cells says the pose is wrong, not that the map was left.
-      out->status = hal::LocalizationStatus::kAmbiguous;
-      out->reason = hal::StatusReason::kTrackFault;
-    }
+    note_how_the_map_was_left(ts, wheel, n, out);
     if (ts.large_fault && !ts.lost && tracker_.options().cross_check_steps > 0) {
       // The robot may have been carried anywhere (a kidnap into a twin corridor fits every local
       // test): the pose needs MML's word again, from a local map that starts after the fault.

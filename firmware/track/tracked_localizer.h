@@ -83,6 +83,7 @@ class TrackedLocalizer final : public Localizer {
  private:
   std::size_t scan_points(const hal::LaserScan& scan);
   void publish_track(const TrackStep& ts, hal::PoseEstimate* out) const;
+  void note_how_the_map_was_left(const TrackStep& ts, const Se2f& wheel, std::size_t n, hal::PoseEstimate* out);
   void await_mml_confirmation();
   // MML's fix in `g` → tracker started on it: true when accepted on this scan or while its replay
   // on the scans before it catches up (replay_past_scans); false (tracker reset) if rejected.
