@@ -88,8 +88,12 @@ void TrackedLocalizer::note_how_the_map_was_left(const TrackStep& ts, const Se2f
   if (ts.known_part_contradicts || ts.large_fault) left_map_cleanly_ = false;
   const RememberedScan* previous = history_.size() >= 2 ? &history_[history_.size() - 2] : nullptr;
   // Does a scan the map does not support continue the one before it? (Supported scans need no
-  // such test: the map vouches for them.)
-  if (ts.verdict != ScanVerdict::kSupported && previous != nullptr &&
+  // such test: the map vouches for them; nor does a track whose carry is already seen, unless the
+  // exit itself is judged.)
+  const bool asks = ts.verdict == ScanVerdict::kOutsideMap ||
+                    (ts.verdict != ScanVerdict::kSupported && !carry_seen_ &&
+                     tracker_.options().outside_map_needs_clean_exit);
+  if (asks && previous != nullptr &&
       continuity_.explained_fraction(previous->pts, previous->n, pts_, n, previous->wheel.between(wheel),
                                      tracker_.options().align.outlier_m) <
           tracker_.options().min_explained_fraction) {
