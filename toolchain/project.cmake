@@ -17,6 +17,15 @@ target_compile_definitions(eigen3 INTERFACE EIGEN_NO_MALLOC EIGEN_DONT_PARALLELI
 # aarch64, which changes float results), no fast-math anywhere.
 add_compile_options(-ffp-contract=off)
 
+# Under the sanitizers the inliner gives up on Eigen's small expression templates (the instrumented
+# bodies grow past its threshold), so a 2×2 product becomes a chain of calls and the tests run 14×
+# slower than release instead of the ~2–3× the checks themselves cost. Eigen's hook for this is
+# EIGEN_STRONG_INLINE (Macros.h: `inline` on GCC/clang unless defined): forced here, in sanitized
+# builds only; the checks inside the inlined code are kept.
+macro(mmlfw_eigen_always_inline)
+  add_compile_definitions("EIGEN_STRONG_INLINE=inline __attribute__((always_inline))")
+endmacro()
+
 if(MMLFW_SANITIZE STREQUAL "address")
   # -fno-sanitize=vptr: UBSan's vptr check needs typeinfo, which the -fno-rtti firmware/hal libraries
   # (e.g. hal_sim's polymorphic sources used from RTTI-enabled tests) do not emit: link errors otherwise.
@@ -27,6 +36,7 @@ if(MMLFW_SANITIZE STREQUAL "address")
     # -fno-rtti firmware libraries included (symbol_check would report RTTI); GCC has no such check.
     add_compile_options(-fno-sanitize=function)
   endif()
+  mmlfw_eigen_always_inline()
 elseif(MMLFW_SANITIZE STREQUAL "fuzzer")
   # libFuzzer targets (tests/fuzz, `fuzz` preset, clang only): every library carries the fuzzer's
   # coverage instrumentation plus ASan+UBSan; only the fuzz executables link libFuzzer's main.
@@ -36,9 +46,11 @@ elseif(MMLFW_SANITIZE STREQUAL "fuzzer")
   add_compile_options(-fsanitize=fuzzer-no-link,address,undefined -fno-sanitize=vptr -fno-omit-frame-pointer
                       -fno-sanitize-recover=undefined)
   add_link_options(-fsanitize=address,undefined)
+  mmlfw_eigen_always_inline()
 elseif(MMLFW_SANITIZE STREQUAL "thread")
   add_compile_options(-fsanitize=thread -fno-omit-frame-pointer)
   add_link_options(-fsanitize=thread)
+  mmlfw_eigen_always_inline()
 endif()
 
 # Embedded rules for firmware/ and hal/ targets (DEVELOPERS.md): no exceptions, no RTTI, warnings
@@ -97,11 +109,15 @@ endfunction()
 #   (determinism: a property of the release build, not of memory safety; the reset paths run under
 #   ASan in fw_mml_reset_test), the ring's ant-colony run (AntSLAM's ACO and LM run under ASan on
 #   the intel prefix, sim_slam_data_test), and the scripts labelled `scenario` (scripts/test.sh).
-#   Measured: ASan tests 1151 -> 813 s on 2 cores before the ring case was added here.
+#   Measured: ASan tests 1151 -> 813 s on 2 cores before the ring case was added here. Also the
+#   final refinement after LM (the same refinement code as after the ant colony, whose case runs
+#   here) and the mit-killian carry replays that only judge the scenario (neighbouring steps, the
+#   witness without the rule): the 2026-12-01 landing's CI took 68 min, fw_antslam_test 959 s and
+#   sim_mml_localize_data_test 348 s of ASan time. The emulated build leaves out the LM case too.
 # -DMMLFW_SLOW_BUILD_FULL=ON runs them all.
 option(MMLFW_SLOW_BUILD_FULL "In emulated and sanitized builds, run the long scenario cases too" OFF)
 set(MMLFW_EMULATED_SKIP
-    "fw_antslam_test=AntSlamTest.ClosesTheRingAndBeatsTheDriftingFrontEnd:AntSlamTest.SecondLapTraversesTheFirstLapsFragments:AntSlamTest.SameSeedSamePoses:AntSlamTest.NoHeapAfterInit"
+    "fw_antslam_test=AntSlamTest.ClosesTheRingAndBeatsTheDriftingFrontEnd:AntSlamTest.SecondLapTraversesTheFirstLapsFragments:AntSlamTest.SameSeedSamePoses:AntSlamTest.NoHeapAfterInit:AntSlamTest.FinalRefinementAfterLmLowersTheWholeGraphsCost"
     "fw_mml_handoff_test=MmlZeroHeapTest.MmlMclAndHandoffStepsAllocateNothing:MmlZeroHeapTest.CorrectionAndReductionAllocateNothing:HandoffTest.TracksAndRecoversFromKidnap"
     "fw_mcl_test=MclTest.GlobalLocalizationBeamModel:MclLocalizerTest.ResetGivesAFreshStart"
     "fw_rbsm_test=RbsmTest.MotionPriorShrinksTheJumpsAlongAFeaturelessCorridor"
@@ -109,9 +125,10 @@ set(MMLFW_EMULATED_SKIP
     "fw_mml_reset_test=MmlResetTest.ResetGivesAFreshStart*"
     "fw_track_test=TrackedLocalizerTest.DeterministicAndResettable:TrackedLocalizerTest.LargeFaultWaitsForGlobalConfirmation:TrackedLocalizerTest.HeadingOnlyFaultRecoversWithoutWaitingForMml:TrackedLocalizerTest.FixIsConfirmedOnTheScansBeforeIt:TrackedLocalizerTest.KidnapIsDetectedAndRefixed:GlobalContextTest.ThreadedEqualsInlineWhenOnTime:GlobalContextTest.LiveScheduleInlineLocalizes:GlobalContextTest.ConfirmedFixScanIsNotOffered")
 set(MMLFW_SANITIZED_SKIP
-    "fw_antslam_test=AntSlamTest.SameSeedSamePoses:AntSlamTest.ClosesTheRingAndBeatsTheDriftingFrontEnd"
+    "fw_antslam_test=AntSlamTest.SameSeedSamePoses:AntSlamTest.ClosesTheRingAndBeatsTheDriftingFrontEnd:AntSlamTest.FinalRefinementAfterLmLowersTheWholeGraphsCost"
     "fw_mml_test=MmlLocalizerTest.DeterministicAndResettable"
-    "fw_track_test=TrackedLocalizerTest.DeterministicAndResettable")
+    "fw_track_test=TrackedLocalizerTest.DeterministicAndResettable"
+    "sim_mml_localize_data_test=LocalizeData.MitKillianCarryOneStepEarlierOrLaterIsNotLocalized:LocalizeData.MitKillianCarryWithoutTheRuleIsTheWitness")
 function(mmlfw_slow_build_filter name)
   if(MMLFW_SLOW_BUILD_FULL)
     return()

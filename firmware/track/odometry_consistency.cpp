@@ -55,7 +55,7 @@ float OdometryConsistency::max_chi2(const Se2f& pose, const Eigen::Matrix3f& cov
     const Eigen::Vector3d d(static_cast<double>(pose.x) - expected.x, static_cast<double>(pose.y) - expected.y,
                             static_cast<double>(wrap_angle(pose.theta - expected.theta)));
     bool invertible = false;
-    Eigen::Matrix3d ci;
+    Eigen::Matrix3d ci = Eigen::Matrix3d::Zero();  // left unset when not invertible
     c.computeInverseWithCheck(ci, invertible);
     if (!invertible) continue;  // no noise at all on either end: nothing to test against
     const double chi2 = d.dot(ci * d);
