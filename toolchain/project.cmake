@@ -104,7 +104,12 @@ endfunction()
 #   the stage's test time (1841 s of qemu CPU, 1007 s on 2 cores; fw_antslam_test alone 487 s). On
 #   aarch64, TrackedLocalizerTest.FixThenTrackEveryScan still drives MML + tracker end to end and
 #   TrackedLocalizerTest.NoHeapInSteps counts the heap in every step. (AntSlamTest.NoHeapAfterInit
-#   is out with the ring runs it reads: 299 s under qemu.)
+#   is out with the ring runs it reads: 299 s under qemu.) Cases added since then and over the
+#   line, left out on 2026-12-01 (aarch64 tests 250 s on 2 cores, fw_track_test 244 s of it): the
+#   look-alike wing and dead-reckoned outside-map cases (70 % of fw_track_test on the host) and the
+#   ring's final-refinement runs (221 s: every AntSLAM ring run is now left to the host and ASan;
+#   on aarch64 AntColonyTest, the front end's PoseInEveryFragmentMatchesPropagationFromItsFrame and
+#   the host/aarch64 comparison of the ant colony's answer remain).
 # - Under ASan, the cases that repeat a run another case already made, to compare the two
 #   (determinism: a property of the release build, not of memory safety; the reset paths run under
 #   ASan in fw_mml_reset_test), the ring's ant-colony run (AntSLAM's ACO and LM run under ASan on
@@ -117,13 +122,13 @@ endfunction()
 # -DMMLFW_SLOW_BUILD_FULL=ON runs them all.
 option(MMLFW_SLOW_BUILD_FULL "In emulated and sanitized builds, run the long scenario cases too" OFF)
 set(MMLFW_EMULATED_SKIP
-    "fw_antslam_test=AntSlamTest.ClosesTheRingAndBeatsTheDriftingFrontEnd:AntSlamTest.SecondLapTraversesTheFirstLapsFragments:AntSlamTest.SameSeedSamePoses:AntSlamTest.NoHeapAfterInit:AntSlamTest.FinalRefinementAfterLmLowersTheWholeGraphsCost"
+    "fw_antslam_test=AntSlamTest.ClosesTheRingAndBeatsTheDriftingFrontEnd:AntSlamTest.SecondLapTraversesTheFirstLapsFragments:AntSlamTest.SameSeedSamePoses:AntSlamTest.NoHeapAfterInit:AntSlamTest.FinalRefinementLowersTheWholeGraphsCost:AntSlamTest.FinalRefinementAfterLmLowersTheWholeGraphsCost"
     "fw_mml_handoff_test=MmlZeroHeapTest.MmlMclAndHandoffStepsAllocateNothing:MmlZeroHeapTest.CorrectionAndReductionAllocateNothing:HandoffTest.TracksAndRecoversFromKidnap"
     "fw_mcl_test=MclTest.GlobalLocalizationBeamModel:MclLocalizerTest.ResetGivesAFreshStart"
     "fw_rbsm_test=RbsmTest.MotionPriorShrinksTheJumpsAlongAFeaturelessCorridor"
     "fw_mml_test=MmlLocalizerTest.UniqueRoomLocalizes*:MmlLocalizerTest.DeterministicAndResettable:MmlLocalizerTest.UnknownAreaReportsOutsideMap:MmlLocalizerTest.SymmetricCorridorStaysAmbiguous:MmlLocalizerTest.StartInUnknownAreaNeverLocalizes"
     "fw_mml_reset_test=MmlResetTest.ResetGivesAFreshStart*"
-    "fw_track_test=TrackedLocalizerTest.DeterministicAndResettable:TrackedLocalizerTest.LargeFaultWaitsForGlobalConfirmation:TrackedLocalizerTest.HeadingOnlyFaultRecoversWithoutWaitingForMml:TrackedLocalizerTest.FixIsConfirmedOnTheScansBeforeIt:TrackedLocalizerTest.KidnapIsDetectedAndRefixed:GlobalContextTest.ThreadedEqualsInlineWhenOnTime:GlobalContextTest.LiveScheduleInlineLocalizes:GlobalContextTest.ConfirmedFixScanIsNotOffered")
+    "fw_track_test=TrackedLocalizerTest.DeterministicAndResettable:TrackedLocalizerTest.LargeFaultWaitsForGlobalConfirmation:TrackedLocalizerTest.HeadingOnlyFaultRecoversWithoutWaitingForMml:TrackedLocalizerTest.FixIsConfirmedOnTheScansBeforeIt:TrackedLocalizerTest.KidnapIsDetectedAndRefixed:GlobalContextTest.ThreadedEqualsInlineWhenOnTime:GlobalContextTest.LiveScheduleInlineLocalizes:GlobalContextTest.ConfirmedFixScanIsNotOffered:TrackedLocalizerTest.LookAlikeWingBeyondTheMapIsNeverLocalized:TrackedLocalizerTest.OutsideMapComesFromTheScanAtTheDeadReckonedPose")
 set(MMLFW_SANITIZED_SKIP
     "fw_antslam_test=AntSlamTest.SameSeedSamePoses:AntSlamTest.ClosesTheRingAndBeatsTheDriftingFrontEnd:AntSlamTest.FinalRefinementAfterLmLowersTheWholeGraphsCost"
     "fw_mml_test=MmlLocalizerTest.DeterministicAndResettable"
