@@ -163,7 +163,8 @@ TEST(AntSlamTest, ClosesTheRingAndBeatsTheDriftingFrontEnd) {
 // end errs only systematically (1 % long, 0.15°/m), which no edge covariance models, and the
 // least-squares frames of such edges sit 1.5 cm further from the truth than Alg. 3's (0.121 vs
 // 0.104–0.107 m, printed); on the logs' relations it was the other way round on four of five
-// (README, AntSLAM section). Alg. 3's own closures (no isolation test), so that on and off differ by the refinement alone.
+// (README, AntSLAM section). Alg. 3's own closures (no isolation test), so that on and off
+// differ by the refinement alone.
 void expect_final_refinement_lowers_the_cost(LoopOptimizer opt) {
   const RingRun& r = ring();
   AntSlamOptions o = test_options(opt);
