@@ -12,45 +12,10 @@
 #include "firmware/base/rng.h"
 #include "firmware/map/distance_field.h"
 #include "firmware/map/distance_sample.h"
+#include "firmware/map/two_wall_test_map.h"
 
 namespace fw {
 namespace {
-
-// A 70 × 50-cell map (5 × 4 tiles, the last row and column partly outside the grid) at 5 cm with
-// two walls, truncated at 0.3 m: the tiles far from both walls are not stored.
-struct TestMap {
-  DistanceFieldLayout layout;
-  std::vector<std::uint32_t> slots;
-  std::vector<std::uint16_t> cells;
-  std::vector<float> table;
-  GlobalMap map;
-
-  TestMap() {
-    const std::uint32_t w = 70, h = 50;
-    const float res = 0.05f;
-    std::vector<float> metres(w * h);
-    for (std::uint32_t y = 0; y < h; ++y) {
-      for (std::uint32_t x = 0; x < w; ++x) {
-        // Distance to the wall y = 10 (cells 0..39) and to the wall x = 55 (all rows), exact per cell.
-        const float dy = x < 40 ? std::fabs(static_cast<float>(y) - 10.0f) : 1e9f;
-        const float dx = std::fabs(static_cast<float>(x) - 55.0f);
-        metres[y * w + x] = std::fmin(dx, dy) * res;
-      }
-    }
-    EXPECT_TRUE(plan_distance_field(metres.data(), w, h, res, 0.3f, &layout).is_ok());
-    slots.assign(layout.slot_count(), 0);
-    cells.assign(layout.cell_count(), 0);
-    table.assign(layout.table_count(), 0.0f);
-    map.geometry.resolution = res;
-    map.geometry.origin_x = -1.3f;
-    map.geometry.origin_y = 0.7f;
-    map.geometry.width = w;
-    map.geometry.height = h;
-    map.distance = fill_distance_field(layout, metres.data(), slots.data(), cells.data(), table.data());
-  }
-};
-
-bool same_bits(float a, float b) { return std::memcmp(&a, &b, sizeof a) == 0; }
 
 void expect_batches_equal(const GlobalMap& map, const std::vector<Point2f>& pts, const Se2f& pose, float clip) {
   const float c = std::cos(pose.theta), s = std::sin(pose.theta);
@@ -67,17 +32,17 @@ void expect_batches_equal(const GlobalMap& map, const std::vector<Point2f>& pts,
       ASSERT_EQ(ref.use[i], on && !(d > clip) ? 1 : 0) << i;
       ASSERT_EQ(got.use[i], ref.use[i]) << "build " << static_cast<int>(build) << " point " << i;
       if (!on) continue;  // off the grid the values are documented as meaningless
-      ASSERT_TRUE(same_bits(got.d[i], d)) << i << ": " << got.d[i] << " vs " << d;
-      ASSERT_TRUE(same_bits(got.gx[i], gx)) << i;
-      ASSERT_TRUE(same_bits(got.gy[i], gy)) << i;
-      ASSERT_TRUE(same_bits(got.jt[i], ref.jt[i])) << i;
-      ASSERT_TRUE(same_bits(ref.jt[i], gx * (-s * px - c * py) + gy * (c * px - s * py))) << i;
+      ASSERT_TRUE(same_float_bits(got.d[i], d)) << i << ": " << got.d[i] << " vs " << d;
+      ASSERT_TRUE(same_float_bits(got.gx[i], gx)) << i;
+      ASSERT_TRUE(same_float_bits(got.gy[i], gy)) << i;
+      ASSERT_TRUE(same_float_bits(got.jt[i], ref.jt[i])) << i;
+      ASSERT_TRUE(same_float_bits(ref.jt[i], gx * (-s * px - c * py) + gy * (c * px - s * py))) << i;
     }
   }
 }
 
 TEST(DistanceBatchTest, EveryBuildGivesTheScalarSamplersBits) {
-  const TestMap t;
+  const TwoWallTestMap t;
   ASSERT_GT(t.map.distance.stored_tiles, 0u);
   ASSERT_LT(t.map.distance.stored_tiles, t.map.distance.tiles_x * t.map.distance.tiles_y);  // some not stored
   RandomStream rng(7, 0);
@@ -115,7 +80,7 @@ TEST(DistanceBatchTest, EveryBuildGivesTheScalarSamplersBits) {
 }
 
 TEST(DistanceBatchTest, NanAndInfinitePointsAreOffTheGrid) {
-  const TestMap t;
+  const TwoWallTestMap t;
   const float nan = std::numeric_limits<float>::quiet_NaN(), inf = std::numeric_limits<float>::infinity();
   const std::vector<Point2f> pts = {Point2f(nan, 0.0f), Point2f(0.0f, nan), Point2f(inf, 0.1f), Point2f(-inf, 0.1f),
                                     Point2f(0.2f, 0.1f)};

@@ -2,6 +2,8 @@
 
 #include <cmath>
 
+#include "firmware/map/nearest_distance_batch.h"
+
 namespace fw {
 namespace track {
 
@@ -11,6 +13,22 @@ inline float point_score(const GlobalMap& map, float x, float y, float inv_clip2
   const float d = map.distance_at(x, y, 1e9f);
   const float s = 1.0f - d * d * inv_clip2;
   return s > 0.0f ? s : 0.0f;
+}
+// Σ point_score over `points` translated by (x, y), in point order: the cell look-ups in batches
+// (nearest_distance_batch.h, distance_at's bits), the sum as the scalar loop adds it.
+inline double translated_score_sum(const GlobalMap& map, const Point2f* points, std::size_t m, float x, float y,
+                                   float inv_clip2) {
+  alignas(32) float d[kDistanceBatch];
+  double sum = 0.0;
+  for (std::size_t k = 0; k < m; k += kDistanceBatch) {
+    const std::size_t len = m - k < kDistanceBatch ? m - k : kDistanceBatch;
+    nearest_distance_batch(map, points + k, len, x, y, 1e9f, d);
+    for (std::size_t i = 0; i < len; ++i) {
+      const float s = 1.0f - d[i] * d[i] * inv_clip2;
+      sum += s > 0.0f ? s : 0.0f;
+    }
+  }
+  return sum;
 }
 }  // namespace
 
@@ -65,8 +83,7 @@ CorrelativeResult correlative_search(const GlobalMap& map, const Point2f* points
       for (std::int32_t iy = -nx; iy <= nx; ++iy) {
         const float y = seed.y + static_cast<float>(iy) * lin;
         ++r.candidates;
-        double sum = 0.0;
-        for (std::size_t i = 0; i < m; ++i) sum += point_score(map, x + rot[i].x(), y + rot[i].y(), inv);
+        const double sum = translated_score_sum(map, rot, m, x, y, inv);
         const float sc = static_cast<float>(sum / static_cast<double>(m));
         if (sc > r.score) {  // strict: the seed (and the first of equals) wins ties
           r.score = sc;
