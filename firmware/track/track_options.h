@@ -303,7 +303,12 @@ struct TrackOptions {
   // missed the 75 Hz deadline (bench.sh realtime: intel 14.0 ms, fr079 20.3 ms on the fix's scan).
   // The scans that arrive meanwhile join the replay, so it reaches the present after
   // ⌈(recovery_steps + 1 − past_scans_per_step) / (past_scans_per_step − 1)⌉ further scans (3: two;
-  // forward confirmation needs recovery_steps), not `localized` until then.
+  // forward confirmation needs recovery_steps), not `localized` until then. A replayed step that ran
+  // the correlative pre-search (correlative_search.h, up to max_candidates) ends that scan's share:
+  // one pre-search per scan period at most, so the step is bounded by one search's budget, not by
+  // past_scans_per_step of them (a confirmation starts with σθ ≥ 2.9°, over the search's trigger).
+  // The replayed steps are the same, only spread over more scans; every scan still replays ≥ 1, so
+  // the lag never grows.
   std::uint32_t past_scans_per_step = 3;
   // Protection level (protection_level.h): integrity risk per `localized` step and alert limits.
   float integrity_risk = 1e-3f;

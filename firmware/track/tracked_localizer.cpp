@@ -29,6 +29,7 @@ void TrackedLocalizer::reset() {
   tracker_.reset();
   global_.restart();
   fixes_ = fix_rejections_ = tracks_lost_ = cross_check_switches_ = confirmations_ = cross_check_conflicts_ = fixes_on_past_scans_ = 0;
+  searches_this_scan_ = most_searches_in_one_scan_ = 0;
   fixes_refused_by_wheels_ = 0;
   cross_check_left_ = 0;
   unconfirmed_ = false;
@@ -118,6 +119,7 @@ Status TrackedLocalizer::step(const hal::LaserScan& scan, const hal::Odometry& o
     return Status::error(Errc::kInvalidArgument, "TrackedLocalizer: non-finite odometry at scan %u", scan.scan_id);
   }
   global_.tick();
+  searches_this_scan_ = 0;
   const Se2f wheel(odom.x, odom.y, odom.theta);
   const std::size_t n = scan_points(scan);
   {  // the continuity test reads the previous scan, the replay of confirm_fix_on_past_scans all of them
@@ -136,7 +138,7 @@ Status TrackedLocalizer::step(const hal::LaserScan& scan, const hal::Odometry& o
     return Status::ok();
   }
   if (tracker_.active()) {
-    const TrackStep ts = tracker_.step(pts_, n, wheel);
+    const TrackStep ts = step_tracker(pts_, n, wheel);
     *out = hal::PoseEstimate();
     out->timestamp_ns = scan.timestamp_ns;
     out->scan_id = scan.scan_id;
@@ -272,7 +274,7 @@ bool TrackedLocalizer::start_forward(const Se2f& fix, const Eigen::Matrix3f& cov
                                      hal::PoseEstimate* out) {
   const bool confirm = tracker_.options().confirm_fix;
   tracker_.start(fix, cov, wheel, confirm);
-  const TrackStep ts = tracker_.step(pts_, n, wheel, /*predict=*/false);
+  const TrackStep ts = step_tracker(pts_, n, wheel, /*predict=*/false);
   // The scan must support MML's pose; with confirm_fix every test but the hysteresis must pass
   // (the scan is consistent, unique, within the alert limits), and the track then recovers.
   const bool accepted = confirm ? ts.reason == hal::StatusReason::kTrackRecovering
@@ -292,6 +294,14 @@ bool TrackedLocalizer::start_forward(const Se2f& fix, const Eigen::Matrix3f& cov
   return false;
 }
 
+TrackStep TrackedLocalizer::step_tracker(const Point2f* pts, std::size_t n, const Se2f& wheel, bool predict) {
+  const TrackStep ts = tracker_.step(pts, n, wheel, predict);
+  if (ts.search_candidates > 0 && ++searches_this_scan_ > most_searches_in_one_scan_) {
+    most_searches_in_one_scan_ = searches_this_scan_;
+  }
+  return ts;
+}
+
 // Nothing is published `localized` on the way; only the end on the newest scan counts. While the
 // replay lags, the estimate is the replayed pose carried to this scan by the wheels, not `localized`.
 bool TrackedLocalizer::replay_past_scans(const Se2f& wheel, std::size_t n, hal::PoseEstimate* out) {
@@ -299,11 +309,12 @@ bool TrackedLocalizer::replay_past_scans(const Se2f& wheel, std::size_t n, hal::
   Se2f replayed_wheel = wheel;
   for (std::uint32_t b = 0; b < tracker_.options().past_scans_per_step && replay_lag_ > 0; ++b) {
     const RememberedScan& r = history_[history_.size() - replay_lag_];
-    ts = tracker_.step(r.pts, r.n, r.wheel, /*predict=*/!replay_first_);
+    ts = step_tracker(r.pts, r.n, r.wheel, /*predict=*/!replay_first_);
     replayed_wheel = r.wheel;
     replay_first_ = false;
     --replay_lag_;
     if (ts.lost) break;
+    if (searches_this_scan_ > 0) break;  // one pre-search per scan period (past_scans_per_step)
   }
   if (!ts.lost && replay_lag_ > 0) {
     publish_track(ts, out);

@@ -72,44 +72,72 @@ TEST(TrackedLocalizerTest, FixThenTrackEveryScan) {
 
 // TrackOptions::confirm_fix_on_past_scans: MML's fix is confirmed on the recovery_steps scans the
 // robot saw before it (replayed from the fix carried back by the wheels) and the fix's own scan, so
-// the first `localized` comes on the fix's scan instead of recovery_steps scans later — never
-// wrong, always within the protection level. Forward-only confirmation is the reference.
+// the first `localized` comes scans earlier than with forward confirmation — never wrong, always
+// within the protection level. Forward-only confirmation is the reference. The replay steps at most
+// past_scans_per_step scans per scan period and at most one of them may run the correlative
+// pre-search (a confirmation starts over the search's trigger): checked with the search, and the
+// stated catch-up count without it.
 TEST(TrackedLocalizerTest, FixIsConfirmedOnTheScansBeforeIt) {
-  TrackOptions forward_only, on_past_scans;
-  forward_only.confirm_fix_on_past_scans = false;
-  on_past_scans.confirm_fix_on_past_scans = true;
-  const auto path = testing::room_tour();
-  Rig fwd, past;
-  ASSERT_TRUE(fwd.init(room_map().map, forward_only).is_ok());
-  ASSERT_TRUE(past.init(room_map().map, on_past_scans).is_ok());
-  const auto rf = mml::testing::drive(fwd.loc.get(), room(), path, 1);
-  const auto rp = mml::testing::drive(past.loc.get(), room(), path, 1);
-  const Tally tf = tally(rf), tp = tally(rp);
-  ASSERT_GE(tf.first, 0);
-  ASSERT_GE(tp.first, 0);
-  EXPECT_EQ(tp.wrong, 0);
-  EXPECT_EQ(tp.outside_pl, 0);
-  EXPECT_EQ(fwd.loc->fixes_on_past_scans(), 0u);
-  EXPECT_GE(past.loc->fixes_on_past_scans(), 1u) << "no fix was confirmed on the scans before it";
-  // MML's steps do not depend on the tracker, so MML fixes on the same scan in both runs; the
-  // forward confirmation needs recovery_steps more scans (a scan earlier at most for the hysteresis),
-  // the replay catch_up (past_scans_per_step scans per step, the new ones joining it).
   const int k = static_cast<int>(TrackOptions().recovery_steps);
   const int b = static_cast<int>(TrackOptions().past_scans_per_step);
   const int catch_up = (k + 1 - b + (b - 2)) / (b - 1);  // ⌈(k + 1 − b) / (b − 1)⌉
   ASSERT_LT(catch_up, k - 1) << "the replay would be no earlier than forward confirmation";
-  EXPECT_LE(tp.first, tf.first - (k - 1) + catch_up) << "forward " << tf.first << ", on past scans " << tp.first;
-  EXPECT_EQ(rp[static_cast<std::size_t>(tp.first)].est.mode, hal::LocalizationMode::kTracking);
-  // All at once (past_scans_per_step > recovery_steps): `localized` on the fix's own scan.
-  TrackOptions at_once = on_past_scans;
-  at_once.past_scans_per_step = static_cast<std::uint32_t>(k + 1);
-  Rig all;
-  ASSERT_TRUE(all.init(room_map().map, at_once).is_ok());
-  const auto ra = mml::testing::drive(all.loc.get(), room(), path, 1);
-  const Tally ta = tally(ra);
-  ASSERT_GE(ta.first, 0);
-  EXPECT_EQ(ta.wrong, 0);
-  EXPECT_EQ(ta.first + catch_up, tp.first) << "the catch-up is not the stated number of scans";
+  const auto path = testing::room_tour();
+  struct Run {
+    Tally t;
+    hal::LocalizationMode first_mode = hal::LocalizationMode::kGlobal;
+    std::uint32_t on_past_scans = 0, most_searches = 0;
+  };
+  auto run = [&](bool past_scans, bool search, std::uint32_t per_step, bool search_always = false) {
+    TrackOptions o;
+    o.confirm_fix_on_past_scans = past_scans;
+    o.search.enabled = search;
+    if (search_always) o.search.trigger_sigma_xy_m = o.search.trigger_sigma_theta_rad = 0.0f;
+    o.past_scans_per_step = per_step;
+    Rig rig;
+    EXPECT_TRUE(rig.init(room_map().map, o).is_ok());
+    const auto rec = mml::testing::drive(rig.loc.get(), room(), path, 1);
+    Run r;
+    r.t = tally(rec);
+    if (r.t.first >= 0) r.first_mode = rec[static_cast<std::size_t>(r.t.first)].est.mode;
+    r.on_past_scans = rig.loc->fixes_on_past_scans();
+    r.most_searches = rig.loc->most_searches_in_one_scan();
+    return r;
+  };
+  const std::uint32_t bu = static_cast<std::uint32_t>(b), all = static_cast<std::uint32_t>(k + 1);
+  for (const bool search : {true, false}) {
+    SCOPED_TRACE(search ? "with the pre-search" : "without the pre-search");
+    const Run fwd = run(false, search, bu), past = run(true, search, bu), at_once = run(true, search, all);
+    ASSERT_GE(fwd.t.first, 0);
+    ASSERT_GE(past.t.first, 0);
+    ASSERT_GE(at_once.t.first, 0);
+    EXPECT_EQ(past.t.wrong, 0);
+    EXPECT_EQ(past.t.outside_pl, 0);
+    EXPECT_EQ(at_once.t.wrong, 0);
+    EXPECT_EQ(fwd.on_past_scans, 0u);
+    EXPECT_GE(past.on_past_scans, 1u) << "no fix was confirmed on the scans before it";
+    EXPECT_EQ(past.first_mode, hal::LocalizationMode::kTracking);
+    // MML's steps do not depend on the tracker, so MML fixes on the same scan in every run.
+    EXPECT_LT(past.t.first, fwd.t.first) << "forward " << fwd.t.first << ", on past scans " << past.t.first;
+    if (search) {
+      // The confirmation's first scans search; one search per scan period even all at once.
+      EXPECT_EQ(past.most_searches, 1u);
+      EXPECT_EQ(at_once.most_searches, 1u);
+    } else {
+      EXPECT_EQ(past.most_searches, 0u);
+      // The forward confirmation needs recovery_steps more scans (a scan earlier at most for the
+      // hysteresis), the replay catch_up (past_scans_per_step scans per step, the new ones joining).
+      EXPECT_LE(past.t.first, fwd.t.first - (k - 1) + catch_up) << "forward " << fwd.t.first;
+      EXPECT_EQ(at_once.t.first + catch_up, past.t.first) << "the catch-up is not the stated number of scans";
+    }
+  }
+  // Every step of the recovery searches (triggers at 0): all at once, the replay would run k + 1
+  // searches on the fix's scan; it runs one per scan and still confirms the fix on the past scans.
+  const Run each = run(true, true, all, /*search_always=*/true);
+  ASSERT_GE(each.t.first, 0);
+  EXPECT_EQ(each.t.wrong, 0);
+  EXPECT_GE(each.on_past_scans, 1u);
+  EXPECT_EQ(each.most_searches, 1u);
 }
 
 // More scans of confirmation than the history holds is a configuration error, named as such.
