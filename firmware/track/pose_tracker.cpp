@@ -158,8 +158,9 @@ ScanAlignment PoseTracker::align_from_prediction(const Point2f* points, std::siz
   CorrelativeWindow w;
   w.xy_m = std::fmin(o.search.window_sigmas * sxy, o.search.max_window_xy_m);
   w.theta_rad = std::fmin(o.search.window_sigmas * sth, o.search.max_window_theta_rad);
-  const CorrelativeResult cr =
-      correlative_search(map_, points, n, pred, w, o.search, search_scratch_, kSearchScratch);
+  CorrelativeSearchOptions so = o.search;
+  if (search_cap_ > 0 && search_cap_ < so.max_candidates) so.max_candidates = search_cap_;
+  const CorrelativeResult cr = correlative_search(map_, points, n, pred, w, so, search_scratch_, kSearchScratch);
   out->search_candidates = cr.candidates;
   if (cr.candidates == 0 || !(cr.score > cr.seed_score)) return a;
   const ScanAlignment b = align_scan(map_, points, n, cr.pose, o.align);
@@ -229,6 +230,8 @@ void PoseTracker::update_confidence_excess(const Point2f* points, std::size_t n,
 // state, (7) protection level and status.
 TrackStep PoseTracker::step(const Point2f* points, std::size_t n, const Se2f& odom, bool predict) {
   TrackStep out;
+  search_cap_ = next_search_cap_;
+  next_search_cap_ = 0;
   if (!active_) {
     out.lost = true;
     last_ = out;

@@ -110,6 +110,9 @@ class PoseTracker {
   // `predict` = false checks/fuses the scan at the current pose without an odometry step (the scan
   // the track was started on). Returns the published view; `lost` ends the track (active() false).
   TrackStep step(const Point2f* points, std::size_t n, const Se2f& odom, bool predict = true);
+  // The next step's correlative pre-search may score at most this many candidates (≥ 1; the
+  // options' max_candidates when larger): a budget shared by several steps in one scan period.
+  void limit_next_search(std::uint32_t max_candidates) { next_search_cap_ = max_candidates; }
   const TrackStep& last() const { return last_; }
   const TrackOptions& options() const { return options_; }
   const GlobalMap& map() const { return map_; }
@@ -170,6 +173,8 @@ class PoseTracker {
   // Protection level beyond the covariance's, from the last supporting scan's confidence extent.
   float excess_xy_m_ = 0.0f, excess_theta_rad_ = 0.0f;
   ProtectionFactors k_;
+  std::uint32_t next_search_cap_ = 0;  // limit_next_search (0 = the options' cap)
+  std::uint32_t search_cap_ = 0;       // this step's
   bool initialized_ = false;
   bool active_ = false;
   Se2f pose_;

@@ -303,12 +303,13 @@ struct TrackOptions {
   // missed the 75 Hz deadline (bench.sh realtime: intel 14.0 ms, fr079 20.3 ms on the fix's scan).
   // The scans that arrive meanwhile join the replay, so it reaches the present after
   // ⌈(recovery_steps + 1 − past_scans_per_step) / (past_scans_per_step − 1)⌉ further scans (3: two;
-  // forward confirmation needs recovery_steps), not `localized` until then. A replayed step that ran
-  // the correlative pre-search (correlative_search.h, up to max_candidates) ends that scan's share:
-  // one pre-search per scan period at most, so the step is bounded by one search's budget, not by
-  // past_scans_per_step of them (a confirmation starts with σθ ≥ 2.9°, over the search's trigger).
-  // The replayed steps are the same, only spread over more scans; every scan still replays ≥ 1, so
-  // the lag never grows.
+  // forward confirmation needs recovery_steps), not `localized` until then. The replayed steps of one
+  // scan share one pre-search budget (search.max_candidates): a confirmation starts with σθ ≥ 2.9°
+  // (the start's floor), over the search's trigger, so each of them may search, and three full
+  // searches in one period (≈ 17 ms on the slow 2-core VM) would miss it. A step's search gets what
+  // the earlier steps of the scan left (its grid coarsens to fit, as at the cap); once it is spent the
+  // replay goes on at the next scan (every scan still replays ≥ 1 step, so the lag never grows).
+  // Searches that fit together (the usual ~800 candidates each) are unchanged.
   std::uint32_t past_scans_per_step = 3;
   // Protection level (protection_level.h): integrity risk per `localized` step and alert limits.
   float integrity_risk = 1e-3f;

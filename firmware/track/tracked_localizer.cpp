@@ -29,7 +29,7 @@ void TrackedLocalizer::reset() {
   tracker_.reset();
   global_.restart();
   fixes_ = fix_rejections_ = tracks_lost_ = cross_check_switches_ = confirmations_ = cross_check_conflicts_ = fixes_on_past_scans_ = 0;
-  searches_this_scan_ = most_searches_in_one_scan_ = 0;
+  search_candidates_this_scan_ = most_search_candidates_in_one_scan_ = 0;
   fixes_refused_by_wheels_ = 0;
   cross_check_left_ = 0;
   unconfirmed_ = false;
@@ -119,7 +119,7 @@ Status TrackedLocalizer::step(const hal::LaserScan& scan, const hal::Odometry& o
     return Status::error(Errc::kInvalidArgument, "TrackedLocalizer: non-finite odometry at scan %u", scan.scan_id);
   }
   global_.tick();
-  searches_this_scan_ = 0;
+  search_candidates_this_scan_ = 0;
   const Se2f wheel(odom.x, odom.y, odom.theta);
   const std::size_t n = scan_points(scan);
   {  // the continuity test reads the previous scan, the replay of confirm_fix_on_past_scans all of them
@@ -296,8 +296,9 @@ bool TrackedLocalizer::start_forward(const Se2f& fix, const Eigen::Matrix3f& cov
 
 TrackStep TrackedLocalizer::step_tracker(const Point2f* pts, std::size_t n, const Se2f& wheel, bool predict) {
   const TrackStep ts = tracker_.step(pts, n, wheel, predict);
-  if (ts.search_candidates > 0 && ++searches_this_scan_ > most_searches_in_one_scan_) {
-    most_searches_in_one_scan_ = searches_this_scan_;
+  search_candidates_this_scan_ += ts.search_candidates;
+  if (search_candidates_this_scan_ > most_search_candidates_in_one_scan_) {
+    most_search_candidates_in_one_scan_ = search_candidates_this_scan_;
   }
   return ts;
 }
@@ -307,14 +308,19 @@ TrackStep TrackedLocalizer::step_tracker(const Point2f* pts, std::size_t n, cons
 bool TrackedLocalizer::replay_past_scans(const Se2f& wheel, std::size_t n, hal::PoseEstimate* out) {
   TrackStep ts;
   Se2f replayed_wheel = wheel;
+  // One pre-search budget per scan period (TrackOptions::past_scans_per_step): each step's search
+  // gets what this scan's earlier steps left; once it is spent the replay goes on at the next scan.
+  const std::uint32_t cap = tracker_.options().search.max_candidates;
   for (std::uint32_t b = 0; b < tracker_.options().past_scans_per_step && replay_lag_ > 0; ++b) {
+    const std::uint32_t spent = search_candidates_this_scan_;
+    if (b > 0 && spent >= cap) break;
+    if (spent > 0) tracker_.limit_next_search(spent < cap ? cap - spent : 1);
     const RememberedScan& r = history_[history_.size() - replay_lag_];
     ts = step_tracker(r.pts, r.n, r.wheel, /*predict=*/!replay_first_);
     replayed_wheel = r.wheel;
     replay_first_ = false;
     --replay_lag_;
     if (ts.lost) break;
-    if (searches_this_scan_ > 0) break;  // one pre-search per scan period (past_scans_per_step)
   }
   if (!ts.lost && replay_lag_ > 0) {
     publish_track(ts, out);

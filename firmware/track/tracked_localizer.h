@@ -79,9 +79,10 @@ class TrackedLocalizer final : public Localizer {
   // A large fault (TrackStep::large_fault) was seen and MML has not yet isolated the tracked pose.
   bool awaiting_confirmation() const { return unconfirmed_; }
   std::uint32_t confirmations() const { return confirmations_; }  // tracked poses MML confirmed
-  // The most tracker steps of one scan that ran the correlative pre-search, since reset (the replay
-  // of confirm_fix_on_past_scans holds it to one; a failed replay's forward start may add one).
-  std::uint32_t most_searches_in_one_scan() const { return most_searches_in_one_scan_; }
+  // The most correlative pre-search candidates of one scan's tracker steps, since reset (the replay
+  // of confirm_fix_on_past_scans holds them to search.max_candidates; a failed replay's forward
+  // start on the same scan may add one more search).
+  std::uint32_t most_search_candidates_in_one_scan() const { return most_search_candidates_in_one_scan_; }
 
  private:
   std::size_t scan_points(const hal::LaserScan& scan);
@@ -99,9 +100,9 @@ class TrackedLocalizer final : public Localizer {
   // past_scans_per_step per call. true while it catches up or once the track is `localized` on the
   // newest scan; when it ends otherwise, forward confirmation from the fix (start_forward's result).
   bool replay_past_scans(const Se2f& wheel, std::size_t n, hal::PoseEstimate* out);
-  // tracker_.step, counting the steps of this scan that ran the correlative pre-search.
+  // tracker_.step, counting this scan's correlative pre-search candidates.
   TrackStep step_tracker(const Point2f* pts, std::size_t n, const Se2f& wheel, bool predict = true);
-  std::uint32_t searches_this_scan_ = 0, most_searches_in_one_scan_ = 0;
+  std::uint32_t search_candidates_this_scan_ = 0, most_search_candidates_in_one_scan_ = 0;
   Status cross_check(const hal::LaserScan& scan, const hal::Odometry& odom, const Se2f& wheel, std::size_t n,
                      const TrackStep& ts, hal::PoseEstimate* out);
   mml::MmlLocalizer* mml_ = nullptr;

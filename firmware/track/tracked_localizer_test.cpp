@@ -74,9 +74,9 @@ TEST(TrackedLocalizerTest, FixThenTrackEveryScan) {
 // robot saw before it (replayed from the fix carried back by the wheels) and the fix's own scan, so
 // the first `localized` comes scans earlier than with forward confirmation — never wrong, always
 // within the protection level. Forward-only confirmation is the reference. The replay steps at most
-// past_scans_per_step scans per scan period and at most one of them may run the correlative
-// pre-search (a confirmation starts over the search's trigger): checked with the search, and the
-// stated catch-up count without it.
+// past_scans_per_step scans per scan period, whose correlative pre-searches (a confirmation starts
+// over the search's trigger) share one budget of search.max_candidates; the searches of the room's
+// confirmation fit in it together, so the stated catch-up count holds with and without the search.
 TEST(TrackedLocalizerTest, FixIsConfirmedOnTheScansBeforeIt) {
   const int k = static_cast<int>(TrackOptions().recovery_steps);
   const int b = static_cast<int>(TrackOptions().past_scans_per_step);
@@ -86,13 +86,17 @@ TEST(TrackedLocalizerTest, FixIsConfirmedOnTheScansBeforeIt) {
   struct Run {
     Tally t;
     hal::LocalizationMode first_mode = hal::LocalizationMode::kGlobal;
-    std::uint32_t on_past_scans = 0, most_searches = 0;
+    std::uint32_t on_past_scans = 0, most_candidates = 0;
   };
-  auto run = [&](bool past_scans, bool search, std::uint32_t per_step, bool search_always = false) {
+  auto run = [&](bool past_scans, bool search, std::uint32_t per_step, std::uint32_t search_cap = 0) {
     TrackOptions o;
     o.confirm_fix_on_past_scans = past_scans;
     o.search.enabled = search;
-    if (search_always) o.search.trigger_sigma_xy_m = o.search.trigger_sigma_theta_rad = 0.0f;
+    if (search_cap > 0) {  // every step of the recovery searches, on a small budget
+      o.search.trigger_sigma_xy_m = o.search.trigger_sigma_theta_rad = 0.0f;
+      o.search.window_sigmas = 10.0f;  // wide windows: each search alone would fill the budget
+      o.search.max_candidates = search_cap;
+    }
     o.past_scans_per_step = per_step;
     Rig rig;
     EXPECT_TRUE(rig.init(room_map().map, o).is_ok());
@@ -101,7 +105,7 @@ TEST(TrackedLocalizerTest, FixIsConfirmedOnTheScansBeforeIt) {
     r.t = tally(rec);
     if (r.t.first >= 0) r.first_mode = rec[static_cast<std::size_t>(r.t.first)].est.mode;
     r.on_past_scans = rig.loc->fixes_on_past_scans();
-    r.most_searches = rig.loc->most_searches_in_one_scan();
+    r.most_candidates = rig.loc->most_search_candidates_in_one_scan();
     return r;
   };
   const std::uint32_t bu = static_cast<std::uint32_t>(b), all = static_cast<std::uint32_t>(k + 1);
@@ -119,25 +123,23 @@ TEST(TrackedLocalizerTest, FixIsConfirmedOnTheScansBeforeIt) {
     EXPECT_EQ(past.first_mode, hal::LocalizationMode::kTracking);
     // MML's steps do not depend on the tracker, so MML fixes on the same scan in every run.
     EXPECT_LT(past.t.first, fwd.t.first) << "forward " << fwd.t.first << ", on past scans " << past.t.first;
-    if (search) {
-      // The confirmation's first scans search; one search per scan period even all at once.
-      EXPECT_EQ(past.most_searches, 1u);
-      EXPECT_EQ(at_once.most_searches, 1u);
-    } else {
-      EXPECT_EQ(past.most_searches, 0u);
-      // The forward confirmation needs recovery_steps more scans (a scan earlier at most for the
-      // hysteresis), the replay catch_up (past_scans_per_step scans per step, the new ones joining).
-      EXPECT_LE(past.t.first, fwd.t.first - (k - 1) + catch_up) << "forward " << fwd.t.first;
-      EXPECT_EQ(at_once.t.first + catch_up, past.t.first) << "the catch-up is not the stated number of scans";
-    }
+    if (search) EXPECT_GT(past.most_candidates, 0u) << "the confirmation did not search";
+    if (!search) EXPECT_EQ(past.most_candidates, 0u);
+    // The forward confirmation needs recovery_steps more scans (a scan earlier at most for the
+    // hysteresis), the replay catch_up (past_scans_per_step scans per step, the new ones joining).
+    EXPECT_LE(past.t.first, fwd.t.first - (k - 1) + catch_up) << "forward " << fwd.t.first;
+    EXPECT_EQ(at_once.t.first + catch_up, past.t.first) << "the catch-up is not the stated number of scans";
   }
-  // Every step of the recovery searches (triggers at 0): all at once, the replay would run k + 1
-  // searches on the fix's scan; it runs one per scan and still confirms the fix on the past scans.
-  const Run each = run(true, true, all, /*search_always=*/true);
+  // Every step of the recovery searches, on a budget of 300 candidates (its windows need far more):
+  // all at once, the replay would spend k + 1 searches on the fix's scan; it spends one budget per
+  // scan and still confirms the fix on the past scans, never wrong.
+  const std::uint32_t budget = 300;
+  const Run each = run(true, true, all, budget);
   ASSERT_GE(each.t.first, 0);
   EXPECT_EQ(each.t.wrong, 0);
   EXPECT_GE(each.on_past_scans, 1u);
-  EXPECT_EQ(each.most_searches, 1u);
+  EXPECT_GT(each.most_candidates, budget / 2) << "the budget was not used";
+  EXPECT_LE(each.most_candidates, budget);
 }
 
 // More scans of confirmation than the history holds is a configuration error, named as such.
