@@ -8,11 +8,14 @@ namespace fw {
 namespace track {
 
 namespace {
-// Truncated score of one end-point in world coordinates: 1 on a wall, 0 beyond clip or off the map.
-inline float point_score(const GlobalMap& map, float x, float y, float inv_clip2) {
-  const float d = map.distance_at(x, y, 1e9f);
+// Truncated score of an end-point at distance d from the nearest wall: 1 on it, 0 beyond clip.
+inline float truncated_score(float d, float inv_clip2) {
   const float s = 1.0f - d * d * inv_clip2;
   return s > 0.0f ? s : 0.0f;
+}
+// The same at an end-point in world coordinates (0 off the map).
+inline float point_score(const GlobalMap& map, float x, float y, float inv_clip2) {
+  return truncated_score(map.distance_at(x, y, 1e9f), inv_clip2);
 }
 // Σ point_score over `points` translated by (x, y), in point order: the cell look-ups in batches
 // (nearest_distance_batch.h, distance_at's bits), the sum as the scalar loop adds it.
@@ -23,10 +26,7 @@ inline double translated_score_sum(const GlobalMap& map, const Point2f* points, 
   for (std::size_t k = 0; k < m; k += kDistanceBatch) {
     const std::size_t len = m - k < kDistanceBatch ? m - k : kDistanceBatch;
     nearest_distance_batch(map, points + k, len, x, y, 1e9f, d);
-    for (std::size_t i = 0; i < len; ++i) {
-      const float s = 1.0f - d[i] * d[i] * inv_clip2;
-      sum += s > 0.0f ? s : 0.0f;
-    }
+    for (std::size_t i = 0; i < len; ++i) sum += truncated_score(d[i], inv_clip2);
   }
   return sum;
 }
