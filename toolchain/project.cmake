@@ -55,9 +55,9 @@ endif()
 
 # Embedded rules for firmware/ and hal/ targets (DEVELOPERS.md): no exceptions, no RTTI, warnings
 # are errors. Tests and sim/ are ordinary C++20 and do not call this.
+set(MMLFW_EMBEDDED_FLAGS -fno-exceptions -fno-rtti -Wall -Wextra -Wshadow -Werror -Wno-psabi)
 function(mmlfw_embedded_target tgt)
-  target_compile_options(${tgt} PRIVATE
-    -fno-exceptions -fno-rtti -Wall -Wextra -Wshadow -Werror -Wno-psabi)
+  target_compile_options(${tgt} PRIVATE ${MMLFW_EMBEDDED_FLAGS})
   target_link_libraries(${tgt} PUBLIC eigen3)
   set_property(GLOBAL APPEND PROPERTY MMLFW_EMBEDDED_LIBS ${tgt})
 endfunction()
@@ -68,6 +68,9 @@ if(NOT TARGET gtest)
   set(BUILD_GMOCK OFF CACHE BOOL "" FORCE)
   add_subdirectory(/usr/src/googletest ${CMAKE_BINARY_DIR}/_googletest EXCLUDE_FROM_ALL)
 endif()
+
+include(${CMAKE_CURRENT_LIST_DIR}/pch.cmake)
+mmlfw_pch_donors()
 
 # mmlfw_add_test(NAME SOURCES... LIBS ...): a gtest binary registered with CTest. Tests sit
 # beside the code they test (Cartographer style); the fault handler is made fatal by test_main.

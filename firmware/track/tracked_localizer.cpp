@@ -274,6 +274,7 @@ bool TrackedLocalizer::start_forward(const Se2f& fix, const Eigen::Matrix3f& cov
                                      hal::PoseEstimate* out) {
   const bool confirm = tracker_.options().confirm_fix;
   tracker_.start(fix, cov, wheel, confirm);
+  limit_search_to_what_this_scan_left();  // after a failed replay on this scan
   const TrackStep ts = step_tracker(pts_, n, wheel, /*predict=*/false);
   // The scan must support MML's pose; with confirm_fix every test but the hysteresis must pass
   // (the scan is consistent, unique, within the alert limits), and the track then recovers.
@@ -303,6 +304,15 @@ TrackStep TrackedLocalizer::step_tracker(const Point2f* pts, std::size_t n, cons
   return ts;
 }
 
+// One pre-search budget (search.max_candidates) per scan period, whichever steps of the tracker
+// this scan runs: the next step's search gets what the earlier ones left (at least one candidate,
+// the prediction itself).
+void TrackedLocalizer::limit_search_to_what_this_scan_left() {
+  const std::uint32_t cap = tracker_.options().search.max_candidates;
+  const std::uint32_t spent = search_candidates_this_scan_;
+  if (spent > 0) tracker_.limit_next_search(spent < cap ? cap - spent : 1);
+}
+
 // Nothing is published `localized` on the way; only the end on the newest scan counts. While the
 // replay lags, the estimate is the replayed pose carried to this scan by the wheels, not `localized`.
 bool TrackedLocalizer::replay_past_scans(const Se2f& wheel, std::size_t n, hal::PoseEstimate* out) {
@@ -312,9 +322,8 @@ bool TrackedLocalizer::replay_past_scans(const Se2f& wheel, std::size_t n, hal::
   // gets what this scan's earlier steps left; once it is spent the replay goes on at the next scan.
   const std::uint32_t cap = tracker_.options().search.max_candidates;
   for (std::uint32_t b = 0; b < tracker_.options().past_scans_per_step && replay_lag_ > 0; ++b) {
-    const std::uint32_t spent = search_candidates_this_scan_;
-    if (b > 0 && spent >= cap) break;
-    if (spent > 0) tracker_.limit_next_search(spent < cap ? cap - spent : 1);
+    if (b > 0 && search_candidates_this_scan_ >= cap) break;
+    limit_search_to_what_this_scan_left();
     const RememberedScan& r = history_[history_.size() - replay_lag_];
     ts = step_tracker(r.pts, r.n, r.wheel, /*predict=*/!replay_first_);
     replayed_wheel = r.wheel;

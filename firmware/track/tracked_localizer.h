@@ -100,6 +100,7 @@ class TrackedLocalizer final : public Localizer {
   // past_scans_per_step per call. true while it catches up or once the track is `localized` on the
   // newest scan; when it ends otherwise, forward confirmation from the fix (start_forward's result).
   bool replay_past_scans(const Se2f& wheel, std::size_t n, hal::PoseEstimate* out);
+  void limit_search_to_what_this_scan_left();
   // tracker_.step, counting this scan's correlative pre-search candidates.
   TrackStep step_tracker(const Point2f* pts, std::size_t n, const Se2f& wheel, bool predict = true);
   std::uint32_t search_candidates_this_scan_ = 0, most_search_candidates_in_one_scan_ = 0;
