@@ -3,6 +3,7 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <cstdint>
 #include <fstream>
 #include <map>
 #include <sstream>
@@ -61,10 +62,11 @@ std::map<std::uint32_t, Message> load_dbc() {
 }
 
 double extract(const hal::CanFrame& f, const Signal& s) {
-  unsigned __int128 raw = 0;
-  for (int b = 0; b < s.bits; ++b) {
+  // A DBC signal is at most 64 bits; std::uint64_t, not __int128, which 32-bit ARM (armhf) lacks.
+  std::uint64_t raw = 0;
+  for (int b = 0; b < s.bits && b < 64; ++b) {
     const int bit = s.start + b;
-    if (f.data[bit / 8] & (1u << (bit % 8))) raw |= static_cast<unsigned __int128>(1) << b;
+    if (f.data[bit / 8] & (1u << (bit % 8))) raw |= std::uint64_t{1} << b;
   }
   long double v = static_cast<long double>(raw);
   if (s.is_signed && (raw >> (s.bits - 1)) & 1) v -= std::ldexp(1.0L, s.bits);
@@ -109,6 +111,7 @@ TEST(Dbc, DescribesEveryFrameTheEncoderProduces) {
       EXPECT_LE(f[i].len, dbc.at(f[i].id).dlc);
       // Every signal the DBC puts in this frame lies inside the bytes the encoder sends.
       for (const auto& [name, s] : dbc.at(f[i].id).signals) {
+        EXPECT_LE(s.bits, 64) << dbc.at(f[i].id).name << "." << name;
         EXPECT_LE(s.start + s.bits, 8 * f[i].len) << dbc.at(f[i].id).name << "." << name;
       }
     }
