@@ -29,6 +29,7 @@ void TrackedLocalizer::reset() {
   tracker_.reset();
   global_.restart();
   fixes_ = fix_rejections_ = tracks_lost_ = cross_check_switches_ = confirmations_ = cross_check_conflicts_ = fixes_on_past_scans_ = 0;
+  fix_replays_failed_ = 0;
   search_candidates_this_scan_ = most_search_candidates_in_one_scan_ = 0;
   fixes_refused_by_wheels_ = 0;
   cross_check_left_ = 0;
@@ -352,6 +353,7 @@ bool TrackedLocalizer::replay_past_scans(const Se2f& wheel, std::size_t n, hal::
     return true;
   }
   // Forward confirmation from MML's fix, carried to this scan by the wheels.
+  ++fix_replays_failed_;
   tracker_.stop();
   return start_forward(replay_fix_.compose(replay_fix_wheel_.between(wheel)), replay_cov_, wheel, n, out);
 }

@@ -66,6 +66,8 @@ class TrackedLocalizer final : public Localizer {
   std::uint32_t fix_rejections() const { return fix_rejections_; }
   // Fixes confirmed on the scans before them (TrackOptions::confirm_fix_on_past_scans), of fixes().
   std::uint32_t fixes_on_past_scans() const { return fixes_on_past_scans_; }
+  // Replays of a fix on the past scans that failed, each followed by forward confirmation on its scan.
+  std::uint32_t fix_replays_failed() const { return fix_replays_failed_; }
   std::uint32_t tracks_lost() const { return tracks_lost_; }
   // MML fixes refused because the wheels, carrying a track given up outside the map, rule them out
   // (dead_reckoning.h); counted once per scan.
@@ -126,7 +128,7 @@ class TrackedLocalizer final : public Localizer {
   Eigen::Matrix3f replay_cov_ = Eigen::Matrix3f::Zero();
   std::uint32_t fixes_ = 0, fix_rejections_ = 0, tracks_lost_ = 0, cross_check_switches_ = 0;
   std::uint32_t cross_check_left_ = 0;  // scans the background search still runs (0 = idle)
-  std::uint32_t confirmations_ = 0, cross_check_conflicts_ = 0, fixes_on_past_scans_ = 0;
+  std::uint32_t confirmations_ = 0, cross_check_conflicts_ = 0, fixes_on_past_scans_ = 0, fix_replays_failed_ = 0;
   bool unconfirmed_ = false;
   // Since the last track was given up (reset() clears it): its last pose carried by the wheels, for
   // the outside-map status while MML searches and, after a track given up outside the map, as the

@@ -142,6 +142,73 @@ TEST(TrackedLocalizerTest, FixIsConfirmedOnTheScansBeforeIt) {
   EXPECT_LE(each.most_candidates, budget);
 }
 
+// A replay that fails on a scan where it searched starts the forward confirmation on that same scan:
+// its search gets what the replay left of the scan's budget (limit_search_to_what_this_scan_left).
+// The budget run of the test above, with the replay over several scan periods and the wheels
+// slipping on the scan after MML's fix (their heading jumps by 0.6 or 1.0 rad the robot did not
+// turn): the replay stepping through that scan loses the track and the forward start from MML's
+// fix, carried by the same wheels, searches on the same scan. Without the rule: 553 and 556
+// candidates in one scan on this budget of 300.
+TEST(TrackedLocalizerTest, ForwardStartAfterAFailedReplaySharesTheScansBudget) {
+  const auto path = testing::room_tour();
+  const std::uint32_t budget = 300;
+  struct Run {
+    Tally t;
+    std::uint32_t replays_failed = 0, most_candidates = 0;
+  };
+  auto run = [&](int slip_at, float slip, bool at_once) {
+    TrackOptions o;
+    o.confirm_fix_on_past_scans = true;
+    o.search.trigger_sigma_xy_m = o.search.trigger_sigma_theta_rad = 0.0f;  // every recovering step searches
+    o.search.window_sigmas = 10.0f;
+    o.search.max_candidates = budget;
+    if (at_once) o.past_scans_per_step = o.recovery_steps + 1;  // the replay ends on MML's fix scan
+    Rig rig;
+    EXPECT_TRUE(rig.init(room_map().map, o).is_ok());
+    static hal::LaserScan scan;
+    RandomStream rng(1, 42);
+    Se2f odom(0, 0, 0);
+    std::vector<mml::testing::StepRecord> rec;
+    for (std::size_t i = 0; i < path.size(); ++i) {
+      if (i > 0) odom = odom.compose(path[i - 1].between(path[i]));
+      if (static_cast<int>(i) == slip_at) odom.theta = wrap_angle(odom.theta + slip);
+      mcl::testing::simulate_scan(room().view(), path[i].x, path[i].y, path[i].theta, &scan);
+      for (std::uint32_t b = 0; b < scan.beam_count; ++b)
+        if (scan.ranges[b] < scan.range_max) scan.ranges[b] += 0.005f * static_cast<float>(rng.gaussian());
+      scan.scan_id = static_cast<std::uint32_t>(i);
+      scan.timestamp_ns = i * 100000000ull;
+      hal::Odometry od;
+      od.timestamp_ns = scan.timestamp_ns;
+      od.x = odom.x;
+      od.y = odom.y;
+      od.theta = odom.theta;
+      mml::testing::StepRecord r;
+      r.truth = path[i];
+      EXPECT_TRUE(rig.loc->step(scan, od, &r.est).is_ok());
+      rec.push_back(r);
+    }
+    Run out;
+    out.t = tally(rec);
+    out.replays_failed = rig.loc->fix_replays_failed();
+    out.most_candidates = rig.loc->most_search_candidates_in_one_scan();
+    return out;
+  };
+  // MML's steps do not depend on the tracker: with the whole replay in one scan period the first
+  // `localized` is MML's fix scan, in every run that does not slip before it.
+  const Run clean = run(-1, 0.0f, true);
+  ASSERT_GE(clean.t.first, 0);
+  EXPECT_EQ(clean.replays_failed, 0u);
+  for (const float slip : {0.6f, 1.0f}) {
+    SCOPED_TRACE(slip);
+    const Run s = run(clean.t.first + 1, slip, false);
+    EXPECT_GE(s.replays_failed, 1u) << "no replay failed: the case is not exercised";
+    EXPECT_GE(s.t.first, 0) << "never localized after the slip";
+    EXPECT_EQ(s.t.wrong, 0);
+    EXPECT_GT(s.most_candidates, budget / 2) << "the budget was not used";
+    EXPECT_LE(s.most_candidates, budget);
+  }
+}
+
 // More scans of confirmation than the history holds is a configuration error, named as such.
 TEST(TrackedLocalizerTest, RecoveryStepsBeyondTheScanHistoryIsRefused) {
   TrackOptions o;
