@@ -44,9 +44,11 @@ struct StepRecord {
 };
 
 // Drives `loc` along `path` (true poses) in `world`, feeding odometry with small multiplicative
-// noise (seeded). Returns one record per scan.
+// noise (seeded). Returns one record per scan. `wheels`, if given, may change the odometry of scan
+// i before it is fed (a slip: the change stays in every later odometry).
 inline std::vector<StepRecord> drive(Localizer* loc, const GridWorld& world, const std::vector<Se2f>& path,
-                                     std::uint64_t seed, std::function<void(StepRecord*)> hook = nullptr) {
+                                     std::uint64_t seed, std::function<void(StepRecord*)> hook = nullptr,
+                                     std::function<void(std::size_t, Se2f*)> wheels = nullptr) {
   static hal::LaserScan scan;
   RandomStream rng(seed, 42);
   std::vector<StepRecord> out;
@@ -60,6 +62,7 @@ inline std::vector<StepRecord> drive(Localizer* loc, const GridWorld& world, con
       d.theta = d.theta * scale + 0.002f * static_cast<float>(rng.gaussian());
       odom = odom.compose(d);
     }
+    if (wheels) wheels(i, &odom);
     mcl::testing::simulate_scan(world.view(), path[i].x, path[i].y, path[i].theta, &scan);
     for (std::uint32_t b = 0; b < scan.beam_count; ++b) {
       if (scan.ranges[b] < scan.range_max) scan.ranges[b] += 0.005f * static_cast<float>(rng.gaussian());
