@@ -10,6 +10,11 @@ struct RayHit {
   bool hit = false;
   double range = 0;  // distance to the first surface (≤ max_range when hit)
   bool person = false;
+  // The first surface is a glass pane (World::glass): then behind_* is the first surface that is
+  // not glass behind it (behind_hit false when none within max_range).
+  bool glass = false;
+  bool behind_hit = false;
+  double behind_range = 0;
 };
 
 // First surface along origin + t·(cos a, sin a), 0 < t ≤ max_range, at time t_s (people move).

@@ -47,6 +47,9 @@ struct World {
   std::string name;
   Box bounds;                  // the building outline (walls lie on or inside it)
   std::vector<Segment> walls;  // static structure, in the map
+  // Glass panes: in the map (drawn from the plan), but a laser beam may pass through them and return
+  // from what is behind, or not return at all (LaserModelOptions::glass_return_probability).
+  std::vector<Segment> glass;
   std::vector<Box> unknown_areas;  // in the world, erased from the map (Sec. 5.6)
   std::vector<Person> people;  // dynamic obstacles, never in the map
   RouteGraph route;
