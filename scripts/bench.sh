@@ -62,5 +62,7 @@ for n in "${names[@]}"; do
       echo "bench.sh: bench_pransam_pcl not built (PCL not found): no pcl_* figures" >&2
     fi
   fi
+  # ground (issue 55, item 6): the table and the picture are written beside the JSON.
+  if [ "$n" = "ground" ]; then echo "--- build/bench/ground.md, build/bench/ground.svg"; fi
   echo "--- build/bench/$n.json"; cat "build/bench/$n.json"; echo
 done
