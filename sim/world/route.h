@@ -26,18 +26,29 @@ struct RouteOptions {
   double straight_weight = 3.0;
   double unvisited_weight = 4.0;
   double room_weight = 0.35;
+  // Issue 55 (off by default; a default route is bit for bit what it was). Speed per leg: every
+  // drive from node to node at a speed drawn uniformly in [speed_min, speed_max] m/s (both 0 =
+  // every leg at `speed`). Stops: on arriving at a node the robot stands still with probability
+  // stop_probability for a time drawn uniformly in [stop_min_s, stop_max_s]. Their draws come from
+  // a stream of their own (seeded from a copy of the route's stream), so the path is the same with
+  // or without them; only its timing changes.
+  double speed_min = 0, speed_max = 0;
+  double stop_probability = 0;
+  double stop_min_s = 2, stop_max_s = 10;
 
+  bool varied_motion() const { return speed_max > 0 || stop_probability > 0; }
   std::string validate() const;
 };
 
-// A piecewise motion: segments of pure rotation or pure straight driving.
+// A piecewise motion: segments of pure rotation, pure straight driving or standing still.
 class RouteTrajectory {
  public:
   struct Piece {
     double t0, t1;      // time span, s
     fw::Se2d start;     // pose at t0
-    double v, omega;    // forward speed, turn rate during the piece
+    double v, omega;    // forward speed, turn rate during the piece (both 0: a stop)
   };
+  void add_stop(double duration_s);
   void add_turn(double target_heading, double turn_rate);
   void add_drive(const Vec2& to, double speed);
   void start_at(const fw::Se2d& pose);

@@ -99,6 +99,7 @@ bool SyntheticRun::init(const World& world, const SyntheticRunOptions& opt, std:
   last_odom_t_ = 0;
   travelled_ = 0;
   laser_rng_.reseed(opt.seed, 3);
+  laser_extra_rng_.reseed(opt.seed, 7);
   odom_sim_ = OdometrySimulator(opt.odometry, opt.seed);
   last_truth_ = trajectory_.pose_at(0);
   return true;
@@ -148,7 +149,7 @@ bool SyntheticRun::next(SyntheticFrame* out) {
   }
   out->scan.timestamp_ns = time_ns(t);
   out->scan.scan_id = static_cast<std::uint32_t>(next_scan_);
-  simulate_scan(world_, out->truth, t, opt_.laser, &laser_rng_, &out->scan);
+  simulate_scan(world_, out->truth, t, opt_.laser, &laser_rng_, &out->scan, &laser_extra_rng_);
   ++next_scan_;
   return true;
 }

@@ -2,8 +2,10 @@
 // odometry at its own rate and laser scans — delivered frame by frame in the order a robot's
 // drivers would deliver them: for each scan, the odometry samples up to and including the first
 // one at or after the scan time, then the scan. Random streams per consumer (fw::RandomStream with
-// the run seed): 1 route, 2 odometry, 3 laser, 4 people. Same world + options + seed ⇒ identical
-// frames.
+// the run seed): 1 route, 2 odometry, 3 laser, 4 people, 5 the route after a kidnapping, and for the
+// issue-55 extensions (drawn only when on) 6 the wheel errors, 7 the laser's glass, far dropouts and
+// irregular angles. Same world + options + seed ⇒ identical frames. A sensor's own rate is the
+// caller's to set as scan_period_s (sensor_profiles.h gives rate_hz).
 #pragma once
 
 #include <cstdint>
@@ -81,6 +83,7 @@ class SyntheticRun {
   double travelled_ = 0;
   fw::Se2d last_truth_;
   fw::RandomStream laser_rng_;
+  fw::RandomStream laser_extra_rng_;
   OdometrySimulator odom_sim_{OdometryNoiseOptions(), 0};
 };
 
