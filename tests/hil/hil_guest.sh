@@ -1,5 +1,5 @@
 #!/bin/bash
-# Runs INSIDE user-mode Linux (via run-in-uml.sh): every CAN peer must live in the same guest.
+# Runs INSIDE the guest (run-in-guest.sh: user-mode Linux or QEMU): every CAN peer must live in the same guest.
 # hil_guest.sh WORKDIR BUILD_DIR — runs the SocketCAN unit tests, then each scenario listed in
 # WORKDIR/scenarios (name iface config replay.log) : mmlfw on the interface, candump recording
 # its pose/health frames, canplayer replaying the log; everything with timeouts.
