@@ -5,6 +5,7 @@
 #include <cstdio>
 #include <filesystem>
 #include <limits>
+#include <random>
 
 #include "sim/io/carmen_log.h"
 #include "sim/io/datasets.h"
@@ -77,7 +78,27 @@ bool log_pairs(const std::string& dataset, std::vector<fw::Se2d>* odom, std::vec
   return true;
 }
 
+// The truth seen through a reference with iid per-pose errors (seeded per run).
+std::vector<fw::Se2d> noisy_reference(const std::vector<fw::Se2d>& ref, const GroundOptions& opt, int seed) {
+  std::mt19937_64 rng(0x9e3779b97f4a7c15ull ^ static_cast<std::uint64_t>(seed));
+  std::normal_distribution<double> g(0.0, 1.0);
+  std::vector<fw::Se2d> out;
+  out.reserve(ref.size());
+  for (const fw::Se2d& p : ref) {
+    out.emplace_back(p.x + opt.ref_sigma_m * g(rng), p.y + opt.ref_sigma_m * g(rng),
+                     fw::wrap_angle(p.theta + opt.ref_sigma_deg * M_PI / 180.0 * g(rng)));
+  }
+  return out;
+}
+
 }  // namespace
+
+void rest_noise_from(const OdometryMeasure& log, double* sigma_m, double* sigma_deg) {
+  *sigma_m = *sigma_deg = 0;
+  if (log.rest_pairs < 20 || !std::isfinite(log.rest_m_p95) || !std::isfinite(log.rest_deg_p95)) return;
+  *sigma_m = log.rest_m_p95 / (2.4477 * std::sqrt(2.0));
+  *sigma_deg = log.rest_deg_p95 / (1.96 * std::sqrt(2.0));
+}
 
 const std::vector<std::string>& odometry_datasets() {
   static const std::vector<std::string> v = {"intel", "fr079", "aces", "fr-clinic"};
@@ -176,7 +197,7 @@ bool measure_profile_odometry(const std::string& name, const OdometryNoiseOption
   out->is_log = false;
   World world;
   if (!make_builtin_world(opt.world, &world, err)) return false;
-  std::vector<OdometryWindow> ws, wl;
+  std::vector<OdometryWindow> ws, wl, wr;
   std::vector<fw::Se2d> all_odom, all_ref;
   for (int seed = 1; seed <= opt.sim_seeds; ++seed) {
     SyntheticRunOptions ro;
@@ -202,12 +223,17 @@ bool measure_profile_odometry(const std::string& name, const OdometryNoiseOption
     l.stride_m = opt.long_stride_m;
     for (const OdometryWindow& w : odometry_windows(odom, ref, s)) ws.push_back(w);
     for (const OdometryWindow& w : odometry_windows(odom, ref, l)) wl.push_back(w);
+    if (opt.ref_sigma_m > 0 || opt.ref_sigma_deg > 0) {
+      for (const OdometryWindow& w : odometry_windows(odom, noisy_reference(ref, opt, seed), l)) wr.push_back(w);
+    }
     all_odom.insert(all_odom.end(), odom.begin(), odom.end());
     all_ref.insert(all_ref.end(), ref.begin(), ref.end());
     out->pairs += odom.size();
   }
   out->short_w = summarize(ws);
   out->long_w = summarize(wl);
+  out->through_ref = !wr.empty();
+  out->long_w_ref = summarize(wr);
   out->path_m = 0;
   for (std::size_t i = 1; i < all_ref.size(); ++i) {
     const double step = std::hypot(all_ref[i].x - all_ref[i - 1].x, all_ref[i].y - all_ref[i - 1].y);

@@ -27,6 +27,9 @@ struct GroundOptions {
   std::string world = "large-office";
   ResidualOptions residual;
   bool progress = false;
+  // The profiles also seen through a reference with this iid per-pose error (σ per axis, m / deg;
+  // 0 = not done). run_grounding derives it from fr079's reference at rest (rest_noise_from).
+  double ref_sigma_m = 0, ref_sigma_deg = 0;
 };
 
 struct OdometryMeasure {
@@ -41,6 +44,10 @@ struct OdometryMeasure {
   // the reference's noise floor (m, deg); NaN when no such pair.
   std::size_t rest_pairs = 0;
   double rest_m_p95 = 0, rest_deg_p95 = 0;
+  // Profiles: the 5 m windows against the truth plus the reference-like noise of
+  // GroundOptions::ref_sigma_* (measured only when that is > 0).
+  bool through_ref = false;
+  OdometryErrorSummary long_w_ref;
 };
 
 struct ResidualMeasure {
@@ -55,6 +62,8 @@ struct Verdict {
   std::string profile;
   bool is_odometry = true;
   std::vector<std::string> resembles;  // empty: no real log resembles it
+  bool through_ref = false;
+  std::vector<std::string> resembles_through_ref;  // the same with the profile seen through a SLAM-like reference
 };
 
 struct GroundReport {
@@ -65,6 +74,7 @@ struct GroundReport {
   std::vector<Verdict> verdicts;
   bool profiles_available = false;         // odometry_profiles() / sensor_profiles() linked in
   bool sensor_profiles_available = false;
+  double ref_sigma_m = 0, ref_sigma_deg = 0;  // the reference-like noise the profiles were also seen through
 };
 
 // Real datasets measured for odometry (raw odometry + a reference) and for residuals (a global map).
@@ -84,6 +94,11 @@ bool measure_sensor_residuals(const std::string& name, const LaserModelOptions& 
 // The pose pairs' windows summarised (the estimator as used for logs and profiles alike).
 void summarize_pairs(const std::vector<fw::Se2d>& odom, const std::vector<fw::Se2d>& ref, const GroundOptions& opt,
                      OdometryMeasure* out);
+
+// The per-pose reference error (σ per axis, m and deg) implied by a reference's motion at rest: the
+// motion between two poses at rest is the difference of two independent errors (σ√2 per axis); its
+// p95 is 2.45 σ√2 in the plane (Rayleigh) and 1.96 σ√2 in heading.
+void rest_noise_from(const OdometryMeasure& log, double* sigma_m, double* sigma_deg);
 
 // The verdict rule (fixed before any figure was seen): a profile resembles a log when, for both the
 // translation error per metre and the heading error per metre of the 5 m windows, the profile's

@@ -58,6 +58,17 @@ void verdicts(const GroundReport& r, std::ostringstream& o) {
     for (std::size_t i = 0; i < v.resembles.size(); ++i) o << (i ? ", " : " ") << v.resembles[i];
     o << "\n";
   }
+  for (const Verdict& v : r.verdicts) {
+    if (!v.through_ref) continue;
+    o << "- odometry profile **" << v.profile << "** seen through the fr079-like reference: ";
+    if (v.resembles_through_ref.empty()) {
+      o << "no real log resembles it\n";
+      continue;
+    }
+    o << "resembles";
+    for (std::size_t i = 0; i < v.resembles_through_ref.size(); ++i) o << (i ? ", " : " ") << v.resembles_through_ref[i];
+    o << "\n";
+  }
   for (const OdometryMeasure& l : r.odometry) {
     if (!l.is_log || !l.measured) continue;
     std::string by;
@@ -67,6 +78,17 @@ void verdicts(const GroundReport& r, std::ostringstream& o) {
       }
     }
     o << "- real log **" << l.name << "** (odometry): " << (by.empty() ? "**no profile spans it**" : "resembled by " + by)
+      << "\n";
+  }
+  for (const ResidualMeasure& l : r.residuals) {
+    if (!l.is_log || !l.measured) continue;
+    std::string by;
+    for (const Verdict& v : r.verdicts) {
+      for (const std::string& x : v.resembles) {
+        if (!v.is_odometry && x == l.name) by += (by.empty() ? "" : ", ") + v.profile;
+      }
+    }
+    o << "- real log **" << l.name << "** (residuals): " << (by.empty() ? "**no sensor profile spans it**" : "resembled by " + by)
       << "\n";
   }
 }
@@ -92,6 +114,19 @@ std::string markdown(const GroundReport& r) {
        "5 m windows than over 1 m windows.\n\n";
   o << "## Odometry error, 5 m windows (verdicts use these)\n\n";
   odometry_table(r, true, o);
+  if (r.ref_sigma_m > 0) {
+    o << "\n### The profiles seen through a reference like fr079's (5 m windows)\n\nThe truth plus iid per-pose "
+         "errors of " << fmt("%.3f", r.ref_sigma_m) << " m per axis and " << fmt("%.2f", r.ref_sigma_deg)
+      << " deg, derived from fr079's reference at rest (p95 = 2.45 sigma sqrt 2 in the plane, 1.96 sigma sqrt 2 in "
+         "heading): what the same estimator would report for the profile on a real log with such a reference.\n\n"
+         "| profile | windows | trans. error %/m p50 (p95) | heading error deg/m p50 (p95) |\n| --- | ---: | ---: | ---: |\n";
+    for (const OdometryMeasure& m : r.odometry) {
+      if (!m.through_ref) continue;
+      const OdometryErrorSummary& s = m.long_w_ref;
+      o << "| " << m.name << " | " << s.windows << " | " << pair("%.2f", 100 * s.trans_p50, 100 * s.trans_p95) << " | "
+        << pair("%.2f", s.head_deg_per_m_p50, s.head_deg_per_m_p95) << " |\n";
+    }
+  }
   o << "\n## Odometry error, 1 m windows (the reference's own error weighs more here)\n\n";
   odometry_table(r, false, o);
   o << "\n## The reference's own motion while the odometry stands still (p95 over consecutive reference poses)\n\n"

@@ -120,15 +120,17 @@ void add_verdicts(GroundReport* r) {
   r->verdicts.clear();
   for (const OdometryMeasure& p : r->odometry) {
     if (p.is_log || !p.measured) continue;
-    Verdict v{p.name, true, {}};
+    Verdict v{p.name, true, {}, p.through_ref, {}};
     for (const OdometryMeasure& l : r->odometry) {
-      if (l.is_log && l.measured && odometry_resembles(p.long_w, l.long_w)) v.resembles.push_back(l.name);
+      if (!l.is_log || !l.measured) continue;
+      if (odometry_resembles(p.long_w, l.long_w)) v.resembles.push_back(l.name);
+      if (p.through_ref && odometry_resembles(p.long_w_ref, l.long_w)) v.resembles_through_ref.push_back(l.name);
     }
     r->verdicts.push_back(v);
   }
   for (const ResidualMeasure& p : r->residuals) {
     if (p.is_log || !p.measured) continue;
-    Verdict v{p.name, false, {}};
+    Verdict v{p.name, false, {}, false, {}};
     for (const ResidualMeasure& l : r->residuals) {
       if (l.is_log && l.measured && residuals_resemble(p.s, l.s)) v.resembles.push_back(l.name);
     }
@@ -143,8 +145,16 @@ GroundReport run_grounding(const GroundOptions& opt) {
     const std::string f = !d.raw_log.empty() ? d.raw_log : d.corrected_log;
     if (!f.empty() && std::filesystem::exists(data_path(f))) r.data_present = true;
   }
+  GroundOptions o = opt;
   if (opt.real && r.data_present) run_real(opt, &r);
-  if (opt.simulated) run_simulated(opt, &r);
+  for (const OdometryMeasure& m : r.odometry) {
+    if (m.is_log && m.name == "fr079" && m.measured && o.ref_sigma_m == 0) {
+      rest_noise_from(m, &o.ref_sigma_m, &o.ref_sigma_deg);
+    }
+  }
+  r.ref_sigma_m = o.ref_sigma_m;
+  r.ref_sigma_deg = o.ref_sigma_deg;
+  if (opt.simulated) run_simulated(o, &r);
   add_verdicts(&r);
   return r;
 }
@@ -153,6 +163,8 @@ void add_json(const GroundReport& r, BenchJson* json) {
   json->add_bool("ground_data_present", r.data_present);
   json->add_bool("ground_odometry_profiles_linked", r.profiles_available);
   json->add_bool("ground_sensor_profiles_linked", r.sensor_profiles_available);
+  json->add("ground_ref_sigma_m", r.ref_sigma_m);
+  json->add("ground_ref_sigma_deg", r.ref_sigma_deg);
   if (!r.data_present) json->add_string("ground_note", "SKIP real logs: no data in " + r.data_dir);
   for (const OdometryMeasure& m : r.odometry) {
     if (!m.measured) continue;
@@ -179,6 +191,12 @@ void add_json(const GroundReport& r, BenchJson* json) {
       json->add(k + "ref_rest_m_p95", m.rest_m_p95);
       json->add(k + "ref_rest_deg_p95", m.rest_deg_p95);
     }
+    if (m.through_ref) {
+      json->add(k + "through_ref_trans_err_per_m_p50", m.long_w_ref.trans_p50);
+      json->add(k + "through_ref_trans_err_per_m_p95", m.long_w_ref.trans_p95);
+      json->add(k + "through_ref_head_err_deg_per_m_p50", m.long_w_ref.head_deg_per_m_p50);
+      json->add(k + "through_ref_head_err_deg_per_m_p95", m.long_w_ref.head_deg_per_m_p95);
+    }
   }
   for (const ResidualMeasure& m : r.residuals) {
     if (!m.measured) continue;
@@ -192,8 +210,12 @@ void add_json(const GroundReport& r, BenchJson* json) {
   for (const Verdict& v : r.verdicts) {
     std::string list;
     for (const std::string& l : v.resembles) list += (list.empty() ? "" : ",") + l;
-    json->add_string("ground_" + std::string(v.is_odometry ? "profile_" : "sensor_") + key_name(v.profile) + "_resembles",
-                     list.empty() ? "none" : list);
+    const std::string k = "ground_" + std::string(v.is_odometry ? "profile_" : "sensor_") + key_name(v.profile);
+    json->add_string(k + "_resembles", list.empty() ? "none" : list);
+    if (!v.through_ref) continue;
+    std::string list2;
+    for (const std::string& l : v.resembles_through_ref) list2 += (list2.empty() ? "" : ",") + l;
+    json->add_string(k + "_resembles_through_ref", list2.empty() ? "none" : list2);
   }
   int unspanned = 0, logs = 0;
   for (const OdometryMeasure& l : r.odometry) {

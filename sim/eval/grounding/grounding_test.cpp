@@ -175,3 +175,23 @@ TEST(Verdicts, ResemblanceIsMutualAndNamesTheMisfits) {
 
 }  // namespace
 }  // namespace sim::ground
+
+namespace sim::ground {
+namespace {
+
+TEST(ReferenceNoise, DerivedFromTheReferenceAtRest) {
+  OdometryMeasure fr079;
+  fr079.rest_pairs = 100;
+  fr079.rest_m_p95 = 2.4477 * std::sqrt(2.0) * 0.02;
+  fr079.rest_deg_p95 = 1.96 * std::sqrt(2.0) * 0.5;
+  double m = 0, deg = 0;
+  rest_noise_from(fr079, &m, &deg);
+  EXPECT_NEAR(m, 0.02, 1e-9);
+  EXPECT_NEAR(deg, 0.5, 1e-9);
+  fr079.rest_pairs = 3;  // too few pairs: no figure
+  rest_noise_from(fr079, &m, &deg);
+  EXPECT_EQ(m, 0.0);
+}
+
+}  // namespace
+}  // namespace sim::ground
