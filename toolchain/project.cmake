@@ -122,6 +122,8 @@ endfunction()
 #   here) and the mit-killian carry replays that only judge the scenario (neighbouring steps, the
 #   witness without the rule): the 2026-12-01 landing's CI took 68 min, fw_antslam_test 959 s and
 #   sim_mml_localize_data_test 348 s of ASan time. The emulated build leaves out the LM case too.
+# - Both leave the corpus runner's end-to-end case to the host (sim_corpus_test CorpusRunnerTest: three
+#   short generated runs made twice to compare them: determinism, and whole-world behaviour).
 # -DMMLFW_SLOW_BUILD_FULL=ON runs them all.
 option(MMLFW_SLOW_BUILD_FULL "In emulated and sanitized builds, run the long scenario cases too" OFF)
 set(MMLFW_EMULATED_SKIP
@@ -131,11 +133,13 @@ set(MMLFW_EMULATED_SKIP
     "fw_rbsm_test=RbsmTest.MotionPriorShrinksTheJumpsAlongAFeaturelessCorridor"
     "fw_mml_test=MmlLocalizerTest.UniqueRoomLocalizes*:MmlLocalizerTest.DeterministicAndResettable:MmlLocalizerTest.UnknownAreaReportsOutsideMap:MmlLocalizerTest.SymmetricCorridorStaysAmbiguous:MmlLocalizerTest.StartInUnknownAreaNeverLocalizes"
     "fw_mml_reset_test=MmlResetTest.ResetGivesAFreshStart*"
-    "fw_track_test=TrackedLocalizerTest.DeterministicAndResettable:TrackedLocalizerTest.LargeFaultWaitsForGlobalConfirmation:TrackedLocalizerTest.HeadingOnlyFaultRecoversWithoutWaitingForMml:TrackedLocalizerTest.FixIsConfirmedOnTheScansBeforeIt:TrackedLocalizerTest.KidnapIsDetectedAndRefixed:GlobalContextTest.ThreadedEqualsInlineWhenOnTime:GlobalContextTest.LiveScheduleInlineLocalizes:GlobalContextTest.ConfirmedFixScanIsNotOffered:TrackedLocalizerTest.LookAlikeWingBeyondTheMapIsNeverLocalized:TrackedLocalizerTest.OutsideMapComesFromTheScanAtTheDeadReckonedPose:TrackedLocalizerTest.ForwardStartAfterAFailedReplaySharesTheScansBudget")
+    "fw_track_test=TrackedLocalizerTest.DeterministicAndResettable:TrackedLocalizerTest.LargeFaultWaitsForGlobalConfirmation:TrackedLocalizerTest.HeadingOnlyFaultRecoversWithoutWaitingForMml:TrackedLocalizerTest.FixIsConfirmedOnTheScansBeforeIt:TrackedLocalizerTest.KidnapIsDetectedAndRefixed:GlobalContextTest.ThreadedEqualsInlineWhenOnTime:GlobalContextTest.LiveScheduleInlineLocalizes:GlobalContextTest.ConfirmedFixScanIsNotOffered:TrackedLocalizerTest.LookAlikeWingBeyondTheMapIsNeverLocalized:TrackedLocalizerTest.OutsideMapComesFromTheScanAtTheDeadReckonedPose:TrackedLocalizerTest.ForwardStartAfterAFailedReplaySharesTheScansBudget"
+    "sim_corpus_test=CorpusRunnerTest.*")
 set(MMLFW_SANITIZED_SKIP
     "fw_antslam_test=AntSlamTest.SameSeedSamePoses:AntSlamTest.ClosesTheRingAndBeatsTheDriftingFrontEnd:AntSlamTest.FinalRefinementAfterLmLowersTheWholeGraphsCost"
     "fw_mml_test=MmlLocalizerTest.DeterministicAndResettable"
     "fw_track_test=TrackedLocalizerTest.DeterministicAndResettable"
+    "sim_corpus_test=CorpusRunnerTest.*"
     "sim_mml_localize_data_test=LocalizeData.MitKillianCarryOneStepEarlierOrLaterIsNotLocalized:LocalizeData.MitKillianCarryWithoutTheRuleIsTheWitness")
 function(mmlfw_slow_build_filter name)
   if(MMLFW_SLOW_BUILD_FULL)

@@ -1,5 +1,7 @@
 #include "firmware/mml/mml_localizer.h"
 
+#include <algorithm>
+
 #include <cmath>
 
 #include "firmware/pransam/relation_table_io.h"
@@ -74,6 +76,9 @@ Status MmlLocalizer::init(const MmlLocalizerConfig& config, const GlobalMap& map
   FW_RETURN_IF_ERROR(local_map_.init(config.local_map, arena));
   FW_RETURN_IF_ERROR(front_end_.init(config.front_end, &rbsm_, &local_map_));
   pransam::MatcherOptions mo = config.matcher;
+  // The model capacity is the map's point count when the map is larger than the default: sized once
+  // here, at start-up, from the map the robot is given (a 138 × 84 m building has ~150,000 wall points).
+  mo.max_model_points = std::max(mo.max_model_points, map.num_points);
   const bool have_section = config.mml.precomputed_table && table_section != nullptr && table_len > 0;
   mo.allocate_model_table = !have_section;
   FW_RETURN_IF_ERROR(matcher_.init(mo, arena, pool));

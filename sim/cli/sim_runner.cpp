@@ -118,6 +118,9 @@ bool check_sources(SimConfig* cfg, std::string* err) {
       return false;
     }
     cfg->world = cfg->custom_world->name.empty() ? "custom" : cfg->custom_world->name;
+  } else if (cfg->custom_map_world != nullptr) {
+    *err = "a custom map world needs a custom world";
+    return false;
   }
   if (cfg->world.empty() == cfg->log_path.empty()) {
     *err = "give exactly one of a world (--world) or a log (--log)";
@@ -208,7 +211,8 @@ bool load_world_source(const SimConfig& cfg, SimSource* src, SimSummary* sum, st
     *err = "world '" + cfg.world + "': " + *err;
     return false;
   }
-  if (!rasterize_world(src->world, cfg.raster, &src->grid, err)) return false;
+  const World& mapped = cfg.custom_map_world != nullptr ? *cfg.custom_map_world : src->world;
+  if (!rasterize_world(mapped, cfg.raster, &src->grid, err)) return false;
   src->have_grid = true;
   src->total = src->synthetic.num_scans();
   sum->source = "world:" + cfg.world;

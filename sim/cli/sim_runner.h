@@ -28,6 +28,9 @@ constexpr double kLogKidnapMinJumpM = 5.0;
 struct SimConfig {
   std::string world;           // built-in world name, or
   const World* custom_world = nullptr;  // a world built in code (tests: a unique room, a symmetric corridor), or
+  // With custom_world: the world the map is drawn from, when it is not the world the laser sees
+  // (sim/world/map_changes.h: clutter, doors, furniture moved, a wing drawn turned); nullptr = the same.
+  const World* custom_map_world = nullptr;
   std::string dataset;         // a dataset of ../shared/data (log, reference and cached global map), or
   std::string log_path;        // CARMEN log (plain or .gz)
   std::string reference_path;  // *.corrected-poses.txt for a log (ground truth)

@@ -17,6 +17,8 @@
 //   --help prints the usage.
 //   --steps 0 = whole-log runs continue to the end of the log (else at most that many steps).
 //   --global ref|live|live-deadline: mml-track's global search schedule (mml_systems.h; issue 14)
+// The generated corpus (issue 55; sim/cli/corpus/README.md):
+//   mml-eval --corpus N [--seed S] [--jobs 2] [--out build/eval/corpus] [--pictures 4] [--no-timing]
 // Any building by path (implies --localize; only this building unless --datasets is given):
 //   mml-eval --log LOG.clf[.gz] --map MAP.yaml|MAP.mmap --reference POSES.txt|CORRECTED.log[.gz]
 //            [--relations R] [--name NAME] [--synthetic-odometry]
@@ -30,6 +32,7 @@
 #include "sim/eval/mml_eval/localize_eval.h"
 #include "sim/eval/mml_eval/mml_eval_run.h"
 #include "sim/eval/mml_eval/mml_systems.h"
+#include "sim/cli/corpus/corpus_cli.h"
 #include "sim/common/cli_main.h"
 #include "sim/io/datasets.h"
 
@@ -255,5 +258,7 @@ static int run_main(int argc, char** argv) {
 }
 
 int main(int argc, char** argv) {
-  return sim::guarded_main("mml-eval", [&] { return run_main(argc, argv); });
+  return sim::guarded_main("mml-eval", [&] {
+    return sim::corpus::wants_corpus(argc, argv) ? sim::corpus::corpus_main(argc, argv) : run_main(argc, argv);
+  });
 }

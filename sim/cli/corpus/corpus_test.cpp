@@ -1,0 +1,150 @@
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <filesystem>
+#include <fstream>
+#include <sstream>
+
+#include "hal/msg/pose_estimate.h"
+#include "sim/cli/corpus/corpus_draw.h"
+#include "sim/cli/corpus/corpus_figures.h"
+#include "sim/cli/corpus/corpus_run.h"
+#include "sim/cli/corpus/corpus_runner.h"
+
+namespace sim::corpus {
+namespace {
+
+CorpusStep step(float travelled, hal::LocalizationStatus st, float err_m, float err_deg = 0.1f) {
+  CorpusStep s;
+  s.travelled_m = travelled;
+  s.status = static_cast<std::uint8_t>(st);
+  s.mode = static_cast<std::uint8_t>(st == hal::LocalizationStatus::kSearching ? hal::LocalizationMode::kGlobal
+                                                                                : hal::LocalizationMode::kTracking);
+  s.has_pose = st != hal::LocalizationStatus::kSearching;
+  s.err_m = err_m;
+  s.err_deg = err_deg;
+  s.pl_xy_m = st == hal::LocalizationStatus::kLocalized ? 0.2f : 0.0f;
+  s.pl_theta_deg = st == hal::LocalizationStatus::kLocalized ? 1.0f : 0.0f;
+  s.reason = static_cast<std::uint8_t>(st == hal::LocalizationStatus::kLocalized ? hal::StatusReason::kNone
+                                                                                  : hal::StatusReason::kTrackBeyondAlert);
+  return s;
+}
+
+TEST(CorpusDrawTest, DrawsDependOnTheSeedAndTheirIndexOnly) {
+  const std::vector<CorpusDraw> a = draw_corpus(7, 20), b = draw_corpus(7, 5), c = draw_corpus(8, 5);
+  ASSERT_EQ(a.size(), 20u);
+  for (std::size_t k = 0; k < 5; ++k) {
+    EXPECT_EQ(describe_draw(a[k]), describe_draw(b[k]));
+    EXPECT_EQ(a[k].seed, b[k].seed);
+  }
+  int differ = 0;
+  for (std::size_t k = 0; k < 5; ++k) differ += describe_draw(a[k]) != describe_draw(c[k]);
+  EXPECT_GT(differ, 0);
+  // Every family appears in any 6 consecutive draws (rotation), and clean and changed maps both occur.
+  int families = 0, clean = 0;
+  for (std::size_t k = 0; k < 6; ++k) families |= 1 << static_cast<int>(a[k].building.family);
+  for (const CorpusDraw& d : a) clean += d.changes.clean();
+  EXPECT_EQ(families, (1 << kBuildingFamilyCount) - 1);
+  EXPECT_GT(clean, 0);
+  EXPECT_LT(clean, 20);
+}
+
+TEST(CorpusFiguresTest, ClopperPearsonUpperBound) {
+  EXPECT_NEAR(binomial_ucb95(0, 3000), 1 - std::pow(0.05, 1.0 / 3000), 1e-6);  // ≈ 3/n
+  EXPECT_NEAR(binomial_ucb95(1, 100), 0.0466, 5e-4);                              // tables: 0.04655
+  EXPECT_NEAR(binomial_ucb95(10, 1000), 0.01696, 3e-4);
+  EXPECT_EQ(binomial_ucb95(0, 0), 1.0);
+}
+
+TEST(CorpusFiguresTest, AvailabilityGapsAndKidnapsFromTheSteps) {
+  using S = hal::LocalizationStatus;
+  CorpusRun r;
+  r.ok = true;
+  // Searching, fix at 2 m, withheld while right over 2 → 5 m (a 3 m gap from the last `localized` step at 2 m),
+  // localized, withheld while wrong (not a gap), localized, then carried: the steps until the re-fix are not judged.
+  r.steps = {step(0, S::kSearching, NAN), step(1, S::kSearching, NAN), step(2, S::kLocalized, 0.02f),
+             step(3, S::kAmbiguous, 0.03f),  step(4, S::kAmbiguous, 0.05f), step(5, S::kAmbiguous, 0.04f),
+             step(6, S::kLocalized, 0.03f),  step(7, S::kAmbiguous, 0.4f),  step(8, S::kLocalized, 0.03f)};
+  CorpusStep carried = step(9, S::kSearching, NAN);
+  carried.kidnapped = 1;
+  r.steps.push_back(carried);
+  r.steps.push_back(step(10, S::kSearching, NAN));
+  r.steps.push_back(step(11, S::kLocalized, 0.6f));  // the re-fix: judged again, and an integrity failure
+  const RunFigures f = run_figures(r);
+  EXPECT_TRUE(f.fixed);
+  EXPECT_DOUBLE_EQ(f.metres_to_fix, 2.0);
+  EXPECT_EQ(f.judged, 8u);  // steps 2–8 and the re-fix
+  EXPECT_EQ(f.judged_localized, 4u);
+  EXPECT_DOUBLE_EQ(f.longest_gap_m, 3.0);
+  const CorpusFigures c = corpus_figures({&r});
+  EXPECT_EQ(c.localized_steps, 4u);
+  EXPECT_EQ(c.integrity_failures, 1u);
+  EXPECT_EQ(c.withheld_while_right, 3u);
+  EXPECT_EQ(c.withheld_by_reason[static_cast<int>(hal::StatusReason::kTrackBeyondAlert)], 3u);
+  EXPECT_EQ(c.pl_exceed_xy, 1u);  // 0.6 m against 0.2 m
+}
+
+TEST(CorpusRunTest, RecordsRoundTripAndTruncationIsAnError) {
+  CorpusRun r;
+  r.ok = true;
+  r.error = "";
+  r.width_m = 40;
+  r.steps = {step(1, hal::LocalizationStatus::kLocalized, 0.01f)};
+  CorpusRun back;
+  std::string err;
+  ASSERT_TRUE(deserialize_run(serialize_run(r), &back, &err)) << err;
+  EXPECT_EQ(back.steps.size(), 1u);
+  EXPECT_FLOAT_EQ(back.steps[0].err_m, 0.01f);
+  EXPECT_DOUBLE_EQ(back.width_m, 40);
+  const std::string bytes = serialize_run(r);
+  EXPECT_FALSE(deserialize_run(bytes.substr(0, bytes.size() - 3), &back, &err));
+  EXPECT_NE(err.find("truncated"), std::string::npos);
+}
+
+TEST(CorpusRunTest, ProcessedScanPeriodIsAWholeNumberOfSensorScans) {
+  EXPECT_NEAR(processed_scan_period(75), 15 / 75.0, 1e-12);
+  EXPECT_NEAR(processed_scan_period(40), 0.2, 1e-12);
+  EXPECT_NEAR(processed_scan_period(15), 0.2, 1e-12);
+  EXPECT_NEAR(processed_scan_period(5.5), 1 / 5.5, 1e-12);
+}
+
+std::string slurp(const std::string& path) {
+  std::ifstream f(path);
+  std::ostringstream s;
+  s << f.rdbuf();
+  return s.str();
+}
+
+// The same seed gives the same figures bit for bit, in child processes or in this one.
+TEST(CorpusRunnerTest, SameSeedSameJsonWhateverTheJobs) {
+  CorpusOptions opt;
+  opt.runs = 2;
+  opt.seed = 5;
+  opt.timing = false;
+  opt.pictures = 0;
+  opt.progress = false;
+  opt.run.max_scans = 25;
+  opt.run.route_scale = 0.25;
+  const std::string dir = ::testing::TempDir() + "corpus_test";
+  std::string err;
+  BenchJson j1, j2;
+  std::vector<CorpusRun> runs;
+  opt.jobs = 2;
+  opt.out_dir = dir + "/a";
+  ASSERT_TRUE(run_corpus(opt, &j1, &runs, &err)) << err;
+  ASSERT_TRUE(j1.write(opt.out_dir + "/corpus.json"));
+  opt.jobs = 1;
+  opt.out_dir = dir + "/b";
+  ASSERT_TRUE(run_corpus(opt, &j2, nullptr, &err)) << err;
+  ASSERT_TRUE(j2.write(opt.out_dir + "/corpus.json"));
+  EXPECT_EQ(slurp(dir + "/a/corpus.json"), slurp(dir + "/b/corpus.json"));
+  ASSERT_EQ(runs.size(), 2u);
+  for (const CorpusRun& r : runs) {
+    EXPECT_TRUE(r.ok) << describe_draw(r.draw) << ": " << r.error;
+    EXPECT_EQ(r.steps.size(), 25u) << describe_draw(r.draw);
+  }
+  std::filesystem::remove_all(dir);
+}
+
+}  // namespace
+}  // namespace sim::corpus
