@@ -57,6 +57,8 @@ RunFigures run_figures(const CorpusRun& run) {
   double gap_start = -1;
   for (std::size_t i = first; i < run.steps.size(); ++i) {
     const CorpusStep& s = run.steps[i];
+    if (s.kidnapped) f.carried_after_fix = true;
+    if (f.carried_after_fix && localized(s) && !s.kidnapped) f.refixed = true;
     if (!judged[i]) {
       gap_start = -1;
       continue;
@@ -111,6 +113,8 @@ CorpusFigures corpus_figures(const std::vector<const CorpusRun*>& runs) {
       to_fix.push_back(rf.metres_to_fix);
       gaps.push_back(rf.longest_gap_m);
       if (rf.judged > 0) avail.push_back(static_cast<double>(rf.judged_localized) / rf.judged);
+      f.kidnap_runs += rf.carried_after_fix;
+      f.kidnap_refixed += rf.refixed;
     }
     for (const CorpusStep& s : r->steps) {
       ++f.steps;
@@ -195,6 +199,8 @@ void add_figures(const std::string& p, const CorpusFigures& f, bool with_timing,
   j->add(p + "track_err_m_p95", f.track_err_m_p95);
   j->add(p + "track_err_deg_p50", f.track_err_deg_p50);
   j->add(p + "track_err_deg_p95", f.track_err_deg_p95);
+  j->add_int(p + "kidnap_runs", static_cast<long long>(f.kidnap_runs));
+  j->add_int(p + "kidnap_refixed", static_cast<long long>(f.kidnap_refixed));
   j->add(p + "pl_xy_m_p50", f.pl_xy_m_p50);
   j->add(p + "pl_theta_deg_p50", f.pl_theta_deg_p50);
   if (with_timing) {

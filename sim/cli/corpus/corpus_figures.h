@@ -34,6 +34,8 @@ struct CorpusFigures {
   double track_err_m_p50 = 0, track_err_m_p95 = 0, track_err_deg_p50 = 0, track_err_deg_p95 = 0;
   double pl_xy_m_p50 = 0, pl_theta_deg_p50 = 0;
   double track_step_ms_p50 = 0, track_step_ms_p99 = 0;
+  // Kidnapped runs: carried once after their first fix; re-fixed = `localized` again after the carry.
+  std::size_t kidnap_runs = 0, kidnap_refixed = 0;
 };
 
 // Per run: figures a group pools (exposed for tests).
@@ -42,6 +44,7 @@ struct RunFigures {
   double metres_to_fix = 0;
   std::size_t judged = 0, judged_localized = 0;  // availability: steps after the fix, not in unmapped space
   double longest_gap_m = 0;                       // withheld while right, metres driven
+  bool carried_after_fix = false, refixed = false;  // a kidnap after the first fix, and `localized` after it
 };
 RunFigures run_figures(const CorpusRun& run);
 

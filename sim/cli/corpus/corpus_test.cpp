@@ -76,6 +76,8 @@ TEST(CorpusFiguresTest, AvailabilityGapsAndKidnapsFromTheSteps) {
   EXPECT_EQ(f.judged, 8u);  // steps 2–8 and the re-fix
   EXPECT_EQ(f.judged_localized, 4u);
   EXPECT_DOUBLE_EQ(f.longest_gap_m, 3.0);
+  EXPECT_TRUE(f.carried_after_fix);
+  EXPECT_TRUE(f.refixed);
   const CorpusFigures c = corpus_figures({&r});
   EXPECT_EQ(c.localized_steps, 4u);
   EXPECT_EQ(c.integrity_failures, 1u);
