@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <vector>
 
 #include "firmware/map/global_map.h"
 
@@ -35,7 +36,12 @@ bool rasterize_world(const World& world, const RasterOptions& opt, OccupancyGrid
       if (!world.bounds.contains(centre(cx, cy))) out->cells[g.index(cx, cy)] = fw::kCellUnknown;
     }
   }
-  for (const Segment& s : world.walls) {
+  // Glass panes are drawn like walls: the map is drawn from the plan, whatever a laser makes of them.
+  std::vector<const Segment*> drawn;
+  for (const Segment& s : world.walls) drawn.push_back(&s);
+  for (const Segment& s : world.glass) drawn.push_back(&s);
+  for (const Segment* sp : drawn) {
+    const Segment& s = *sp;
     const double len = (s.b - s.a).norm();
     const int n = std::max(1, static_cast<int>(std::ceil(len / (res / 8))));
     for (int i = 0; i <= n; ++i) {
