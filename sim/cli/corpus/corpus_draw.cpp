@@ -51,7 +51,7 @@ std::vector<CorpusDraw> draw_corpus(std::uint64_t seed, std::size_t n, const Cor
     d.people = d.changes.clean() ? 0 : static_cast<int>(r.uniform_index(6));
     const double u = r.uniform01();
     if (u < opt.kidnap_share) {
-      d.kidnap_at_scan = 150 + r.uniform_index(150);
+      d.kidnap_at_scan = 100 + r.uniform_index(100);
     } else if (u < opt.kidnap_share + opt.unmapped_share) {
       d.via_unknown = true;
     }

@@ -34,7 +34,7 @@ struct CorpusDrawOptions {
   double kidnap_share = 0.15;      // draws carried elsewhere once, mid-run
   double unmapped_share = 0.1;     // draws that first drive into a wing erased from the map
   double distorted_share = 0.2;    // of the changed draws: a wing of the map drawn turned 0.5–1°
-  double route_length_min_m = 80, route_length_max_m = 160;
+  double route_length_min_m = 60, route_length_max_m = 120;
 };
 
 // Draws k = 0 … n−1 of corpus `seed`.
