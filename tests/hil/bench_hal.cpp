@@ -1,6 +1,7 @@
-// bench_hal: the figures of the HAL/HIL issue in build/bench/hal.json. Runs the vcan HIL (user-mode
-// Linux) and the serial pty HIL scripts on this build directory, then the 75 Hz host replay with
-// pinned workers (budget check), and merges everything into one flat JSON object.
+// bench_hal: the figures of the HAL/HIL issue in build/bench/hal.json. Runs the vcan HIL (in the guest
+// tests/hil/run-in-guest.sh chooses: user-mode Linux, else QEMU; hil_vcan_guest says which) and the
+// serial pty HIL scripts on this build directory, then the 75 Hz host replay with pinned workers
+// (budget check), and merges everything into one flat JSON object.
 #include <cmath>
 #include <cstdio>
 #include <cstdlib>
@@ -27,14 +28,27 @@ int main(int argc, char** argv) {
   const std::string src = MMLFW_SOURCE_DIR;
   sim::BenchJson j;
 
-  std::printf("bench_hal: vcan HIL inside user-mode Linux ...\n");
+  std::printf("bench_hal: vcan HIL inside a guest (user-mode Linux, else QEMU) ...\n");
   std::fflush(stdout);
   const int vrc = std::system(("bash " + src + "/tests/hil/hil_vcan.sh " + build + " > " + build + "/hil_vcan.log 2>&1").c_str());
   const std::string v = read_all(build + "/hil/vcan/results.json");
   j.add_bool("hil_vcan_passed", vrc == 0);
+  // The guest ("uml" | "qemu"; "none" when none could start) and QEMU's accelerator (tcg | kvm).
+  std::string guest = read_all(build + "/hil/vcan/guest");
+  while (!guest.empty() && (guest.back() == '\n' || guest.back() == ' ')) guest.pop_back();
+  if (guest.empty()) guest = "none";
+  const size_t dash = guest.find('-');
+  j.add_string("hil_vcan_guest", guest.substr(0, dash));
+  if (dash == std::string::npos) {
+    j.add_raw("hil_vcan_guest_accel", "null");
+  } else {
+    j.add_string("hil_vcan_guest_accel", guest.substr(dash + 1));
+  }
   for (const char* k : {"hil_vcan_scans_sent", "hil_vcan_scans_decoded", "hil_vcan_scans_processed", "hil_vcan_localized",
                         "hil_vcan_localized_scans", "hil_vcan_availability", "hil_vcan_pose_err_m", "hil_vcan_pose_err_all_m", "hil_fd_ok",
-                        "hil_classic_scans_decoded", "corrupt_segments_counted", "fault_scans_faulty", "fault_crc_errors",
+                        "hil_classic_ok", "hil_canplayer_ok", "hil_faults_passed", "hil_dbc_poses_decoded",
+                        "hil_vcan_guest_seconds", "hil_vcan_first_localized_scan", "hil_classic_scans_decoded",
+                        "corrupt_segments_counted", "fault_scans_faulty", "fault_crc_errors",
                         "fault_bus_off", "fault_wrong_localized"}) {
     copy_num(j, v, k);
   }

@@ -29,6 +29,7 @@ check() {  # check DESCRIPTION COMMAND...: records a failed assertion (and its s
   if "${@:2}"; then say "ok   - $1"; else say "FAIL - $1"; fail=1; failed_groups+="$group "; fi
 }
 group_ok() { [[ "$failed_groups" != *" $1 "* ]] && echo true || echo false; }
+rm -f "$W/results.json" "$W/guest"  # never leave an earlier run's figures for bench_hal to read
 
 case "${MMLFW_HIL:-}" in
   skip) say "SKIP: MMLFW_HIL=skip (explicit opt-out: the vcan HIL did not run)"; exit 77 ;;
