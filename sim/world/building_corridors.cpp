@@ -98,9 +98,17 @@ void corridor_room_row(PlanBuilder* b, const CorridorStyle& s, CorridorBand* ban
 }  // namespace
 
 int build_corridor_family(PlanBuilder* b, const Rect& r, BuildingFamily family, bool entrance) {
-  const CorridorStyle s = draw_style(b, family);
+  CorridorStyle s = draw_style(b, family);
   const double cw = s.corridor_w;
-  const double xv = b->uniform(r.x0 + 0.3 * r.w(), r.x0 + 0.7 * r.w());  // the vertical corridor
+  double xv = b->uniform(r.x0 + 0.3 * r.w(), r.x0 + 0.7 * r.w());  // the vertical corridor
+  if (s.identical) {
+    // Look-alike rooms on both sides of the vertical corridor: one room width that divides the
+    // building's length, the corridor placed on a room boundary.
+    const int n = std::max(2, static_cast<int>(std::lround((r.w() - cw) / s.room_w)));
+    s.room_w = (r.w() - cw) / n;
+    const int left = std::clamp(static_cast<int>(std::lround((xv - cw / 2 - r.x0) / s.room_w)), 1, n - 1);
+    xv = r.x0 + left * s.room_w + cw / 2;
+  }
   const int n_bands = std::max(1, static_cast<int>(std::lround(r.h() / (2 * s.room_depth + cw))));
   const double bh = r.h() / n_bands;
   // Outline: the bottom wall opens onto the vertical corridor when the wing has an entrance.

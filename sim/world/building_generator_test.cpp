@@ -208,7 +208,17 @@ TEST(BuildingGenerator, HospitalRoomsLookAlike) {
   }
   ASSERT_GE(xs.size(), 4u);
   std::sort(xs.begin(), xs.end());
-  EXPECT_NEAR(xs[2] - xs[1], xs[1] - xs[0], 1e-9);
+  // One room width everywhere: consecutive doors a room apart, or a room and the vertical corridor.
+  const double room = xs[1] - xs[0];
+  int across_corridor = 0;
+  for (size_t i = 1; i < xs.size(); ++i) {
+    const double gap = xs[i] - xs[i - 1];
+    if (std::fabs(gap - room) > 1e-9) ++across_corridor;
+  }
+  EXPECT_EQ(across_corridor, 1);
+  // And one furniture layout in every room.
+  EXPECT_EQ(plan.furniture.size() % plan.doors.size(), 0u);
+  EXPECT_GT(plan.furniture.size(), plan.doors.size());
 }
 
 TEST(RayCast, GlassReturnsThePaneAndWhatIsBehindIt) {
