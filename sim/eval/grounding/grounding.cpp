@@ -85,8 +85,10 @@ std::vector<fw::Se2d> noisy_reference(const std::vector<fw::Se2d>& ref, const Gr
   std::vector<fw::Se2d> out;
   out.reserve(ref.size());
   for (const fw::Se2d& p : ref) {
-    out.emplace_back(p.x + opt.ref_sigma_m * g(rng), p.y + opt.ref_sigma_m * g(rng),
-                     fw::wrap_angle(p.theta + opt.ref_sigma_deg * M_PI / 180.0 * g(rng)));
+    // One draw per declarator: sequenced, the same order on every compiler (check_draw_order.py).
+    const double nx = g(rng), ny = g(rng), nt = g(rng);
+    out.emplace_back(p.x + opt.ref_sigma_m * nx, p.y + opt.ref_sigma_m * ny,
+                     fw::wrap_angle(p.theta + opt.ref_sigma_deg * M_PI / 180.0 * nt));
   }
   return out;
 }

@@ -28,8 +28,9 @@ void drive(const Noise& n, std::size_t steps, std::vector<fw::Se2d>* odom, std::
     const bool turning = (i % 210) >= 200;
     const double dx = turning ? 0.01 : 0.1, dth = turning ? (M_PI / 2) / 10 : 0.0;
     t = t.compose(fw::Se2d(dx, 0, dth));
-    o = o.compose(fw::Se2d(dx * (1 + n.dist_scale) + n.sigma_xy * g(rng), n.sigma_xy * g(rng),
-                           dth * (1 + n.turn_scale) + n.sigma_theta * g(rng)));
+    const double nx = g(rng), ny = g(rng), nt = g(rng);
+    o = o.compose(fw::Se2d(dx * (1 + n.dist_scale) + n.sigma_xy * nx, n.sigma_xy * ny,
+                           dth * (1 + n.turn_scale) + n.sigma_theta * nt));
     odom->push_back(o);
     ref->push_back(t);
   }
@@ -92,7 +93,8 @@ TEST(OdometryWindows, RecoversTranslationNoise) {
   ref.push_back(t);
   for (int i = 0; i < 50000; ++i) {
     t = t.compose(fw::Se2d(0.1, 0, 0));
-    o = o.compose(fw::Se2d(0.1 + sigma * g(rng), sigma * g(rng), 0));
+    const double nx = g(rng), ny = g(rng);
+    o = o.compose(fw::Se2d(0.1 + sigma * nx, sigma * ny, 0));
     odom.push_back(o);
     ref.push_back(t);
   }
