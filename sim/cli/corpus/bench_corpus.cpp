@@ -1,6 +1,7 @@
 // scripts/bench.sh corpus (issue 55): mml-track on the generated corpus, build/bench/corpus.json.
 // The seed is MMLFW_CORPUS_SEED (default 101, a seed never used while developing: README of this
-// folder), the size MMLFW_CORPUS_RUNS (default 200), both also written into the JSON.
+// folder), the size MMLFW_CORPUS_RUNS (default 240: about 100,000 `localized` steps), both also
+// written into the JSON.
 #include <cstdio>
 #include <cstdlib>
 #include <string>
@@ -26,7 +27,7 @@ int main(int argc, char** argv) {
   const std::string out = argc > 1 ? argv[1] : "build/bench/corpus.json";
   sim::corpus::CorpusOptions opt;
   opt.seed = env_or("MMLFW_CORPUS_SEED", 101);
-  opt.runs = env_or("MMLFW_CORPUS_RUNS", 200);
+  opt.runs = env_or("MMLFW_CORPUS_RUNS", 240);
   opt.jobs = static_cast<int>(env_or("MMLFW_CORPUS_JOBS", 2));
   opt.out_dir = "build/bench/corpus_" + std::to_string(opt.seed);
   std::printf("bench_corpus: seed %llu, %zu runs, %d at once -> %s\n", static_cast<unsigned long long>(opt.seed), opt.runs,

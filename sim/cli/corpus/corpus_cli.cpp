@@ -12,7 +12,7 @@ namespace sim::corpus {
 namespace {
 
 int bad(const std::string& what) {
-  std::fprintf(stderr, "mml-eval: %s\nusage: mml-eval --corpus N [--seed S] [--jobs J] [--out DIR] [--pictures K] [--no-timing] [--draw K]\n",
+  std::fprintf(stderr, "mml-eval: %s\nusage: mml-eval --corpus N [--seed S] [--jobs J] [--out DIR] [--pictures K] [--no-timing] [--draw K] [--opt KEY=VALUE]...\n",
                what.c_str());
   return 2;
 }
@@ -44,7 +44,7 @@ int corpus_main(int argc, char** argv) {
       opt.timing = false;
       continue;
     }
-    if (a != "--corpus" && a != "--seed" && a != "--jobs" && a != "--out" && a != "--pictures" && a != "--draw") {
+    if (a != "--corpus" && a != "--seed" && a != "--jobs" && a != "--out" && a != "--pictures" && a != "--draw" && a != "--opt") {
       return bad("unknown argument '" + a + "' with --corpus");
     }
     if (v == nullptr) return bad("missing value for " + a);
@@ -57,6 +57,11 @@ int corpus_main(int argc, char** argv) {
     } else if (a == "--seed") {
       if (!parse_count(v, 0, 1ull << 40, &n)) return bad("bad value for --seed: '" + std::string(v) + "'");
       opt.seed = n;
+    } else if (a == "--opt") {
+      const std::string kv = v;
+      const std::size_t eq = kv.find('=');
+      if (eq == std::string::npos || eq == 0) return bad("bad value for --opt: '" + kv + "' (KEY=VALUE)");
+      opt.run.localizer_options[kv.substr(0, eq)] = kv.substr(eq + 1);
     } else if (a == "--draw") {
       if (!parse_count(v, 0, 1000000, &n)) return bad("bad value for --draw: '" + std::string(v) + "'");
       opt.first_draw = n;

@@ -4,6 +4,7 @@
 #pragma once
 
 #include <cstdint>
+#include <map>
 #include <string>
 #include <vector>
 
@@ -38,6 +39,9 @@ struct CorpusRunOptions {
   std::string picture_dir;   // non-empty: mml-sim's pictures and steps.csv of this run there
   std::size_t max_scans = 0; // 0 = the whole route (tests shorten it)
   double route_scale = 1.0;  // the drawn route length × this (tests shorten it)
+  // mml-track's options for every run (mml-sim's --opt KEY=VALUE, e.g. valley=0): what a rule buys
+  // is measured as the same corpus with and without it. They override the odometry profile's keys.
+  std::map<std::string, std::string> localizer_options;
 };
 
 // The processed scan period of a sensor of `rate_hz`: every k-th scan, k = round(0.2 s × rate) ≥ 1

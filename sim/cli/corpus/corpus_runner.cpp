@@ -223,6 +223,9 @@ bool run_corpus(const CorpusOptions& opt, BenchJson* json, std::vector<CorpusRun
   std::vector<const CorpusRun*> all;
   for (const CorpusRun& r : runs) all.push_back(&r);
   json->add_int("corpus_seed", static_cast<long long>(opt.seed));
+  std::string given;
+  for (const auto& [key, value] : opt.run.localizer_options) given += (given.empty() ? "" : ",") + key + "=" + value;
+  json->add_string("corpus_localizer_options", given);
   json->add_int("corpus_families", kBuildingFamilyCount);
   json->add_int("corpus_sensor_profiles", static_cast<long long>(sensor_profiles().size()));
   json->add_int("corpus_odometry_profiles", static_cast<long long>(odometry_profiles().size()));
