@@ -40,5 +40,24 @@ float ScanContinuity::explained_fraction(const Point2f* prev, std::size_t n_prev
   return static_cast<float>(explained) / static_cast<float>(n_cur);
 }
 
+float ScanContinuity::explained_fraction_within(const Point2f* prev, std::size_t n_prev, const Point2f* cur,
+                                                std::size_t n_cur, const Se2f& motion, float sigma_xy_m,
+                                                float sigma_theta_rad, float tolerance_m) {
+  constexpr float kTurns[7] = {0.0f, -0.67f, 0.67f, -1.33f, 1.33f, -2.0f, 2.0f};  // × σθ
+  constexpr float kShifts[5][2] = {{0, 0}, {2, 0}, {-2, 0}, {0, 2}, {0, -2}};    // × σxy
+  float best = 0.0f;
+  for (const float t : kTurns) {
+    for (const auto& s : kShifts) {
+      // The offset applies in the frame of this scan's sensor: motion ⊕ δ.
+      const Se2f m = motion.compose(Se2f(s[0] * sigma_xy_m, s[1] * sigma_xy_m, t * sigma_theta_rad));
+      best = std::fmax(best, explained_fraction(prev, n_prev, cur, n_cur, m, tolerance_m));
+      if (best >= 1.0f) return best;
+      if (sigma_xy_m <= 0.0f) break;  // no translation noise: the shifts are all the same
+    }
+    if (sigma_theta_rad <= 0.0f) break;
+  }
+  return best;
+}
+
 }  // namespace track
 }  // namespace fw

@@ -27,6 +27,14 @@ class ScanContinuity {
   // 1 when `cur` is empty (nothing unexplained); 0 when `prev` is empty.
   float explained_fraction(const Point2f* prev, std::size_t n_prev, const Point2f* cur, std::size_t n_cur,
                            const Se2f& motion, float tolerance_m);
+  // The best fraction over the increments the wheels allow: `motion` moved by up to 2σ (sigma_xy_m
+  // on x and y, sigma_theta_rad on θ; the tracker's odometry noise model for that increment). The
+  // wheels' increment is itself uncertain, and a turn off by 4° moves a wall 10 m away by 0.7 m,
+  // past any tolerance: a robot that drove on has some increment within its wheels' bound that
+  // explains the scan, a carried one has none (issue 56: the corpus's noisy wheels — 4 cm / 4° a
+  // step — made right tracks look carried). 7 turns × 5 shifts, the wheels' own increment first.
+  float explained_fraction_within(const Point2f* prev, std::size_t n_prev, const Point2f* cur, std::size_t n_cur,
+                                  const Se2f& motion, float sigma_xy_m, float sigma_theta_rad, float tolerance_m);
 
  private:
   float nearest_[kBins];

@@ -144,6 +144,19 @@ struct TrackOptions {
   // decides (before 2026-12-01; the large office kidnap of scripts/run.sh said `outside-map` at 82
   // steps of a building mapped wall to wall).
   bool outside_map_needs_clean_exit = true;
+  // Without a sign of a carry, the wheels bind MML (issue 56, measured on the generated corpus):
+  // MML isolates a pose against the map, so where the map misrepresents the robot's place — a block
+  // it lacks, a wing drawn turned — a look-alike elsewhere can be "isolated" while the robot never
+  // left the place the wheels say (corpus seed 101: a warehouse aisle 34 m away after a drive through
+  // an unmapped block; seed 202: a lab's 180° twin 28 m away after the track waited for MML). Unless
+  // a scan of the track showed a sign of a carry (carry_seen_: a scan the map does not support that
+  // does not continue the one before it), (a) a track given up for any reason leaves the wheels
+  // binding MML's fixes (dead_reckoning.h; before: only after a clean outside-map exit), and (b) a
+  // track waiting for MML after a large fault is replaced by MML's fix only where the scan prefers
+  // MML's pose significantly, as a track that saw no fault. A carried robot shows the sign (the scan
+  // continuity test) and MML is free as before. false = MML's fix replaces a waiting track, and
+  // binds only after a clean exit.
+  bool wheels_bind_mml_without_carry = true;
   // After a contradicting scan, this many consecutive consistent scans before `localized` again
   // (hysteresis: a fault seen is evidence that the odometry or the fit may be wrong unseen too).
   std::uint32_t recovery_steps = 5;

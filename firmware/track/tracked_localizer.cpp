@@ -95,9 +95,13 @@ void TrackedLocalizer::note_how_the_map_was_left(const TrackStep& ts, const Se2f
   const bool asks = ts.verdict == ScanVerdict::kOutsideMap ||
                     (ts.verdict != ScanVerdict::kSupported && !carry_seen_ &&
                      tracker_.options().outside_map_needs_clean_exit);
+  const Se2f increment = previous != nullptr ? previous->wheel.between(wheel) : Se2f();
+  const Eigen::Matrix3f q =
+      odometry_increment_noise(increment, tracker_.options(), tracker_.odometry_noise_scale());
   if (asks && previous != nullptr &&
-      continuity_.explained_fraction(previous->pts, previous->n, pts_, n, previous->wheel.between(wheel),
-                                     tracker_.options().align.outlier_m) <
+      continuity_.explained_fraction_within(previous->pts, previous->n, pts_, n, increment,
+                                            std::sqrt(std::fmax(q(0, 0), q(1, 1))), std::sqrt(q(2, 2)),
+                                            tracker_.options().align.outlier_m) <
           tracker_.options().min_explained_fraction) {
     // The scan is not what the robot saw a scan ago: it may have been carried.
     carry_seen_ = true;
@@ -175,7 +179,11 @@ Status TrackedLocalizer::step(const hal::LaserScan& scan, const hal::Odometry& o
       // the first scans after the carry were 63 % and 53 % unknown at the old pose; in the
       // first the end-points on the map fitted 0.59, a fit drop, in the second 0.79, but the scan
       // was unlike the one before it; bound by the wheels, both right re-fixes came late or never).
-      const bool binding = ts.verdict == ScanVerdict::kOutsideMap && left_map_cleanly_;
+      // TrackOptions::wheels_bind_mml_without_carry: also any other loss the scans did not show
+      // to be a carry.
+      const bool binding = ts.verdict == ScanVerdict::kOutsideMap
+                               ? left_map_cleanly_
+                               : tracker_.options().wheels_bind_mml_without_carry && !carry_seen_;
       dead_reckoning_.start(ts.pose, ts.cov, wheel, binding, !carry_seen_);
       hal::PoseEstimate g;
       FW_RETURN_IF_ERROR(global_.step(scan, odom, &g));
@@ -394,7 +402,9 @@ Status TrackedLocalizer::cross_check(const hal::LaserScan& scan, const hal::Odom
   // alias check): a corridor that looks the same turned 180° (aces scan 6281: MML isolated the
   // track's mirror image, 4.7 m and 180° away, and the track was right) fits both, and then neither
   // pose is `localized` until MML isolates the tracked pose from a fresh local map.
-  if (!unconfirmed_) {
+  // A waiting track whose scans showed no sign of a carry is held to the same test
+  // (TrackOptions::wheels_bind_mml_without_carry): the robot is where the wheels carried it.
+  if (!unconfirmed_ || (tracker_.options().wheels_bind_mml_without_carry && !carry_seen_)) {
     const TrackOptions& o = tracker_.options();
     const Se2f mml_pose(g.x, g.y, g.theta);
     const bool scan_prefers_mml = rival_significantly_better(tracker_.map(), pts_, n, ts.pose, mml_pose, o.alias_clip_m,

@@ -187,9 +187,10 @@ static bool parse_odom_noise(const std::map<std::string, std::string>& options, 
 // mmlfw's config keys of the same names);
 // odom_adapt=0|1 (wheel-noise self-calibration, TrackOptions::odom_noise_window 64; 0 = default);
 // valley=0|1 (TrackOptions::alias_valley_is_one_mode; default 1, as TrackOptions);
-// outside_clean=0|1 (TrackOptions::outside_map_needs_clean_exit; default 1, as TrackOptions).
+// outside_clean=0|1 (TrackOptions::outside_map_needs_clean_exit; default 1, as TrackOptions);
+// wheels_bind=0|1 (TrackOptions::wheels_bind_mml_without_carry; default 1, as TrackOptions).
 std::unique_ptr<fw::Localizer> make_track_localizer(const LocalizerContext& ctx, std::string* err) {
-  const std::string bad = check_keys("mml-track", ctx.options, {"config", "correct", "reduce", "pool", "keep", "contested", "rivals", "alert", "odom_noise", "odom_noise_per_step", "odom_adapt", "valley", "outside_clean"});
+  const std::string bad = check_keys("mml-track", ctx.options, {"config", "correct", "reduce", "pool", "keep", "contested", "rivals", "alert", "odom_noise", "odom_noise_per_step", "odom_adapt", "valley", "outside_clean", "wheels_bind"});
   if (!bad.empty()) { *err = bad; return nullptr; }
   if (ctx.global_map == nullptr) { *err = "localizer mml-track: needs a global map"; return nullptr; }
   long config = 3;
@@ -218,6 +219,9 @@ std::unique_ptr<fw::Localizer> make_track_localizer(const LocalizerContext& ctx,
   long outside_clean = to.outside_map_needs_clean_exit ? 1 : 0;
   if (!parse_int(ctx.options, "outside_clean", 0, 1, &outside_clean, "mml-track", err)) return nullptr;
   to.outside_map_needs_clean_exit = outside_clean == 1;
+  long wheels_bind = to.wheels_bind_mml_without_carry ? 1 : 0;
+  if (!parse_int(ctx.options, "wheels_bind", 0, 1, &wheels_bind, "mml-track", err)) return nullptr;
+  to.wheels_bind_mml_without_carry = wheels_bind == 1;
   static const std::vector<std::uint8_t> kEmpty;
   return wrap_hooks(OwnedLocalizer::make_track(*ctx.global_map, ctx.map_image ? *ctx.map_image : kEmpty, cfg, to,
                                                ctx.threads, err),
