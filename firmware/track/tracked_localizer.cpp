@@ -79,6 +79,17 @@ void TrackedLocalizer::await_mml_confirmation() {
   cross_check_left_ = tracker_.options().cross_check_steps;
 }
 
+// Does this scan (pts_) continue the one before it, moved by an increment the wheels allow
+// (ScanContinuity::explained_fraction_within, σ from the tracker's odometry noise model)?
+bool TrackedLocalizer::continues_previous_scan(const RememberedScan& previous, const Se2f& wheel, std::size_t n) {
+  const TrackOptions& o = tracker_.options();
+  const Se2f increment = previous.wheel.between(wheel);
+  const Eigen::Matrix3f q = odometry_increment_noise(increment, o, tracker_.odometry_noise_scale());
+  return continuity_.explained_fraction_within(previous.pts, previous.n, pts_, n, increment,
+                                               std::sqrt(std::fmax(q(0, 0), q(1, 1))), std::sqrt(q(2, 2)),
+                                               o.align.outlier_m) >= o.min_explained_fraction;
+}
+
 // Since the track's last supported scan: did the scans leave the map as a robot driving out of it
 // would (left_map_cleanly_, for the wheels' binding), and did any show a sign of a carry
 // (carry_seen_, for the outside-map status)? An `outside-map` of the track after such a sign is
@@ -95,14 +106,7 @@ void TrackedLocalizer::note_how_the_map_was_left(const TrackStep& ts, const Se2f
   const bool asks = ts.verdict == ScanVerdict::kOutsideMap ||
                     (ts.verdict != ScanVerdict::kSupported && !carry_seen_ &&
                      tracker_.options().outside_map_needs_clean_exit);
-  const Se2f increment = previous != nullptr ? previous->wheel.between(wheel) : Se2f();
-  const Eigen::Matrix3f q =
-      odometry_increment_noise(increment, tracker_.options(), tracker_.odometry_noise_scale());
-  if (asks && previous != nullptr &&
-      continuity_.explained_fraction_within(previous->pts, previous->n, pts_, n, increment,
-                                            std::sqrt(std::fmax(q(0, 0), q(1, 1))), std::sqrt(q(2, 2)),
-                                            tracker_.options().align.outlier_m) <
-          tracker_.options().min_explained_fraction) {
+  if (asks && previous != nullptr && !continues_previous_scan(*previous, wheel, n)) {
     // The scan is not what the robot saw a scan ago: it may have been carried.
     carry_seen_ = true;
     if (ts.verdict == ScanVerdict::kOutsideMap) left_map_cleanly_ = false;

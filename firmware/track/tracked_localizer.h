@@ -120,6 +120,8 @@ class TrackedLocalizer final : public Localizer {
     Se2f wheel;
   };
   RingBuffer<RememberedScan, kFixHistoryScans + 1> history_;
+  // This scan (pts_, n) continues `previous` moved by an increment the wheels allow (scan_continuity.h).
+  bool continues_previous_scan(const RememberedScan& previous, const Se2f& wheel, std::size_t n);
   // The replay in progress: the newest replay_lag_ scans of history_ are still to be stepped (0 =
   // none); MML's fix, the wheels at its scan and its covariance, for forward confirmation.
   std::uint32_t replay_lag_ = 0;

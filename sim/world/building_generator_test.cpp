@@ -310,7 +310,7 @@ TEST(RayCast, IndexSpeedUpOnALargeBuilding) {
     return std::make_pair(s / n * 1e6, sum);
   };
   const auto brute = time_casts([&](const Vec2& o, double a) { return cast_ray_brute_force(w, o, a, 30.0, 0); });
-  const auto indexed = time_casts([&](const Vec2& o, double a) { return cast_ray(w, o, a, 30.0, 0); });
+  const auto indexed = time_casts([&](const Vec2& o, double a) { return cast_ray(w, index, o, a, 30.0, 0); });
   EXPECT_EQ(brute.second, indexed.second);
   std::printf("ray cast on %s (%zu segments): brute force %.2f us/ray, indexed %.3f us/ray, speed-up %.0fx\n",
               w.name.c_str(), w.walls.size() + w.glass.size(), brute.first, indexed.first, brute.first / indexed.first);

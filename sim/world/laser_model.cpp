@@ -50,9 +50,10 @@ namespace {
 // One beam's reading at world angle `a`: the cast, then the two draws of `rng` every beam takes
 // (noise, dropout: the stream position does not depend on geometry), then the extensions' draws of
 // `extra` (each taken on every beam while its feature is on, for the same reason).
-double measure_beam(const World& world, const Vec2& origin, double a, double t_s, const LaserModelOptions& opt,
-                    fw::RandomStream* rng, fw::RandomStream* extra) {
-  const RayHit h = cast_ray(world, origin, a, opt.max_range, t_s, opt.people_visible);
+double measure_beam(const World& world, const WorldIndex* index, const Vec2& origin, double a, double t_s,
+                    const LaserModelOptions& opt, fw::RandomStream* rng, fw::RandomStream* extra) {
+  const RayHit h = index != nullptr ? cast_ray(world, *index, origin, a, opt.max_range, t_s, opt.people_visible)
+                                    : cast_ray(world, origin, a, opt.max_range, t_s, opt.people_visible);
   const double g = rng->gaussian();
   const bool drop = rng->uniform01() < opt.dropout_rate;
   bool hit = h.hit;
@@ -94,8 +95,9 @@ double measure_beam(const World& world, const Vec2& origin, double a, double t_s
 // a door frame and the wall behind), which no driver reports; chosen over "slot ⌊angle/step⌋" (up
 // to a whole step of angle error) because the error bound is then half a step. For a 360° scan the
 // slots wrap around; otherwise a measurement outside the grid is dropped.
-void simulate_irregular(const World& world, const fw::Se2d& pose, double t_s, const LaserModelOptions& opt,
-                        fw::RandomStream* rng, fw::RandomStream* extra, hal::LaserScan* out) {
+void simulate_irregular(const World& world, const WorldIndex* index, const fw::Se2d& pose, double t_s,
+                        const LaserModelOptions& opt, fw::RandomStream* rng, fw::RandomStream* extra,
+                        hal::LaserScan* out) {
   const int n = opt.beams;
   const double fov = opt.fov_deg * M_PI / 180.0;
   const double inc = opt.angle_increment();
@@ -111,7 +113,7 @@ void simulate_irregular(const World& world, const fw::Se2d& pose, double t_s, co
   for (int k = 0; k < n; ++k) {
     const double jitter = jitter_steps > 0.0 ? extra->gaussian() * jitter_steps : 0.0;
     const double s = k + phase + jitter;  // measured angle, in steps from angle_min
-    const double r = measure_beam(world, origin, pose.theta - fov / 2 + s * inc, t_s, opt, rng, extra);
+    const double r = measure_beam(world, index, origin, pose.theta - fov / 2 + s * inc, t_s, opt, rng, extra);
     long j = std::lround(s);
     const double d = std::fabs(s - static_cast<double>(j));
     if (full_turn) {
@@ -129,7 +131,8 @@ void simulate_irregular(const World& world, const fw::Se2d& pose, double t_s, co
 }  // namespace
 
 void simulate_scan(const World& world, const fw::Se2d& sensor_pose, double t_s, const LaserModelOptions& opt,
-                   fw::RandomStream* rng, hal::LaserScan* out, fw::RandomStream* extra_rng) {
+                   fw::RandomStream* rng, hal::LaserScan* out, fw::RandomStream* extra_rng,
+                   const WorldIndex* index) {
   const double fov = opt.fov_deg * M_PI / 180.0;
   const double inc = opt.angle_increment();
   out->beam_count = static_cast<std::uint32_t>(opt.beams);
@@ -147,13 +150,13 @@ void simulate_scan(const World& world, const fw::Se2d& sensor_pose, double t_s, 
     extra_rng = &local;
   }
   if (opt.irregular_angles()) {
-    simulate_irregular(world, sensor_pose, t_s, opt, rng, extra_rng, out);
+    simulate_irregular(world, index, sensor_pose, t_s, opt, rng, extra_rng, out);
     return;
   }
   const Vec2 origin(sensor_pose.x, sensor_pose.y);
   for (int i = 0; i < opt.beams; ++i) {
     const double a = sensor_pose.theta - fov / 2 + i * inc;
-    out->ranges[i] = static_cast<float>(measure_beam(world, origin, a, t_s, opt, rng, extra_rng));
+    out->ranges[i] = static_cast<float>(measure_beam(world, index, origin, a, t_s, opt, rng, extra_rng));
   }
 }
 

@@ -2,8 +2,6 @@
 
 #include <algorithm>
 #include <cmath>
-#include <cstdint>
-#include <cstring>
 #include <limits>
 
 namespace sim {
@@ -192,59 +190,9 @@ RayHit cast_ray(const World& world, const WorldIndex& index, const Vec2& origin,
   return assemble_hit(n, max_range);
 }
 
-namespace {
-
-std::uint64_t index_mix(std::uint64_t h, double v) {
-  std::uint64_t bits;
-  std::memcpy(&bits, &v, sizeof bits);
-  h ^= bits + 0x9e3779b97f4a7c15ULL + (h << 6) + (h >> 2);
-  return h;
-}
-
-// A index_fingerprint of the segments a cached index was built from: storage, counts and a sample of 64
-// segments' coordinates (a full pass would cost as much as the brute-force cast it saves).
-std::uint64_t index_fingerprint(const World& w) {
-  std::uint64_t h = index_mix(index_mix(0, static_cast<double>(w.walls.size())), static_cast<double>(w.glass.size()));
-  for (const std::vector<Segment>* v : {&w.walls, &w.glass}) {
-    const std::size_t n = v->size(), step = std::max<std::size_t>(1, n / 64);
-    for (std::size_t i = 0; i < n; i += step) {
-      const Segment& s = (*v)[i];
-      h = index_mix(index_mix(index_mix(index_mix(h, s.a.x()), s.a.y()), s.b.x()), s.b.y());
-    }
-    if (n > 0) h = index_mix(index_mix(h, v->back().b.x()), v->back().b.y());
-  }
-  return h;
-}
-
-struct CachedWorldIndex {
-  const Segment* walls = nullptr;
-  const Segment* glass = nullptr;
-  std::uint64_t print = 0;
-  WorldIndex index;
-};
-
-}  // namespace
-
 RayHit cast_ray(const World& world, const Vec2& origin, double angle, double max_range, double t_s,
                 bool include_people) {
-  // Small worlds (the built-in ones' rooms, tests) are cast directly: below this an index costs
-  // more than it saves.
-  if (world.walls.size() + world.glass.size() < 64) {
-    return cast_ray_brute_force(world, origin, angle, max_range, t_s, include_people);
-  }
-  // Two entries: a caller alternating between a world and its map keeps both.
-  thread_local CachedWorldIndex cache[2];
-  thread_local int next_slot = 0;
-  const std::uint64_t print = index_fingerprint(world);
-  for (const CachedWorldIndex& c : cache) {
-    if (c.walls == world.walls.data() && c.glass == world.glass.data() && c.print == print) {
-      return cast_ray(world, c.index, origin, angle, max_range, t_s, include_people);
-    }
-  }
-  CachedWorldIndex& slot = cache[next_slot];
-  next_slot = 1 - next_slot;
-  slot = CachedWorldIndex{world.walls.data(), world.glass.data(), print, WorldIndex(world)};
-  return cast_ray(world, slot.index, origin, angle, max_range, t_s, include_people);
+  return cast_ray_brute_force(world, origin, angle, max_range, t_s, include_people);
 }
 
 }  // namespace sim

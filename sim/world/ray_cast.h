@@ -36,10 +36,8 @@ struct WorldIndex {
 };
 
 // First surface along origin + t·(cos a, sin a), 0 < t ≤ max_range, at time t_s (people move).
-// Static walls only when include_people is false. Worlds of more than a few dozen segments are
-// cast through a WorldIndex cached per thread (rebuilt when the walls' or glass's storage, size or
-// a sample of their coordinates change); a caller that edits walls in place and keeps their count
-// should pass its own index to the overload below.
+// Static walls only when include_people is false. Every segment is tested; a caller casting many
+// rays in one large world builds a WorldIndex once and uses the overload below (SyntheticRun).
 RayHit cast_ray(const World& world, const Vec2& origin, double angle, double max_range, double t_s,
                 bool include_people = true);
 // The same through an index built from this world.

@@ -91,6 +91,7 @@ bool SyntheticRun::init(const World& world, const SyntheticRunOptions& opt, std:
     people = std::min(12, static_cast<int>(size.x() * size.y() / 150.0));
   }
   add_people(&world_, people, opt.people_speed, &people_rng);
+  index_ = WorldIndex(world_);
   const double duration = kidnap_t_ >= 0 ? kidnap_t_ + after_kidnap_.duration() : trajectory_.duration();
   num_scans_ = static_cast<std::size_t>(std::floor(duration / opt.scan_period_s)) + 1;
   if (opt.max_scans > 0) num_scans_ = std::min(num_scans_, opt.max_scans);
@@ -149,7 +150,7 @@ bool SyntheticRun::next(SyntheticFrame* out) {
   }
   out->scan.timestamp_ns = time_ns(t);
   out->scan.scan_id = static_cast<std::uint32_t>(next_scan_);
-  simulate_scan(world_, out->truth, t, opt_.laser, &laser_rng_, &out->scan, &laser_extra_rng_);
+  simulate_scan(world_, out->truth, t, opt_.laser, &laser_rng_, &out->scan, &laser_extra_rng_, &index_);
   ++next_scan_;
   return true;
 }

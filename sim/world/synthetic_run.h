@@ -84,6 +84,7 @@ class SyntheticRun {
   fw::Se2d last_truth_;
   fw::RandomStream laser_rng_;
   fw::RandomStream laser_extra_rng_;
+  WorldIndex index_;  // of world_'s walls and glass, built once in init (the people move: not in it)
   OdometrySimulator odom_sim_{OdometryNoiseOptions(), 0};
 };
 

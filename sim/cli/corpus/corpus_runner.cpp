@@ -10,6 +10,7 @@
 #include <map>
 #include <sstream>
 
+#include "hal/msg/pose_estimate.h"
 #include "sim/cli/corpus/corpus_figures.h"
 #include "sim/world/odometry_profiles.h"
 #include "sim/world/sensor_profiles.h"
@@ -49,7 +50,7 @@ class Progress {
   void done(const CorpusRun& r, std::size_t finished) {
     if (r.ok) {
       for (const CorpusStep& s : r.steps) {
-        if (s.status == 2) {
+        if (s.status == static_cast<std::uint8_t>(hal::LocalizationStatus::kLocalized)) {
           ++localized_;
           if (s.err_m > kAlertM || s.err_deg > kAlertDeg) ++wrong_;
         }
@@ -129,7 +130,7 @@ void write_runs_csv(const std::string& path, const std::vector<CorpusRun>& runs)
     const RunFigures rf = run_figures(r);
     std::size_t loc = 0, wrong = 0, exy = 0, eth = 0;
     for (const CorpusStep& s : r.steps) {
-      if (s.status != 2 || !s.has_pose) continue;
+      if (s.status != static_cast<std::uint8_t>(hal::LocalizationStatus::kLocalized) || !s.has_pose) continue;
       ++loc;
       wrong += s.err_m > kAlertM || s.err_deg > kAlertDeg;
       exy += s.pl_xy_m > 0 && s.err_m > s.pl_xy_m;
