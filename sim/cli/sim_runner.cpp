@@ -453,7 +453,11 @@ class FrameLoop {
     if (unknown_known_ && frame_.has_truth) {
       for (const Box& b : src_.world.unknown_areas) in_unknown |= b.contains(Vec2(frame_.truth.x, frame_.truth.y));
     }
-    info_[frame_.scan.scan_id] = {frame_.t,           frame_.has_truth, frame_.truth,     frame_.truth_bound_m,
+    fw::Se2d truth = frame_.truth;
+    if (cfg_.map_drawing != nullptr && frame_.has_truth) {
+      cfg_.map_drawing->pose(frame_.truth.x, frame_.truth.y, frame_.truth.theta, &truth.x, &truth.y, &truth.theta);
+    }
+    info_[frame_.scan.scan_id] = {frame_.t,           frame_.has_truth, truth,             frame_.truth_bound_m,
                                   frame_.truth_bound_rad, frame_.travelled_m, frame_.kidnapped, in_unknown};
   }
 

@@ -17,6 +17,7 @@
 #include "sim/cli/localizer_factory.h"
 #include "sim/devices/sensor_transport.h"
 #include "sim/io/carmen_log.h"
+#include "sim/world/map_changes.h"
 #include "sim/world/raster.h"
 #include "sim/world/synthetic_run.h"
 
@@ -29,8 +30,12 @@ struct SimConfig {
   std::string world;           // built-in world name, or
   const World* custom_world = nullptr;  // a world built in code (tests: a unique room, a symmetric corridor), or
   // With custom_world: the world the map is drawn from, when it is not the world the laser sees
-  // (sim/world/map_changes.h: clutter, doors, furniture moved, a wing drawn turned); nullptr = the same.
+  // (sim/world/map_changes.h: clutter, doors, furniture moved, a wing drawn bent); nullptr = the same.
   const World* custom_map_world = nullptr;
+  // With custom_map_world drawn bent: how the map draws the world. The truth is judged where the map
+  // draws the robot's place (the pose a navigation stack on that map needs), not in the world's
+  // frame, which no scan can observe; nullptr = the world's frame.
+  const MapDrawing* map_drawing = nullptr;
   std::string dataset;         // a dataset of ../shared/data (log, reference and cached global map), or
   std::string log_path;        // CARMEN log (plain or .gz)
   std::string reference_path;  // *.corrected-poses.txt for a log (ground truth)

@@ -14,6 +14,11 @@ namespace {
 constexpr double kMovedRouteGap = 0.5;    // furniture moved keeps this far from every route edge
 constexpr double kClutterRouteGap = 0.6;  // unmapped clutter: the robot never drives into it
 constexpr double kObstacleGap = 0.05;     // nothing is placed into a wall or another object
+// A bent map's local scale error stays within this (5 mm per metre): what a SLAM map closed by loop
+// constraints keeps locally, and the product's stated assumption on its maps (sim/cli/corpus/README.md).
+// Uncapped, a 1° bend over a 40 m wing strained the far side of an 84 m tall building by 1.7 %:
+// walls 10 m away drawn 17 cm closer, a local error no localizer can see or bound.
+constexpr double kMaxMapStrain = 0.005;
 
 // One random stream per kind of change, so that switching one on leaves the others as they were.
 enum MapChangeStream : std::uint64_t { kDistortStream = 56, kDoorStream = 57, kMoveStream = 58, kClutterStream = 59 };
@@ -24,20 +29,32 @@ Vec2 turn_about(const Vec2& p, const Vec2& pivot, double angle) {
   return pivot + Vec2(c * d.x() - s * d.y(), s * d.x() + c * d.y());
 }
 
-// A wing of the map drawn turned: every point beyond the cut line x = pivot.x is turned about the
-// pivot on the cut (a segment that crosses the cut bends with it, as a SLAM map's would).
-void distort_map(World* map, double angle, const Vec2& pivot) {
-  auto turn = [&](Vec2* p) {
-    if (p->x() > pivot.x()) *p = turn_about(*p, pivot, angle);
-  };
+// Wall pieces at most this long are bent as straight lines: the chord of a bent 1 m piece is off
+// the bend by < 1 mm, far below the map's 5 cm cells.
+constexpr double kBendPieceM = 1.0;
+
+// The map of a wing drawn bent (MapDrawing): walls and glass cut into short pieces where they reach
+// into the wing, so that a long wall follows the bend instead of its chord.
+void distort_map(World* map, const MapDrawing& d) {
   for (std::vector<Segment>* v : {&map->walls, &map->glass}) {
-    for (Segment& s : *v) {
-      turn(&s.a);
-      turn(&s.b);
+    std::vector<Segment> out;
+    out.reserve(v->size());
+    for (const Segment& s : *v) {
+      if (std::max(s.a.x(), s.b.x()) <= d.joint_x) {
+        out.push_back(s);
+        continue;
+      }
+      const int n = std::max(1, static_cast<int>(std::ceil((s.b - s.a).norm() / kBendPieceM)));
+      for (int k = 0; k < n; ++k) {
+        const Vec2 a = s.a + (s.b - s.a) * (static_cast<double>(k) / n);
+        const Vec2 b = s.a + (s.b - s.a) * (static_cast<double>(k + 1) / n);
+        out.push_back(Segment{d.point(a), d.point(b)});
+      }
     }
+    v->swap(out);
   }
-  for (Vec2& n : map->route.nodes) turn(&n);
-  // The outline grows to hold the turned wing (else the raster would clip its walls).
+  for (Vec2& n : map->route.nodes) n = d.point(n);
+  // The outline grows to hold the bent wing (else the raster would clip its walls).
   for (const std::vector<Segment>* v : {&map->walls, &map->glass}) {
     for (const Segment& s : *v) {
       for (const Vec2& p : {s.a, s.b}) {
@@ -195,6 +212,36 @@ int add_clutter(const BuildingPlan& plan, double per_100m2, std::uint64_t seed, 
 
 }  // namespace
 
+namespace {
+// The heading the drawing has turned by at `along` metres beyond the joint (linear up to far_x).
+double drawn_turn(const MapDrawing& d, double along) {
+  const double w = d.far_x - d.joint_x;
+  return w > 0 ? d.angle_rad * std::min(1.0, along / w) : d.angle_rad;
+}
+}  // namespace
+
+Vec2 MapDrawing::point(const Vec2& p) const {
+  if (!bent || p.x() <= joint_x) return p;
+  // The line through the pivot along x is drawn as an arc whose heading grows with the distance
+  // along it (∫ (cos κu, sin κu) du, then straight beyond far_x); a point off the line keeps its
+  // offset across it, turned with the arc. So the drawing turns by drawn_turn() locally (no shear),
+  // with a scale error along x of κ × the offset from the line (capped at 0.5 %, kMaxMapStrain).
+  const double w = far_x - joint_x, along = p.x() - joint_x, s = std::min(along, w);
+  const double k = w > 0 ? angle_rad / w : 0;
+  Vec2 on_line = std::fabs(k) > 1e-12 ? Vec2(std::sin(k * s) / k, (1 - std::cos(k * s)) / k) : Vec2(s, 0);
+  const double a = drawn_turn(*this, along);
+  on_line += (along - s) * Vec2(std::cos(a), std::sin(a));
+  const double off = p.y() - pivot.y();
+  return pivot + on_line + off * Vec2(-std::sin(a), std::cos(a));
+}
+
+void MapDrawing::pose(double x, double y, double theta, double* mx, double* my, double* mtheta) const {
+  const Vec2 m = point(Vec2(x, y));
+  *mx = m.x();
+  *my = m.y();
+  *mtheta = bent && x > joint_x ? theta + drawn_turn(*this, x - joint_x) : theta;
+}
+
 std::string MapChangeOptions::validate() const {
   if (!(clutter_per_100m2 >= 0 && clutter_per_100m2 <= 50)) return "map change clutter_per_100m2 must be in [0, 50]";
   if (!(door_flip_fraction >= 0 && door_flip_fraction <= 1)) return "map change door_flip_fraction must be in [0, 1]";
@@ -215,6 +262,7 @@ bool apply_map_changes(const BuildingPlan& plan, const MapChangeOptions& opt, st
   report->distorted = false;
   report->distorted_region = Box{Vec2::Zero(), Vec2::Zero()};  // empty unless distorted
   report->pivot = Vec2::Zero();
+  report->drawing = MapDrawing{};
   *map = compose_world(plan);
   if (opt.distortion_deg != 0) {
     fw::RandomStream rng(seed, kDistortStream);
@@ -223,7 +271,17 @@ bool apply_map_changes(const BuildingPlan& plan, const MapChangeOptions& opt, st
     report->pivot = Vec2(cut, 0.5 * (b.min.y() + b.max.y()));
     report->distorted = true;
     report->distorted_region = Box{Vec2(cut, b.min.y()), b.max};
-    distort_map(map, opt.distortion_deg * M_PI / 180.0, report->pivot);
+    MapDrawing& d = report->drawing;
+    d.bent = true;
+    d.pivot = report->pivot;
+    d.joint_x = cut;
+    d.far_x = b.max.x();
+    // The bend's scale error along x is κ × the offset from the pivot's line (MapDrawing::point);
+    // the angle is capped so that it stays ≤ kMaxMapStrain everywhere in the building.
+    const double half_height = std::max(b.max.y() - report->pivot.y(), report->pivot.y() - b.min.y());
+    const double cap = kMaxMapStrain * (d.far_x - d.joint_x) / std::max(half_height, 1.0);
+    d.angle_rad = std::copysign(std::min(std::fabs(opt.distortion_deg) * M_PI / 180.0, cap), opt.distortion_deg);
+    distort_map(map, d);
   }
   BuildingPlan seen = plan;
   report->doors_flipped = opt.door_flip_fraction > 0 ? flip_doors(&seen, opt.door_flip_fraction, seed) : 0;

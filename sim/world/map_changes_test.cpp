@@ -148,33 +148,57 @@ TEST(MapChanges, RearrangedFurnitureMovesWithinOneArea) {
   }
 }
 
-TEST(MapChanges, DistortionTurnsOneWingOfTheMapOnly) {
+TEST(MapChanges, DistortionBendsOneWingOfTheMapOnly) {
   const BuildingPlan plan = plan_of(BuildingFamily::kMultiWing, 2);
   MapChangeOptions opt;
   opt.distortion_deg = 1.0;
   const Changed c = apply(plan, opt, 3);
   ASSERT_TRUE(c.report.distorted);
-  const double cut = c.report.pivot.x();
+  const MapDrawing& d = c.report.drawing;
+  ASSERT_TRUE(d.bent);
+  const double cut = d.joint_x;
   EXPECT_GT(cut, plan.structure.bounds.min.x());
   EXPECT_LT(cut, plan.structure.bounds.max.x());
   EXPECT_TRUE(same_segments(c.world.walls, compose_world(plan).walls));  // the world is as built
-  ASSERT_EQ(c.world.walls.size(), c.map.walls.size());
-  int turned = 0;
-  for (size_t i = 0; i < c.world.walls.size(); ++i) {
-    const Segment& w = c.world.walls[i];
-    const Segment& m = c.map.walls[i];
-    if (w.a.x() <= cut && w.b.x() <= cut) {
-      EXPECT_EQ(w.a, m.a);
-      EXPECT_EQ(w.b, m.b);
-    } else if (w.a.x() > cut && w.b.x() > cut) {
-      ++turned;
-      // Turned about the pivot by the angle: distances to it kept, the direction turned by 1°.
-      EXPECT_NEAR((m.a - c.report.pivot).norm(), (w.a - c.report.pivot).norm(), 1e-9);
-      const Vec2 dw = w.b - w.a, dm = m.b - m.a;
-      EXPECT_NEAR(std::atan2(dw.x() * dm.y() - dw.y() * dm.x(), dw.dot(dm)) * 180 / M_PI, 1.0, 1e-9);
-    }
+  // Walls left of the joint are drawn as built; every map wall piece beyond it lies on the drawing
+  // of a world wall (its end-points are drawn points of the world, ≤ 1 m apart).
+  int bent = 0;
+  for (const Segment& m : c.map.walls) {
+    if (std::max(m.a.x(), m.b.x()) <= cut) continue;
+    ++bent;
+    EXPECT_LE((m.b - m.a).norm(), 1.0 + 0.005 + 1e-6);  // 1 m pieces, drawn with the bend's scale error (≤ 0.5 %)
   }
-  EXPECT_GT(turned, 10);
+  EXPECT_GT(bent, 10);
+  // The drawing: identity before the joint, continuous across it, and locally a turn by the angle
+  // reached there (a short cross drawn turned, its arms kept at right angles), the full angle at
+  // the far end.
+  const Vec2 at_joint(cut, d.pivot.y() + 30);
+  EXPECT_EQ(d.point(Vec2(cut - 1, 5)), Vec2(cut - 1, 5));
+  EXPECT_LT((d.point(at_joint + Vec2(0.01, 0)) - (at_joint + Vec2(0.01, 0))).norm(), 1e-3);
+  auto turn_of = [&](const Vec2& p, const Vec2& u) {
+    const Vec2 g = d.point(p + 0.05 * u) - d.point(p - 0.05 * u);
+    return std::atan2(u.x() * g.y() - u.y() * g.x(), u.dot(g)) * 180 / M_PI;
+  };
+  const Vec2 far(d.far_x - 0.1, d.pivot.y() + 10), mid(0.5 * (cut + d.far_x), d.pivot.y() - 20);
+  const double full = d.angle_rad * 180 / M_PI;
+  EXPECT_GT(full, 0.1);
+  EXPECT_LE(full, 1.0);
+  EXPECT_NEAR(turn_of(far, Vec2(1, 0)), full, 0.01);
+  EXPECT_NEAR(turn_of(far, Vec2(0, 1)), full, 0.01);
+  EXPECT_NEAR(turn_of(mid, Vec2(1, 0)), 0.5 * full, 0.01);
+  EXPECT_NEAR(turn_of(mid, Vec2(0, 1)), 0.5 * full, 0.01);
+  // The local scale error stays ≤ 0.5 % everywhere, also at the building's far corners.
+  for (const Vec2& p : {Vec2(0.5 * (cut + d.far_x), plan.structure.bounds.max.y()), Vec2(d.far_x - 1, plan.structure.bounds.min.y())}) {
+    const double drawn_len = (d.point(p + Vec2(0.5, 0)) - d.point(p - Vec2(0.5, 0))).norm();
+    EXPECT_NEAR(drawn_len, 1.0, 0.005 + 1e-6);
+  }
+  // A robot's pose is drawn with its heading turned as the map turns around it.
+  double mx, my, mt;
+  d.pose(mid.x(), mid.y(), 0.3, &mx, &my, &mt);
+  EXPECT_NEAR((mt - 0.3) * 180 / M_PI, 0.5 * full, 1e-6);
+  EXPECT_NEAR((Vec2(mx, my) - d.point(mid)).norm(), 0, 1e-12);
+  d.pose(cut - 2, d.pivot.y(), 0.3, &mx, &my, &mt);
+  EXPECT_DOUBLE_EQ(mt, 0.3);
 }
 
 TEST(MapChanges, BadOptionsAreRefused) {

@@ -33,7 +33,7 @@ void add_unmapped_block(std::uint64_t seed, World* world, World* map) {
 }
 
 bool configure(const CorpusDraw& d, const CorpusRunOptions& opt, const World& world, const World& map,
-               SimConfig* cfg, std::string* err) {
+               const MapDrawing& drawing, SimConfig* cfg, std::string* err) {
   const SensorProfile* sensor = find_sensor_profile(d.sensor);
   const OdometryProfile* wheels = find_odometry_profile(d.odometry);
   if (sensor == nullptr || wheels == nullptr) {
@@ -42,6 +42,7 @@ bool configure(const CorpusDraw& d, const CorpusRunOptions& opt, const World& wo
   }
   cfg->custom_world = &world;
   cfg->custom_map_world = &map;
+  cfg->map_drawing = drawing.bent ? &drawing : nullptr;
   cfg->localizer = "mml-track";
   if (!wheels->tracker_odom_noise.empty()) cfg->localizer_options["odom_noise"] = wheels->tracker_odom_noise;
   cfg->localizer_options["odom_noise_per_step"] =
@@ -105,7 +106,7 @@ CorpusRun run_draw(const CorpusDraw& d, const CorpusRunOptions& opt) {
     const Vec2 size = plan.structure.bounds.max - plan.structure.bounds.min;
     run.width_m = size.x();
     run.height_m = size.y();
-    if (!configure(d, opt, world, map, &cfg, &err) || !run_simulation(cfg, &result, &err)) {
+    if (!configure(d, opt, world, map, run.changes.drawing, &cfg, &err) || !run_simulation(cfg, &result, &err)) {
       run.error = err;
     } else {
       run.ok = true;
