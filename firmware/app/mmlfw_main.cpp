@@ -3,6 +3,7 @@
 // threads (pinned, created once) → localizer → LocalizationLoop; then the arena is sealed and the
 // loop runs until SIGINT/SIGTERM (or --max-scans / --duration). Steady state allocates nothing.
 //   mmlfw --config FILE [--memory-report] [--timing-report] [--max-scans N] [--duration S]
+//   mmlfw --check-config FILE
 // Threads (firmware/runtime/execution_contexts.h, created here once and pinned): the main thread is
 // the `sensor` context (scan in → tracking → pose out, deadline one scan period); mml-track's MML
 // step runs on the `global` context thread (config global_context = thread, the default) and the
@@ -14,6 +15,15 @@
 // the exit status is non-zero (with the reason on stderr) when this machine cannot run the config:
 // the board (bus, device) cannot be opened, the footprint exceeds the memory the machine or its
 // limits allow, or realtime = true and the memory cannot be locked.
+// --check-config FILE: the same start-up without the loop (config, board interface, map image CRC
+// and version, arena_mib against what the map and localizer need, the footprint against the
+// machine's limits); prints "mmlfw: check-config '<FILE>': ok, static memory ..." and exits 0, or one
+// line per problem and exits 1. For the integrator and the package's post-install hint.
+// Service manager (systemd Type=notify, hal_linux/sd_notify.h, firmware/app/service_notify.h):
+// READY=1 after start-up, WATCHDOG=1 from the sensor loop only while it keeps its deadline,
+// STATUS= when the localization status or the faults change, STOPPING=1 on the way out.
+// --test-stall-after S (tests only): after S seconds the sensor loop stops cycling (no steps, no
+// WATCHDOG=1) until a signal, as a hung loop would; the watchdog tests use it.
 // On exit a one-line summary "mmlfw summary: {...}" goes to stderr.
 #include <signal.h>
 #include <sys/mman.h>
@@ -25,6 +35,7 @@
 
 #include "firmware/app/app_config.h"
 #include "firmware/app/memory_limits.h"
+#include "firmware/app/service_notify.h"
 #include "firmware/app/system.h"
 #include "firmware/base/arena.h"
 #include "firmware/base/memory_report.h"
@@ -36,6 +47,7 @@
 #include "firmware/runtime/localization_loop.h"
 #include "firmware/runtime/rt_thread.h"
 #include "hal_linux/board.h"
+#include "hal_linux/sd_notify.h"
 
 namespace {
 
@@ -46,16 +58,55 @@ fw::WorkerPool g_pool;
 fw::LocalizationSystem g_system;  // the localizer objects themselves live in the arena
 fw::LocalizationLoop g_loop;
 fw::AppConfig g_config;
+hal_linux::SdNotify g_notify;
+fw::WatchdogFeed g_watchdog;
 volatile sig_atomic_t g_stop = 0;
 
 void on_signal(int) { g_stop = 1; }
 
 int usage(const char* msg) {
-  std::fprintf(stderr, "mmlfw: %s\nusage: mmlfw --config FILE [--memory-report] [--timing-report] [--max-scans N] [--duration S]\n", msg);
+  std::fprintf(stderr,
+               "mmlfw: %s\nusage: mmlfw --config FILE [--memory-report] [--timing-report] [--max-scans N] [--duration S]\n"
+               "       mmlfw --check-config FILE\n       mmlfw --help\n",
+               msg);
   return 2;
 }
 
+// --help: the text the package ships as the firmware's reference (man page mmlfw(1) says the same).
+void print_help() {
+  std::printf(
+      "mmlfw: onboard global localization (MML, mml-track) for a robot with a 2-D laser and odometry\n"
+      "\n"
+      "usage: mmlfw --config FILE [--memory-report] [--timing-report] [--max-scans N] [--duration S]\n"
+      "       mmlfw --check-config FILE\n"
+      "\n"
+      "  --config FILE        run: start-up from FILE, then localize until SIGINT/SIGTERM\n"
+      "  --check-config FILE  start-up without the loop: the config, the board's bus or device, the map\n"
+      "                       image (CRC, version), arena_mib against what the map and localizer need,\n"
+      "                       the footprint against the machine's limits; prints 'ok' with the static\n"
+      "                       memory, or one line per problem (exit status 1)\n"
+      "  --memory-report      start-up, print the static memory budget by module, exit (non-zero when\n"
+      "                       this machine cannot run the config)\n"
+      "  --timing-report      on exit, per-stage timing of the sensor and global contexts\n"
+      "  --max-scans N, --duration S   stop after N scans or S seconds\n"
+      "\n"
+      "Config (key = value, '#' comments; the packaged example is /etc/mmlfw/mmlfw.conf):\n"
+      "  laser = socketcan:IFACE | serial:DEVICE[@BAUD]   (required)\n"
+      "  odometry = socketcan:IFACE | none    output = socketcan:IFACE | log    can_fd = auto|true|false\n"
+      "  localizer = mml-track | mml | handoff | mcl | odom    map = IMAGE.mmap (mml-mapc)\n"
+      "  workers, cores, realtime, global_context, global_period_scans, arena_mib, step_deadline_ms,\n"
+      "  health_period_ms, laser_timeout_ms, seed, mml_preset, log_level, odom_noise, odom_noise_per_step\n"
+      "\n"
+      "Under systemd (mmlfw.service, Type=notify): READY=1 after start-up, WATCHDOG=1 from the sensor\n"
+      "loop while it keeps its deadline, STATUS= with the localization status (systemctl status mmlfw).\n"
+      "Poses and health go out as CAN frames (DBC: /usr/share/mmlfw/mmlfw.dbc) or to the log.\n"
+      "Exit status: 0 ok, 1 bad input or start-up failure (the message names the input), 2 bad arguments.\n");
+}
+
+fw::Errc g_fail_code = fw::Errc::kOk;  // of the last start-up stage that failed
+
 int fail(const char* stage, const fw::Status& s) {
+  g_fail_code = s.code();
   std::fprintf(stderr, "mmlfw: %s: %s\n", stage, s.message());
   return 1;
 }
@@ -107,6 +158,10 @@ struct Args {
   bool timing_report = false;
   long max_scans = 0;
   double duration_s = 0;
+  bool check_config = false;
+  double test_stall_after_s = 0;  // tests only: the sensor loop stalls after this many seconds
+  // Start-up only, nothing runs: the memory report and the config check.
+  bool preflight() const { return memory_report || check_config; }
 };
 
 // What start-up learned and later steps need.
@@ -131,6 +186,15 @@ int parse_args(int argc, char** argv, Args* a) {
   for (int i = 1; i < argc; ++i) {
     if (!std::strcmp(argv[i], "--config") && i + 1 < argc) {
       a->config_path = argv[++i];
+    } else if (!std::strcmp(argv[i], "--check-config") && i + 1 < argc) {
+      a->config_path = argv[++i];
+      a->check_config = true;
+    } else if (!std::strcmp(argv[i], "--help")) {
+      print_help();
+      return -1;
+    } else if (!std::strcmp(argv[i], "--test-stall-after") && i + 1 < argc) {
+      a->test_stall_after_s = std::strtod(argv[++i], nullptr);
+      if (!(a->test_stall_after_s > 0)) return usage("--test-stall-after needs a positive number of seconds");
     } else if (!std::strcmp(argv[i], "--memory-report")) {
       a->memory_report = true;
     } else if (!std::strcmp(argv[i], "--timing-report")) {
@@ -145,7 +209,8 @@ int parse_args(int argc, char** argv, Args* a) {
       return usage("unknown or incomplete argument");
     }
   }
-  if (!a->config_path) return usage("--config FILE is required");
+  if (!a->config_path) return usage("--config FILE or --check-config FILE is required");
+  if (a->check_config && a->memory_report) return usage("--check-config and --memory-report are separate checks");
   return 0;
 }
 
@@ -163,8 +228,8 @@ int open_board(const Args& a, Startup* su) {
   const fw::Status st = g_board.create(spec);
   su->board_status = st;
   su->board_ok = st.is_ok();
-  if (!su->board_ok && !a.memory_report) return fail("board", st);
-  if (!su->board_ok) std::fprintf(stderr, "mmlfw: board: %s (memory report only)\n", st.message());
+  if (!su->board_ok && !a.preflight()) return fail("board", st);
+  if (!su->board_ok && a.memory_report) std::fprintf(stderr, "mmlfw: board: %s (memory report only)\n", st.message());
   if (su->board_ok) g_board.hal().log->log(hal::LogLevel::kInfo, "mmlfw: board %s", g_board.describe());
   return 0;
 }
@@ -175,14 +240,14 @@ int prepare_memory_and_sensor_context(const Args& a, Startup* su) {
   hal::Hal& hal = g_board.hal();
   if (c.realtime && mlockall(MCL_CURRENT | MCL_FUTURE) != 0) {
     su->lock_refused = true;
-    if (!a.memory_report) {
+    if (!a.preflight()) {
       std::fprintf(stderr, "mmlfw: realtime = true but mlockall was refused (ulimit -l / CAP_IPC_LOCK); set "
                            "realtime = false to run without locked memory\n");
       return 1;
     }
   }
   char warning[160];
-  fw::Status st = fw::apply_execution_context_here(fw::kSensorContext, c.realtime && !a.memory_report, warning);
+  fw::Status st = fw::apply_execution_context_here(fw::kSensorContext, c.realtime && !a.preflight(), warning);
   if (!st) return fail("sensor context", st);
   if (warning[0]) hal.log->log(hal::LogLevel::kWarning, "mmlfw: %s", warning);
   st = g_arena.init_mapped(static_cast<std::size_t>(c.arena_mib) << 20, c.realtime, "arena");
@@ -217,7 +282,7 @@ int start_workers(const Args& a) {
     for (int i = 0; i < c.workers && i < fw::WorkerPoolOptions::kMaxWorkers; ++i)
       po.cores[i] = static_cast<int>((fw::kWorkerContext.core + i) % online);
   }
-  po.realtime = c.realtime && !a.memory_report;
+  po.realtime = c.realtime && !a.preflight();
   po.require_realtime = po.realtime;
   po.priority = fw::kWorkerContext.priority;
   const fw::Status st = g_pool.start(po);
@@ -249,7 +314,7 @@ int build_localizer(const Args& a, Startup* su) {
   sys.track = &su->track;
   su->live = fw::track::live_global_schedule(c.global_period_scans);
   su->global_ctx = fw::track::global_context_for(c.global_period_scans);
-  su->global_thread = c.global_threaded && !std::strcmp(c.localizer, "mml-track") && !a.memory_report;
+  su->global_thread = c.global_threaded && !std::strcmp(c.localizer, "mml-track") && !a.preflight();
   if (su->global_thread) {
     sys.global_schedule = &su->live;
     sys.anytime_global = true;
@@ -282,6 +347,41 @@ int build_localizer(const Args& a, Startup* su) {
   return 0;
 }
 
+// The pre-flight problems found after a complete start-up (board, memory, locking), one line each
+// on stderr; returns how many, plus `already` (problems printed before). `memory` = nullptr when
+// start-up stopped before the budget.
+int print_check_problems(const Args& a, const Startup& su, const fw::Status* memory, int already) {
+  const char* what = a.check_config ? "check-config: problem" : "memory report: cannot run";
+  int problems = already;
+  if (!su.board_ok) {
+    std::fprintf(stderr, "mmlfw: %s: board: %s\n", what, su.board_status.message());
+    ++problems;
+  }
+  if (memory != nullptr && !memory->is_ok()) {
+    std::fprintf(stderr, "mmlfw: %s: memory: %s\n", what, memory->message());
+    ++problems;
+  }
+  if (su.lock_refused) {
+    std::fprintf(stderr, "mmlfw: %s: realtime = true but mlockall was refused (ulimit -l / CAP_IPC_LOCK; the "
+                         "mmlfw.service unit sets LimitMEMLOCK=infinity)\n", what);
+    ++problems;
+  }
+  if (a.check_config && problems > 0) std::fprintf(stderr, "mmlfw: check-config '%s': %d problem(s)\n", a.config_path, problems);
+  return problems;
+}
+
+// A start-up stage failed (its message already printed): --check-config also names the problems
+// found before it (the board), so one run lists everything it could see.
+int stage_failed(const Args& a, const Startup& su, int rc) {
+  if (!a.check_config) return rc;
+  if (g_fail_code == fw::Errc::kCapacityExceeded) {
+    std::fprintf(stderr, "mmlfw: check-config: problem: arena_mib = %u is too small for this map and localizer\n",
+                 g_config.arena_mib);
+  }
+  print_check_problems(a, su, nullptr, 1);
+  return 1;
+}
+
 // The static memory budget; with --memory-report printed with the pre-flight verdict (the exit
 // status, ≥ 0), otherwise -1 (go on; a budget beyond the machine's limits is a warning).
 int memory_budget(const Args& a, const Startup& su) {
@@ -303,9 +403,26 @@ int memory_budget(const Args& a, const Startup& su) {
   // The arena must hold its peak (the map loader's distance check is start-up scratch), not just
   // what stays allocated.
   const std::size_t arena_need = g_arena.peak_used() > g_arena.used() ? g_arena.peak_used() : g_arena.used();
-  if (!a.memory_report) {
+  if (!a.preflight()) {
     if (!memory_status) g_board.hal().log->log(hal::LogLevel::kWarning, "mmlfw: memory: %s", memory_status.message());
     return -1;
+  }
+  g_system.stop_global_context();
+  g_pool.stop();
+  if (a.check_config) {
+    const int problems = print_check_problems(a, su, &memory_status, 0);
+    if (problems == 0) {
+      std::printf("mmlfw: check-config '%s': ok, static memory %.1f MiB (arena_mib %u reserved, %.1f MiB of it used at "
+                  "the peak; static objects %.1f MiB; relation table copy %.1f MiB); localizer %s",
+                  a.config_path, footprint / 1048576.0, c.arena_mib, arena_need / 1048576.0, statics / 1048576.0,
+                  table_copy / 1048576.0, g_system.localizer().name());
+      if (c.map[0]) {
+        std::printf(", map '%s' %ux%u cells at %.3f m", c.map, su.map.geometry.width, su.map.geometry.height,
+                    static_cast<double>(su.map.geometry.resolution));
+      }
+      std::printf(", board %s\n", g_board.describe());
+    }
+    return problems == 0 ? 0 : 1;
   }
   std::printf("mmlfw memory report (config '%s', localizer %s, arena used %zu of %zu bytes)\n", a.config_path,
               g_system.localizer().name(), g_arena.used(), g_arena.capacity());
@@ -314,24 +431,48 @@ int memory_budget(const Args& a, const Startup& su) {
               "(image copy) %.3f MiB = %.3f MiB (%.3f MiB with the arena trimmed to its peak use)\n",
               g_arena.capacity() / 1048576.0, g_arena.used() / 1048576.0, statics / 1048576.0,
               table_copy / 1048576.0, footprint / 1048576.0, (arena_need + statics + table_copy) / 1048576.0);
-  g_system.stop_global_context();
-  g_pool.stop();
   // Pre-flight verdict: a configuration this machine cannot run is an error, with the reason.
-  int reasons = 0;
-  if (!su.board_ok) {
-    std::fprintf(stderr, "mmlfw: memory report: cannot run: board: %s\n", su.board_status.message());
-    ++reasons;
+  return print_check_problems(a, su, &memory_status, 0) == 0 ? 0 : 1;
+}
+
+// Service manager: READY=1 and the first STATUS= once start-up is done; the watchdog feed starts.
+hal::PoseEstimate g_status_sent{};
+std::uint32_t g_faults_sent = 0;
+void send_status() {
+  char text[192];
+  fw::format_service_status(text, sizeof(text), g_loop.last_estimate(), g_loop.health());
+  const fw::Status st = g_notify.send(text);
+  if (!st) g_board.hal().log->log(hal::LogLevel::kWarning, "mmlfw: %s", st.message());
+  g_status_sent = g_loop.last_estimate();
+  g_faults_sent = g_loop.health().fault_bits;
+}
+void notify_ready(std::uint64_t now_ns) {
+  if (!g_notify.enabled()) return;
+  const fw::Status st = g_notify.send("READY=1");
+  if (!st) g_board.hal().log->log(hal::LogLevel::kWarning, "mmlfw: %s", st.message());
+  send_status();
+  const hal::Health& h = g_loop.health();
+  g_watchdog.start(g_notify.watchdog_period_ns(), now_ns, h.scans_processed, h.deadline_misses);
+  g_board.hal().log->log(hal::LogLevel::kInfo, "mmlfw: service manager notified on '%s' (watchdog %s, check every %.0f ms)",
+                         g_notify.socket_name(), g_notify.watchdog_period_ns() ? "on" : "off",
+                         g_watchdog.check_interval_ns() * 1e-6);
+}
+// One sensor-loop cycle: WATCHDOG=1 while the loop keeps its deadline (firmware/app/service_notify.h),
+// STATUS= when the status, its reason or the faults changed. A failed send is logged once per
+// kind and counted (the manager restarting is no reason for the firmware to stop).
+void notify_cycle(std::uint64_t now_ns) {
+  if (!g_notify.enabled()) return;
+  const hal::Health& h = g_loop.health();
+  if (g_watchdog.cycle(now_ns, h.scans_processed, h.deadline_misses)) {
+    const fw::Status st = g_notify.send("WATCHDOG=1");
+    if (!st && g_notify.failed() == 1) g_board.hal().log->log(hal::LogLevel::kWarning, "mmlfw: %s", st.message());
   }
-  if (!memory_status) {
-    std::fprintf(stderr, "mmlfw: memory report: cannot run: memory: %s\n", memory_status.message());
-    ++reasons;
-  }
-  if (su.lock_refused) {
-    std::fprintf(stderr, "mmlfw: memory report: cannot run: realtime = true but mlockall was refused (ulimit -l / "
-                         "CAP_IPC_LOCK)\n");
-    ++reasons;
-  }
-  return reasons == 0 ? 0 : 1;
+  if (fw::service_status_changed(g_status_sent, g_faults_sent, g_loop.last_estimate(), h.fault_bits)) send_status();
+}
+// --test-stall-after: the sensor loop hangs (no steps, no feed) until a signal ends the process.
+void stall_for_test() {
+  g_board.hal().log->log(hal::LogLevel::kWarning, "mmlfw: --test-stall-after: the sensor loop stalls now");
+  while (!g_stop) usleep(10000);
 }
 
 // The steady state: scans in, poses out, heartbeats, until a signal, --max-scans or --duration.
@@ -351,7 +492,12 @@ std::uint64_t run_loop(const Args& a) {
   const std::uint64_t health_period = static_cast<std::uint64_t>(c.health_period_ms) * 1000000ull;
   std::uint64_t last_health = t_start;
   std::uint64_t scans = 0, step_errors = 0;
+  notify_ready(t_start);
   while (!g_stop) {
+    if (a.test_stall_after_s > 0 && static_cast<double>(hal.clock->now_ns() - t_start) * 1e-9 >= a.test_stall_after_s) {
+      stall_for_test();
+      break;
+    }
     g_board.wait_for_input(5);
     for (int k = 0; k < 16 && !g_stop; ++k) {
       const fw::Status st = g_loop.spin_once();
@@ -368,6 +514,7 @@ std::uint64_t run_loop(const Args& a) {
       last_health = now;
     }
     if (a.duration_s > 0 && static_cast<double>(now - t_start) * 1e-9 >= a.duration_s) g_stop = 1;
+    notify_cycle(now);
   }
   return step_errors;
 }
@@ -445,20 +592,28 @@ void print_summary(std::uint64_t step_errors) {
 
 int main(int argc, char** argv) {
   Args a;
-  if (const int rc = parse_args(argc, argv, &a)) return rc;
+  if (const int rc = parse_args(argc, argv, &a)) return rc < 0 ? 0 : rc;
   const fw::Status st = fw::load_app_config(a.config_path, &g_config);
   if (!st) {
     std::fprintf(stderr, "mmlfw: %s\n", st.message());
-    return 2;
+    if (a.check_config) std::fprintf(stderr, "mmlfw: check-config '%s': 1 problem(s)\n", a.config_path);
+    return a.check_config ? 1 : 2;
+  }
+  // The service manager's socket (systemd Type=notify): a malformed NOTIFY_SOCKET / WATCHDOG_USEC
+  // fails start-up, as a watchdog that could never be fed would restart the firmware forever.
+  if (!a.preflight()) {
+    const fw::Status ns = g_notify.open_from_env();
+    if (!ns) return fail("service notification", ns);
   }
   Startup& su = g_startup;
   if (const int rc = open_board(a, &su)) return rc;
-  if (const int rc = prepare_memory_and_sensor_context(a, &su)) return rc;
-  if (const int rc = load_map(&su)) return rc;
-  if (const int rc = start_workers(a)) return rc;
-  if (const int rc = build_localizer(a, &su)) return rc;
+  if (const int rc = prepare_memory_and_sensor_context(a, &su)) return stage_failed(a, su, rc);
+  if (const int rc = load_map(&su)) return stage_failed(a, su, rc);
+  if (const int rc = start_workers(a)) return stage_failed(a, su, rc);
+  if (const int rc = build_localizer(a, &su)) return stage_failed(a, su, rc);
   if (const int rc = memory_budget(a, su); rc >= 0) return rc;
   const std::uint64_t step_errors = run_loop(a);
+  g_notify.send("STOPPING=1");
   g_system.stop_global_context();  // before the pool it drives
   if (a.timing_report) print_timing_report(su);
   print_summary(step_errors);
