@@ -1,0 +1,107 @@
+#!/usr/bin/env python3
+"""mmlfw's systemd notifications against a real AF_UNIX datagram socket (CTest mmlfw_watchdog_test).
+
+The test is the service manager's side: it binds NOTIFY_SOCKET, starts mmlfw with WATCHDOG_USEC
+as systemd would (WatchdogSec=), and reads the datagrams with their arrival times.
+  run 1, healthy: READY=1 after start-up, STATUS= with the status (and the laser-timeout fault the
+         silent laser raises), WATCHDOG=1 at least every half period until SIGTERM, STOPPING=1.
+  run 2, --test-stall-after: WATCHDOG=1 as before until the loop stalls, then none for many
+         watchdog periods while the process is still alive (systemd would kill and restart it).
+  watchdog_test.py MMLFW [--summary FILE]
+"""
+import os, signal, socket, subprocess, sys, tempfile, time
+
+PERIOD_S = 0.5  # WATCHDOG_USEC: the firmware checks every 0.25 s
+
+
+def run(mmlfw, work, name, extra, stall_at=None, seconds=3.0):
+    path = os.path.join(work, name + ".sock")
+    rx = socket.socket(socket.AF_UNIX, socket.SOCK_DGRAM)
+    rx.bind(path)
+    rx.settimeout(0.05)
+    conf = os.path.join(work, name + ".conf")
+    with open(conf, "w") as f:
+        f.write("laser = serial:/dev/ptmx\nodometry = none\noutput = log\nlocalizer = odom\n"
+                "workers = 1\narena_mib = 8\nlaser_timeout_ms = 300\n")
+    env = dict(os.environ, NOTIFY_SOCKET=path, WATCHDOG_USEC=str(int(PERIOD_S * 1e6)))
+    env.pop("WATCHDOG_PID", None)
+    err = open(os.path.join(work, name + ".err"), "w")
+    t0 = time.monotonic()
+    p = subprocess.Popen([mmlfw, "--config", conf] + extra, env=env, stdout=subprocess.DEVNULL, stderr=err)
+    msgs = []
+    while time.monotonic() - t0 < seconds:
+        try:
+            data = rx.recv(4096)
+            msgs.append((time.monotonic() - t0, data.decode()))
+        except socket.timeout:
+            pass
+    alive = p.poll() is None
+    p.send_signal(signal.SIGTERM)
+    try:
+        rc = p.wait(timeout=10)
+    except subprocess.TimeoutExpired:
+        p.kill(); rc = p.wait()
+    t_end = time.monotonic()
+    while True:  # what arrived on the way out
+        try:
+            msgs.append((time.monotonic() - t0, rx.recv(4096).decode()))
+        except socket.timeout:
+            break
+    rx.close(); os.unlink(path); err.close()
+    return msgs, alive, rc, t_end - t0
+
+
+def main():
+    mmlfw = sys.argv[1]
+    summary = sys.argv[sys.argv.index("--summary") + 1] if "--summary" in sys.argv else None
+    work = tempfile.mkdtemp(prefix="mmlfw_watchdog_")
+    failures = []
+
+    def check(name, ok, detail=""):
+        print(("ok   - " if ok else "FAIL - ") + name + (": " + detail if detail else ""))
+        if not ok:
+            failures.append(name)
+
+    # --- run 1: healthy -----------------------------------------------------------------------
+    msgs, alive, rc, _ = run(mmlfw, work, "healthy", [], seconds=3.0)
+    texts = [m for _, m in msgs]
+    dogs = [t for t, m in msgs if m == "WATCHDOG=1"]
+    check("healthy: READY=1 is the first message", bool(texts) and texts[0] == "READY=1", repr(texts[:2]))
+    status = [m for m in texts if m.startswith("STATUS=")]
+    check("healthy: STATUS= with the localization status", any(m.startswith("STATUS=searching") or
+          m.startswith("STATUS=fault") for m in status), repr(status[:3]))
+    check("healthy: STATUS= names the silent laser's fault", any("laser-timeout" in m for m in status), repr(status))
+    gaps = [b - a for a, b in zip(dogs, dogs[1:])]
+    check("healthy: WATCHDOG=1 throughout", len(dogs) >= 8 and dogs[-1] > 2.4, "%d feeds, last at %.2f s" %
+          (len(dogs), dogs[-1] if dogs else -1))
+    check("healthy: never a gap of a watchdog period", bool(gaps) and max(gaps) < PERIOD_S,
+          "largest gap %.3f s" % (max(gaps) if gaps else -1))
+    check("healthy: alive until SIGTERM, exit 0", alive and rc == 0, "alive %s, exit %s" % (alive, rc))
+    check("healthy: STOPPING=1 on the way out", texts[-1:] == ["STOPPING=1"], repr(texts[-2:]))
+    healthy_ok = not failures
+
+    # --- run 2: the loop stalls -----------------------------------------------------------------
+    n_before = len(failures)
+    stall_at = 1.5
+    msgs, alive, rc, _ = run(mmlfw, work, "stall", ["--test-stall-after", str(stall_at)], seconds=4.5)
+    texts = [m for _, m in msgs]
+    dogs = [t for t, m in msgs if m == "WATCHDOG=1"]
+    check("stall: READY=1 first", bool(texts) and texts[0] == "READY=1", repr(texts[:2]))
+    check("stall: fed before the stall", len(dogs) >= 3, "%d feeds" % len(dogs))
+    last = dogs[-1] if dogs else 0.0
+    # Start-up takes some time after t0, so the loop's own clock starts a little later; the last
+    # feed must come no later than stall_at + start-up + one check interval.
+    check("stall: WATCHDOG=1 stops when the loop stalls", bool(dogs) and last < stall_at + 1.0 and
+          4.5 - last > 4 * PERIOD_S, "last feed at %.2f s, %.2f s of silence" % (last, 4.5 - last))
+    check("stall: the process is still alive (hung, not exited)", alive)
+    stall_ok = len(failures) == n_before
+
+    if summary:
+        with open(summary, "w") as f:
+            f.write("healthy_ok %d\nstall_stops_watchdog %d\n" % (healthy_ok, stall_ok))
+    print("watchdog_test: " + ("all passed" if not failures else "FAILED: " + ", ".join(failures)))
+    return 1 if failures else 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())
