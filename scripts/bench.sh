@@ -31,6 +31,15 @@ if [ "${1:-}" = fuzz ]; then
   bash tests/fuzz/bench_fuzz.sh build/fuzz build/bench/fuzz.json
   exit $?
 fi
+# deploy (issue 61; only when named): the Debian packages of the release, aarch64 and armhf presets
+# (own build dirs build/deploy-*), lintian, the systemd unit, --check-config, the watchdog, and an
+# install/start/stop/watchdog/remove run in a user-mode Linux guest booting systemd
+# (scripts/packaging/deploy_check.sh; build/bench/deploy.json, logs in build/bench/deploy/).
+if [ "${1:-}" = deploy ]; then
+  echo "=== bench deploy"
+  bash scripts/packaging/deploy_check.sh build/bench/deploy.json
+  exit $?
+fi
 cmake --preset release >/dev/null
 cmake --build --preset release -j "$(nproc)"
 
