@@ -65,7 +65,7 @@ constexpr const char* kKeys[] = {"laser",     "odometry",  "output",  "can_fd", 
                                  "mml_preset", "map",       "workers", "cores",            "realtime",
                                  "arena_mib", "step_deadline_ms", "health_period_ms", "laser_timeout_ms", "seed",
                                  "log_level", "global_context", "global_period_scans", "odom_noise",
-                                 "odom_noise_per_step"};
+                                 "odom_noise_per_step", "odom_slip"};
 constexpr int kNumKeys = static_cast<int>(sizeof(kKeys) / sizeof(kKeys[0]));
 
 // The config path as shown in messages: at most kShownPath characters, the end kept (the file
@@ -175,6 +175,19 @@ Status parse_app_config(const char* path, const char* text, std::size_t len, App
     std::memcpy(buf, text + pos, n);
     buf[n] = '\0';
     pos = e + 1;
+// "RATE, MAX_M": declared wheel slips (TrackOptions::odom_slip_per_100m, odom_slip_max_m).
+Status parse_odom_slip(const char* name, int line, const char* key, char* v, float out[2]) {
+  static const float kHi[2] = {1000.0f, 100.0f};
+  return parse_number_list(name, line, key, v, out, 2, kHi, "RATE, MAX_M");
+}
+
+// odom_noise, odom_noise_per_step, odom_slip: the tracker's odometry model (kKeys lists them).
+Status parse_odometry_key(const char* name, int line, const char* key, char* v, AppConfig* out) {
+  if (!std::strcmp(key, "odom_noise")) return parse_odom_noise(name, line, key, v, out->odom_noise);
+  if (!std::strcmp(key, "odom_noise_per_step")) return parse_odom_noise_per_step(name, line, key, v, out->odom_noise_per_step);
+  return parse_odom_slip(name, line, key, v, out->odom_slip);
+}
+
     if (char* hash = std::strchr(buf, '#')) *hash = '\0';
     // Trim.
     char* s = buf;
@@ -272,10 +285,8 @@ Status parse_app_config(const char* path, const char* text, std::size_t len, App
     } else if (!std::strcmp(key, "seed")) {
       if (!parse_int(v, 0, 0x7FFFFFFF, &x)) return CFG_ERR("'%s' is not a non-negative integer", v);
       out->seed = static_cast<std::uint64_t>(x);
-    } else if (!std::strcmp(key, "odom_noise")) {
-      FW_RETURN_IF_ERROR(parse_odom_noise(name, line, key, v, out->odom_noise));
-    } else if (!std::strcmp(key, "odom_noise_per_step")) {
-      FW_RETURN_IF_ERROR(parse_odom_noise_per_step(name, line, key, v, out->odom_noise_per_step));
+    } else if (!std::strncmp(key, "odom_", 5)) {
+      FW_RETURN_IF_ERROR(parse_odometry_key(name, line, key, v, out));
     } else if (!std::strcmp(key, "log_level")) {
       static const char* const kLevels[] = {"debug", "info", "warning", "error"};
       int lvl = -1;

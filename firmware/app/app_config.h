@@ -70,6 +70,8 @@ struct AppConfig {
 };
 
 // Parses `text` (len bytes); `path` is used in messages (abbreviated to its last 96 characters).
+  // Declared wheel slips: per 100 m driven, and the largest in metres (TrackOptions::odom_slip_per_100m).
+  float odom_slip[2] = {0.0f, 1.0f};
 Status parse_app_config(const char* path, const char* text, std::size_t len, AppConfig* out);
 // Reads the file (at most 16 KiB) with read(2) into a static buffer and parses it.
 Status load_app_config(const char* path, AppConfig* out);

@@ -189,6 +189,20 @@ TEST(AppConfig, OdomNoiseKey) {
                   {"0.1,0.2,0.3,nan", "number 4 'nan'"}});
 }
 
+// odom_slip: declared wheel slips per 100 m and the largest (default none: 0, 1 m).
+TEST(AppConfig, OdomSlipKey) {
+  AppConfig c;
+  ASSERT_TRUE(parse("laser = socketcan:vcan0\nlocalizer = odom\n", &c).is_ok());
+  EXPECT_FLOAT_EQ(c.odom_slip[0], 0.0f);
+  EXPECT_FLOAT_EQ(c.odom_slip[1], 1.0f);
+  ASSERT_TRUE(parse("laser = socketcan:vcan0\nlocalizer = odom\nodom_slip = 2, 0.8\n", &c).is_ok());
+  EXPECT_FLOAT_EQ(c.odom_slip[0], 2.0f);
+  EXPECT_FLOAT_EQ(c.odom_slip[1], 0.8f);
+  expect_refused("odom_slip", {{"2", "line 3: key 'odom_slip': '2' is not 2 numbers RATE, MAX_M"},
+                               {"2,200", "number 2 '200' is not in 0..100"},
+                               {"-1,1", "number 1 '-1'"}});
+}
+
 // odom_noise_per_step: σ per scan step that does not follow the motion (metres, degrees; default 0, 0).
 TEST(AppConfig, OdomNoisePerStepKey) {
   AppConfig c;

@@ -95,7 +95,7 @@ void print_help() {
       "  odometry = socketcan:IFACE | none    output = socketcan:IFACE | log    can_fd = auto|true|false\n"
       "  localizer = mml-track | mml | handoff | mcl | odom    map = IMAGE.mmap (mml-mapc)\n"
       "  workers, cores, realtime, global_context, global_period_scans, arena_mib, step_deadline_ms,\n"
-      "  health_period_ms, laser_timeout_ms, seed, mml_preset, log_level, odom_noise, odom_noise_per_step\n"
+      "  health_period_ms, laser_timeout_ms, seed, mml_preset, log_level, odom_noise, odom_noise_per_step, odom_slip\n"
       "\n"
       "Under systemd (mmlfw.service, Type=notify): READY=1 after start-up, WATCHDOG=1 from the sensor\n"
       "loop while it keeps its deadline, STATUS= with the localization status (systemctl status mmlfw).\n"
@@ -312,6 +312,8 @@ int build_localizer(const Args& a, Startup* su) {
   su->track.odom_trans_per_step_m = c.odom_noise_per_step[0];
   su->track.odom_rot_per_step_rad = c.odom_noise_per_step[1] * 0.017453292f;
   sys.track = &su->track;
+  su->track.odom_slip_per_100m = c.odom_slip[0];
+  su->track.odom_slip_max_m = c.odom_slip[1];
   su->live = fw::track::live_global_schedule(c.global_period_scans);
   su->global_ctx = fw::track::global_context_for(c.global_period_scans);
   su->global_thread = c.global_threaded && !std::strcmp(c.localizer, "mml-track") && !a.preflight();

@@ -56,6 +56,7 @@ void PoseTracker::stop() {
   bias_xy_m_ = map_.geometry.resolution;
   bias_theta_rad_ = 0.0f;
   unsupported_ = faulty_ = outside_ = 0;
+  unpinned_m_ = 0.0f;
   excess_xy_m_ = excess_theta_rad_ = 0.0f;
   consistent_since_fault_ = 0;
   had_fault_ = false;
@@ -242,6 +243,7 @@ TrackStep PoseTracker::step(const Point2f* points, std::size_t n, const Se2f& od
   if (predict) {
     const Se2f d = prev_odom_.between(odom);
     odom_jump = !(std::hypot(d.x, d.y) <= o.max_odom_step_m && std::fabs(d.theta) <= o.max_odom_step_rad);
+    unpinned_m_ += std::hypot(d.x, d.y);
     predict_to(odom);
   }
   StepWork w;
@@ -622,6 +624,12 @@ void PoseTracker::publish(const Point2f* points, std::size_t n, const StepWork& 
     out->pl.xy_m += std::hypot(w.unfused(0), w.unfused(1));
     out->pl.theta_rad += std::fabs(w.unfused(2));
   }
+  if (v == ScanVerdict::kSupported && !out->valley_dropped) unpinned_m_ = 0.0f;
+  if (o.odom_slip_per_100m > 0.0f &&
+      1.0f - std::exp(-o.odom_slip_per_100m * 0.01f * unpinned_m_) > o.integrity_risk) {
+    out->pl.xy_m += o.odom_slip_max_m;  // a declared slip could be in the pose unseen
+  }
+  out->pl.xy_m += o.odom_scale_error * unpinned_m_;  // the wheels' systematic error over those metres
   out->unsupported_steps = unsupported_;
   out->odom_noise = odom_noise_.scale();
   out->faulty_steps = faulty_;

@@ -188,6 +188,9 @@ class PoseTracker {
   bool fuse_next_ = true;
   float bias_xy_m_ = 0.0f, bias_theta_rad_ = 0.0f;  // of the last supported scan
   std::uint32_t unsupported_ = 0, faulty_ = 0, outside_ = 0;
+  // Metres the wheels carried the pose since a supported scan last pinned every direction of it
+  // (no one-valley drop): how far a declared wheel slip could go unseen (odom_slip_per_100m).
+  float unpinned_m_ = 0.0f;
   std::uint32_t consistent_since_fault_ = 0;  // consistent scans since the last contradicting one
   bool had_fault_ = false;
   // A contradicting scan since the last recovery_steps unique consistent scans (ambiguous scans do

@@ -548,6 +548,7 @@ TEST(PoseTrackerTest, ConfidenceCapIncludesTheUpdatesShift) {
     PoseTracker t;
     TrackOptions o;
     o.confidence_cap_with_update = cap_with_update;
+    o.odom_scale_error = 0.0f;  // the confidence extent's cap alone
     ASSERT_TRUE(t.init(o, map.map).is_ok());
     RandomStream rng(31, 0);
     t.start(start, start_cov, Se2f());

@@ -67,6 +67,9 @@ Status TrackOptions::validate() const {
   FW_RETURN_IF_ERROR(check_range("odom_noise_min_snr", odom_noise_min_snr, 1.0f, 1000.0f));
   FW_RETURN_IF_ERROR(check_range("odom_noise_min_scale", odom_noise_min_scale, 0.01f, 1.0f));
   FW_RETURN_IF_ERROR(check_range("odom_noise_max_scale", odom_noise_max_scale, odom_noise_min_scale, 10.0f));
+  FW_RETURN_IF_ERROR(check_range("odom_slip_per_100m", odom_slip_per_100m, 0.0f, 1000.0f));
+  FW_RETURN_IF_ERROR(check_range("odom_slip_max_m", odom_slip_max_m, 0.0f, 100.0f));
+  FW_RETURN_IF_ERROR(check_range("odom_scale_error", odom_scale_error, 0.0f, 1.0f));
   FW_RETURN_IF_ERROR(check_range("max_odom_step_m", max_odom_step_m, 0.01f, 100.0f));
   FW_RETURN_IF_ERROR(check_range("max_odom_step_rad", max_odom_step_rad, 0.01f, 6.3f));
   FW_RETURN_IF_ERROR(check_range("update_min_d_m", update_min_d_m, 0.0f, 10.0f));

@@ -96,6 +96,24 @@ struct TrackOptions {
   float odom_noise_min_snr = 9.0f;
   float odom_noise_min_scale = 0.1f;
   float odom_noise_max_scale = 1.0f;
+  // Declared wheel-slip faults (issue 56, ARAIM-style: a fault mode with a prior probability). A slip
+  // (the wheels report motion the robot did not make) is seen only by a scan that pins the position
+  // along the slip: along a corridor whose walls fit wherever the robot stands (the one-valley rule
+  // leaves that axis to the wheels) or over scans that say nothing, it is not monitored. So once the
+  // probability of at least one slip over the metres driven since a scan last pinned every direction,
+  // 1 − exp(−rate × metres / 100), exceeds the integrity risk, the PL includes the largest slip.
+  // From the platform's floor and wheels (an integrator's statement, like the α above); 0 = none
+  // declared (the PL then assumes the noise model bounds the wheels). Corpus, slip-events profile
+  // (2 per 100 m, 0.3–1 m): a warehouse aisle `localized` 0.87 m off for 17 steps without it.
+  float odom_slip_per_100m = 0.0f;
+  float odom_slip_max_m = 1.0f;
+  // The wheels' systematic distance error (a wheel radius or base a few % off: UMBmark, Borenstein &
+  // Feng 1996, finds uncalibrated differential drives a few % off, systematic, not noise). The α
+  // model treats every step as independent noise, so over the metres the wheels alone carry the
+  // pose (the same count as for slips) its σ grows as √n while a scale error grows as n: the corpus's
+  // poorly calibrated base (+3 %, calibrated α) was `localized` 0.35 m off under a PL of 0.15 m along
+  // a 12 m warehouse aisle. So the PL adds this fraction of those metres. 0 = the α model alone.
+  float odom_scale_error = 0.05f;
   // Odometry increments beyond these between two scans are not physical (a jump, a reset of the
   // wheel counters): the pose cannot be carried across them.
   float max_odom_step_m = 2.0f;

@@ -18,9 +18,9 @@ struct OdometryProfile {
   std::string name;         // "diff-calibrated", "diff-poor", "skid-steer", "slip-events", "white"
   std::string description;
   OdometryNoiseOptions wheels;
-  // mml-track's odometry keys as an integrator sets them for this base ("TT,TR,RR,RT" and "M,DEG";
-  // empty = the defaults).
-  std::string tracker_odom_noise, tracker_odom_noise_per_step;
+  // mml-track's odometry keys as an integrator sets them for this base ("TT,TR,RR,RT", "M,DEG" and
+  // the declared slips "RATE,MAX_M"; empty = the defaults).
+  std::string tracker_odom_noise, tracker_odom_noise_per_step, tracker_odom_slip;
 };
 
 const std::vector<OdometryProfile>& odometry_profiles();

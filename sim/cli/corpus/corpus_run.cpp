@@ -47,6 +47,7 @@ bool configure(const CorpusDraw& d, const CorpusRunOptions& opt, const World& wo
   if (!wheels->tracker_odom_noise.empty()) cfg->localizer_options["odom_noise"] = wheels->tracker_odom_noise;
   cfg->localizer_options["odom_noise_per_step"] =
       wheels->tracker_odom_noise_per_step.empty() ? "0,0" : wheels->tracker_odom_noise_per_step;
+  if (!wheels->tracker_odom_slip.empty()) cfg->localizer_options["odom_slip"] = wheels->tracker_odom_slip;
   for (const auto& [key, value] : opt.localizer_options) cfg->localizer_options[key] = value;
   cfg->seed = d.seed;
   cfg->threads = opt.threads;

@@ -181,6 +181,30 @@ static bool parse_odom_noise(const std::map<std::string, std::string>& options, 
   return true;
 }
 
+// odom_slip=RATE,MAX → declared wheel slips (TrackOptions::odom_slip_per_100m, odom_slip_max_m).
+static bool parse_odom_slip(const std::map<std::string, std::string>& options, fw::track::TrackOptions* to,
+                            std::string* err) {
+  const auto it = options.find("odom_slip");
+  if (it == options.end()) return true;
+  const char* p = it->second.c_str();
+  char* end = nullptr;
+  const double rate = std::strtod(p, &end);
+  bool ok = end != p && *end == ',' && rate >= 0.0 && rate <= 1000.0;
+  double max_m = 0.0;
+  if (ok) {
+    p = end + 1;
+    max_m = std::strtod(p, &end);
+    ok = end != p && *end == '\0' && max_m >= 0.0 && max_m <= 100.0;
+  }
+  if (!ok) {
+    *err = "localizer mml-track: option odom_slip='" + it->second + "' (expected RATE,MAX_M: slips per 100 m in 0..1000, metres in 0..100)";
+    return false;
+  }
+  to->odom_slip_per_100m = static_cast<float>(rate);
+  to->odom_slip_max_m = static_cast<float>(max_m);
+  return true;
+}
+
 // The product's system (firmware default): MML fix confirmed and tracked with a protection level.
 // Options: config=1..4, correct=0|1, reduce=0|1, pool=0|1, keep=0|1, contested=0|1, rivals=0|1 (MML part); alert=M (alert limit, metres);
 // odom_noise=TT,TR,RR,RT and odom_noise_per_step=M,DEG (the tracker's odometry noise model, as
@@ -188,9 +212,10 @@ static bool parse_odom_noise(const std::map<std::string, std::string>& options, 
 // odom_adapt=0|1 (wheel-noise self-calibration, TrackOptions::odom_noise_window 64; 0 = default);
 // valley=0|1 (TrackOptions::alias_valley_is_one_mode; default 1, as TrackOptions);
 // outside_clean=0|1 (TrackOptions::outside_map_needs_clean_exit; default 1, as TrackOptions);
-// wheels_bind=0|1 (TrackOptions::wheels_bind_mml_without_carry; default 1, as TrackOptions).
+// wheels_bind=0|1 (TrackOptions::wheels_bind_mml_without_carry; default 1, as TrackOptions);
+// odom_slip=RATE,MAX (declared wheel slips, as mmlfw's config key).
 std::unique_ptr<fw::Localizer> make_track_localizer(const LocalizerContext& ctx, std::string* err) {
-  const std::string bad = check_keys("mml-track", ctx.options, {"config", "correct", "reduce", "pool", "keep", "contested", "rivals", "alert", "odom_noise", "odom_noise_per_step", "odom_adapt", "valley", "outside_clean", "wheels_bind"});
+  const std::string bad = check_keys("mml-track", ctx.options, {"config", "correct", "reduce", "pool", "keep", "contested", "rivals", "alert", "odom_noise", "odom_noise_per_step", "odom_adapt", "valley", "outside_clean", "wheels_bind", "odom_slip"});
   if (!bad.empty()) { *err = bad; return nullptr; }
   if (ctx.global_map == nullptr) { *err = "localizer mml-track: needs a global map"; return nullptr; }
   long config = 3;
@@ -209,7 +234,7 @@ std::unique_ptr<fw::Localizer> make_track_localizer(const LocalizerContext& ctx,
     to.alert_limit_m = static_cast<float>(v);
     if (to.lost_limit_m < to.alert_limit_m) to.lost_limit_m = to.alert_limit_m;
   }
-  if (!parse_odom_noise(ctx.options, &to, err)) return nullptr;
+  if (!parse_odom_noise(ctx.options, &to, err) || !parse_odom_slip(ctx.options, &to, err)) return nullptr;
   long adapt = 0;
   if (!parse_int(ctx.options, "odom_adapt", 0, 1, &adapt, "mml-track", err)) return nullptr;
   if (adapt == 1) to.odom_noise_window = 64;
