@@ -9,6 +9,7 @@
 #include <unistd.h>
 
 #include <cmath>
+#include <cstdio>
 #include <cstdlib>
 #include <cstring>
 
@@ -36,17 +37,32 @@ bool copy(char* dst, std::size_t cap, const char* v) {
   return true;
 }
 
+// The serial laser kinds (hal/linux/board.h): "serial" is the older name of "sick".
+constexpr const char* kSerialLaserKinds[] = {"serial:", "sick:", "hokuyo:", "rplidar:"};
+
+// Length of the serial laser kind prefix of v ("hokuyo:" → 7), 0 when v is none of them.
+std::size_t serial_laser_prefix(const char* v) {
+  for (const char* k : kSerialLaserKinds) {
+    const std::size_t n = std::strlen(k);
+    if (!std::strncmp(v, k, n)) return n;
+  }
+  return 0;
+}
+
+// The laser may also be "can:IFACE" (= socketcan:IFACE) or a serial laser.
 bool spec_ok(const char* v, bool allow_serial, const char* extra) {
   if (extra && !std::strcmp(v, extra)) return true;
   if (!std::strncmp(v, "socketcan:", 10) && v[10]) return true;
-  if (allow_serial && !std::strncmp(v, "serial:", 7) && v[7]) return true;
+  if (allow_serial && !std::strncmp(v, "can:", 4) && v[4]) return true;
+  const std::size_t p = serial_laser_prefix(v);
+  if (allow_serial && p > 0 && v[p]) return true;
   return false;
 }
 
 // Serial rates the termios backend sets (hal/serial/termios_port.h); anything else is refused
 // here, with the line and key, instead of at open time.
-constexpr unsigned long kBauds[] = {9600, 19200, 38400, 57600, 115200, 230400, 500000};
-constexpr const char* kBaudList = "9600, 19200, 38400, 57600, 115200, 230400, 500000";
+constexpr unsigned long kBauds[] = {9600, 19200, 38400, 57600, 115200, 230400, 256000, 460800, 500000, 921600, 1000000};
+constexpr const char* kBaudList = "9600, 19200, 38400, 57600, 115200, 230400, 256000, 460800, 500000, 921600, 1000000";
 
 // "@BAUD" of serial:DEVICE@BAUD: digits only, no overflow, a supported rate.
 bool parse_baud(const char* v, unsigned long* out) {
@@ -94,20 +110,33 @@ namespace {
 Status check_backend_arg(const char* name, int line, const char* key, const char* v, std::size_t cap) {
   const std::size_t n = std::strlen(v);
   if (n >= cap) return CFG_ERR("value too long (%zu characters, at most %zu)", n, cap - 1);
-  if (!std::strncmp(v, "socketcan:", 10)) {
-    const std::size_t iface = n - 10;
+  const bool can = !std::strncmp(v, "can:", 4);
+  if (can || !std::strncmp(v, "socketcan:", 10)) {
+    const std::size_t iface = n - (can ? 4 : 10);
     if (iface > kMaxCanInterfaceName) {
       return CFG_ERR("interface name too long (%zu characters, at most %zu)", iface, kMaxCanInterfaceName);
     }
     return Status::ok();
   }
-  if (!std::strncmp(v, "serial:", 7)) {
-    const char* at = std::strchr(v + 7, '@');
-    if (at == v + 7) return CFG_ERR("'%s': no device before '@'", v);
-    if (at != nullptr) {
-      unsigned long baud = 0;
-      if (!parse_baud(at + 1, &baud)) return CFG_ERR("baud '%s' is not one of %s", at + 1, kBaudList);
+  const std::size_t p = serial_laser_prefix(v);
+  if (p == 0) return Status::ok();
+  // DEVICE[@BAUD][,OPTION]: hokuyo takes "intensity" (ME), rplidar "express" or "force".
+  char arg[128];
+  std::snprintf(arg, sizeof(arg), "%s", v + p);
+  if (char* comma = std::strchr(arg, ',')) {
+    *comma = '\0';
+    const char* opt = comma + 1;
+    const bool hokuyo = !std::strncmp(v, "hokuyo:", 7), rplidar = !std::strncmp(v, "rplidar:", 8);
+    if (!(hokuyo && !std::strcmp(opt, "intensity")) &&
+        !(rplidar && (!std::strcmp(opt, "express") || !std::strcmp(opt, "force")))) {
+      return CFG_ERR("'%s': option '%s' unknown (hokuyo: intensity; rplidar: express, force)", v, opt);
     }
+  }
+  const char* at = std::strchr(arg, '@');
+  if (at == arg || arg[0] == '\0') return CFG_ERR("'%s': no device", v);
+  if (at != nullptr) {
+    unsigned long baud = 0;
+    if (!parse_baud(at + 1, &baud)) return CFG_ERR("baud '%s' is not one of %s", at + 1, kBaudList);
   }
   return Status::ok();
 }
@@ -146,6 +175,19 @@ Status parse_odom_noise_per_step(const char* name, int line, const char* key, ch
   return parse_number_list(name, line, key, v, out, 2, kHi, "M, DEG");
 }
 
+// "RATE, MAX_M": declared wheel slips (TrackOptions::odom_slip_per_100m, odom_slip_max_m).
+Status parse_odom_slip(const char* name, int line, const char* key, char* v, float out[2]) {
+  static const float kHi[2] = {1000.0f, 100.0f};
+  return parse_number_list(name, line, key, v, out, 2, kHi, "RATE, MAX_M");
+}
+
+// odom_noise, odom_noise_per_step, odom_slip: the tracker's odometry model (kKeys lists them).
+Status parse_odometry_key(const char* name, int line, const char* key, char* v, AppConfig* out) {
+  if (!std::strcmp(key, "odom_noise")) return parse_odom_noise(name, line, key, v, out->odom_noise);
+  if (!std::strcmp(key, "odom_noise_per_step")) return parse_odom_noise_per_step(name, line, key, v, out->odom_noise_per_step);
+  return parse_odom_slip(name, line, key, v, out->odom_slip);
+}
+
 }  // namespace
 
 Status parse_app_config(const char* path, const char* text, std::size_t len, AppConfig* out) {
@@ -175,19 +217,6 @@ Status parse_app_config(const char* path, const char* text, std::size_t len, App
     std::memcpy(buf, text + pos, n);
     buf[n] = '\0';
     pos = e + 1;
-// "RATE, MAX_M": declared wheel slips (TrackOptions::odom_slip_per_100m, odom_slip_max_m).
-Status parse_odom_slip(const char* name, int line, const char* key, char* v, float out[2]) {
-  static const float kHi[2] = {1000.0f, 100.0f};
-  return parse_number_list(name, line, key, v, out, 2, kHi, "RATE, MAX_M");
-}
-
-// odom_noise, odom_noise_per_step, odom_slip: the tracker's odometry model (kKeys lists them).
-Status parse_odometry_key(const char* name, int line, const char* key, char* v, AppConfig* out) {
-  if (!std::strcmp(key, "odom_noise")) return parse_odom_noise(name, line, key, v, out->odom_noise);
-  if (!std::strcmp(key, "odom_noise_per_step")) return parse_odom_noise_per_step(name, line, key, v, out->odom_noise_per_step);
-  return parse_odom_slip(name, line, key, v, out->odom_slip);
-}
-
     if (char* hash = std::strchr(buf, '#')) *hash = '\0';
     // Trim.
     char* s = buf;
@@ -217,7 +246,7 @@ Status parse_odometry_key(const char* name, int line, const char* key, char* v, 
     }
     long x = 0;
     if (!std::strcmp(key, "laser")) {
-      if (!spec_ok(v, true, nullptr)) return CFG_ERR("'%s' is not socketcan:IFACE or serial:DEVICE[@BAUD]", v);
+      if (!spec_ok(v, true, nullptr)) return CFG_ERR("'%s' is not can:IFACE, sick:, hokuyo: or rplidar:DEVICE[@BAUD]", v);
       FW_RETURN_IF_ERROR(check_backend_arg(name, line, key, v, sizeof(out->laser)));
       copy(out->laser, sizeof(out->laser), v);
       seen_laser = true;

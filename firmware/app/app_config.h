@@ -1,8 +1,11 @@
 // mmlfw configuration: a "key = value" text file ('#' comments), validated once at start-up.
 // Every error names the file, the line and the key; a key set twice, a NUL byte and an overlong
 // value are errors too (nothing is silently dropped or overridden). Keys (defaults in brackets):
-//   laser            socketcan:IFACE | serial:DEVICE[@BAUD]            (required)
-//                    BAUD: 9600 19200 38400 57600 115200 230400 500000 [38400]; IFACE ≤ 15 characters
+//   laser            (required) can:IFACE (= socketcan:IFACE) | sick:DEVICE[@BAUD] (= serial:) |
+//                    hokuyo:DEVICE[@BAUD][,intensity] | rplidar:DEVICE[@BAUD][,express|,force]
+//                    BAUD: 9600 19200 38400 57600 115200 230400 256000 460800 500000 921600 1000000
+//                    [sick 38400, hokuyo and rplidar 115200]; IFACE ≤ 15 characters. Hokuyo and
+//                    RPLIDAR must answer their start-up handshake (hal/linux/board.h)
 //   odometry         socketcan:IFACE | none              [laser's interface when socketcan, else none]
 //   output           socketcan:IFACE | log               [laser's interface when socketcan, else log]
 //   can_fd           auto | true | false                 [auto: FD when the interface MTU is 72]
@@ -67,11 +70,11 @@ struct AppConfig {
   // (on x and y) and degrees per scan interval that does not follow the motion, added in quadrature
   // to the model above. 0, 0 (default) for wheels whose error follows the motion.
   float odom_noise_per_step[2] = {0.0f, 0.0f};
+  // Declared wheel slips: per 100 m driven, and the largest in metres (TrackOptions::odom_slip_per_100m).
+  float odom_slip[2] = {0.0f, 1.0f};
 };
 
 // Parses `text` (len bytes); `path` is used in messages (abbreviated to its last 96 characters).
-  // Declared wheel slips: per 100 m driven, and the largest in metres (TrackOptions::odom_slip_per_100m).
-  float odom_slip[2] = {0.0f, 1.0f};
 Status parse_app_config(const char* path, const char* text, std::size_t len, AppConfig* out);
 // Reads the file (at most 16 KiB) with read(2) into a static buffer and parses it.
 Status load_app_config(const char* path, AppConfig* out);

@@ -251,5 +251,30 @@ TEST(AppConfig, MissingFileNamesThePath) {
   EXPECT_NE(std::strstr(s.message(), "/nonexistent/mmlfw.conf"), nullptr);
 }
 
+// Issue 59: laser = can | sick | hokuyo | rplidar with the port, the rate and a protocol option.
+TEST(AppConfig, LaserKinds) {
+  for (const char* ok : {"can:can0", "socketcan:can0", "sick:/dev/ttyS0@500000", "serial:/dev/ttyS0",
+                         "hokuyo:/dev/ttyACM0", "hokuyo:/dev/ttyACM0@115200,intensity", "rplidar:/dev/ttyUSB0@256000",
+                         "rplidar:/dev/ttyUSB0,express", "rplidar:/dev/ttyUSB0@1000000,force"}) {
+    AppConfig c;
+    const Status s = parse(std::string("localizer = odom\nlaser = ") + ok + "\n", &c);
+    ASSERT_TRUE(s.is_ok()) << ok << ": " << s.message();
+    EXPECT_STREQ(c.laser, ok);
+  }
+  const RefusedValue refused[] = {{"velodyne:/dev/ttyUSB0", "is not can:IFACE, sick:, hokuyo: or rplidar:DEVICE"},
+                                  {"hokuyo:", "is not can:IFACE"},
+                                  {"rplidar:@115200", "no device"},
+                                  {"rplidar:/dev/ttyUSB0@256001", "baud '256001' is not one of"},
+                                  {"hokuyo:/dev/ttyACM0,express", "option 'express' unknown"},
+                                  {"rplidar:/dev/ttyUSB0,intensity", "option 'intensity' unknown"},
+                                  {"can:an-interface-name-too-long", "interface name too long"}};
+  for (const RefusedValue& r : refused) {
+    AppConfig c;
+    const Status s = parse(std::string("localizer = odom\nlaser = ") + r.value + "\n", &c);
+    ASSERT_FALSE(s.is_ok()) << r.value;
+    EXPECT_NE(std::strstr(s.message(), r.must_contain), nullptr) << s.message();
+  }
+}
+
 }  // namespace
 }  // namespace fw

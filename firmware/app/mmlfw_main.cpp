@@ -91,7 +91,8 @@ void print_help() {
       "  --max-scans N, --duration S   stop after N scans or S seconds\n"
       "\n"
       "Config (key = value, '#' comments; the packaged example is /etc/mmlfw/mmlfw.conf):\n"
-      "  laser = socketcan:IFACE | serial:DEVICE[@BAUD]   (required)\n"
+      "  laser = can:IFACE | sick:DEVICE[@BAUD] | hokuyo:DEVICE[@BAUD][,intensity]\n"
+      "          | rplidar:DEVICE[@BAUD][,express|,force]   (required; socketcan: and serial: still accepted)\n"
       "  odometry = socketcan:IFACE | none    output = socketcan:IFACE | log    can_fd = auto|true|false\n"
       "  localizer = mml-track | mml | handoff | mcl | odom    map = IMAGE.mmap (mml-mapc)\n"
       "  workers, cores, realtime, global_context, global_period_scans, arena_mib, step_deadline_ms,\n"
@@ -311,9 +312,9 @@ int build_localizer(const Args& a, Startup* su) {
   su->track.odom_rot_per_m = c.odom_noise[3];
   su->track.odom_trans_per_step_m = c.odom_noise_per_step[0];
   su->track.odom_rot_per_step_rad = c.odom_noise_per_step[1] * 0.017453292f;
-  sys.track = &su->track;
   su->track.odom_slip_per_100m = c.odom_slip[0];
   su->track.odom_slip_max_m = c.odom_slip[1];
+  sys.track = &su->track;
   su->live = fw::track::live_global_schedule(c.global_period_scans);
   su->global_ctx = fw::track::global_context_for(c.global_period_scans);
   su->global_thread = c.global_threaded && !std::strcmp(c.localizer, "mml-track") && !a.preflight();
@@ -562,6 +563,9 @@ void print_summary(std::uint64_t step_errors) {
   const hal::Health& h = g_loop.health();
   const hal_can::CanNode* node = g_board.can_node();
   const hal::CanBusStats* bus = g_board.can_bus() ? &g_board.can_bus()->stats() : nullptr;
+  // SICK, Hokuyo or RPLIDAR: the same counters (hal_serial::SerialLaser).
+  const hal_serial::SerialLaserCounters sl =
+      g_board.serial_laser() ? g_board.serial_laser()->counters() : hal_serial::SerialLaserCounters{};
   std::fprintf(stderr,
                "mmlfw summary: {\"scans_processed\": %u, \"step_errors\": %llu, \"step_p50_ms\": %.3f, "
                "\"step_p99_ms\": %.3f, \"step_max_ms\": %.3f, \"cycle_p99_ms\": %.3f, \"deadline_misses\": %u, "
@@ -570,7 +574,8 @@ void print_summary(std::uint64_t step_errors) {
                "\"can_odometry\": %u, \"can_rx_frames\": %llu, \"can_rx_dropped\": %llu, \"can_error_frames\": %llu, "
                "\"can_bus_off\": %llu, \"can_tx_failed\": %llu, \"serial_scans\": %u, \"serial_crc_errors\": %u, "
                "\"invalid_scans\": %u, \"can_invalid_scans\": %u, \"serial_bad_measurements\": %u, "
-               "\"serial_reconnects\": %u, \"laser_timeouts\": %llu, \"fault_bits\": %u, "
+               "\"serial_reconnects\": %u, \"serial_dropped\": %u, \"serial_device_restarts\": %u, "
+               "\"laser_timeouts\": %llu, \"fault_bits\": %u, "
                "\"last_status\": \"%s\"}\n",
                h.scans_processed, static_cast<unsigned long long>(step_errors), step.p50_ms, step.p99_ms, step.max_ms,
                total.p99_ms, h.deadline_misses, h.dropped_scans, h.timeouts,
@@ -583,10 +588,9 @@ void print_summary(std::uint64_t step_errors) {
                bus ? static_cast<unsigned long long>(bus->error_frames) : 0ull,
                bus ? static_cast<unsigned long long>(bus->bus_off) : 0ull,
                bus ? static_cast<unsigned long long>(bus->tx_failed) : 0ull,
-               g_board.sick() ? g_board.sick()->stats().scans : 0,
-               g_board.sick() ? g_board.sick()->parser_stats().crc_errors : 0, h.invalid_scans,
-               node ? node->decoder_stats().invalid_scans : 0, g_board.sick() ? g_board.sick()->stats().bad_measurements : 0,
-               g_board.serial_reconnects(), static_cast<unsigned long long>(g_loop.counters().laser_timeouts),
+               sl.scans, sl.checksum_errors, h.invalid_scans, node ? node->decoder_stats().invalid_scans : 0,
+               sl.bad_measurements, g_board.serial_reconnects(), sl.dropped, sl.device_restarts,
+               static_cast<unsigned long long>(g_loop.counters().laser_timeouts),
                h.fault_bits, hal::status_name(g_loop.last_estimate().status));
 }
 

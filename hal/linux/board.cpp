@@ -23,7 +23,7 @@ Status parse_backend_spec(const char* what, const char* spec, char* kind, std::s
   }
   const std::size_t kl = static_cast<std::size_t>(colon - spec);
   if (kl == 0 || kl >= kind_len || !colon[1]) {
-    return Status::error(Errc::kInvalidArgument, "%s: '%s' is not KIND:ARG (socketcan:IFACE, serial:DEVICE[@BAUD])",
+    return Status::error(Errc::kInvalidArgument, "%s: '%s' is not KIND:ARG (socketcan:IFACE, sick|hokuyo|rplidar:DEVICE[@BAUD])",
                          what, spec);
   }
   if (std::strlen(colon + 1) >= arg_len) {
@@ -70,6 +70,98 @@ void Board::LogPoseSink::publish_health(const hal::Health& h) {
                    names);
 }
 
+std::uint32_t default_serial_baud(const char* kind) {
+  if (!std::strcmp(kind, "serial") || !std::strcmp(kind, "sick")) return 38400;
+  if (!std::strcmp(kind, "hokuyo") || !std::strcmp(kind, "rplidar")) return 115200;
+  return 0;
+}
+
+Status parse_serial_laser_spec(const char* kind, const char* arg, SerialLaserSpec* out) {
+  *out = SerialLaserSpec{};
+  if (std::strlen(arg) >= sizeof(out->device)) {
+    return Status::error(Errc::kInvalidArgument, "laser: %s:%s: argument too long", kind, arg);
+  }
+  std::strcpy(out->device, arg);
+  if (char* comma = std::strchr(out->device, ',')) {
+    *comma = '\0';
+    const char* opt = comma + 1;
+    const bool ok = (!std::strcmp(kind, "hokuyo") && !std::strcmp(opt, "intensity")) ||
+                    (!std::strcmp(kind, "rplidar") && (!std::strcmp(opt, "express") || !std::strcmp(opt, "force")));
+    if (!ok) {
+      return Status::error(Errc::kInvalidArgument, "laser: %s:%s: option '%s' unknown (hokuyo: intensity; rplidar: express, force)",
+                           kind, arg, opt);
+    }
+    std::snprintf(out->option, sizeof(out->option), "%s", opt);
+  }
+  out->baud = default_serial_baud(kind);
+  if (char* at = std::strchr(out->device, '@')) {
+    *at = '\0';
+    // Digits only and no wrap-around: "@4295005696" (2^32 + 38400) used to run at 38400 Bd.
+    const char* b = at + 1;
+    std::uint64_t v = 0;
+    bool ok = *b != '\0';
+    for (const char* c = b; ok && *c; ++c) {
+      ok = *c >= '0' && *c <= '9';
+      v = v * 10 + static_cast<std::uint64_t>(*c - '0');
+      if (v > 0xFFFFFFFFull) ok = false;
+    }
+    if (!ok) return Status::error(Errc::kInvalidArgument, "laser: baud '%s' is not a rate in Bd", b);
+    out->baud = static_cast<std::uint32_t>(v);
+  }
+  if (!out->device[0]) return Status::error(Errc::kInvalidArgument, "laser: %s:%s: no device", kind, arg);
+  return Status::ok();
+}
+
+// The RPLIDAR A1's USB adapter: DTR cleared runs the motor, set stops it (the SDK's
+// startMotor/stopMotor). A pty has no modem lines: refused, counted by the driver.
+bool Board::rplidar_motor(void* board, bool on) {
+  return static_cast<Board*>(board)->port_.set_dtr(!on).is_ok();
+}
+
+// Polls the driver until its handshake is done or handshake_ms passed (requests are resent
+// inside); the error names the port and what the device answered.
+Status Board::await_handshake(const char* kind, std::uint32_t handshake_ms) {
+  const std::uint64_t end = clock_.now_ns() + static_cast<std::uint64_t>(handshake_ms) * 1000000ull;
+  while (!serial_laser_->ready() && clock_.now_ns() < end && port_.is_open()) {
+    port_.wait_readable(20);
+    serial_laser_->poll(&handshake_scan_);
+  }
+  if (serial_laser_->ready()) return Status::ok();
+  char what[320];
+  serial_laser_->describe_handshake(what, sizeof(what));
+  return Status::error(Errc::kTimeout, "laser: %s on '%s' at %u Bd: no answer as a %s within %u ms: %s", kind,
+                       serial_device_, serial_baud_, serial_laser_->protocol_name(), handshake_ms, what);
+}
+
+Status Board::open_serial_laser(const char* kind, const char* arg, std::uint32_t handshake_ms) {
+  SerialLaserSpec ls;
+  FW_RETURN_IF_ERROR(parse_serial_laser_spec(kind, arg, &ls));
+  FW_RETURN_IF_ERROR(port_.open(ls.device, ls.baud));
+  std::snprintf(serial_device_, sizeof(serial_device_), "%s", ls.device);
+  serial_baud_ = ls.baud;
+  serial_down_ = false;
+  if (!std::strcmp(kind, "hokuyo")) {
+    hal_serial::HokuyoOptions o;
+    o.intensity = !std::strcmp(ls.option, "intensity");
+    hokuyo_.init(&port_, &clock_, o);
+    serial_laser_ = &hokuyo_;
+  } else if (!std::strcmp(kind, "rplidar")) {
+    hal_serial::RplidarOptions o;
+    if (!std::strcmp(ls.option, "express")) o.mode = hal_serial::RplidarScanMode::kExpress;
+    if (!std::strcmp(ls.option, "force")) o.mode = hal_serial::RplidarScanMode::kForceScan;
+    rplidar_.init(&port_, &clock_, o);
+    rplidar_.set_motor_control(&Board::rplidar_motor, this);
+    serial_laser_ = &rplidar_;
+  } else {
+    sick_.init(&port_, &clock_, hal_serial::SickLaserOptions{});
+    serial_laser_ = &sick_;
+  }
+  if (!serial_laser_->start()) {
+    return Status::error(Errc::kIoError, "laser: %s on '%s': request write failed", kind, ls.device);
+  }
+  return await_handshake(kind, handshake_ms);
+}
+
 Status Board::create(const BoardSpec& spec) {
   log_ = StderrLogSink(spec.log_level);
   hal_ = hal::Hal{};
@@ -77,14 +169,16 @@ Status Board::create(const BoardSpec& spec) {
   hal_.log = &log_;
   char lkind[16], larg[kMaxBackendArg];
   FW_RETURN_IF_ERROR(parse_backend_spec("laser", spec.laser, lkind, sizeof(lkind), larg, sizeof(larg)));
+  if (std::strcmp(lkind, "can") == 0) std::strcpy(lkind, "socketcan");  // laser = can:IFACE
   const bool laser_can = std::strcmp(lkind, "socketcan") == 0;
-  const bool laser_serial = std::strcmp(lkind, "serial") == 0;
-  if (!laser_can && !laser_serial) {
-    return Status::error(Errc::kInvalidArgument, "laser: backend '%s' unknown (socketcan:IFACE or serial:DEVICE)",
-                         lkind);
+  if (!laser_can && default_serial_baud(lkind) == 0) {
+    return Status::error(Errc::kInvalidArgument,
+                         "laser: backend '%s' unknown (can:IFACE, sick:DEVICE, hokuyo:DEVICE, rplidar:DEVICE)", lkind);
   }
-  const char* odom_spec = spec.odometry ? spec.odometry : (laser_can ? spec.laser : "none");
-  const char* out_spec = spec.output ? spec.output : (laser_can ? spec.laser : "log");
+  char can_spec[kMaxBackendArg + 16];
+  std::snprintf(can_spec, sizeof(can_spec), "socketcan:%s", larg);
+  const char* odom_spec = spec.odometry ? spec.odometry : (laser_can ? can_spec : "none");
+  const char* out_spec = spec.output ? spec.output : (laser_can ? can_spec : "log");
   char okind[16], oarg[kMaxBackendArg], pkind[16], parg[kMaxBackendArg];
   FW_RETURN_IF_ERROR(parse_backend_spec("odometry", odom_spec, okind, sizeof(okind), oarg, sizeof(oarg)));
   FW_RETURN_IF_ERROR(parse_backend_spec("output", out_spec, pkind, sizeof(pkind), parg, sizeof(parg)));
@@ -127,42 +221,28 @@ Status Board::create(const BoardSpec& spec) {
   if (laser_can) {
     hal_.laser = &node_.laser();
   } else {
-    // serial:DEVICE[@BAUD]
-    char dev[kMaxBackendArg];
-    std::strcpy(dev, larg);
-    std::uint32_t baud = 38400;
-    if (char* at = std::strchr(dev, '@')) {
-      *at = '\0';
-      // Digits only and no wrap-around: "@4295005696" (2^32 + 38400) used to run at 38400 Bd.
-      const char* b = at + 1;
-      std::uint64_t v = 0;
-      bool ok = *b != '\0';
-      for (const char* c = b; ok && *c; ++c) {
-        ok = *c >= '0' && *c <= '9';
-        v = v * 10 + static_cast<std::uint64_t>(*c - '0');
-        if (v > 0xFFFFFFFFull) ok = false;
-      }
-      if (!ok) return Status::error(Errc::kInvalidArgument, "laser: baud '%s' is not a rate in Bd", b);
-      baud = static_cast<std::uint32_t>(v);
-    }
-    FW_RETURN_IF_ERROR(port_.open(dev, baud));
-    std::snprintf(serial_device_, sizeof(serial_device_), "%s", dev);
-    serial_baud_ = baud;
-    serial_down_ = false;
-    sick_.init(&port_, &clock_, hal_serial::SickLaserOptions{});
-    if (!sick_.start()) return Status::error(Errc::kIoError, "laser: serial '%s': request write failed", dev);
-    sick_used_ = true;
-    hal_.laser = &sick_;
+    FW_RETURN_IF_ERROR(open_serial_laser(lkind, larg, spec.laser_handshake_ms));
+    hal_.laser = serial_laser_;
   }
   hal_.odometry = std::strcmp(okind, "socketcan") == 0 ? &node_.odometry() : static_cast<hal::OdometrySource*>(&zero_odom_);
   hal_.pose_sink = std::strcmp(pkind, "socketcan") == 0 ? &node_.pose_sink() : static_cast<hal::PoseSink*>(&log_sink_pose_);
-  std::snprintf(description_, sizeof(description_), "laser=%s odometry=%s output=%s%s", spec.laser, odom_spec,
+  char device[96] = "";
+  if (serial_laser_ == &hokuyo_) {
+    const hal_serial::ScipParameters& pp = hokuyo_.parameters();
+    std::snprintf(device, sizeof(device), " (%.40s, steps %u..%u of %u, %u..%u mm)", hokuyo_.product(), pp.amin, pp.amax,
+                  pp.ares, pp.dmin_mm, pp.dmax_mm);
+  } else if (serial_laser_ == &rplidar_) {
+    const hal_serial::RplidarInfo& i = rplidar_.info();
+    std::snprintf(device, sizeof(device), " (RPLIDAR model 0x%02X, firmware %u.%02u, hardware %u, health %u)", i.model,
+                  i.firmware_major, i.firmware_minor, i.hardware, rplidar_.health().status);
+  }
+  std::snprintf(description_, sizeof(description_), "laser=%s%s odometry=%s output=%s%s", spec.laser, device, odom_spec,
                 out_spec, can_iface ? (can_fd_ ? " (CAN FD)" : " (classic CAN)") : "");
   return Status::ok();
 }
 
 void Board::service_serial_link() {
-  if (!sick_used_) return;
+  if (serial_laser_ == nullptr) return;
   const std::uint64_t now = clock_.now_ns();
   if (!serial_down_) {
     if (port_.is_open()) return;
@@ -180,11 +260,12 @@ void Board::service_serial_link() {
   }
   if (now < serial_retry_ns_) return;
   const Status s = port_.open(serial_device_, serial_baud_);
-  if (s.is_ok() && sick_.restart()) {
+  if (s.is_ok() && serial_laser_->restart()) {
     serial_down_ = false;
     ++serial_reconnects_;
-    log_.log(hal::LogLevel::kInfo, "laser: serial '%s' reopened after %.1f s (%u attempts); continuous output requested",
-             serial_device_, static_cast<double>(now - serial_down_ns_) * 1e-9, serial_failed_attempts_ + 1);
+    log_.log(hal::LogLevel::kInfo, "laser: serial '%s' reopened after %.1f s (%u attempts); %s scans requested",
+             serial_device_, static_cast<double>(now - serial_down_ns_) * 1e-9, serial_failed_attempts_ + 1,
+             serial_laser_->protocol_name());
     return;
   }
   if (s.is_ok()) port_.hang_up(0);  // opened but the request could not be written: try again later

@@ -135,5 +135,64 @@ TEST(BoardSerial, PeerClosesThenReturns) {
   ::rmdir(dir);
 }
 
+TEST(BoardSerial, LaserSpecsOfTheSerialLasers) {
+  SerialLaserSpec ls;
+  ASSERT_TRUE(parse_serial_laser_spec("rplidar", "/dev/ttyUSB0@256000,express", &ls).is_ok());
+  EXPECT_STREQ(ls.device, "/dev/ttyUSB0");
+  EXPECT_EQ(ls.baud, 256000u);
+  EXPECT_STREQ(ls.option, "express");
+  ASSERT_TRUE(parse_serial_laser_spec("hokuyo", "/dev/ttyACM0", &ls).is_ok());
+  EXPECT_EQ(ls.baud, 115200u);  // the default of a Hokuyo (USB-ACM ignores it)
+  ASSERT_TRUE(parse_serial_laser_spec("sick", "/dev/ttyS0", &ls).is_ok());
+  EXPECT_EQ(ls.baud, 38400u);
+  fw::Status s = parse_serial_laser_spec("hokuyo", "/dev/ttyACM0,express", &ls);
+  ASSERT_FALSE(s.is_ok());
+  EXPECT_NE(std::string(s.message()).find("option 'express' unknown"), std::string::npos) << s.message();
+  EXPECT_FALSE(parse_serial_laser_spec("rplidar", "/dev/ttyUSB0@9x", &ls).is_ok());
+}
+
+// Issue 59: a device that is not the configured laser is a start-up error naming the port and what
+// it answered (a SICK-like peer that says something else, a silent one).
+TEST(BoardSerial, WrongDeviceIsAStartupErrorNamingPortAndAnswer) {
+  char dir[] = "/tmp/mmlfw-board-serial.XXXXXX";
+  ASSERT_NE(::mkdtemp(dir), nullptr);
+  const std::string link = std::string(dir) + "/ttyLIDAR";
+  {
+    Peer peer;
+    ASSERT_TRUE(peer.open(link));
+    const char junk[] = "Welcome to the LD06\r\n";
+    ASSERT_EQ(::write(peer.master, junk, sizeof(junk) - 1), static_cast<ssize_t>(sizeof(junk) - 1));
+    static Board board;
+    BoardSpec spec;
+    const std::string laser = "hokuyo:" + link + "@115200";
+    spec.laser = laser.c_str();
+    spec.log_level = hal::LogLevel::kError;
+    spec.laser_handshake_ms = 400;
+    const fw::Status s = board.create(spec);
+    ASSERT_FALSE(s.is_ok());
+    const std::string m = s.message();
+    EXPECT_NE(m.find(link), std::string::npos) << m;
+    EXPECT_NE(m.find("no answer as a hokuyo within 400 ms"), std::string::npos) << m;
+    EXPECT_NE(m.find("Welcome to the LD06"), std::string::npos) << m;
+  }
+  {
+    Peer peer;
+    ASSERT_TRUE(peer.open(link));
+    static Board board;
+    BoardSpec spec;
+    const std::string laser = "rplidar:" + link;
+    spec.laser = laser.c_str();
+    spec.log_level = hal::LogLevel::kError;
+    spec.laser_handshake_ms = 300;
+    const fw::Status s = board.create(spec);
+    ASSERT_FALSE(s.is_ok());
+    const std::string m = s.message();
+    EXPECT_NE(m.find(link), std::string::npos) << m;
+    EXPECT_NE(m.find("waiting for the GET_HEALTH answer"), std::string::npos) << m;
+    EXPECT_NE(m.find("nothing"), std::string::npos) << m;
+  }
+  ::rmdir(dir);
+}
+
 }  // namespace
 }  // namespace hal_linux

@@ -16,6 +16,7 @@ void RplidarRevolution::init(const RplidarRevolutionOptions& options) {
 }
 
 void RplidarRevolution::reset() {
+  if (started_ && count_ > 0) ++stats_.partial;  // a turn cut off by a restart
   started_ = false;
   count_ = 0;
 }

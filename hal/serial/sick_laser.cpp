@@ -1,5 +1,7 @@
 #include "hal_serial/sick_laser.h"
 
+#include <cstdio>
+
 namespace hal_serial {
 
 void SickLaser::init(hal::SerialPort* port, const hal::Clock* clock, const SickLaserOptions& options) {
@@ -29,6 +31,20 @@ bool SickLaser::restart() {
 std::uint32_t SickLaser::fault_bits() const {
   if (port_ != nullptr && !port_->connected()) return static_cast<std::uint32_t>(hal::HealthFault::kLaserDisconnected);
   return 0;
+}
+
+void SickLaser::describe_handshake(char* out, std::size_t cap) const {
+  std::snprintf(out, cap, "continuous output requested; %u telegrams, %u CRC errors so far", parser_.stats().telegrams,
+                parser_.stats().crc_errors);
+}
+
+SerialLaserCounters SickLaser::counters() const {
+  SerialLaserCounters c;
+  c.scans = stats_.scans;
+  c.checksum_errors = parser_.stats().crc_errors;
+  c.bad_measurements = stats_.bad_measurements;
+  c.dropped = parser_.stats().bad_length;
+  return c;
 }
 
 void SickLaser::convert(const MeasuredValues& v, std::uint64_t t_ns) {

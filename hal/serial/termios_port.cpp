@@ -4,10 +4,13 @@
 #include <fcntl.h>
 #include <poll.h>
 #include <string.h>
+#include <sys/ioctl.h>
 #include <termios.h>
 #include <unistd.h>
 
 #include <cstring>
+
+#include "termios_custom_rate.h"
 
 namespace hal_serial {
 namespace {
@@ -22,7 +25,10 @@ bool speed_of(std::uint32_t baud, speed_t* out) {
     case 57600: *out = B57600; return true;
     case 115200: *out = B115200; return true;
     case 230400: *out = B230400; return true;
+    case 460800: *out = B460800; return true;
     case 500000: *out = B500000; return true;
+    case 921600: *out = B921600; return true;
+    case 1000000: *out = B1000000; return true;
     default: return false;
   }
 }
@@ -63,9 +69,18 @@ Status TermiosPort::open(const char* device, std::uint32_t baud) {
 
 Status TermiosPort::set_baud(std::uint32_t baud) {
   speed_t sp;
+  if (baud == 256000) {  // RPLIDAR A3/S1: no B256000, the kernel's termios2 rate instead
+    if (fd_ < 0) return Status::error(Errc::kIoError, "serial '%s': not open", device_);
+    std::uint32_t actual = 0;
+    const int e = set_custom_rate(fd_, baud, &actual);
+    if (e != 0) return Status::error(Errc::kUnsupported, "serial '%s': %u Bd refused: %s", device_, baud, strerror(e));
+    if (actual != baud) return Status::error(Errc::kUnsupported, "serial '%s': %u Bd not kept (%u)", device_, baud, actual);
+    baud_ = baud;
+    return Status::ok();
+  }
   if (!speed_of(baud, &sp)) {
-    return Status::error(Errc::kInvalidArgument, "serial '%s': baud %u not supported (9600..230400, 500000)", device_,
-                         baud);
+    return Status::error(Errc::kInvalidArgument, "serial '%s': baud %u not supported (%s)", device_, baud,
+                         kSupportedBauds);
   }
   termios t{};
   if (fd_ < 0 || ::tcgetattr(fd_, &t) != 0) return Status::error(Errc::kIoError, "serial '%s': not open", device_);
@@ -80,6 +95,16 @@ Status TermiosPort::set_baud(std::uint32_t baud) {
     return Status::error(Errc::kUnsupported, "serial '%s': %u Bd not kept by the driver", device_, baud);
   }
   baud_ = baud;
+  return Status::ok();
+}
+
+Status TermiosPort::set_dtr(bool asserted) {
+  if (fd_ < 0) return Status::error(Errc::kIoError, "serial '%s': not open", device_);
+  int bits = TIOCM_DTR;
+  if (::ioctl(fd_, asserted ? TIOCMBIS : TIOCMBIC, &bits) != 0) {
+    const int e = errno;
+    return Status::error(Errc::kUnsupported, "serial '%s': DTR cannot be set: %s", device_, strerror(e));
+  }
   return Status::ok();
 }
 

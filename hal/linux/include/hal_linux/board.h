@@ -1,8 +1,13 @@
 // Board: the Linux backend set behind hal::Hal (ArduPilot style: the backend is chosen when the
 // binary is linked and configured at start-up; firmware code never includes a backend).
 // create_board() builds the HAL from backend specs:
-//   laser:    "socketcan:IFACE"  scans as the mmlfw CAN message set (hal/can)
-//             "serial:DEVICE[@BAUD]"  SICK LMS2xx telegrams on a serial port (hal/serial)
+//   laser:    "socketcan:IFACE" | "can:IFACE"  scans as the mmlfw CAN message set (hal/can)
+//             "sick:DEVICE[@BAUD]" | "serial:DEVICE[@BAUD]"  SICK LMS2xx telegrams (hal/serial) [38400]
+//             "hokuyo:DEVICE[@BAUD][,intensity]"  Hokuyo URG/UTM/UST, SCIP 2.0 [115200; USB-ACM ignores it]
+//             "rplidar:DEVICE[@BAUD][,express|,force]"  Slamtec RPLIDAR (SCAN, EXPRESS_SCAN legacy,
+//                        FORCE_SCAN) [115200: A1/A2; 256000: A3/S1; 1000000: S2]
+//             Hokuyo and RPLIDAR answer a start-up handshake; a device that does not within
+//             BoardSpec::laser_handshake_ms is an error naming the port and what it answered.
 //   odometry: "socketcan:IFACE" | "none" (zero odometry at the scan rate: a parked robot)
 //   output:   "socketcan:IFACE" (pose + health frames) | "log" (text on stderr)
 // One SocketCanBus per distinct interface; everything is a member (no heap).
@@ -16,6 +21,9 @@
 #include "hal_can/can_node.h"
 #include "hal_linux/linux_clock.h"
 #include "hal_linux/stderr_log_sink.h"
+#include "hal_serial/hokuyo_laser.h"
+#include "hal_serial/rplidar_laser.h"
+#include "hal_serial/serial_laser.h"
 #include "hal_serial/sick_laser.h"
 #include "hal_serial/termios_port.h"
 #include "hal_socketcan/socketcan_bus.h"
@@ -28,12 +36,23 @@ struct BoardSpec {
   const char* output = nullptr;    // nullptr = same as laser when that is socketcan, else "log"
   int can_fd = -1;                 // -1 auto (FD when the interface MTU allows), 0 classic, 1 require FD
   hal::LogLevel log_level = hal::LogLevel::kInfo;
+  std::uint32_t laser_handshake_ms = 3000;  // Hokuyo / RPLIDAR start-up answers (retried within it)
 };
 
 // Longest "arg" of a backend spec + 1 (the config's laser/odometry/output values are < 128).
 constexpr std::size_t kMaxBackendArg = 128;
 
-// Parses "kind:arg" (kind socketcan|serial) into the parts; errors name the spec and say whether
+// A serial laser spec "DEVICE[@BAUD][,OPTION]" taken apart (board.cpp; the config checks it too).
+struct SerialLaserSpec {
+  char device[kMaxBackendArg] = {0};
+  std::uint32_t baud = 0;  // 0 = the protocol's default
+  char option[16] = {0};   // "", "intensity", "express", "force"
+};
+// Errors name the spec and the part that is wrong.
+fw::Status parse_serial_laser_spec(const char* kind, const char* arg, SerialLaserSpec* out);
+std::uint32_t default_serial_baud(const char* kind);
+
+// Parses "kind:arg" (kind socketcan|can|serial|sick|hokuyo|rplidar) into the parts; errors name the spec and say whether
 // it is malformed or too long.
 fw::Status parse_backend_spec(const char* what, const char* spec, char* kind, std::size_t kind_len, char* arg,
                               std::size_t arg_len);
@@ -61,7 +80,11 @@ class Board {
   bool can_fd() const { return can_fd_; }
   const hal_can::CanNode* can_node() const { return node_used_ ? &node_ : nullptr; }
   const hal_socketcan::SocketCanBus* can_bus() const { return bus_.is_open() ? &bus_ : nullptr; }
-  const hal_serial::SickLaser* sick() const { return sick_used_ ? &sick_ : nullptr; }
+  const hal_serial::SickLaser* sick() const { return serial_laser_ == &sick_ ? &sick_ : nullptr; }
+  const hal_serial::HokuyoLaser* hokuyo() const { return serial_laser_ == &hokuyo_ ? &hokuyo_ : nullptr; }
+  const hal_serial::RplidarLaser* rplidar() const { return serial_laser_ == &rplidar_ ? &rplidar_ : nullptr; }
+  // The serial laser in use (SICK, Hokuyo or RPLIDAR), nullptr for a CAN laser.
+  const hal_serial::SerialLaser* serial_laser() const { return serial_laser_; }
   const char* describe() const { return description_; }
 
  private:
@@ -92,9 +115,15 @@ class Board {
   bool node_used_ = false;
   bool can_fd_ = false;
   void service_serial_link();
+  fw::Status open_serial_laser(const char* kind, const char* arg, std::uint32_t handshake_ms);
+  fw::Status await_handshake(const char* kind, std::uint32_t handshake_ms);
+  static bool rplidar_motor(void* board, bool on);
   hal_serial::TermiosPort port_;
   hal_serial::SickLaser sick_;
-  bool sick_used_ = false;
+  hal_serial::HokuyoLaser hokuyo_;
+  hal_serial::RplidarLaser rplidar_;
+  hal_serial::SerialLaser* serial_laser_ = nullptr;
+  hal::LaserScan handshake_scan_;  // a scan polled while the handshake ends is dropped here
   char serial_device_[kMaxBackendArg] = {0};
   std::uint32_t serial_baud_ = 0;
   bool serial_down_ = false;            // lost and not yet reopened
@@ -106,7 +135,7 @@ class Board {
   int serial_hup_polls_ = 0;            // consecutive waits that saw a hang-up with data pending
   ZeroOdometry zero_odom_;
   LogPoseSink log_sink_pose_;
-  char description_[200] = {0};
+  char description_[512] = {0};
 };
 
 }  // namespace hal_linux

@@ -10,6 +10,7 @@
 #include "hal/clock.h"
 #include "hal/sensor_io.h"
 #include "hal/serial_port.h"
+#include "hal_serial/serial_laser.h"
 #include "hal_serial/sick_telegram.h"
 
 namespace hal_serial {
@@ -30,14 +31,20 @@ struct SickLaserStats {
   std::uint32_t restarts = 0;          // restart() after the port was reopened
 };
 
-class SickLaser final : public hal::LaserScanSource {
+class SickLaser final : public SerialLaser {
  public:
   void init(hal::SerialPort* port, const hal::Clock* clock, const SickLaserOptions& options);
   // Sends the request for continuous output (if configured). False if the write failed.
-  bool start();
+  bool start() override;
   // After the port was reopened (the scanner or its cable came back): forgets the partial
   // telegram of the old connection and requests continuous output again.
-  bool restart();
+  bool restart() override;
+  // The LMS2xx streams once asked (its 0xA0 acknowledgement is counted, not awaited: a scanner
+  // already streaming never sends one), so there is no start-up handshake to wait for.
+  bool ready() const override { return true; }
+  void describe_handshake(char* out, std::size_t cap) const override;
+  SerialLaserCounters counters() const override;
+  const char* protocol_name() const override { return "sick"; }
   bool poll(hal::LaserScan* out) override;
   // laser-disconnected while the port is gone; CRC-valid telegrams with impossible content.
   std::uint32_t fault_bits() const override;

@@ -1,5 +1,7 @@
-// TermiosPort: hal::SerialPort on a Linux tty (termios): raw 8N1, non-blocking, standard rates
-// and 500 kBd (B500000) where the driver accepts it; the rate is read back and verified.
+// TermiosPort: hal::SerialPort on a Linux tty (termios): raw 8N1, non-blocking, standard rates,
+// 460800/500000/921600/1000000 Bd where the driver accepts them and 256000 Bd (RPLIDAR A3/S1)
+// through termios2; the rate is read back and verified. DTR can be set (the RPLIDAR A1 adapter's
+// motor enable).
 // A port whose peer went away (pty master closed: EIO; USB adapter unplugged: ENODEV/ENXIO; a
 // hang-up seen by poll) is closed by read()/hang_up() and reports connected() == false, so the
 // caller stops polling a dead descriptor (it used to spin ~7000 reads a second) and reopens it.
@@ -13,6 +15,8 @@
 
 namespace hal_serial {
 
+constexpr const char* kSupportedBauds = "9600, 19200, 38400, 57600, 115200, 230400, 256000, 460800, 500000, 921600, 1000000";
+
 class TermiosPort final : public hal::SerialPort {
  public:
   TermiosPort() = default;
@@ -20,10 +24,12 @@ class TermiosPort final : public hal::SerialPort {
   TermiosPort& operator=(const TermiosPort&) = delete;
   ~TermiosPort() override { close(); }
 
-  // baud: 9600, 19200, 38400, 57600, 115200, 230400, 500000. Errors name the device.
+  // baud: one of kSupportedBauds. Errors name the device.
   fw::Status open(const char* device, std::uint32_t baud);
   // Changes the rate of an open port (after the scanner acknowledged a baud-rate change).
   fw::Status set_baud(std::uint32_t baud);
+  // Asserts or clears DTR (TIOCMBIS/TIOCMBIC); a port without modem lines (a pty) refuses.
+  fw::Status set_dtr(bool asserted);
   void close();
   bool is_open() const { return fd_ >= 0; }
   int native_handle() const { return fd_; }
