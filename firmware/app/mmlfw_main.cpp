@@ -441,6 +441,7 @@ int memory_budget(const Args& a, const Startup& su) {
 // Service manager: READY=1 and the first STATUS= once start-up is done; the watchdog feed starts.
 hal::PoseEstimate g_status_sent{};
 std::uint32_t g_faults_sent = 0;
+std::uint64_t g_status_sent_ns = 0;
 void send_status() {
   char text[192];
   fw::format_service_status(text, sizeof(text), g_loop.last_estimate(), g_loop.health());
@@ -454,6 +455,7 @@ void notify_ready(std::uint64_t now_ns) {
   const fw::Status st = g_notify.send("READY=1");
   if (!st) g_board.hal().log->log(hal::LogLevel::kWarning, "mmlfw: %s", st.message());
   send_status();
+  g_status_sent_ns = now_ns;
   const hal::Health& h = g_loop.health();
   g_watchdog.start(g_notify.watchdog_period_ns(), now_ns, h.scans_processed, h.deadline_misses);
   g_board.hal().log->log(hal::LogLevel::kInfo, "mmlfw: service manager notified on '%s' (watchdog %s, check every %.0f ms)",
@@ -461,8 +463,8 @@ void notify_ready(std::uint64_t now_ns) {
                          g_watchdog.check_interval_ns() * 1e-6);
 }
 // One sensor-loop cycle: WATCHDOG=1 while the loop keeps its deadline (firmware/app/service_notify.h),
-// STATUS= when the status, its reason or the faults changed. A failed send is logged once per
-// kind and counted (the manager restarting is no reason for the firmware to stop).
+// STATUS= when the status, its reason or the faults changed (at most every 250 ms). A failed send
+// is logged once per kind and counted (the manager restarting is no reason for the firmware to stop).
 void notify_cycle(std::uint64_t now_ns) {
   if (!g_notify.enabled()) return;
   const hal::Health& h = g_loop.health();
@@ -470,7 +472,11 @@ void notify_cycle(std::uint64_t now_ns) {
     const fw::Status st = g_notify.send("WATCHDOG=1");
     if (!st && g_notify.failed() == 1) g_board.hal().log->log(hal::LogLevel::kWarning, "mmlfw: %s", st.message());
   }
-  if (fw::service_status_changed(g_status_sent, g_faults_sent, g_loop.last_estimate(), h.fault_bits)) send_status();
+  if (fw::service_status_due(g_status_sent, g_faults_sent, g_loop.last_estimate(), h.fault_bits, now_ns,
+                             g_status_sent_ns)) {
+    send_status();
+    g_status_sent_ns = now_ns;
+  }
 }
 // --test-stall-after: the sensor loop hangs (no steps, no feed) until a signal ends the process.
 void stall_for_test() {

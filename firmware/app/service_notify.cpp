@@ -58,4 +58,11 @@ bool service_status_changed(const hal::PoseEstimate& previous, std::uint32_t pre
   return previous.status != estimate.status || previous.reason != estimate.reason || previous_faults != faults;
 }
 
+bool service_status_due(const hal::PoseEstimate& previous, std::uint32_t previous_faults,
+                        const hal::PoseEstimate& estimate, std::uint32_t faults, std::uint64_t now_ns,
+                        std::uint64_t last_sent_ns) {
+  return service_status_changed(previous, previous_faults, estimate, faults) &&
+         now_ns - last_sent_ns >= kServiceStatusMinIntervalNs;
+}
+
 }  // namespace fw

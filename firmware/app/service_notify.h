@@ -50,4 +50,14 @@ std::size_t format_service_status(char* buf, std::size_t len, const hal::PoseEst
 bool service_status_changed(const hal::PoseEstimate& previous, std::uint32_t previous_faults,
                             const hal::PoseEstimate& estimate, std::uint32_t faults);
 
+// STATUS= goes out at most this often: a status that flips on every scan (75 Hz) must not flood
+// the service manager; the last change is sent once the interval has passed.
+constexpr std::uint64_t kServiceStatusMinIntervalNs = 250000000ull;
+
+// True when a STATUS= is due now: changed since the last one sent (at last_sent_ns) and at least
+// kServiceStatusMinIntervalNs after it.
+bool service_status_due(const hal::PoseEstimate& previous, std::uint32_t previous_faults,
+                        const hal::PoseEstimate& estimate, std::uint32_t faults, std::uint64_t now_ns,
+                        std::uint64_t last_sent_ns);
+
 }  // namespace fw

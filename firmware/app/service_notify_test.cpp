@@ -93,5 +93,14 @@ TEST(ServiceStatus, ChangesOnStatusReasonOrFaultsOnly) {
   EXPECT_TRUE(service_status_changed(a, 0, a, 1u << 16));
 }
 
+TEST(ServiceStatus, AFlappingStatusIsSentAtMostEveryInterval) {
+  hal::PoseEstimate sent, now;
+  now.status = hal::LocalizationStatus::kLocalized;
+  const std::uint64_t t0 = 1000 * kMs;
+  EXPECT_FALSE(service_status_due(sent, 0, now, 0, t0 + 10 * kMs, t0));   // changed, but 10 ms after the last
+  EXPECT_TRUE(service_status_due(sent, 0, now, 0, t0 + 250 * kMs, t0));   // still changed: sent once due
+  EXPECT_FALSE(service_status_due(now, 0, now, 0, t0 + 900 * kMs, t0));   // unchanged: never
+}
+
 }  // namespace
 }  // namespace fw
