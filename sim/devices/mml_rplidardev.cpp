@@ -43,7 +43,7 @@ struct Counts {
 
 // Damage to the bytes of one tenth of turn k (the middle tenth); true if it damaged them.
 bool damage(const Faults& f, size_t k, bool express, std::mt19937* rng, std::string* bytes, Counts* c) {
-  if (bytes->size() < 100) return false;
+  if (bytes->size() < 10) return false;
   if (f.corrupt && k % f.corrupt == 0) {
     const size_t rec = express ? 84 : 5;
     const size_t p = (bytes->size() / rec / 2) * rec;

@@ -61,6 +61,27 @@ int main(int argc, char** argv) {
   copy_num(j, s, "serial_scans_sent");
   copy_num(j, s, "serial_scans_received");
 
+  // Issue 59: Hokuyo and RPLIDAR over a pty (hil_serial_lidar.sh): clean streams with line faults
+  // (every intact answer / turn a scan) and the fault runs (truncation, reset mid-scan, motor stop,
+  // health error, clock wrap: scans resume, no crash, no hang).
+  for (const char* sensor : {"hokuyo", "rplidar"}) {
+    for (const char* mode : {"clean", "faults"}) {
+      std::printf("bench_hal: %s over a socat pty pair (%s) ...\n", sensor, mode);
+      std::fflush(stdout);
+      const std::string tag = std::string(sensor) + "-" + mode;
+      const int rc = std::system(("bash " + src + "/tests/hil/hil_serial_lidar.sh " + build + " " + sensor + " " + mode +
+                                  " > " + build + "/hil_serial_" + tag + ".log 2>&1").c_str());
+      const std::string r = read_all(build + "/hil/serial-" + tag + "/results.json");
+      const std::string key = std::string(sensor) + "_" + mode + "_ok";
+      std::string v;
+      const bool ok = rc == 0 && json_value(r, key, &v) && v == "true";
+      j.add_bool(std::string(sensor) + (std::string(mode) == "clean" ? "_pty_ok" : "_faults_passed"), ok);
+      for (const char* k : {"_units_sent", "_scans", "_checksum_errors", "_dropped", "_device_restarts"}) {
+        copy_num(j, r, std::string(sensor) + "_" + mode + k);
+      }
+    }
+  }
+
   std::printf("bench_hal: 75 Hz host replay (aces, mmlfw's default localizer, 2 pinned workers) ...\n");
   std::fflush(stdout);
   mmlfw_hil::ReplayOptions o;
