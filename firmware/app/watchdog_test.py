@@ -9,7 +9,7 @@ as systemd would (WatchdogSec=), and reads the datagrams with their arrival time
          watchdog periods while the process is still alive (systemd would kill and restart it).
   watchdog_test.py MMLFW [--summary FILE]
 """
-import os, signal, socket, subprocess, sys, tempfile, time
+import os, shutil, signal, socket, subprocess, sys, tempfile, time
 
 PERIOD_S = 0.5  # WATCHDOG_USEC: the firmware checks every 0.25 s
 
@@ -102,6 +102,10 @@ def main():
     if summary:
         with open(summary, "w") as f:
             f.write("healthy_ok %d\nstall_stops_watchdog %d\n" % (healthy_ok, stall_ok))
+    if not failures:
+        shutil.rmtree(work, ignore_errors=True)
+    else:
+        print("watchdog_test: firmware logs in " + work)
     print("watchdog_test: " + ("all passed" if not failures else "FAILED: " + ", ".join(failures)))
     return 1 if failures else 0
 

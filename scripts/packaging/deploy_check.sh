@@ -5,8 +5,9 @@
 #      architecture, Depends, contents and conffile; its binary run (amd64 natively, arm64 and
 #      armhf under qemu-user): --help, --check-config on a good and on a broken config.
 #   2. lintian on every package (errors and warnings counted, the warning tags listed).
-#   3. --check-config on good and bad configs and maps (firmware/app/check_config_test.sh) and the
-#      sd_notify / watchdog test against a real socket (firmware/app/watchdog_test.py).
+#   3. --check-config on good and bad configs and maps (firmware/app/check_config_test.sh), on CAN
+#      interfaces in the HIL's guest kernel (vcan), and the sd_notify / watchdog test against a real
+#      socket (firmware/app/watchdog_test.py).
 #   4. a Debian bookworm root with systemd (debootstrap, once, in build/deploy-guest/root): the amd64
 #      package installed with dpkg --root (maintainer scripts chrooted) and its unit checked with
 #      systemd-analyze verify (which must also reject a planted broken copy); then a fresh copy
@@ -152,6 +153,32 @@ if [ -x "$AMD/firmware/app/mmlfw" ] && [ -x "$MAPC" ]; then
   key notify_watchdog_stops_on_stall "$(awk '/^stall_stops_watchdog/ {print ($2 == 1 ? "true" : "false")}' "$L/watchdog.txt" 2>/dev/null || echo null)"
 else
   key check_config_ok null; key check_config_bad_inputs_rejected null
+fi
+
+# The board's CAN interface through --check-config in a kernel that has CAN (this one may not):
+# vcan0 (FD) ok, a missing interface and an FD config on the classic vcan1 rejected, inside the
+# HIL's guest (tests/hil/run-in-guest.sh: user-mode Linux, else QEMU).
+if [ -x "$AMD/firmware/app/mmlfw" ]; then
+  printf 'laser = socketcan:vcan0\nlocalizer = odom\narena_mib = 8\n' > "$W/vcan0.conf"
+  printf 'laser = socketcan:mmlfwcan9\nlocalizer = odom\narena_mib = 8\n' > "$W/nocan.conf"
+  printf 'laser = socketcan:vcan1\nlocalizer = odom\ncan_fd = true\narena_mib = 8\n' > "$W/fdclassic.conf"
+  amd_abs=$(cd "$AMD" && pwd)
+  cat > "$W/can_check.sh" <<CAN
+#!/bin/bash
+for c in vcan0 nocan fdclassic; do "$amd_abs/firmware/app/mmlfw" --check-config "$W/\$c.conf" > "$W/can-\$c.out" 2>&1; echo \$? > "$W/can-\$c.rc"; done
+CAN
+  chmod +x "$W/can_check.sh"
+  rm -f "$W"/can-*.rc
+  timeout 300 tests/hil/run-in-guest.sh "$W/can_check.sh" > "$L/can_check.log" 2>&1
+  if [ -f "$W/can-vcan0.rc" ]; then
+    if [ "$(cat "$W/can-vcan0.rc")" = 0 ] && grep -q ": ok, static memory" "$W/can-vcan0.out" &&
+       [ "$(cat "$W/can-nocan.rc")" = 1 ] && grep -q "socketcan 'mmlfwcan9': no such interface" "$W/can-nocan.out" &&
+       [ "$(cat "$W/can-fdclassic.rc")" = 1 ] && grep -q "CAN FD required but interface MTU is 16" "$W/can-fdclassic.out"; then
+      key check_config_can_interface_ok true
+    else key check_config_can_interface_ok false; fi
+  else
+    say "no guest for the CAN interface check (see $L/can_check.log)"; key check_config_can_interface_ok null
+  fi
 fi
 
 # --- 4. a Debian root with systemd: dpkg --root install, unit verify, the guest ------------------------------
