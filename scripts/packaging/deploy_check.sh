@@ -13,7 +13,8 @@
 #      systemd-analyze verify (which must also reject a planted broken copy); then a fresh copy
 #      booted in user-mode Linux with systemd as PID 1: install, start, stop, a stalled loop
 #      restarted by the watchdog, remove and purge (guest_systemd_test.sh).
-# Every key of OUT.json comes from a check that can fail; a check that could not run is null
+# Packages are built from HEAD (git archive to build/deploy-src; DEPLOY_SRC=worktree: the working
+# tree). Every key of OUT.json comes from a check that can fail; a check that could not run is null
 # (and named in "not_run"), never true. DEPLOY_GUEST_DIR overrides build/deploy-guest.
 set -u
 cd "$(dirname "$0")/../.."
@@ -46,11 +47,24 @@ TOOLS="mml-mapc mml-mapbuild mml-slam mml-sim mml-eval mml-carmen mml-candev mml
 declare -A DEB
 
 # --- 1. build the packages ---------------------------------------------------------------------------
+# From the committed tree (HEAD exported with git archive to build/deploy-src): a package is what
+# was committed, not whatever else the working tree holds. DEPLOY_SRC=worktree builds the working
+# tree instead (with the DEPLOY_BUILD_* directories of a normal configure).
+version="0.0.$(git rev-list --count HEAD)+g$(git rev-parse --short=9 HEAD)"
+vargs=()
+SRC=$ROOT
+if [ "${DEPLOY_SRC:-head}" != worktree ]; then
+  SRC=$ROOT/build/deploy-src
+  rm -rf "$SRC"; mkdir -p "$SRC"
+  git archive --format=tar HEAD | tar -x -C "$SRC"
+  vargs=(-DMMLFW_PACKAGE_VERSION_OVERRIDE="$version" -DMMLFW_PACKAGE_DATE_OVERRIDE="$(git log -1 --format=%cD)")
+  say "building from HEAD $(git rev-parse --short HEAD) exported to $SRC (version $version)"
+fi
 for a in amd64 arm64 armhf; do
-  d=${DIR[$a]}
+  d=${DIR[$a]}; [[ "$d" = /* ]] || d=$ROOT/$d; DIR[$a]=$d
   targets=mmlfw; [ $a = amd64 ] && targets="mmlfw $TOOLS"
   say "building ${PRESET[$a]} in $d ($targets)"
-  if cmake --preset "${PRESET[$a]}" -B "$d" > "$L/configure-$a.log" 2>&1 &&
+  if (cd "$SRC" && cmake --preset "${PRESET[$a]}" -B "$d" "${vargs[@]}") > "$L/configure-$a.log" 2>&1 &&
      nice -n 10 cmake --build "$d" -j2 --target $targets > "$L/build-$a.log" 2>&1; then
     rm -f "$d"/*.deb
     (cd "$d" && cpack -G DEB) > "$L/cpack-$a.log" 2>&1
@@ -140,7 +154,7 @@ fi
 
 # --- 3. --check-config and the notify/watchdog test -------------------------------------------------------
 if [ -x "$AMD/firmware/app/mmlfw" ] && [ -x "$MAPC" ]; then
-  bash firmware/app/check_config_test.sh "$AMD" "$L/check_config.txt" > "$L/check_config.log" 2>&1
+  bash "$SRC/firmware/app/check_config_test.sh" "$AMD" "$L/check_config.txt" > "$L/check_config.log" 2>&1
   rc=$?
   read -r _ g gn < <(awk '/^good_ok/ {print $1, $2, $4}' "$L/check_config.txt" 2>/dev/null) || true
   read -r _ b bn < <(awk '/^bad_rejected/ {print $1, $2, $4}' "$L/check_config.txt" 2>/dev/null) || true
@@ -148,7 +162,7 @@ if [ -x "$AMD/firmware/app/mmlfw" ] && [ -x "$MAPC" ]; then
   key check_config_good_ok "${g:-null}"
   key check_config_bad_inputs_rejected "${b:-null}"
   key check_config_bad_inputs_tried "${bn:-null}"
-  python3 firmware/app/watchdog_test.py "$AMD/firmware/app/mmlfw" --summary "$L/watchdog.txt" > "$L/watchdog.log" 2>&1
+  python3 "$SRC/firmware/app/watchdog_test.py" "$AMD/firmware/app/mmlfw" --summary "$L/watchdog.txt" > "$L/watchdog.log" 2>&1
   key notify_ready_status_watchdog_ok "$(awk '/^healthy_ok/ {print ($2 == 1 ? "true" : "false")}' "$L/watchdog.txt" 2>/dev/null || echo null)"
   key notify_watchdog_stops_on_stall "$(awk '/^stall_stops_watchdog/ {print ($2 == 1 ? "true" : "false")}' "$L/watchdog.txt" 2>/dev/null || echo null)"
 else
@@ -169,7 +183,7 @@ for c in vcan0 nocan fdclassic; do "$amd_abs/firmware/app/mmlfw" --check-config 
 CAN
   chmod +x "$W/can_check.sh"
   rm -f "$W"/can-*.rc
-  timeout 300 tests/hil/run-in-guest.sh "$W/can_check.sh" > "$L/can_check.log" 2>&1
+  timeout 300 "$SRC/tests/hil/run-in-guest.sh" "$W/can_check.sh" > "$L/can_check.log" 2>&1
   if [ -f "$W/can-vcan0.rc" ]; then
     if [ "$(cat "$W/can-vcan0.rc")" = 0 ] && grep -q ": ok, static memory" "$W/can-vcan0.out" &&
        [ "$(cat "$W/can-nocan.rc")" = 1 ] && grep -q "socketcan 'mmlfwcan9': no such interface" "$W/can-nocan.out" &&
@@ -208,7 +222,7 @@ if [ -x "$G/root/lib/systemd/systemd" ] && [ -n "${DEB[amd64]:-}" ]; then
     key unit_verify_ok null
   fi
   rm -rf "$V"
-  if bash scripts/packaging/guest_systemd_test.sh "$G/root" "${DEB[amd64]}" "$W/room.mmap" "$G/run" "$L/guest.txt" > "$L/guest.log" 2>&1 ||
+  if bash "$SRC/scripts/packaging/guest_systemd_test.sh" "$G/root" "${DEB[amd64]}" "$W/room.mmap" "$G/run" "$L/guest.txt" > "$L/guest.log" 2>&1 ||
      [ -s "$L/guest.txt" ]; then
     v() { awk -v k="$1" '$1 == k {print $2}' "$L/guest.txt"; }
     all() { local k; for k in "$@"; do [ "$(v "$k")" = 1 ] || return 1; done; }
@@ -237,6 +251,7 @@ else
   key install_start_stop_ok null; key watchdog_restart_ok null; key remove_keeps_conffile_ok null
 fi
 key version "\"$(dpkg-deb -f "${DEB[amd64]:-/dev/null}" Version 2>/dev/null)\""
+key built_from "\"$([ "$SRC" = "$ROOT" ] && echo "working tree" || echo "HEAD (git archive)")\""
 key commit "\"$(git rev-parse --short HEAD)\""
 
 # --- the JSON ------------------------------------------------------------------------------------------

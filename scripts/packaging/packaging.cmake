@@ -12,9 +12,16 @@
 set(_pkg ${CMAKE_CURRENT_LIST_DIR})
 
 # --- version from the tree ------------------------------------------------------------------------
+# An exported tree (git archive, no .git) gets its version from the caller:
+# -DMMLFW_PACKAGE_VERSION_OVERRIDE=0.0.N+gHASH -DMMLFW_PACKAGE_DATE_OVERRIDE="<RFC 2822 date>".
+set(MMLFW_PACKAGE_VERSION_OVERRIDE "" CACHE STRING "package version (default: from git)")
+set(MMLFW_PACKAGE_DATE_OVERRIDE "" CACHE STRING "changelog date (default: the HEAD commit's)")
 set(MMLFW_PACKAGE_VERSION "0.0.0")
 find_package(Git QUIET)
-if(GIT_FOUND)
+if(MMLFW_PACKAGE_VERSION_OVERRIDE)
+  set(MMLFW_PACKAGE_VERSION "${MMLFW_PACKAGE_VERSION_OVERRIDE}")
+  set(_date "${MMLFW_PACKAGE_DATE_OVERRIDE}")
+elseif(GIT_FOUND)
   execute_process(COMMAND ${GIT_EXECUTABLE} rev-list --count HEAD WORKING_DIRECTORY ${PROJECT_SOURCE_DIR}
                   OUTPUT_VARIABLE _count OUTPUT_STRIP_TRAILING_WHITESPACE ERROR_QUIET RESULT_VARIABLE _r1)
   execute_process(COMMAND ${GIT_EXECUTABLE} rev-parse --short=9 HEAD WORKING_DIRECTORY ${PROJECT_SOURCE_DIR}
