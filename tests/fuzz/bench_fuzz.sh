@@ -7,7 +7,7 @@ B=$(cd "$1" && pwd)
 out=$2
 here=$(cd "$(dirname "$0")" && pwd)
 secs=${FUZZ_SECONDS:-300}
-targets=(can_decoder sick_telegram map_image app_config carmen_log pgm ros_map relations)
+targets=(can_decoder sick_telegram scip rplidar map_image app_config carmen_log pgm ros_map relations)
 total=0 crashes=0 n=0 extra=""
 for t in "${targets[@]}"; do
   echo "=== fuzz $t for $secs s"

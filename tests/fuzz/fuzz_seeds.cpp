@@ -13,6 +13,8 @@
 #include <vector>
 
 #include "hal_can/codec.h"
+#include "hal_serial/rplidar_protocol.h"
+#include "hal_serial/scip.h"
 #include "hal_serial/sick_telegram.h"
 #include "sim/io/carmen_log.h"
 #include "sim/io/relations.h"
@@ -22,6 +24,7 @@
 #include "sim/map/relation_table_builder.h"
 #include "tests/fuzz/byte_reader.h"
 #include "tests/fuzz/can_fuzz_ops.h"
+#include "tests/fuzz/serial_lidar_fuzz_ops.h"
 #include "tests/fuzz/sick_fuzz_ops.h"
 
 namespace fs = std::filesystem;
@@ -212,6 +215,116 @@ void sick_seeds(const Source& src) {
   put("sick_telegram", "measured_mm", m.data());
 }
 
+// Hokuyo (issue 59): a whole UTM-30LX handshake, then two scans made from the real ones (nearest
+// beam per 0.25° step), a silence long enough for the driver to ask again.
+void scip_seeds(const Source& src) {
+  fuzz::ByteWriter w;
+  w.u8(0);  // MD, no intensity
+  auto status = [&w](const char* echo, const char* st) {
+    w.u8(fuzz::kScipStatus);
+    w.blob(to_bytes(echo));
+    w.u8(static_cast<std::uint8_t>(st[0]));
+    w.u8(static_cast<std::uint8_t>(st[1]));
+  };
+  auto info = [&w](const char* echo, const char* lines) {
+    w.u8(fuzz::kScipInfo);
+    w.blob(to_bytes(echo));
+    w.blob(to_bytes(lines));
+  };
+  status("SCIP2.0", "0E");
+  status("QT", "00");
+  info("VV", "VEND:Hokuyo Automatic Co.,Ltd.\nPROD:SOKUIKI Sensor TOP-URG UTM-30LX\nFIRM:1.1\nPROT:SCIP 2.0");
+  info("PP", "MODL:UTM-30LX\nDMIN:23\nDMAX:60000\nARES:1440\nAMIN:0\nAMAX:1080\nAFRT:540\nSCAN:2400");
+  info("II", "MODL:UTM-30LX\nLASR:OFF\nSTAT:Stable 000 no error.");
+  status("BM", "00");
+  status("MD0000108001000", "00");
+  w.u8(fuzz::kScipPoll);
+  w.u8(255);
+  for (std::size_t k = 0; k < src.scans.size() && k < 2; ++k) {
+    const sim::CarmenScan& sc = src.scans[k];
+    w.u8(fuzz::kScipScan);
+    w.u8(0);
+    w.u16(0);
+    w.u16(1080);
+    w.u8(1);
+    w.u32(static_cast<std::uint32_t>(0xFFFFF0 + 25 * k));  // the 24-bit clock wraps between the two
+    w.u16(1081);
+    for (int i = 0; i < 1081; ++i) {
+      const double a = (i - 540) * 2 * M_PI / 1440;
+      const long b = std::lround((a - sc.angle_min) / sc.angle_increment);
+      const double r = (b >= 0 && b < static_cast<long>(sc.ranges.size())) ? sc.ranges[b] : 0.0;
+      w.u32(static_cast<std::uint32_t>(std::lround(r * 1000.0)));
+    }
+    w.u8(fuzz::kScipPoll);
+    w.u8(255);
+  }
+  w.u8(fuzz::kScipAdvance);
+  w.u16(1100);
+  w.u8(fuzz::kScipPoll);
+  w.u8(3);
+  put("scip", "utm30lx_handshake_scans", w.data());
+}
+
+// RPLIDAR (issue 59): health, info, the SCAN descriptor and two turns of samples from a real scan;
+// and the same in express mode with capsules.
+void rplidar_seeds(const Source& src) {
+  const sim::CarmenScan* sc = src.scans.empty() ? nullptr : &src.scans[0];
+  auto range_q2 = [sc](double cw_deg) -> std::uint16_t {
+    if (!sc) return 4000;
+    const double a = -cw_deg * M_PI / 180.0;
+    const long b = std::lround((a - sc->angle_min) / sc->angle_increment);
+    if (b < 0 || b >= static_cast<long>(sc->ranges.size())) return 0;
+    return static_cast<std::uint16_t>(std::min(65535.0, std::round(sc->ranges[b] * 4000.0)));
+  };
+  for (const int express : {0, 1}) {
+    fuzz::ByteWriter w;
+    w.u8(express ? 2 : 0);
+    w.u16(360);
+    w.u8(49);  // min samples 50
+    w.u8(fuzz::kRpHealth);
+    w.u8(0);
+    w.u16(0);
+    w.u8(fuzz::kRpInfo);
+    const std::uint8_t info[20] = {0x18, 29, 1, 7};
+    w.bytes(info, 20);
+    w.u8(fuzz::kRpDescriptor);
+    w.u32(express ? (84u | (1u << 30)) : (5u | (1u << 30)));
+    w.u8(express ? hal_serial::kRplidarAnsCapsule : hal_serial::kRplidarAnsSample);
+    w.u8(fuzz::kRpPoll);
+    w.u8(255);
+    if (!express) {
+      for (int turn = 0; turn < 3; ++turn) {
+        w.u8(fuzz::kRpSamples);
+        w.u8(120);
+        for (int k = 0; k < 120; ++k) {
+          const double deg = 0.4 + k * 3.0;
+          w.u8(static_cast<std::uint8_t>((k == 0 ? 1 : 0) | (40 << 1)));
+          w.u16(static_cast<std::uint16_t>(deg * 64));
+          w.u16(range_q2(deg));
+        }
+        w.u8(fuzz::kRpPoll);
+        w.u8(255);
+      }
+    } else {
+      for (int c = 0; c < 12; ++c) {
+        const double start = std::fmod(c * 45.0 + 0.3, 360.0);
+        w.u8(fuzz::kRpCapsule);
+        w.u8(c == 0 ? 1 : 0);
+        w.u16(static_cast<std::uint16_t>(start * 64));
+        for (int k = 0; k < 32; ++k) w.u16(static_cast<std::uint16_t>(range_q2(start + k * 45.0 / 32) / 4));
+        for (int k = 0; k < 32; ++k) w.u8(0);
+        w.u8(fuzz::kRpPoll);
+        w.u8(255);
+      }
+    }
+    w.u8(fuzz::kRpAdvance);
+    w.u16(2100);
+    w.u8(fuzz::kRpPoll);
+    w.u8(1);
+    put("rplidar", express ? "a1_express_capsules" : "a1_scan_turns", w.data());
+  }
+}
+
 // A small occupancy map from the first scans (their odometry poses), 0.2 m cells.
 sim::OccupancyGrid seed_grid(const Source& src) {
   std::vector<sim::PosedScan> posed;
@@ -306,6 +419,8 @@ int main(int argc, char** argv) {
   const Source src = load_source();
   can_seeds(src);
   sick_seeds(src);
+  scip_seeds(src);
+  rplidar_seeds(src);
   map_seeds(src);
   text_seeds(src);
   std::printf("fuzz_seeds: %d seed files in %s (%s)\n", g_written, g_out.c_str(),
