@@ -390,7 +390,7 @@ int stage_failed(const Args& a, const Startup& su, int rc) {
 int memory_budget(const Args& a, const Startup& su) {
   const fw::AppConfig& c = g_config;
   fw::MemoryReport& mr = fw::MemoryReport::instance();
-  mr.add({"hal", "board (sockets, CAN node rings, SICK parser)", sizeof(g_board), 0, nullptr});
+  mr.add({"hal", "board (sockets, CAN node rings, SICK/Hokuyo/RPLIDAR drivers)", sizeof(g_board), 0, nullptr});
   mr.add({"runtime", "localization loop (odometry ring, pending scan, perf)", sizeof(g_loop), 0, nullptr});
   mr.add({"runtime", "worker pool", sizeof(g_pool), static_cast<std::size_t>(c.workers), nullptr});
   if (su.table_in_use) mr.add({"map", "relation table (image copy)", su.table_len, 0, nullptr});
