@@ -119,17 +119,23 @@ if want serial_corrupt_telegrams; then
 fi
 
 # Issue 59: the Hokuyo and RPLIDAR drivers against their device models with the faults of a real
-# unit (tests/hil/hil_serial_lidar.sh faults): truncated answers / lost bytes, a reset in the middle
-# of a scan, the 24-bit clock wrapping (Hokuyo), the motor stopping 2.5 s and a health error at
-# start-up (RPLIDAR). Scans must resume (the driver asks again), damage is counted, no crash or hang.
+# unit (tests/hil/hil_serial_lidar.sh): faults = truncated answers / lost bytes, a reset in the
+# middle of a scan, the 24-bit clock wrapping (Hokuyo), the motor stopping 2.5 s and a health error
+# at start-up (RPLIDAR); replug = the cable pulled and plugged in again. Scans must resume (the
+# driver asks again), damage is counted, no crash or hang.
 for sensor in hokuyo rplidar; do
-  want "${sensor}_faults" || continue
-  bash "$hil/hil_serial_lidar.sh" "$B" "$sensor" faults > "$O/${sensor}_faults.log" 2>&1; rc=$?
-  r=$B/hil/serial-$sensor-faults/results.json
-  ok=0; [ "$rc" = 0 ] && ok=1
-  crash=$(grep -c "\"${sensor}_faults_crash\": true" "$r" 2>/dev/null); hang=$(grep -c "\"${sensor}_faults_hang\": true" "$r" 2>/dev/null)
-  result "${sensor}_faults" serial "$sensor device model: truncation, reset mid-scan, $([ "$sensor" = hokuyo ] && echo 'clock wrap' || echo 'motor stop, health error'): scans resume, damage counted" \
-    $ok "${crash:-0}" "${hang:-0}" 0 "$(grep -E 'FAIL|scans resumed' "$O/${sensor}_faults.log" | tr '\n' ' ' | cut -c1-300) (exit $rc)"
+  for mode in faults replug; do
+    want "${sensor}_${mode}" || continue
+    bash "$hil/hil_serial_lidar.sh" "$B" "$sensor" "$mode" > "$O/${sensor}_${mode}.log" 2>&1; rc=$?
+    r=$B/hil/serial-$sensor-$mode/results.json
+    ok=0; [ "$rc" = 0 ] && ok=1
+    crash=$(grep -c "\"${sensor}_${mode}_crash\": true" "$r" 2>/dev/null); hang=$(grep -c "\"${sensor}_${mode}_hang\": true" "$r" 2>/dev/null)
+    if [ "$mode" = replug ]; then what="unplugged and plugged in again: laser-disconnected, reopened, handshake again, scans resume"
+    elif [ "$sensor" = hokuyo ]; then what="truncation, reset mid-scan, clock wrap: scans resume, damage counted"
+    else what="truncation, reset mid-scan, motor stop, health error: scans resume, damage counted"; fi
+    result "${sensor}_${mode}" serial "$sensor device model: $what" $ok "${crash:-0}" "${hang:-0}" 0 \
+      "$(grep -E 'FAIL|scans resumed|both halves' "$O/${sensor}_${mode}.log" | tr '\n' ' ' | cut -c1-300) (exit $rc)"
+  done
 done
 
 # Start-up and map-file cases need the aces map (built by the release tests into the map cache).
