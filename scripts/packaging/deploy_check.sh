@@ -50,15 +50,16 @@ declare -A DEB
 # From the committed tree (HEAD exported with git archive to build/deploy-src): a package is what
 # was committed, not whatever else the working tree holds. DEPLOY_SRC=worktree builds the working
 # tree instead (with the DEPLOY_BUILD_* directories of a normal configure).
-version="0.0.$(git rev-list --count HEAD)+g$(git rev-parse --short=9 HEAD)"
+head=$(git rev-parse HEAD)  # others may commit while this runs: one commit throughout
+version="0.0.$(git rev-list --count "$head")+g$(git rev-parse --short=9 "$head")"
 vargs=()
 SRC=$ROOT
 if [ "${DEPLOY_SRC:-head}" != worktree ]; then
   SRC=$ROOT/build/deploy-src
   rm -rf "$SRC"; mkdir -p "$SRC"
-  git archive --format=tar HEAD | tar -x -C "$SRC"
-  vargs=(-DMMLFW_PACKAGE_VERSION_OVERRIDE="$version" -DMMLFW_PACKAGE_DATE_OVERRIDE="$(git log -1 --format=%cD)")
-  say "building from HEAD $(git rev-parse --short HEAD) exported to $SRC (version $version)"
+  git archive --format=tar "$head" | tar -x -C "$SRC"
+  vargs=(-DMMLFW_PACKAGE_VERSION_OVERRIDE="$version" -DMMLFW_PACKAGE_DATE_OVERRIDE="$(git log -1 --format=%cD "$head")")
+  say "building from HEAD ${head:0:9} exported to $SRC (version $version)"
 fi
 for a in amd64 arm64 armhf; do
   d=${DIR[$a]}; [[ "$d" = /* ]] || d=$ROOT/$d; DIR[$a]=$d
@@ -252,7 +253,7 @@ else
 fi
 key version "\"$(dpkg-deb -f "${DEB[amd64]:-/dev/null}" Version 2>/dev/null)\""
 key built_from "\"$([ "$SRC" = "$ROOT" ] && echo "working tree" || echo "HEAD (git archive)")\""
-key commit "\"$(git rev-parse --short HEAD)\""
+key commit "\"${head:0:9}\""
 
 # --- the JSON ------------------------------------------------------------------------------------------
 python3 - "$K" "$OUT" <<'PY'
