@@ -312,7 +312,9 @@ Status decode_scip_parameters(const ScipResponse& r, ScipParameters* out) {
       return Status::error(Errc::kCorruptData, "SCIP PP %s '%s' is not a number", f.key, v);
     }
   }
-  if (out->ares == 0 || out->amin > out->amax || out->amax >= 2 * out->ares || out->dmax_mm <= out->dmin_mm) {
+  // Steps are 4-digit fields of MD/MS (Sec. 8.1): a unit with more than 9999 is not SCIP 2.0.
+  if (out->ares == 0 || out->amin > out->amax || out->amax >= 2 * out->ares || out->amax > 9999 ||
+      out->dmax_mm <= out->dmin_mm) {
     return Status::error(Errc::kCorruptData, "SCIP PP geometry impossible (ARES %u, AMIN %u, AMAX %u, DMIN %u, DMAX %u)",
                          out->ares, out->amin, out->amax, out->dmin_mm, out->dmax_mm);
   }

@@ -92,6 +92,11 @@ TEST(Scip, ParameterAnswerWithImpossibleGeometryIsAnError) {
   const fw::Status s = decode_scip_parameters(rs[0], &pp);
   EXPECT_FALSE(s.is_ok());
   EXPECT_NE(std::string(s.message()).find("ARES 0"), std::string::npos) << s.message();
+  const char* wide[] = {"DMIN:20", "DMAX:5600", "ARES:20000", "AMIN:0", "AMAX:10000", "AFRT:5000"};
+  const std::size_t m = encode_scip_info("PP", wide, 6, buf, sizeof(buf));
+  const auto ws = parse_all(&p, std::string(buf, m));
+  ASSERT_EQ(ws.size(), 1u);
+  EXPECT_FALSE(decode_scip_parameters(ws[0], &pp).is_ok());  // steps beyond the 4-digit MD fields
 }
 
 std::string scan_answer(const char* echo, std::uint32_t ts, const std::vector<std::uint32_t>& r,
