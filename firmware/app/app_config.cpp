@@ -81,7 +81,7 @@ constexpr const char* kKeys[] = {"laser",     "odometry",  "output",  "can_fd", 
                                  "mml_preset", "map",       "workers", "cores",            "realtime",
                                  "arena_mib", "step_deadline_ms", "health_period_ms", "laser_timeout_ms", "seed",
                                  "log_level", "global_context", "global_period_scans", "odom_noise",
-                                 "odom_noise_per_step", "odom_slip"};
+                                 "odom_noise_per_step", "odom_slip", "laser_mount"};
 constexpr int kNumKeys = static_cast<int>(sizeof(kKeys) / sizeof(kKeys[0]));
 
 // The config path as shown in messages: at most kShownPath characters, the end kept (the file
@@ -188,6 +188,34 @@ Status parse_odometry_key(const char* name, int line, const char* key, char* v, 
   return parse_odom_slip(name, line, key, v, out->odom_slip);
 }
 
+// laser: the backend spec; laser_mount: "YAW_DEG[, upside-down]", how the laser sits on the robot
+// (its zero direction turned YAW degrees counter-clockwise from the robot's front; upside down it
+// sees the world mirrored). The board turns every scan into the robot's orientation.
+Status parse_laser_key(const char* name, int line, const char* key, char* v, AppConfig* out) {
+  if (!std::strcmp(key, "laser")) {
+    if (!spec_ok(v, true, nullptr)) return CFG_ERR("'%s' is not can:IFACE, sick:, hokuyo: or rplidar:DEVICE[@BAUD]", v);
+    FW_RETURN_IF_ERROR(check_backend_arg(name, line, key, v, sizeof(out->laser)));
+    copy(out->laser, sizeof(out->laser), v);
+    return Status::ok();
+  }
+  char* comma = std::strchr(v, ',');
+  if (comma != nullptr) {
+    *comma = '\0';
+    char* flag = comma + 1;
+    while (*flag == ' ' || *flag == '\t') ++flag;
+    if (std::strcmp(flag, "upside-down") != 0) return CFG_ERR("'%s' is not 'upside-down'", flag);
+    out->laser_upside_down = true;
+  }
+  char* pe = nullptr;
+  const double d = std::strtod(v, &pe);
+  while (pe != nullptr && (*pe == ' ' || *pe == '\t')) ++pe;
+  if (pe == v || *pe || !std::isfinite(d) || d < -180.0 || d > 180.0) {
+    return CFG_ERR("yaw '%s' is not a number of degrees in -180..180 (laser_mount = YAW_DEG[, upside-down])", v);
+  }
+  out->laser_mount_yaw_deg = static_cast<float>(d);
+  return Status::ok();
+}
+
 }  // namespace
 
 Status parse_app_config(const char* path, const char* text, std::size_t len, AppConfig* out) {
@@ -245,11 +273,9 @@ Status parse_app_config(const char* path, const char* text, std::size_t len, App
       key_line[k] = line;
     }
     long x = 0;
-    if (!std::strcmp(key, "laser")) {
-      if (!spec_ok(v, true, nullptr)) return CFG_ERR("'%s' is not can:IFACE, sick:, hokuyo: or rplidar:DEVICE[@BAUD]", v);
-      FW_RETURN_IF_ERROR(check_backend_arg(name, line, key, v, sizeof(out->laser)));
-      copy(out->laser, sizeof(out->laser), v);
-      seen_laser = true;
+    if (!std::strcmp(key, "laser") || !std::strcmp(key, "laser_mount")) {
+      FW_RETURN_IF_ERROR(parse_laser_key(name, line, key, v, out));
+      seen_laser = seen_laser || !std::strcmp(key, "laser");
     } else if (!std::strcmp(key, "odometry")) {
       if (!spec_ok(v, false, "none")) return CFG_ERR("'%s' is not socketcan:IFACE or none", v);
       FW_RETURN_IF_ERROR(check_backend_arg(name, line, key, v, sizeof(out->odometry)));

@@ -6,6 +6,10 @@
 //                    BAUD: 9600 19200 38400 57600 115200 230400 256000 460800 500000 921600 1000000
 //                    [sick 38400, hokuyo and rplidar 115200]; IFACE ≤ 15 characters. Hokuyo and
 //                    RPLIDAR must answer their start-up handshake (hal/linux/board.h)
+//   laser_mount      YAW_DEG[, upside-down]: the laser's zero direction turned YAW degrees (CCW,
+//                    -180..180) from the robot's front, and mounted upside down (mirrored); every
+//                    scan is turned into the robot's orientation. The laser is taken to sit on the
+//                    robot's centre: a lever arm is not modelled (the pose is the laser's) [0]
 //   odometry         socketcan:IFACE | none              [laser's interface when socketcan, else none]
 //   output           socketcan:IFACE | log               [laser's interface when socketcan, else log]
 //   can_fd           auto | true | false                 [auto: FD when the interface MTU is 72]
@@ -43,6 +47,8 @@ constexpr std::size_t kMaxCanInterfaceName = 15;
 struct AppConfig {
   static constexpr int kMaxCores = 16;
   char laser[128] = {0};
+  float laser_mount_yaw_deg = 0.0f;  // laser_mount: yaw of the laser on the robot (degrees, CCW)
+  bool laser_upside_down = false;
   char odometry[128] = {0};  // empty = default
   char output[128] = {0};
   int can_fd = -1;           // -1 auto, 0 classic, 1 FD required

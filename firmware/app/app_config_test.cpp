@@ -276,5 +276,22 @@ TEST(AppConfig, LaserKinds) {
   }
 }
 
+// laser_mount: the laser's yaw on the robot and whether it hangs upside down.
+TEST(AppConfig, LaserMountKey) {
+  AppConfig c;
+  ASSERT_TRUE(parse("laser = socketcan:vcan0\nlocalizer = odom\n", &c).is_ok());
+  EXPECT_FLOAT_EQ(c.laser_mount_yaw_deg, 0.0f);
+  EXPECT_FALSE(c.laser_upside_down);
+  ASSERT_TRUE(parse("laser = socketcan:vcan0\nlocalizer = odom\nlaser_mount = 180\n", &c).is_ok());
+  EXPECT_FLOAT_EQ(c.laser_mount_yaw_deg, 180.0f);
+  EXPECT_FALSE(c.laser_upside_down);
+  ASSERT_TRUE(parse("laser = socketcan:vcan0\nlocalizer = odom\nlaser_mount = -90, upside-down\n", &c).is_ok());
+  EXPECT_FLOAT_EQ(c.laser_mount_yaw_deg, -90.0f);
+  EXPECT_TRUE(c.laser_upside_down);
+  expect_refused("laser_mount", {{"200", "yaw '200' is not a number of degrees in -180..180"},
+                                 {"90, sideways", "'sideways' is not 'upside-down'"},
+                                 {"nan", "yaw 'nan'"}});
+}
+
 }  // namespace
 }  // namespace fw

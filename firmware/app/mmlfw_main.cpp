@@ -93,6 +93,7 @@ void print_help() {
       "Config (key = value, '#' comments; the packaged example is /etc/mmlfw/mmlfw.conf):\n"
       "  laser = can:IFACE | sick:DEVICE[@BAUD] | hokuyo:DEVICE[@BAUD][,intensity]\n"
       "          | rplidar:DEVICE[@BAUD][,express|,force]   (required; socketcan: and serial: still accepted)\n"
+      "  laser_mount = YAW_DEG[, upside-down]   (how the laser sits on the robot; default 0)\n"
       "  odometry = socketcan:IFACE | none    output = socketcan:IFACE | log    can_fd = auto|true|false\n"
       "  localizer = mml-track | mml | handoff | mcl | odom    map = IMAGE.mmap (mml-mapc)\n"
       "  workers, cores, realtime, global_context, global_period_scans, arena_mib, step_deadline_ms,\n"
@@ -222,6 +223,8 @@ int open_board(const Args& a, Startup* su) {
   const fw::AppConfig& c = g_config;
   hal_linux::BoardSpec spec;
   spec.laser = c.laser;
+  spec.laser_yaw_rad = c.laser_mount_yaw_deg * 0.017453292f;
+  spec.laser_upside_down = c.laser_upside_down;
   spec.odometry = c.odometry[0] ? c.odometry : nullptr;
   spec.output = c.output[0] ? c.output : nullptr;
   spec.can_fd = c.can_fd;

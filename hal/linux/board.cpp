@@ -46,6 +46,26 @@ bool Board::ZeroOdometry::poll(hal::Odometry* out) {
   return true;
 }
 
+bool Board::MountedLaser::poll(hal::LaserScan* out) {
+  if (!inner_->poll(out)) return false;
+  const std::uint32_t n = out->beam_count;
+  if (upside_down_ && n > 0) {
+    // Mirrored: beam i at angle a is seen at -a; reversed, the grid stays regular and ascending.
+    for (std::uint32_t i = 0, j = n - 1; i < j; ++i, --j) {
+      const float t = out->ranges[i];
+      out->ranges[i] = out->ranges[j];
+      out->ranges[j] = t;
+    }
+    out->angle_min = -(out->angle_min + static_cast<float>(n - 1) * out->angle_increment);
+  }
+  float a = out->angle_min + yaw_rad_;
+  const float pi = 3.14159265f;
+  while (a < -pi) a += 2.0f * pi;
+  while (a >= pi) a -= 2.0f * pi;
+  out->angle_min = a;
+  return true;
+}
+
 void Board::LogPoseSink::publish(const hal::PoseEstimate& e) {
   board_->log_.log(hal::LogLevel::kInfo, "pose scan=%u x=%.3f y=%.3f th=%.4f status=%s", e.scan_id,
                    static_cast<double>(e.x), static_cast<double>(e.y), static_cast<double>(e.theta),
@@ -219,11 +239,12 @@ Status Board::create(const BoardSpec& spec) {
     node_used_ = true;
   }
   if (laser_can) {
-    hal_.laser = &node_.laser();
+    mounted_laser_.set(&node_.laser(), spec.laser_yaw_rad, spec.laser_upside_down);
   } else {
     FW_RETURN_IF_ERROR(open_serial_laser(lkind, larg, spec.laser_handshake_ms));
-    hal_.laser = serial_laser_;
+    mounted_laser_.set(serial_laser_, spec.laser_yaw_rad, spec.laser_upside_down);
   }
+  hal_.laser = &mounted_laser_;
   hal_.odometry = std::strcmp(okind, "socketcan") == 0 ? &node_.odometry() : static_cast<hal::OdometrySource*>(&zero_odom_);
   hal_.pose_sink = std::strcmp(pkind, "socketcan") == 0 ? &node_.pose_sink() : static_cast<hal::PoseSink*>(&log_sink_pose_);
   char device[96] = "";

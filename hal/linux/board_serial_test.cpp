@@ -194,5 +194,41 @@ TEST(BoardSerial, WrongDeviceIsAStartupErrorNamingPortAndAnswer) {
   ::rmdir(dir);
 }
 
+// laser_mount (issue 59): a laser turned 90° CCW on the robot and hanging upside down; the board
+// hands the firmware the scan in the robot's orientation.
+TEST(BoardSerial, MountTurnsAndMirrorsTheScan) {
+  char dir[] = "/tmp/mmlfw-board-serial.XXXXXX";
+  ASSERT_NE(::mkdtemp(dir), nullptr);
+  const std::string link = std::string(dir) + "/ttyLASER";
+  Peer peer;
+  ASSERT_TRUE(peer.open(link));
+  static Board board;
+  BoardSpec spec;
+  const std::string laser = "sick:" + link + "@38400";
+  spec.laser = laser.c_str();
+  spec.log_level = hal::LogLevel::kError;
+  spec.laser_yaw_rad = 1.5707963f;
+  spec.laser_upside_down = true;
+  ASSERT_TRUE(board.create(spec).is_ok());
+  ASSERT_TRUE(peer.got_request(1000));
+  ASSERT_TRUE(peer.send_scan(100));  // 181 beams, 1°, from -90°: beam i reads 100 + i cm
+  int scans = 0;
+  hal::LaserScan scan;
+  const auto end = Clock::now() + std::chrono::milliseconds(500);
+  while (scans == 0 && Clock::now() < end) {
+    board.wait_for_input(5);
+    if (board.hal().laser->poll(&scan)) ++scans;
+  }
+  ASSERT_EQ(scans, 1);
+  // Upside down the sensor's -90° beam (1.00 m) looks to +90°, its +90° beam (2.80 m) to -90°;
+  // then the mount turns both by +90°: the scan runs from 0° to 180°, starting with 2.80 m.
+  EXPECT_NEAR(scan.angle_min, 0.0f, 1e-5);
+  EXPECT_NEAR(scan.ranges[0], 2.80f, 1e-4);
+  EXPECT_NEAR(scan.ranges[180], 1.00f, 1e-4);
+  EXPECT_NEAR(scan.angle_increment, 3.14159265f / 180.0f, 1e-6);
+  ::unlink(link.c_str());
+  ::rmdir(dir);
+}
+
 }  // namespace
 }  // namespace hal_linux

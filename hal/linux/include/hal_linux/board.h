@@ -37,6 +37,12 @@ struct BoardSpec {
   int can_fd = -1;                 // -1 auto (FD when the interface MTU allows), 0 classic, 1 require FD
   hal::LogLevel log_level = hal::LogLevel::kInfo;
   std::uint32_t laser_handshake_ms = 3000;  // Hokuyo / RPLIDAR start-up answers (retried within it)
+  // How the laser sits on the robot (config laser_mount): its zero direction turned laser_yaw_rad
+  // (CCW) from the robot's front, upside down (mirrored). Every scan is turned into the robot's
+  // orientation before the firmware sees it (exact on the regular grid: angle_min moves, an upside
+  // down scan is reversed). A lever arm is not modelled here.
+  float laser_yaw_rad = 0.0f;
+  bool laser_upside_down = false;
 };
 
 // Longest "arg" of a backend spec + 1 (the config's laser/odometry/output values are < 128).
@@ -96,6 +102,23 @@ class Board {
     Board* board_;
     std::uint64_t last_ns_ = 0;
   };
+  // The laser source as the firmware sees it: the configured mount applied to every scan.
+  class MountedLaser final : public hal::LaserScanSource {
+   public:
+    void set(hal::LaserScanSource* inner, float yaw_rad, bool upside_down) {
+      inner_ = inner;
+      yaw_rad_ = yaw_rad;
+      upside_down_ = upside_down;
+    }
+    bool poll(hal::LaserScan* out) override;
+    std::uint32_t fault_bits() const override { return inner_->fault_bits(); }
+    std::uint32_t invalid_scans() const override { return inner_->invalid_scans(); }
+    std::uint32_t skipped_scans() const override { return inner_->skipped_scans(); }
+   private:
+    hal::LaserScanSource* inner_ = nullptr;
+    float yaw_rad_ = 0.0f;
+    bool upside_down_ = false;
+  };
   class LogPoseSink final : public hal::PoseSink {
    public:
     explicit LogPoseSink(Board* b) : board_(b) {}
@@ -124,6 +147,7 @@ class Board {
   hal_serial::RplidarLaser rplidar_;
   hal_serial::SerialLaser* serial_laser_ = nullptr;
   hal::LaserScan handshake_scan_;  // a scan polled while the handshake ends is dropped here
+  MountedLaser mounted_laser_;
   char serial_device_[kMaxBackendArg] = {0};
   std::uint32_t serial_baud_ = 0;
   bool serial_down_ = false;            // lost and not yet reopened
