@@ -7,18 +7,14 @@
 namespace fw {
 namespace track {
 
-Eigen::Matrix3f odometry_increment_noise(const Se2f& delta, const TrackOptions& o, const OdometryNoiseScale& scale,
-                                         float* unscaled_trans_sigma, float* unscaled_rot_sigma) {
+Eigen::Matrix3f odometry_increment_noise(const Se2f& delta, const TrackOptions& o) {
   const float ds = std::hypot(delta.x, delta.y), da = std::fabs(delta.theta);
   const float at = o.odom_trans_per_m * ds + o.odom_trans_per_rad * da;
   const float ar = o.odom_rot_per_rad * da + o.odom_rot_per_m * ds;
   const float ft = o.odom_trans_per_step_m, fr = o.odom_rot_per_step_rad;
   // The per-step part in quadrature (track_options.h); without one, the AMCL model exactly.
-  const float st0 = ft > 0.0f ? std::sqrt(at * at + ft * ft) : at;
-  const float sr0 = fr > 0.0f ? std::sqrt(ar * ar + fr * fr) : ar;
-  if (unscaled_trans_sigma != nullptr) *unscaled_trans_sigma = st0;
-  if (unscaled_rot_sigma != nullptr) *unscaled_rot_sigma = sr0;
-  const float st = scale.trans * st0, sr = scale.rot * sr0;
+  const float st = ft > 0.0f ? std::sqrt(at * at + ft * ft) : at;
+  const float sr = fr > 0.0f ? std::sqrt(ar * ar + fr * fr) : ar;
   Eigen::Matrix3f q = Eigen::Matrix3f::Zero();
   q(0, 0) = q(1, 1) = st * st;
   q(2, 2) = sr * sr;
@@ -45,11 +41,11 @@ void DeadReckoning::start(const Se2f& pose, const Eigen::Matrix3f& cov, const Se
   outside_ = reentered_ = false;
 }
 
-void DeadReckoning::advance(const Se2f& wheel, const TrackOptions& o, const OdometryNoiseScale& scale) {
+void DeadReckoning::advance(const Se2f& wheel, const TrackOptions& o) {
   if (!active_) return;
   const Se2f delta = wheel_.between(wheel);
   wheel_ = wheel;
-  const Eigen::Matrix3f q = odometry_increment_noise(delta, o, scale);
+  const Eigen::Matrix3f q = odometry_increment_noise(delta, o);
   const Eigen::Matrix3f f = pose_.jacobian_compose_first(delta);
   const Eigen::Matrix3f g = pose_.jacobian_compose_second();
   pose_ = pose_.compose(delta);

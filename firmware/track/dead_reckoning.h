@@ -18,7 +18,6 @@
 
 #include "firmware/base/se2.h"
 #include "firmware/map/global_map.h"
-#include "firmware/track/odometry_noise_estimate.h"
 #include "firmware/track/protection_level.h"
 #include "firmware/track/track_options.h"
 
@@ -26,10 +25,8 @@ namespace fw {
 namespace track {
 
 // Q of one odometry increment, diagonal in the robot frame of the increment: the AMCL α model with
-// the per-step part in quadrature (track_options.h), scaled by the wheel-noise self-calibration.
-// `unscaled_*_sigma` (optional) receive σ before the scale (the self-calibration's model variance).
-Eigen::Matrix3f odometry_increment_noise(const Se2f& delta, const TrackOptions& o, const OdometryNoiseScale& scale,
-                                         float* unscaled_trans_sigma = nullptr, float* unscaled_rot_sigma = nullptr);
+// the per-step part in quadrature (track_options.h).
+Eigen::Matrix3f odometry_increment_noise(const Se2f& delta, const TrackOptions& o);
 
 // What the scan at the dead-reckoned pose says about it.
 enum class DeadReckoningVerdict : std::uint8_t {
@@ -48,7 +45,7 @@ class DeadReckoning {
   // continue the one before it): only then does the carried pose say where the robot is (outside-map).
   void start(const Se2f& pose, const Eigen::Matrix3f& cov, const Se2f& wheel, bool binding, bool trusted);
   // Carries the pose to the wheel pose `wheel` and grows the covariance.
-  void advance(const Se2f& wheel, const TrackOptions& o, const OdometryNoiseScale& scale);
+  void advance(const Se2f& wheel, const TrackOptions& o);
   // The scan (sensor-frame end-points) at the carried pose; a chain refuted max_faulty_steps scans
   // in a row stops binding. Returns the verdict (a chain that binds nothing is only tested for
   // kOutside, else kSaysNothing).

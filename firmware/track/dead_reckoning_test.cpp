@@ -34,20 +34,13 @@ TEST(DeadReckoningTest, CarriesThePoseAndGrowsTheCovarianceByTheOdometryModel) {
     truth = truth.compose(d);
     const float sr = 0.2f * std::fabs(d.theta) + 0.2f * 0.1f;
     var_theta += sr * sr;
-    dr.advance(wheel, o, OdometryNoiseScale());
+    dr.advance(wheel, o);
   }
   EXPECT_NEAR(dr.pose().x, truth.x, 1e-4f);
   EXPECT_NEAR(dr.pose().y, truth.y, 1e-4f);
   EXPECT_NEAR(dr.pose().theta, truth.theta, 1e-5f);
   EXPECT_NEAR(dr.cov()(2, 2), var_theta, 1e-6f);
   EXPECT_GT(dr.cov()(0, 0) + dr.cov()(1, 1), 2.0f * 0.05f * 0.05f + 40 * 2 * 0.02f * 0.02f);
-  // A self-calibrated scale of 0.5 grows the heading variance by a quarter of that.
-  DeadReckoning half;
-  half.start(Se2f(), Eigen::Matrix3f::Zero(), Se2f(), true, true);
-  OdometryNoiseScale s;
-  s.trans = s.rot = 0.5f;
-  half.advance(Se2f(1.0f, 0.0f, 0.0f), o, s);
-  EXPECT_NEAR(half.cov()(2, 2), 0.25f * 0.2f * 0.2f, 1e-6f);
 }
 
 // A binding chain admits a fix inside its protection level plus the alert limits and refuses one

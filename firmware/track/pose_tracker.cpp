@@ -32,21 +32,15 @@ Status PoseTracker::init(const TrackOptions& options, const GlobalMap& map) {
   map_ = map;
   k_ = ProtectionFactors::for_risk(options.integrity_risk);
   odometry_check_.configure(options.odometry_window);
-  odom_noise_.configure(options.odom_noise_window, options.odom_noise_min_samples, options.odom_noise_min_scale,
-                        options.odom_noise_max_scale, options.integrity_risk);
   initialized_ = true;
   reset();
   return Status::ok();
 }
 
-void PoseTracker::reset() {
-  stop();
-  odom_noise_.clear();
-}
+void PoseTracker::reset() { stop(); }
 
 void PoseTracker::stop() {
   active_ = false;
-  noise_origin_ = false;
   pose_ = Se2f();
   cov_.setZero();
   prev_odom_ = odom_at_fuse_ = Se2f();
@@ -57,12 +51,11 @@ void PoseTracker::stop() {
   bias_theta_rad_ = 0.0f;
   unsupported_ = faulty_ = outside_ = 0;
   unpinned_m_ = 0.0f;
-  excess_xy_m_ = excess_theta_rad_ = 0.0f;
+  excess_xy_m_ = 0.0f;
   consistent_since_fault_ = 0;
   had_fault_ = false;
   contradicted_ = false;
   fit_fraction_ = 0.0f;
-  fit_rms_m_ = 0.0f;
   fit_cells_ = 0;
   odometry_check_.clear();
   last_ = TrackStep();
@@ -91,12 +84,7 @@ void PoseTracker::predict_to(const Se2f& odom) {
   const Se2f delta = prev_odom_.between(odom);
   prev_odom_ = odom;
   ++predicted_since_fuse_;
-  float st0 = 0.0f, sr0 = 0.0f;
-  const Eigen::Matrix3f q = odometry_increment_noise(delta, options_, odom_noise_.scale(), &st0, &sr0);
-  if (options_.odom_noise_window > 0) {
-    noise_model_var_t_ += st0 * st0;
-    noise_model_var_r_ += sr0 * sr0;
-  }
+  const Eigen::Matrix3f q = odometry_increment_noise(delta, options_);
   const Eigen::Matrix3f f = pose_.jacobian_compose_first(delta);
   const Eigen::Matrix3f g = pose_.jacobian_compose_second();
   pose_ = pose_.compose(delta);
@@ -106,12 +94,6 @@ void PoseTracker::predict_to(const Se2f& odom) {
 }
 
 namespace {
-// Normal deviate of F with (d1, d2) degrees of freedom (Paulson's approximation of the F distribution).
-float f_test_z(float f, float d1, float d2) {
-  const float a1 = 2.0f / (9.0f * d1), a2 = 2.0f / (9.0f * d2);
-  const float c = std::cbrt(f);
-  return ((1.0f - a2) * c - (1.0f - a1)) / std::sqrt(a2 * c * c + a1);
-}
 // The fit-drop test's statistic (judge_scan): the previous scan's inlier fraction p1 over its n1
 // correlation cells against this alignment's, z = (p1 − p2) / se with the pooled proportion (0 when
 // se is 0).
@@ -191,7 +173,7 @@ void PoseTracker::update_confidence_excess(const Point2f* points, std::size_t n,
   co.clip_m = o.alias_clip_m;
   co.z = o.alias_z;
   co.max_xy_m = o.confidence_extent_xy ? o.alert_limit_m : 0.0f;
-  co.max_rad = o.confidence_extent_theta ? o.alert_limit_rad : 0.0f;
+  co.max_rad = 0.0f;  // position only: in heading the paired test is weak (track_options.h)
   const std::size_t m = subsample_alias_points(points, n);
   const ConfidenceExtent ce = confidence_extent(map_, alias_points_, m, a.pose, a.information(0, 0),
                                                 a.information(0, 1), a.information(1, 1), a.independent, co);
@@ -204,8 +186,7 @@ void PoseTracker::update_confidence_excess(const Point2f* points, std::size_t n,
   // the reference; whole run, PL exceedance 0.0023 → 0.0004, availability unchanged). A fused
   // scan moves the pose, and its own shift from the prediction is what the cap adds (`moved`).
   const float carried_xy = out->fused ? 0.0f : excess_xy_m_;
-  const float carried_theta = out->fused ? 0.0f : excess_theta_rad_;
-  excess_xy_m_ = excess_theta_rad_ = 0.0f;
+  excess_xy_m_ = 0.0f;
   // The update's shift from the prediction, per axis (0 = the old cap).
   const float with_update = o.confidence_cap_with_update ? 1.0f : 0.0f;
   // Open along both axes up to the alert limit: the scan checks nothing of the odometry (track_options.h).
@@ -217,12 +198,6 @@ void PoseTracker::update_confidence_excess(const Point2f* points, std::size_t n,
     const float cap = pins_nothing ? INFINITY : w.pred_pl.xy_m + carried_xy + moved;
     const float bound = std::fmin(ce.xy_m + std::hypot(pose_.x - a.pose.x, pose_.y - a.pose.y) + bias_xy_m_, cap);
     excess_xy_m_ = std::fmax(bound - pl.xy_m, 0.0f);
-  }
-  if (o.confidence_extent_theta) {
-    const float moved = with_update * std::fabs(wrap_angle(pose_.theta - w.pred.theta));
-    const float bound = std::fmin(ce.theta_rad + std::fabs(wrap_angle(pose_.theta - a.pose.theta)) + bias_theta_rad_,
-                                  w.pred_pl.theta_rad + carried_theta + moved);
-    excess_theta_rad_ = std::fmax(bound - pl.theta_rad, 0.0f);
   }
 }
 
@@ -261,7 +236,6 @@ TrackStep PoseTracker::step(const Point2f* points, std::size_t n, const Se2f& od
   // scan is compared with the dropped one, so a place that fits worse faults once, not at every scan.
   if (out.alignment.inliers + out.alignment.contradicting >= o.min_points) {
     fit_fraction_ = out.alignment.inlier_fraction();
-    fit_rms_m_ = out.alignment.rms_m;
     fit_cells_ = out.alignment.independent;
   }
   publish(points, n, w, &out);
@@ -316,26 +290,11 @@ void PoseTracker::judge_scan(const Point2f* points, std::size_t n, bool odom_jum
   // recovery_steps consistent scans, and no alias rival is ruled out meanwhile (contradicted_); as
   // a large fault it waited for MML after every such scan (fr-campus availability 0.49 → 0.36).
   if (o.fit_drop_z > 0.0f && fit_cells_ >= 2 && a.independent >= 2) {
-    const float n1 = static_cast<float>(fit_cells_), n2 = static_cast<float>(a.independent);
     w->fit_drop_z = fit_drop_statistic(fit_fraction_, fit_cells_, a);
     if (w->fit_drop_z > o.fit_drop_z) {
       w->v = ScanVerdict::kContradicting;
       out->fit_drop = true;
       return;
-    }
-    // The same drop seen in the residuals: the inliers' variance against the previous scan's (F test,
-    // the correlation cells as degrees of freedom, the previous RMS floored at the per-point noise
-    // floor). The 0.3 m inlier gate hides a place that fits only roughly (intel kidnap 4658 → 6330,
-    // 15 m and 28° away: inliers 1.00 → 0.87 of 19 → 20 cells, z 1.7, but the RMS 0.023 → 0.105 m,
-    // F 21; `localized` 15.1 m off for one scan without this).
-    if (o.fit_drop_rms && a.inliers > 0 && fit_rms_m_ >= 0.0f) {
-      const float ref = std::fmax(fit_rms_m_, o.align.min_sigma_m);
-      const float f = (a.rms_m * a.rms_m) / (ref * ref);
-      if (f > 1.0f && f_test_z(f, n2, n1) > o.fit_drop_z) {
-        w->v = ScanVerdict::kContradicting;
-        out->fit_drop = true;
-        return;
-      }
     }
   }
   // Innovation of the scan fix against the prediction: d² = eᵀ S⁻¹ e with S = P⁻ + H⁻¹, computed as
@@ -506,52 +465,10 @@ PoseTracker::Update PoseTracker::propose_update(const Se2f& odom, bool predict, 
   return u;
 }
 
-// Wheel-noise self-calibration (odometry_noise_estimate.h): one sample per `odom_noise_span` fused
-// scan fixes of a trusted track with only supported scans between them (a span, not one step: wheel
-// errors are correlated from step to step — a wheel base off by 1 % turns every turn wrong the same
-// way — and add up faster than the model's independent steps, which a span measures and one step
-// hides); the scans of a standing robot that are not fused keep adding the model's variance.
-void PoseTracker::sample_odometry_noise(const Se2f& odom, bool trusted, ScanVerdict v, bool fused,
-                                        const ScanAlignment& a) {
-  if (options_.odom_noise_window == 0) return;  // off: the configured model, nothing to measure
-  if (v != ScanVerdict::kSupported || !trusted) {
-    noise_origin_ = false;
-    return;
-  }
-  if (!fused) return;
-  float var_xy = std::numeric_limits<float>::infinity(), var_theta = var_xy;
-  const Eigen::Matrix3d h = a.information.cast<double>();
-  if (h.allFinite() && h.determinant() > 0.0) {
-    const Eigen::Matrix3d r = h.inverse();
-    if (r.allFinite()) {
-      var_xy = sym2_eigen(static_cast<float>(r(0, 0)), static_cast<float>(r(0, 1)), static_cast<float>(r(1, 1))).lambda_max;
-      var_theta = static_cast<float>(r(2, 2));
-    }
-  }
-  if (noise_origin_ && ++noise_span_ < options_.odom_noise_span) return;
-  if (noise_origin_) {
-    const Se2f fix = noise_fix_.between(a.pose);
-    const Se2f wheels = noise_odom_.between(odom);
-    const float rx = fix.x - wheels.x, ry = fix.y - wheels.y, rt = wrap_angle(fix.theta - wheels.theta);
-    const float snr = options_.odom_noise_min_snr;
-    if (noise_model_var_t_ >= snr * (noise_fix_var_xy_ + var_xy)) odom_noise_.add_translation(rx * rx + ry * ry, noise_model_var_t_);
-    if (noise_model_var_r_ >= snr * (noise_fix_var_theta_ + var_theta)) odom_noise_.add_rotation(rt * rt, noise_model_var_r_);
-  }
-  noise_origin_ = true;
-  noise_span_ = 0;
-  noise_fix_ = a.pose;
-  noise_odom_ = odom;
-  noise_fix_var_xy_ = var_xy;
-  noise_fix_var_theta_ = var_theta;
-  noise_model_var_t_ = noise_model_var_r_ = 0.0f;
-}
-
 // (6) The track's state after the verdict: fused (and the map bias of this scan), or the counters of
 // unsupported / faulty / outside scans and, after an innovation fault, a widened covariance.
 void PoseTracker::apply_verdict(const Se2f& odom, const StepWork& w, const Update& u, TrackStep* out) {
   const ScanVerdict v = w.v;
-  sample_odometry_noise(odom, !had_fault_ || consistent_since_fault_ >= options_.recovery_steps, v, u.fuse,
-                        out->alignment);
   if (v == ScanVerdict::kSupported || v == ScanVerdict::kAmbiguous) {
     if (u.fuse) {
       pose_ = u.pose;
@@ -614,12 +531,11 @@ void PoseTracker::publish(const Point2f* points, std::size_t n, const StepWork& 
   out->pl = protection_level(cov_, k_, bias_xy_m_, bias_theta_rad_);
   // Not on the scan a track starts on: that pose is MML's, isolated from a local map of many
   // scans that constrains what this one scan may leave open (a corridor's axis).
-  if ((o.confidence_extent_xy || o.confidence_extent_theta) && w.predicted &&
+  if (o.confidence_extent_xy && w.predicted &&
       (v == ScanVerdict::kSupported || v == ScanVerdict::kAmbiguous)) {
     update_confidence_excess(points, n, out->alignment, w, out->pl, out);
   }
   out->pl.xy_m += excess_xy_m_;
-  out->pl.theta_rad += excess_theta_rad_;
   if (o.cover_unfused_update && !out->fused && (v == ScanVerdict::kSupported || v == ScanVerdict::kAmbiguous)) {
     out->pl.xy_m += std::hypot(w.unfused(0), w.unfused(1));
     out->pl.theta_rad += std::fabs(w.unfused(2));
@@ -631,7 +547,6 @@ void PoseTracker::publish(const Point2f* points, std::size_t n, const StepWork& 
   }
   out->pl.xy_m += o.odom_scale_error * unpinned_m_;  // the wheels' systematic error over those metres
   out->unsupported_steps = unsupported_;
-  out->odom_noise = odom_noise_.scale();
   out->faulty_steps = faulty_;
   out->outside_steps = outside_;
   const bool within = out->pl.xy_m <= o.alert_limit_m && out->pl.theta_rad <= o.alert_limit_rad;

@@ -27,7 +27,6 @@
 #include "firmware/base/status.h"
 #include "firmware/map/global_map.h"
 #include "firmware/track/odometry_consistency.h"
-#include "firmware/track/odometry_noise_estimate.h"
 #include "firmware/track/correlative_search.h"
 #include "firmware/track/protection_level.h"
 #include "firmware/track/scan_alignment.h"
@@ -90,16 +89,15 @@ struct TrackStep {
   bool valley_dropped = false;
   std::uint32_t search_candidates = 0;  // correlative pre-search (0 = not run: prediction tight)
   bool search_moved = false;            // the alignment started from the search's best pose
-  OdometryNoiseScale odom_noise;        // wheel-noise self-calibration in use (odometry_noise_estimate.h)
   ScanAlignment alignment;
 };
 
 class PoseTracker {
  public:
   Status init(const TrackOptions& options, const GlobalMap& map);
-  // A fresh start (a new trial): no track, and the wheel-noise estimate forgotten.
+  // A fresh start (a new trial): no track.
   void reset();
-  // Ends the track (back to global localization); what was learnt about the wheels is kept.
+  // Ends the track (back to global localization).
   void stop();
   bool active() const { return active_; }
   // Starts a track at a global fix (`cov` = the fix's covariance, inflated and floored per options).
@@ -116,8 +114,6 @@ class PoseTracker {
   const TrackStep& last() const { return last_; }
   const TrackOptions& options() const { return options_; }
   const GlobalMap& map() const { return map_; }
-  // The wheel-noise self-calibration in use (scale 1 when off or still learning).
-  const OdometryNoiseScale& odometry_noise_scale() const { return odom_noise_.scale(); }
 
  private:
   // Working state of one step() between its stages (pose_tracker.cpp).
@@ -158,20 +154,11 @@ class PoseTracker {
   // which halves its cost at the 360 points of the alignment and keeps one point = 1/180 of the cost.
   static constexpr std::size_t kAliasMaxPoints = 180;
   Point2f alias_points_[kAliasMaxPoints];
-  // Wheel-noise self-calibration: the origin of the next increment sample (a trusted fused scan
-  // fix, its odometry, its variances) and the model's variance accumulated since, at the configured α.
-  void sample_odometry_noise(const Se2f& odom, bool trusted, ScanVerdict v, bool fused, const ScanAlignment& a);
-  OdometryNoiseEstimate odom_noise_;
-  bool noise_origin_ = false;
-  std::uint32_t noise_span_ = 0;  // fused scans since the origin
-  Se2f noise_fix_, noise_odom_;
-  float noise_fix_var_xy_ = 0.0f, noise_fix_var_theta_ = 0.0f;
-  float noise_model_var_t_ = 0.0f, noise_model_var_r_ = 0.0f;
   OdometryConsistency odometry_check_;
   TrackOptions options_;
   GlobalMap map_;
   // Protection level beyond the covariance's, from the last supporting scan's confidence extent.
-  float excess_xy_m_ = 0.0f, excess_theta_rad_ = 0.0f;
+  float excess_xy_m_ = 0.0f;
   ProtectionFactors k_;
   std::uint32_t next_search_cap_ = 0;  // limit_next_search (0 = the options' cap)
   std::uint32_t search_cap_ = 0;       // this step's
@@ -199,7 +186,6 @@ class PoseTracker {
   // Fit of the previous scan with enough points on known cells (inlier fraction, correlation
   // cells), the reference of the fit-drop test (judge_scan); fit_cells_ = 0 until there is one.
   float fit_fraction_ = 0.0f;
-  float fit_rms_m_ = 0.0f;  // RMS residual of its inliers (the fit-drop test's residual form)
   std::uint32_t fit_cells_ = 0;
   TrackStep last_;
 };

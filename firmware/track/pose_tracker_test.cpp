@@ -300,33 +300,6 @@ TEST(PoseTrackerTest, ScanThatSuddenlyFitsWorseIsAFault) {
   }
 }
 
-// TrackOptions::fit_drop_rms (extension, off by default): a scan whose points still all lie within
-// the inlier gate but scatter about the walls far more than the previous scan's is a fault only with
-// the residual (F) form of the fit-drop test; the inlier-fraction form cannot see it.
-TEST(PoseTrackerTest, ResidualsThatRiseAreAFaultOnlyWithTheRmsTest) {
-  const Se2f a(4.5f, 6.0f, -0.4f);
-  for (const bool rms : {false, true}) {
-    PoseTracker t;
-    TrackOptions o;
-    o.fit_drop_rms = rms;
-    RandomStream rng(43, 0);
-    ASSERT_NO_FATAL_FAILURE(settle_at(&t, o, a, &rng));
-    auto pts = testing::scan_at(room(), a, &rng);
-    for (std::size_t k = 0; k < pts.size(); ++k) {  // every point 0.15 m nearer or farther, alternately
-      const float r = std::hypot(pts[k].x(), pts[k].y());
-      const float f = (r + (k % 2 == 0 ? 0.15f : -0.15f)) / r;
-      pts[k] = Point2f(pts[k].x() * f, pts[k].y() * f);
-    }
-    const TrackStep s = t.step(pts.data(), pts.size(), Se2f(), false);
-    ASSERT_GE(s.alignment.inlier_fraction(), 0.9f) << "the scatter stays within the inlier gate";
-    EXPECT_EQ(s.fit_drop, rms) << "rms " << rms << ": residual RMS " << s.alignment.rms_m;
-    if (rms) {
-      EXPECT_EQ(s.verdict, ScanVerdict::kContradicting);
-      EXPECT_NE(s.status, hal::LocalizationStatus::kLocalized);
-    }
-  }
-}
-
 // TrackOptions::confirm_fix: a track started from a global fix with `confirm` publishes
 // `track-recovering` (never `localized`) until recovery_steps consistent scans have followed, as after
 // a fault; without it the first consistent scan is `localized`.
@@ -980,74 +953,6 @@ TEST(PoseTrackerTest, CorrelativeSearchRecoversAfterASlipBeyondTheCaptureRange) 
   }
 }
 
-// Wheel-noise self-calibration (odometry_noise_estimate.h): wheels far better than the configured
-// model (AMCL's α = 0.2) are measured against the scan fixes, and the prediction over a scan that
-// says nothing then widens by what the wheels really do, not by the default; off (window 0) it
-// widens as before. A new track keeps what was learnt, reset() (a new trial) forgets it.
-TEST(PoseTrackerTest, WheelsBetterThanTheModelAreMeasuredAndNarrowThePrediction) {
-  const std::vector<Se2f> loop = mml::testing::waypoint_path(
-      {{1.5f, 1.5f}, {1.5f, 6.5f}, {4.5f, 6.5f}, {4.5f, 2.0f}, {10.5f, 3.5f}, {10.5f, 6.5f}, {1.5f, 6.5f}, {1.5f, 1.5f}},
-      0.5f);
-  std::vector<Se2f> path;  // three laps: enough spans of odom_noise_span fused scans for the estimate
-  for (int lap = 0; lap < 3; ++lap) {
-    path.insert(path.end(), loop.begin(), loop.end() - 1);
-    // Turn in place (0.8 rad per scan) from the last heading back to the first.
-    const Se2f end = loop.back();
-    const float turn = wrap_angle(loop.front().theta - end.theta);
-    for (int k = 1; k <= 4; ++k) path.push_back(Se2f(end.x, end.y, wrap_angle(end.theta + turn * k / 4.0f)));
-  }
-  float grown[2] = {0.0f, 0.0f};
-  for (int adapt = 0; adapt < 2; ++adapt) {
-    TrackOptions o;
-    o.odom_noise_window = adapt == 1 ? 64 : 0;  // off by default (track_options.h)
-    PoseTracker t;
-    ASSERT_TRUE(t.init(o, room_map().map).is_ok());
-    RandomStream rng(21, 0);
-    Se2f odom;
-    t.start(path[0], small_cov(), odom);
-    for (std::size_t i = 0; i < path.size(); ++i) {
-      if (i > 0) {
-        Se2f d = path[i - 1].between(path[i]);
-        d.x += 0.005f * static_cast<float>(rng.gaussian());  // 1 % of a 0.5 m step
-        d.y += 0.005f * static_cast<float>(rng.gaussian());
-        d.theta += 0.003f * static_cast<float>(rng.gaussian());
-        odom = odom.compose(d);
-      }
-      const auto pts = testing::scan_at(room(), path[i], &rng);
-      const TrackStep s = t.step(pts.data(), pts.size(), odom, i > 0);
-      ASSERT_FALSE(s.lost) << "step " << i;
-      if (s.status == hal::LocalizationStatus::kLocalized) {
-        EXPECT_LT(err_xy(s.pose, path[i]), s.pl.xy_m) << "step " << i;
-        EXPECT_LT(std::fabs(wrap_angle(s.pose.theta - path[i].theta)), s.pl.theta_rad) << "step " << i;
-      }
-    }
-    const OdometryNoiseScale sc = t.last().odom_noise;
-    if (adapt == 1) {
-      EXPECT_GE(sc.trans_samples, o.odom_noise_min_samples);
-      EXPECT_GE(sc.rot_samples, o.odom_noise_min_samples);
-      EXPECT_LT(sc.trans, 0.5f);  // the wheels err by ~5 % of the model's σ: the bound is well below 1
-      EXPECT_LT(sc.rot, 0.5f);
-      EXPECT_GE(sc.trans, o.odom_noise_min_scale);
-    } else {
-      EXPECT_EQ(sc.trans, 1.0f);
-      EXPECT_EQ(sc.trans_samples, 0u);
-    }
-    // One blind step of 0.5 m: the protection level grows by what the model (as measured) allows.
-    const float before = t.last().pl.xy_m;
-    odom = odom.compose(Se2f(0.5f, 0.0f, 0.0f));
-    grown[adapt] = t.step(nullptr, 0, odom).pl.xy_m - before;
-    const auto pts = testing::scan_at(room(), path[0], &rng);
-    t.start(path[0], small_cov(), odom);  // a new track: the wheels are the same
-    EXPECT_EQ(t.step(pts.data(), pts.size(), odom, false).odom_noise.trans, sc.trans);
-    t.reset();  // a new trial: forgotten
-    t.start(path[0], small_cov(), odom);
-    EXPECT_EQ(t.step(pts.data(), pts.size(), odom, false).odom_noise.trans, 1.0f);
-  }
-  EXPECT_GT(grown[0], 0.0f);
-  EXPECT_GT(grown[1], 0.0f);
-  EXPECT_LT(grown[1], 0.6f * grown[0]);
-}
-
 TEST(PoseTrackerTest, BadOptionsNameTheField) {
   TrackOptions o;
   o.alert_limit_m = -1.0f;
@@ -1058,12 +963,11 @@ TEST(PoseTrackerTest, BadOptionsNameTheField) {
   o.align.max_points = 5;
   EXPECT_NE(std::string(o.validate().message()).find("max_points"), std::string::npos);
   o = TrackOptions();
-  o.odom_noise_window = 64;
-  o.odom_noise_min_samples = 65;
-  EXPECT_NE(std::string(o.validate().message()).find("odom_noise_window"), std::string::npos);
+  o.odom_slip_per_100m = -1.0f;
+  EXPECT_NE(std::string(o.validate().message()).find("odom_slip_per_100m"), std::string::npos);
   o = TrackOptions();
-  o.odom_noise_max_scale = 0.5f * o.odom_noise_min_scale;
-  EXPECT_NE(std::string(o.validate().message()).find("odom_noise_max_scale"), std::string::npos);
+  o.odom_scale_error = 2.0f;
+  EXPECT_NE(std::string(o.validate().message()).find("odom_scale_error"), std::string::npos);
 }
 
 }  // namespace

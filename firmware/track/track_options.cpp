@@ -57,16 +57,6 @@ Status TrackOptions::validate() const {
   FW_RETURN_IF_ERROR(check_range("odom_rot_per_m", odom_rot_per_m, 0.0f, 10.0f));
   FW_RETURN_IF_ERROR(check_range("odom_trans_per_step_m", odom_trans_per_step_m, 0.0f, 1.0f));
   FW_RETURN_IF_ERROR(check_range("odom_rot_per_step_rad", odom_rot_per_step_rad, 0.0f, 0.5f));
-  if (odom_noise_window > 128 || (odom_noise_window > 0 && (odom_noise_min_samples < 2 ||
-                                                            odom_noise_min_samples > odom_noise_window))) {
-    return Status::error(Errc::kInvalidArgument,
-                         "TrackOptions.odom_noise_window = %u / odom_noise_min_samples = %u: window at most 128, "
-                         "min_samples in [2, window]", odom_noise_window, odom_noise_min_samples);
-  }
-  FW_RETURN_IF_ERROR(check_count("odom_noise_span", odom_noise_span, 1, 1000));
-  FW_RETURN_IF_ERROR(check_range("odom_noise_min_snr", odom_noise_min_snr, 1.0f, 1000.0f));
-  FW_RETURN_IF_ERROR(check_range("odom_noise_min_scale", odom_noise_min_scale, 0.01f, 1.0f));
-  FW_RETURN_IF_ERROR(check_range("odom_noise_max_scale", odom_noise_max_scale, odom_noise_min_scale, 10.0f));
   FW_RETURN_IF_ERROR(check_range("odom_slip_per_100m", odom_slip_per_100m, 0.0f, 1000.0f));
   FW_RETURN_IF_ERROR(check_range("odom_slip_max_m", odom_slip_max_m, 0.0f, 100.0f));
   FW_RETURN_IF_ERROR(check_range("odom_scale_error", odom_scale_error, 0.0f, 1.0f));

@@ -75,27 +75,6 @@ struct TrackOptions {
   // robot's odometry spec, as the four α; mml-sim gives the tracker its simulated robot's.
   float odom_trans_per_step_m = 0.0f;
   float odom_rot_per_step_rad = 0.0f;
-  // Wheel-noise self-calibration (odometry_noise_estimate.h, extension, OFF by default): the four α
-  // above are scaled (translation pair and rotation pair separately) by an upper confidence bound, at
-  // the integrity risk, on how far the wheels disagree with the scan fixes of a trusted track, over the
-  // last `odom_noise_window` spans whose model variance is at least `odom_noise_min_snr` × the fixes'
-  // own. The α above are the prior and the ceiling (max_scale 1). Why off (README "Protection level",
-  // measured 2026-11-26 on whole runs of the seven logs): where the odometry is synthetic (fr101,
-  // fr-campus: independent Gaussian increments) it helps (availability +0.01 / +0.05, fr-campus no
-  // longer loses a right track to three unexplained scans), but real wheels are not independent
-  // Gaussian steps — slips and fast turns come after quiet stretches the window learnt from — and
-  // there the PL exceedance rose (aces 0.0012 → 0.0042, fr079 0.0049 → 0.0057) and availability fell
-  // (mit-killian 0.88 → 0.83). A bound learnt from recent steps does not hold for the next slip.
-  // 0 = off (the α as configured); 64 with the rest as below = the measured setting.
-  std::uint32_t odom_noise_window = 0;
-  // Each sample spans this many fused scans: wheel errors correlated from step to step (a wheel base
-  // off by 1 %) grow faster over a span than the model's independent steps, so a span measures them
-  // (one-scan spans: aces PL exceedance 0.0025, mit-killian availability 0.85).
-  std::uint32_t odom_noise_span = 8;
-  std::uint32_t odom_noise_min_samples = 16;
-  float odom_noise_min_snr = 9.0f;
-  float odom_noise_min_scale = 0.1f;
-  float odom_noise_max_scale = 1.0f;
   // Declared wheel-slip faults (issue 56, ARAIM-style: a fault mode with a prior probability). A slip
   // (the wheels report motion the robot did not make) is seen only by a scan that pins the position
   // along the slip: along a corridor whose walls fit wherever the robot stands (the one-valley rule
@@ -136,13 +115,6 @@ struct TrackOptions {
   // pose: what a robot carried elsewhere sees first, when that scan still fits near the old pose.
   // 3.09 = one-sided 1e-3, the integrity risk. 0 = off.
   float fit_drop_z = 3.09f;
-  // Extension, off: the same test on the residuals, the inliers' variance rising against the previous
-  // scan's by an F test at fit_drop_z (pose_tracker.cpp, judge_scan). It caught one kidnap the inlier
-  // test missed (intel 4658 → 6330: inliers 1.00 → 0.87, RMS 0.023 → 0.105 m), but the residuals of
-  // real scans vary far more from scan to scan than an F test over the correlation cells assumes:
-  // on whole runs it faulted right poses again and again (fr101 availability 0.95 → 0.70, fr-campus
-  // 0.54 → 0.45, intel 0.94 → 0.91; README "Protection level"). false = the inlier fraction only.
-  bool fit_drop_rms = false;
   // χ²(3) at 1 − 1e-3: scan fix vs odometry prediction; a fault only when the fix also lies outside
   // the prediction's protection level.
   float innovation_chi2 = 16.27f;
@@ -247,11 +219,10 @@ struct TrackOptions {
   // the published pose's distance from the fix and the map bias — where the information matrix
   // claims more than the data can tell apart (aces scan 5120: PL 0.13 m, error 0.25 m along a
   // corridor that fits as well there). Never beyond the prediction's own protection level: the
-  // odometry still carries a featureless corridor. In heading the same test is weak (intel: turns
-  // of 3–5° not rejected at steps the heading PL covers; availability 0.95 → 0.61), so it is off by
-  // default there.
+  // odometry still carries a featureless corridor. In position only: in heading the same test is
+  // weak (intel: turns of 3–5° not rejected at steps the heading PL covers; availability 0.95 →
+  // 0.61), and that option, never on by default, was removed with issue 56.
   bool confidence_extent_xy = true;
-  bool confidence_extent_theta = false;
   // The confidence extent is capped at the prediction's PL plus the update's shift from the
   // prediction (the truth is within pred PL of the prediction, the published pose that far from it);
   // false = the old cap at the prediction's PL alone, which can be shorter than the error it bounds.

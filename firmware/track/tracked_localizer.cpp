@@ -84,7 +84,7 @@ void TrackedLocalizer::await_mml_confirmation() {
 bool TrackedLocalizer::continues_previous_scan(const RememberedScan& previous, const Se2f& wheel, std::size_t n) {
   const TrackOptions& o = tracker_.options();
   const Se2f increment = previous.wheel.between(wheel);
-  const Eigen::Matrix3f q = odometry_increment_noise(increment, o, tracker_.odometry_noise_scale());
+  const Eigen::Matrix3f q = odometry_increment_noise(increment, o);
   return continuity_.explained_fraction_within(previous.pts, previous.n, pts_, n, increment,
                                                std::sqrt(std::fmax(q(0, 0), q(1, 1))), std::sqrt(q(2, 2)),
                                                o.align.outlier_m) >= o.min_explained_fraction;
@@ -207,7 +207,7 @@ Status TrackedLocalizer::step(const hal::LaserScan& scan, const hal::Odometry& o
   // thrown away, and on the 2-core board it would share the cores with the confirming step, the
   // sensor context's longest (aces replay: 10.5 ms, which stretched that global step to 16 ms).
   // The wheels carry the last track's pose on; this scan judged there (dead_reckoning.h).
-  dead_reckoning_.advance(wheel, tracker_.options(), tracker_.odometry_noise_scale());
+  dead_reckoning_.advance(wheel, tracker_.options());
   const DeadReckoningVerdict dr = dead_reckoning_.judge(tracker_.map(), pts_, n, tracker_.options());
   // Back on the map by the wheels, and the scan fits there: MML's local map starts again, so it
   // holds only scans the map may explain (its scans of an unmapped wing match only by accident,

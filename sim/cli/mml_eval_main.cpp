@@ -53,7 +53,7 @@ const char kUsage[] =
     "                [--fix-steps 200] [--mcl-trials 10] [--mcl-datasets intel,fr079] [--kidnap-runs 2]\n"
     "                [--kidnap-datasets intel,fr079,aces] [--no-unknown] [--seed 1] [--threads 2] [--out DIR]\n"
     "                [--no-pool] [--global ref|live|live-deadline] [--odom-noise TT,TR,RR,RT]\n"
-    "                [--odom-noise-per-step M,DEG] [--odom-adapt] [--fit-drop-rms] [--no-confirm-fix] [--no-confirm-on-past-scans]\n"
+    "                [--odom-noise-per-step M,DEG] [--no-confirm-fix] [--no-confirm-on-past-scans]\n"
     "                [--no-steady-fit-trust] [--valley-one-mode] [--no-valley-one-mode] [--keep-valley-information]\n"
     "                [--no-cover-unfused] [--confidence-cap-pred-pl]\n"
     "       mml-eval --log LOG.clf[.gz] --map MAP.yaml|MAP.mmap --reference POSES.txt|CORRECTED.log[.gz]\n"
@@ -66,9 +66,8 @@ const char kUsage[] =
     "used) --reference REF (REF: 'mml-carmen reference' rows or a CARMEN log with one pose per scan of\n"
     "RAW). --odom-noise: the tracker's odometry noise model (mmlfw's config key odom_noise; default\n"
     "0.2,0.2,0.2,0.2). --odom-noise-per-step: σ per scan step that does not follow the motion, metres\n"
-    "and degrees (odom_noise_per_step; default 0,0). --odom-adapt: the tracker's wheel-noise self-calibration (off by default;\n"
-    "firmware/track/track_options.h says why). --fit-drop-rms: the residual (F) form of the fit-drop test\n"
-    "(off by default, same header). --no-confirm-fix: MML's fix `localized` on its first consistent scan\n"
+    "and degrees (odom_noise_per_step; default 0,0).\n"
+    "--no-confirm-fix: MML's fix `localized` on its first consistent scan\n"
     "(TrackOptions::confirm_fix). --no-confirm-on-past-scans: MML's fix confirmed forward only, not on the\n"
     "scans before it first (TrackOptions::confirm_fix_on_past_scans, on by default). --no-steady-fit-trust:\n"
     "an alias rival beyond the prediction stays exempt when the fit fell at z 1.645\n"
@@ -157,7 +156,6 @@ static int run_main(int argc, char** argv) {
     else if (a == "--no-keep-support") lp.keep_support_across_empty_steps = false;
     else if (a == "--keep-contested") lp.keep_support_across_contested_steps = true;
     else if (a == "--no-keep-contested") lp.keep_support_across_contested_steps = false;
-    else if (a == "--fit-drop-rms") { lp.track.fit_drop_rms = true; localize = true; }
     else if (a == "--no-confirm-fix") { lp.track.confirm_fix = false; localize = true; }
     else if (a == "--no-confirm-on-past-scans") { lp.track.confirm_fix_on_past_scans = false; localize = true; }
     else if (a == "--no-steady-fit-trust") { lp.track.alias_trust_needs_steady_fit = false; localize = true; }
@@ -167,7 +165,6 @@ static int run_main(int argc, char** argv) {
     else if (a == "--no-cover-unfused") { lp.track.cover_unfused_update = false; localize = true; }
     else if (a == "--confidence-cap-pred-pl") { lp.track.confidence_cap_with_update = false; localize = true; }
     else if (a == "--cap-unpinned-scans") { lp.track.confidence_cap_needs_a_pinned_axis = false; localize = true; }
-    else if (a == "--odom-adapt") { lp.track.odom_noise_window = 64; localize = true; }
     else if (a == "--outside-map-any-pose") { lp.track.outside_map_needs_clean_exit = false; localize = true; }
     else if (a == "--odom-noise") {
       const std::string v = str();

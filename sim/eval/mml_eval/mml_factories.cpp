@@ -205,17 +205,61 @@ static bool parse_odom_slip(const std::map<std::string, std::string>& options, f
   return true;
 }
 
+// off=NAME[+NAME...] → those rules of TrackOptions off (the ablations of issue 56: what each rule
+// buys on the generated corpus, `mml-eval --corpus N --opt off=NAME`).
+static bool parse_rules_off(const std::map<std::string, std::string>& options, fw::track::TrackOptions* to,
+                            std::string* err) {
+  using T = fw::track::TrackOptions;
+  static const std::pair<const char*, bool T::*> kRules[] = {
+      {"outside_map_needs_clean_exit", &T::outside_map_needs_clean_exit},
+      {"wheels_bind_mml_without_carry", &T::wheels_bind_mml_without_carry},
+      {"alias_check", &T::alias_check},
+      {"alias_valley_is_one_mode", &T::alias_valley_is_one_mode},
+      {"alias_valley_drops_information", &T::alias_valley_drops_information},
+      {"heading_fault_local_recovery", &T::heading_fault_local_recovery},
+      {"confidence_extent_xy", &T::confidence_extent_xy},
+      {"confidence_cap_with_update", &T::confidence_cap_with_update},
+      {"confidence_cap_needs_a_pinned_axis", &T::confidence_cap_needs_a_pinned_axis},
+      {"cover_unfused_update", &T::cover_unfused_update},
+      {"confirm_alias_beyond_alert", &T::confirm_alias_beyond_alert},
+      {"alias_rival_must_be_credible", &T::alias_rival_must_be_credible},
+      {"alias_trust_needs_steady_fit", &T::alias_trust_needs_steady_fit},
+      {"confirm_fix", &T::confirm_fix},
+      {"confirm_fix_on_past_scans", &T::confirm_fix_on_past_scans}};
+  const auto it = options.find("off");
+  if (it == options.end()) return true;
+  std::string rest = it->second;
+  while (!rest.empty()) {
+    const std::size_t plus = rest.find('+');
+    const std::string name = rest.substr(0, plus);
+    rest = plus == std::string::npos ? "" : rest.substr(plus + 1);
+    bool found = false;
+    for (const auto& [rule, member] : kRules) {
+      if (name == rule) {
+        to->*member = false;
+        found = true;
+      }
+    }
+    if (!found) {
+      std::string list;
+      for (const auto& r : kRules) list += (list.empty() ? "" : ", ") + std::string(r.first);
+      *err = "localizer mml-track: option off='" + it->second + "': unknown rule '" + name + "' (rules: " + list + ")";
+      return false;
+    }
+  }
+  return true;
+}
+
 // The product's system (firmware default): MML fix confirmed and tracked with a protection level.
 // Options: config=1..4, correct=0|1, reduce=0|1, pool=0|1, keep=0|1, contested=0|1, rivals=0|1 (MML part); alert=M (alert limit, metres);
 // odom_noise=TT,TR,RR,RT and odom_noise_per_step=M,DEG (the tracker's odometry noise model, as
 // mmlfw's config keys of the same names);
-// odom_adapt=0|1 (wheel-noise self-calibration, TrackOptions::odom_noise_window 64; 0 = default);
 // valley=0|1 (TrackOptions::alias_valley_is_one_mode; default 1, as TrackOptions);
 // outside_clean=0|1 (TrackOptions::outside_map_needs_clean_exit; default 1, as TrackOptions);
 // wheels_bind=0|1 (TrackOptions::wheels_bind_mml_without_carry; default 1, as TrackOptions);
-// odom_slip=RATE,MAX (declared wheel slips, as mmlfw's config key).
+// odom_slip=RATE,MAX (declared wheel slips, as mmlfw's config key); off=RULE[+RULE...] (ablation).
 std::unique_ptr<fw::Localizer> make_track_localizer(const LocalizerContext& ctx, std::string* err) {
-  const std::string bad = check_keys("mml-track", ctx.options, {"config", "correct", "reduce", "pool", "keep", "contested", "rivals", "alert", "odom_noise", "odom_noise_per_step", "odom_adapt", "valley", "outside_clean", "wheels_bind", "odom_slip"});
+  const std::string bad = check_keys("mml-track", ctx.options, {"config", "correct", "reduce", "pool", "keep", "contested", "rivals", "alert", "odom_noise", "odom_noise_per_step", "valley", "outside_clean", "wheels_bind", "odom_slip", "off"});
   if (!bad.empty()) { *err = bad; return nullptr; }
   if (ctx.global_map == nullptr) { *err = "localizer mml-track: needs a global map"; return nullptr; }
   long config = 3;
@@ -235,9 +279,6 @@ std::unique_ptr<fw::Localizer> make_track_localizer(const LocalizerContext& ctx,
     if (to.lost_limit_m < to.alert_limit_m) to.lost_limit_m = to.alert_limit_m;
   }
   if (!parse_odom_noise(ctx.options, &to, err) || !parse_odom_slip(ctx.options, &to, err)) return nullptr;
-  long adapt = 0;
-  if (!parse_int(ctx.options, "odom_adapt", 0, 1, &adapt, "mml-track", err)) return nullptr;
-  if (adapt == 1) to.odom_noise_window = 64;
   long valley = to.alias_valley_is_one_mode ? 1 : 0;  // default: TrackOptions'
   if (!parse_int(ctx.options, "valley", 0, 1, &valley, "mml-track", err)) return nullptr;
   to.alias_valley_is_one_mode = valley == 1;
@@ -247,6 +288,7 @@ std::unique_ptr<fw::Localizer> make_track_localizer(const LocalizerContext& ctx,
   long wheels_bind = to.wheels_bind_mml_without_carry ? 1 : 0;
   if (!parse_int(ctx.options, "wheels_bind", 0, 1, &wheels_bind, "mml-track", err)) return nullptr;
   to.wheels_bind_mml_without_carry = wheels_bind == 1;
+  if (!parse_rules_off(ctx.options, &to, err)) return nullptr;
   static const std::vector<std::uint8_t> kEmpty;
   return wrap_hooks(OwnedLocalizer::make_track(*ctx.global_map, ctx.map_image ? *ctx.map_image : kEmpty, cfg, to,
                                                ctx.threads, err),
