@@ -120,16 +120,26 @@ Status check_backend_arg(const char* name, int line, const char* key, const char
   }
   const std::size_t p = serial_laser_prefix(v);
   if (p == 0) return Status::ok();
-  // DEVICE[@BAUD][,OPTION]: hokuyo takes "intensity" (ME), rplidar "express" or "force".
+  // DEVICE[@BAUD][,OPTION]...: hokuyo takes "intensity" (ME); rplidar "express" or "force", "pwm=1..1023"
+  // (A2/A3 motor duty) and "beams=1..1081" (the grid of a revolution), as hal/linux/board.h.
   char arg[128];
   std::snprintf(arg, sizeof(arg), "%s", v + p);
   if (char* comma = std::strchr(arg, ',')) {
     *comma = '\0';
-    const char* opt = comma + 1;
     const bool hokuyo = !std::strncmp(v, "hokuyo:", 7), rplidar = !std::strncmp(v, "rplidar:", 8);
-    if (!(hokuyo && !std::strcmp(opt, "intensity")) &&
-        !(rplidar && (!std::strcmp(opt, "express") || !std::strcmp(opt, "force")))) {
-      return CFG_ERR("'%s': option '%s' unknown (hokuyo: intensity; rplidar: express, force)", v, opt);
+    for (char* opt = comma + 1; opt != nullptr;) {
+      char* next = std::strchr(opt, ',');
+      if (next != nullptr) *next++ = '\0';
+      long x = 0;
+      const bool ok = (hokuyo && !std::strcmp(opt, "intensity")) ||
+                      (rplidar && (!std::strcmp(opt, "express") || !std::strcmp(opt, "force"))) ||
+                      (rplidar && !std::strncmp(opt, "pwm=", 4) && parse_int(opt + 4, 1, 1023, &x)) ||
+                      (rplidar && !std::strncmp(opt, "beams=", 6) && parse_int(opt + 6, 1, 1081, &x));
+      if (!ok) {
+        return CFG_ERR("'%s': option '%s' unknown (hokuyo: intensity; rplidar: express, force, pwm=1..1023, beams=1..1081)",
+                       v, opt);
+      }
+      opt = next;
     }
   }
   const char* at = std::strchr(arg, '@');

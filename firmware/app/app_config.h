@@ -2,7 +2,8 @@
 // Every error names the file, the line and the key; a key set twice, a NUL byte and an overlong
 // value are errors too (nothing is silently dropped or overridden). Keys (defaults in brackets):
 //   laser            (required) can:IFACE (= socketcan:IFACE) | sick:DEVICE[@BAUD] (= serial:) |
-//                    hokuyo:DEVICE[@BAUD][,intensity] | rplidar:DEVICE[@BAUD][,express|,force]
+//                    hokuyo:DEVICE[@BAUD][,intensity] |
+//                    rplidar:DEVICE[@BAUD][,express|,force][,pwm=1..1023][,beams=1..1081]
 //                    BAUD: 9600 19200 38400 57600 115200 230400 256000 460800 500000 921600 1000000
 //                    [sick 38400, hokuyo and rplidar 115200]; IFACE ≤ 15 characters. Hokuyo and
 //                    RPLIDAR must answer their start-up handshake (hal/linux/board.h)

@@ -255,7 +255,8 @@ TEST(AppConfig, MissingFileNamesThePath) {
 TEST(AppConfig, LaserKinds) {
   for (const char* ok : {"can:can0", "socketcan:can0", "sick:/dev/ttyS0@500000", "serial:/dev/ttyS0",
                          "hokuyo:/dev/ttyACM0", "hokuyo:/dev/ttyACM0@115200,intensity", "rplidar:/dev/ttyUSB0@256000",
-                         "rplidar:/dev/ttyUSB0,express", "rplidar:/dev/ttyUSB0@1000000,force"}) {
+                         "rplidar:/dev/ttyUSB0,express", "rplidar:/dev/ttyUSB0@1000000,force",
+                         "rplidar:/dev/ttyUSB0@256000,express,pwm=660,beams=720"}) {
     AppConfig c;
     const Status s = parse(std::string("localizer = odom\nlaser = ") + ok + "\n", &c);
     ASSERT_TRUE(s.is_ok()) << ok << ": " << s.message();
@@ -267,6 +268,8 @@ TEST(AppConfig, LaserKinds) {
                                   {"rplidar:/dev/ttyUSB0@256001", "baud '256001' is not one of"},
                                   {"hokuyo:/dev/ttyACM0,express", "option 'express' unknown"},
                                   {"rplidar:/dev/ttyUSB0,intensity", "option 'intensity' unknown"},
+                                  {"rplidar:/dev/ttyUSB0,express,pwm=2000", "option 'pwm=2000' unknown"},
+                                  {"rplidar:/dev/ttyUSB0,beams=0", "option 'beams=0' unknown"},
                                   {"can:an-interface-name-too-long", "interface name too long"}};
   for (const RefusedValue& r : refused) {
     AppConfig c;

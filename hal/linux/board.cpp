@@ -96,6 +96,40 @@ std::uint32_t default_serial_baud(const char* kind) {
   return 0;
 }
 
+namespace {
+
+// A decimal number in lo..hi (digits only).
+bool small_number(const char* s, std::uint32_t lo, std::uint32_t hi, std::uint32_t* out) {
+  std::uint32_t v = 0;
+  if (!*s || std::strlen(s) > 7) return false;
+  for (const char* c = s; *c; ++c) {
+    if (*c < '0' || *c > '9') return false;
+    v = v * 10 + static_cast<std::uint32_t>(*c - '0');
+  }
+  *out = v;
+  return v >= lo && v <= hi;
+}
+
+// One ",OPTION" of a serial laser spec; false if the kind does not take it.
+bool laser_option(const char* kind, const char* opt, SerialLaserSpec* out) {
+  const bool hokuyo = !std::strcmp(kind, "hokuyo"), rplidar = !std::strcmp(kind, "rplidar");
+  std::uint32_t v = 0;
+  if (hokuyo && !std::strcmp(opt, "intensity")) {
+    out->intensity = true;
+  } else if (rplidar && (!std::strcmp(opt, "express") || !std::strcmp(opt, "force"))) {
+    std::snprintf(out->mode, sizeof(out->mode), "%s", opt);
+  } else if (rplidar && !std::strncmp(opt, "pwm=", 4) && small_number(opt + 4, 1, 1023, &v)) {
+    out->motor_pwm = static_cast<std::uint16_t>(v);
+  } else if (rplidar && !std::strncmp(opt, "beams=", 6) && small_number(opt + 6, 1, hal::LaserScan::kMaxBeams, &v)) {
+    out->beams = v;
+  } else {
+    return false;
+  }
+  return true;
+}
+
+}  // namespace
+
 Status parse_serial_laser_spec(const char* kind, const char* arg, SerialLaserSpec* out) {
   *out = SerialLaserSpec{};
   if (std::strlen(arg) >= sizeof(out->device)) {
@@ -104,14 +138,16 @@ Status parse_serial_laser_spec(const char* kind, const char* arg, SerialLaserSpe
   std::strcpy(out->device, arg);
   if (char* comma = std::strchr(out->device, ',')) {
     *comma = '\0';
-    const char* opt = comma + 1;
-    const bool ok = (!std::strcmp(kind, "hokuyo") && !std::strcmp(opt, "intensity")) ||
-                    (!std::strcmp(kind, "rplidar") && (!std::strcmp(opt, "express") || !std::strcmp(opt, "force")));
-    if (!ok) {
-      return Status::error(Errc::kInvalidArgument, "laser: %s:%s: option '%s' unknown (hokuyo: intensity; rplidar: express, force)",
-                           kind, arg, opt);
+    for (char* opt = comma + 1; opt != nullptr;) {
+      char* next = std::strchr(opt, ',');
+      if (next != nullptr) *next++ = '\0';
+      if (!laser_option(kind, opt, out)) {
+        return Status::error(Errc::kInvalidArgument,
+                             "laser: %s:%s: option '%s' unknown (hokuyo: intensity; rplidar: express, force, pwm=1..1023, "
+                             "beams=1..1081)", kind, arg, opt);
+      }
+      opt = next;
     }
-    std::snprintf(out->option, sizeof(out->option), "%s", opt);
   }
   out->baud = default_serial_baud(kind);
   if (char* at = std::strchr(out->device, '@')) {
@@ -162,13 +198,15 @@ Status Board::open_serial_laser(const char* kind, const char* arg, std::uint32_t
   serial_down_ = false;
   if (!std::strcmp(kind, "hokuyo")) {
     hal_serial::HokuyoOptions o;
-    o.intensity = !std::strcmp(ls.option, "intensity");
+    o.intensity = ls.intensity;
     hokuyo_.init(&port_, &clock_, o);
     serial_laser_ = &hokuyo_;
   } else if (!std::strcmp(kind, "rplidar")) {
     hal_serial::RplidarOptions o;
-    if (!std::strcmp(ls.option, "express")) o.mode = hal_serial::RplidarScanMode::kExpress;
-    if (!std::strcmp(ls.option, "force")) o.mode = hal_serial::RplidarScanMode::kForceScan;
+    if (!std::strcmp(ls.mode, "express")) o.mode = hal_serial::RplidarScanMode::kExpress;
+    if (!std::strcmp(ls.mode, "force")) o.mode = hal_serial::RplidarScanMode::kForceScan;
+    o.motor_pwm = ls.motor_pwm;
+    if (ls.beams > 0) o.revolution.beams = ls.beams;
     rplidar_.init(&port_, &clock_, o);
     rplidar_.set_motor_control(&Board::rplidar_motor, this);
     serial_laser_ = &rplidar_;

@@ -137,11 +137,15 @@ TEST(BoardSerial, PeerClosesThenReturns) {
 
 TEST(BoardSerial, LaserSpecsOfTheSerialLasers) {
   SerialLaserSpec ls;
-  ASSERT_TRUE(parse_serial_laser_spec("rplidar", "/dev/ttyUSB0@256000,express", &ls).is_ok());
+  ASSERT_TRUE(parse_serial_laser_spec("rplidar", "/dev/ttyUSB0@256000,express,pwm=660,beams=720", &ls).is_ok());
   EXPECT_STREQ(ls.device, "/dev/ttyUSB0");
   EXPECT_EQ(ls.baud, 256000u);
-  EXPECT_STREQ(ls.option, "express");
-  ASSERT_TRUE(parse_serial_laser_spec("hokuyo", "/dev/ttyACM0", &ls).is_ok());
+  EXPECT_STREQ(ls.mode, "express");
+  EXPECT_EQ(ls.motor_pwm, 660);
+  EXPECT_EQ(ls.beams, 720u);
+  EXPECT_FALSE(parse_serial_laser_spec("rplidar", "/dev/ttyUSB0,beams=1082", &ls).is_ok());
+  ASSERT_TRUE(parse_serial_laser_spec("hokuyo", "/dev/ttyACM0,intensity", &ls).is_ok());
+  EXPECT_TRUE(ls.intensity);
   EXPECT_EQ(ls.baud, 115200u);  // the default of a Hokuyo (USB-ACM ignores it)
   ASSERT_TRUE(parse_serial_laser_spec("sick", "/dev/ttyS0", &ls).is_ok());
   EXPECT_EQ(ls.baud, 38400u);

@@ -4,8 +4,8 @@
 //   laser:    "socketcan:IFACE" | "can:IFACE"  scans as the mmlfw CAN message set (hal/can)
 //             "sick:DEVICE[@BAUD]" | "serial:DEVICE[@BAUD]"  SICK LMS2xx telegrams (hal/serial) [38400]
 //             "hokuyo:DEVICE[@BAUD][,intensity]"  Hokuyo URG/UTM/UST, SCIP 2.0 [115200; USB-ACM ignores it]
-//             "rplidar:DEVICE[@BAUD][,express|,force]"  Slamtec RPLIDAR (SCAN, EXPRESS_SCAN legacy,
-//                        FORCE_SCAN) [115200: A1/A2; 256000: A3/S1; 1000000: S2]
+//             "rplidar:DEVICE[@BAUD][,express|,force][,pwm=N][,beams=N]"  Slamtec RPLIDAR (SCAN,
+//                        EXPRESS_SCAN legacy, FORCE_SCAN) [115200: A1/A2; 256000: A3/S1; 1000000: S2]
 //             Hokuyo and RPLIDAR answer a start-up handshake; a device that does not within
 //             BoardSpec::laser_handshake_ms is an error naming the port and what it answered.
 //   odometry: "socketcan:IFACE" | "none" (zero odometry at the scan rate: a parked robot)
@@ -48,11 +48,17 @@ struct BoardSpec {
 // Longest "arg" of a backend spec + 1 (the config's laser/odometry/output values are < 128).
 constexpr std::size_t kMaxBackendArg = 128;
 
-// A serial laser spec "DEVICE[@BAUD][,OPTION]" taken apart (board.cpp; the config checks it too).
+// A serial laser spec "DEVICE[@BAUD][,OPTION]..." taken apart (board.cpp; the config checks it too).
+// Options: hokuyo "intensity" (ME); rplidar "express" | "force" (the scan request), "pwm=N" (A2/A3:
+// SET_MOTOR_PWM duty 1..1023, the SDK's default 660; the A1 runs on DTR), "beams=N" (grid slots over
+// 360°, 1..1081; 360 by default, 720 or more for an A2/A3/S1 in express mode).
 struct SerialLaserSpec {
   char device[kMaxBackendArg] = {0};
   std::uint32_t baud = 0;  // 0 = the protocol's default
-  char option[16] = {0};   // "", "intensity", "express", "force"
+  bool intensity = false;
+  char mode[8] = {0};      // "", "express", "force"
+  std::uint16_t motor_pwm = 0;
+  std::uint32_t beams = 0;  // 0 = the driver's default
 };
 // Errors name the spec and the part that is wrong.
 fw::Status parse_serial_laser_spec(const char* kind, const char* arg, SerialLaserSpec* out);
