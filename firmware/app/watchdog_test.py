@@ -7,22 +7,30 @@ as systemd would (WatchdogSec=), and reads the datagrams with their arrival time
          silent laser raises), WATCHDOG=1 at least every half period until SIGTERM, STOPPING=1.
   run 2, --test-stall-after: WATCHDOG=1 as before until the loop stalls, then none for many
          watchdog periods while the process is still alive (systemd would kill and restart it).
-  watchdog_test.py MMLFW [--summary FILE]
+  With --sickdev MML_SICKDEV --mapc MML_MAPC (and socat and the aces log of ../shared/data), scans
+  flow: the SICK device model streams aces telegrams at 75 Hz over a socat pty pair.
+  run 3, scans within the deadline (odometry localizer): WATCHDOG=1 throughout while stepping.
+  run 4, every step late (mml-track with MML inline, step_deadline_ms = 0.1): the loop cycles and
+         steps, but WATCHDOG=1 stops (systemd would restart a firmware that keeps no deadline).
+  watchdog_test.py MMLFW [--summary FILE] [--sickdev PATH --mapc PATH [--data DIR]]
 """
 import os, shutil, signal, socket, subprocess, sys, tempfile, time
 
 PERIOD_S = 0.5  # WATCHDOG_USEC: the firmware checks every 0.25 s
 
 
-def run(mmlfw, work, name, extra, stall_at=None, seconds=3.0):
+SILENT_LASER = ("laser = serial:/dev/ptmx\nodometry = none\noutput = log\nlocalizer = odom\n"
+                "workers = 1\narena_mib = 8\nlaser_timeout_ms = 300\n")
+
+
+def run(mmlfw, work, name, extra, stall_at=None, seconds=3.0, conf_text=SILENT_LASER):
     path = os.path.join(work, name + ".sock")
     rx = socket.socket(socket.AF_UNIX, socket.SOCK_DGRAM)
     rx.bind(path)
     rx.settimeout(0.05)
     conf = os.path.join(work, name + ".conf")
     with open(conf, "w") as f:
-        f.write("laser = serial:/dev/ptmx\nodometry = none\noutput = log\nlocalizer = odom\n"
-                "workers = 1\narena_mib = 8\nlaser_timeout_ms = 300\n")
+        f.write(conf_text)
     env = dict(os.environ, NOTIFY_SOCKET=path, WATCHDOG_USEC=str(int(PERIOD_S * 1e6)))
     env.pop("WATCHDOG_PID", None)
     err = open(os.path.join(work, name + ".err"), "w")
@@ -51,6 +59,85 @@ def run(mmlfw, work, name, extra, stall_at=None, seconds=3.0):
     return msgs, alive, rc, t_end - t0
 
 
+def arg(name):
+    return sys.argv[sys.argv.index(name) + 1] if name in sys.argv else None
+
+
+def mmlfw_summary(path):
+    import json
+    for line in open(path):
+        if line.startswith("mmlfw summary: "):
+            return json.loads(line[len("mmlfw summary: "):])
+    return {}
+
+
+def scan_runs(mmlfw, work, check):
+    """Runs 3 and 4 (scans through the SICK device model); None when they cannot run here."""
+    sickdev, mapc = arg("--sickdev"), arg("--mapc")
+    here = os.path.dirname(os.path.abspath(__file__))
+    data = arg("--data") or os.environ.get("MMLFW_DATA_DIR") or os.path.join(here, "..", "..", "..", "shared", "data")
+    why = None
+    if not sickdev or not mapc:
+        why = "no --sickdev/--mapc given"
+    elif shutil.which("socat") is None:
+        why = "socat not installed"
+    elif not os.path.exists(os.path.join(data, "aces", "aces.clf.gz")):
+        why = "aces log not found under " + data
+    if why:
+        print("SKIP - runs with scans: " + why)
+        return None
+    n_before = len(check.failures)
+    # A 6 x 4 m room (a wrong map for aces: MML searches on every step and never fixes).
+    W, H = 120, 80
+    px = bytearray([254]) * (W * H)
+    for x in range(10, 110):
+        for y in (10, 69): px[y * W + x] = 0
+    for y in range(10, 70):
+        for x in (10, 109): px[y * W + x] = 0
+    for y in range(10, 40): px[y * W + 50] = 0
+    open(os.path.join(work, "room.pgm"), "wb").write(b"P5\n%d %d\n255\n" % (W, H) + bytes(px))
+    open(os.path.join(work, "room.yaml"), "w").write("image: room.pgm\nresolution: 0.05\norigin: [0.0, 0.0, 0.0]\n"
+                                                     "negate: 0\noccupied_thresh: 0.65\nfree_thresh: 0.196\n")
+    mmap = os.path.join(work, "room.mmap")
+    subprocess.run([mapc, "--relation-table", os.path.join(work, "room.yaml"), mmap], stdout=subprocess.DEVNULL,
+                   stderr=subprocess.DEVNULL, check=True)
+    results = []
+    for name, body, feeds_expected in [
+            ("scans_odom", "localizer = odom\n", True),
+            ("scans_late", "localizer = mml-track\nmap = %s\nglobal_context = inline\nstep_deadline_ms = 0.1\n"
+             "arena_mib = 64\n" % mmap, False)]:
+        pty_a, pty_b = os.path.join(work, name + "_ttyA"), os.path.join(work, name + "_ttyB")
+        sp = subprocess.Popen(["socat", "pty,raw,echo=0,link=" + pty_a, "pty,raw,echo=0,link=" + pty_b],
+                              stderr=subprocess.DEVNULL)
+        for _ in range(100):
+            if os.path.exists(pty_a) and os.path.exists(pty_b): break
+            time.sleep(0.05)
+        dev = subprocess.Popen([sickdev, "--device", pty_a, "--dataset", "aces", "--count", "300", "--rate", "75",
+                                "--wait", "10"], env=dict(os.environ, MMLFW_DATA_DIR=data),
+                               stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
+        conf = ("laser = serial:%s@500000\nodometry = none\noutput = log\nworkers = 1\nlog_level = warning\n" % pty_b
+                + body + ("arena_mib = 16\n" if "arena_mib" not in body else ""))
+        msgs, alive, rc, _ = run(mmlfw, work, name, [], seconds=3.5, conf_text=conf)
+        dev.kill(); dev.wait(); sp.kill(); sp.wait()
+        s = mmlfw_summary(os.path.join(work, name + ".err"))
+        steps, missed = s.get("scans_processed", 0), s.get("deadline_misses", 0)
+        t_ready = next((t for t, m in msgs if m == "READY=1"), 0.0)
+        dogs = [t for t, m in msgs if m == "WATCHDOG=1"]
+        late_dogs = [t for t in dogs if t > t_ready + 1.2]  # after the first scans arrived
+        check("%s: alive and stepping scans (%d steps, %d late)" % (name, steps, missed),
+              alive and rc == 0 and steps >= (20 if feeds_expected else 5))
+        if feeds_expected:
+            check("%s: WATCHDOG=1 throughout while every step keeps the deadline" % name,
+                  missed < steps and len(late_dogs) >= 6, "%d feeds after %.1f s" % (len(late_dogs), t_ready + 1.2))
+        else:
+            check("%s: every step late, WATCHDOG=1 withheld though the loop cycles" % name,
+                  missed == steps and not late_dogs, "%d feeds in all, %d after %.1f s" % (len(dogs), len(late_dogs),
+                                                                                        t_ready + 1.2))
+        results.append(len(check.failures) == n_before)
+        n_before = len(check.failures)
+    return tuple(int(r) for r in results)
+
+
 def main():
     mmlfw = sys.argv[1]
     summary = sys.argv[sys.argv.index("--summary") + 1] if "--summary" in sys.argv else None
@@ -61,6 +148,7 @@ def main():
         print(("ok   - " if ok else "FAIL - ") + name + (": " + detail if detail else ""))
         if not ok:
             failures.append(name)
+    check.failures = failures
 
     # --- run 1: healthy -----------------------------------------------------------------------
     msgs, alive, rc, _ = run(mmlfw, work, "healthy", [], seconds=3.0)
@@ -99,9 +187,13 @@ def main():
     check("stall: the process is still alive (hung, not exited)", alive)
     stall_ok = len(failures) == n_before
 
+    scans = scan_runs(mmlfw, work, check)
+
     if summary:
         with open(summary, "w") as f:
             f.write("healthy_ok %d\nstall_stops_watchdog %d\n" % (healthy_ok, stall_ok))
+            if scans is not None:
+                f.write("scans_fed %d\nlate_steps_stop_watchdog %d\n" % scans)
     if not failures:
         shutil.rmtree(work, ignore_errors=True)
     else:
