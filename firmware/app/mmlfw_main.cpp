@@ -466,8 +466,9 @@ void notify_ready(std::uint64_t now_ns) {
                          g_watchdog.check_interval_ns() * 1e-6);
 }
 // One sensor-loop cycle: WATCHDOG=1 while the loop keeps its deadline (firmware/app/service_notify.h),
-// STATUS= when the status, its reason or the faults changed (at most every 250 ms). A failed send
-// is logged once per kind and counted (the manager restarting is no reason for the firmware to stop).
+// STATUS= when the status, its reason or the faults changed (at most every 250 ms; refreshed every
+// 5 s for the counters). A failed send is logged once per kind and counted (the manager
+// restarting is no reason for the firmware to stop).
 void notify_cycle(std::uint64_t now_ns) {
   if (!g_notify.enabled()) return;
   const hal::Health& h = g_loop.health();

@@ -61,8 +61,9 @@ bool service_status_changed(const hal::PoseEstimate& previous, std::uint32_t pre
 bool service_status_due(const hal::PoseEstimate& previous, std::uint32_t previous_faults,
                         const hal::PoseEstimate& estimate, std::uint32_t faults, std::uint64_t now_ns,
                         std::uint64_t last_sent_ns) {
-  return service_status_changed(previous, previous_faults, estimate, faults) &&
-         now_ns - last_sent_ns >= kServiceStatusMinIntervalNs;
+  const std::uint64_t since = now_ns - last_sent_ns;
+  if (since >= kServiceStatusRefreshNs) return true;
+  return service_status_changed(previous, previous_faults, estimate, faults) && since >= kServiceStatusMinIntervalNs;
 }
 
 }  // namespace fw

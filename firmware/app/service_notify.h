@@ -53,9 +53,11 @@ bool service_status_changed(const hal::PoseEstimate& previous, std::uint32_t pre
 // STATUS= goes out at most this often: a status that flips on every scan (75 Hz) must not flood
 // the service manager; the last change is sent once the interval has passed.
 constexpr std::uint64_t kServiceStatusMinIntervalNs = 250000000ull;
+// An unchanged STATUS= is refreshed this often, so that `systemctl status` shows current counters.
+constexpr std::uint64_t kServiceStatusRefreshNs = 5000000000ull;
 
 // True when a STATUS= is due now: changed since the last one sent (at last_sent_ns) and at least
-// kServiceStatusMinIntervalNs after it.
+// kServiceStatusMinIntervalNs after it, or unchanged for kServiceStatusRefreshNs.
 bool service_status_due(const hal::PoseEstimate& previous, std::uint32_t previous_faults,
                         const hal::PoseEstimate& estimate, std::uint32_t faults, std::uint64_t now_ns,
                         std::uint64_t last_sent_ns);

@@ -99,7 +99,8 @@ TEST(ServiceStatus, AFlappingStatusIsSentAtMostEveryInterval) {
   const std::uint64_t t0 = 1000 * kMs;
   EXPECT_FALSE(service_status_due(sent, 0, now, 0, t0 + 10 * kMs, t0));   // changed, but 10 ms after the last
   EXPECT_TRUE(service_status_due(sent, 0, now, 0, t0 + 250 * kMs, t0));   // still changed: sent once due
-  EXPECT_FALSE(service_status_due(now, 0, now, 0, t0 + 900 * kMs, t0));   // unchanged: never
+  EXPECT_FALSE(service_status_due(now, 0, now, 0, t0 + 900 * kMs, t0));   // unchanged: not yet
+  EXPECT_TRUE(service_status_due(now, 0, now, 0, t0 + 5000 * kMs, t0));   // unchanged: refreshed (counters)
 }
 
 }  // namespace

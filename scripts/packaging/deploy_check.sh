@@ -203,14 +203,19 @@ fi
 
 # --- 4. a Debian root with systemd: dpkg --root install, unit verify, the guest ------------------------------
 G=${DEPLOY_GUEST_DIR:-$ROOT/build/deploy-guest}
-if [ ! -x "$G/root/lib/systemd/systemd" ]; then
+# The root's package set; a root made with another set is made again.
+GUEST_PKGS=systemd,systemd-sysv,adduser,dbus,iproute2,kmod,init-system-helpers,can-utils
+if [ ! -x "$G/root/lib/systemd/systemd" ] || [ "$(cat "$G/root.packages" 2>/dev/null)" != "$GUEST_PKGS" ]; then
   say "debootstrap of a bookworm root with systemd into $G/root (once; Debian's packages)"
-  rm -rf "$G/root"; mkdir -p "$G"
+  rm -rf "$G/root" "$G/root.packages"; mkdir -p "$G"
   mirror=$(grep -hE '^(URIs:|deb )' /etc/apt/sources.list.d/*.sources /etc/apt/sources.list 2>/dev/null | grep -v security |
            head -1 | awk '{print $2}')
-  nice debootstrap --variant=minbase --include=systemd,systemd-sysv,adduser,dbus,iproute2,kmod,init-system-helpers \
-    bookworm "$G/root" "${mirror:-http://deb.debian.org/debian}" > "$L/debootstrap.log" 2>&1 ||
-    { say "debootstrap failed (see $L/debootstrap.log)"; rm -rf "$G/root"; }
+  if nice debootstrap --variant=minbase --include=$GUEST_PKGS \
+       bookworm "$G/root" "${mirror:-http://deb.debian.org/debian}" > "$L/debootstrap.log" 2>&1; then
+    echo "$GUEST_PKGS" > "$G/root.packages"
+  else
+    say "debootstrap failed (see $L/debootstrap.log)"; rm -rf "$G/root"
+  fi
 fi
 if [ -x "$G/root/lib/systemd/systemd" ] && [ -n "${DEB[amd64]:-}" ]; then
   V=$G/verify; rm -rf "$V"; cp -a "$G/root" "$V"
@@ -228,7 +233,19 @@ if [ -x "$G/root/lib/systemd/systemd" ] && [ -n "${DEB[amd64]:-}" ]; then
     key unit_verify_ok null
   fi
   rm -rf "$V"
-  if bash "$SRC/scripts/packaging/guest_systemd_test.sh" "$G/root" "${DEB[amd64]}" "$W/room.mmap" "$G/run" "$L/guest.txt" > "$L/guest.log" 2>&1 ||
+  # For the run on vcan: aces as CAN FD traffic (mml-candev, twice the log's speed) and its map.
+  DATA=${MMLFW_DATA_DIR:-$(cd "$ROOT/.." && pwd)/shared/data}
+  can_args=()
+  if [ -f "$DATA/aces/aces.clf.gz" ] && [ -x "$AMD/sim/map/mml-mapbuild" ] && [ -x "$AMD/sim/devices/mml-candev" ]; then
+    MMLFW_DATA_DIR=$DATA "$AMD/sim/map/mml-mapbuild" --dataset aces --out "$W/maps" > "$L/aces-map.log" 2>&1 &&
+      "$MAPC" --relation-table "$W/maps/aces.yaml" "$W/aces-table.mmap" >> "$L/aces-map.log" 2>&1 &&
+      MMLFW_DATA_DIR=$DATA "$AMD/sim/devices/mml-candev" log2can --dataset aces --count 400 --fd --speed 2 \
+        --out "$W/aces.replay" > "$L/aces-replay.json" 2>> "$L/aces-map.log" &&
+      can_args=("$W/aces.replay" "$W/aces-table.mmap")
+  fi
+  [ ${#can_args[@]} = 0 ] && say "no aces map or replay (log under $DATA?): the guest's CAN run is left out"
+  if bash "$SRC/scripts/packaging/guest_systemd_test.sh" "$G/root" "${DEB[amd64]}" "$W/room.mmap" "$G/run" "$L/guest.txt" \
+       "${can_args[@]}" > "$L/guest.log" 2>&1 ||
      [ -s "$L/guest.txt" ]; then
     v() { awk -v k="$1" '$1 == k {print $2}' "$L/guest.txt"; }
     all() { local k; for k in "$@"; do [ "$(v "$k")" = 1 ] || return 1; done; }
@@ -245,6 +262,15 @@ if [ -x "$G/root/lib/systemd/systemd" ] && [ -n "${DEB[amd64]:-}" ]; then
     key service_status_text "$(awk '$1 == "status_text" {$1=""; sub(/^ /, ""); print}' "$L/guest.txt")"
     if all watchdog_timeout_logged watchdog_restarted; then key watchdog_restart_ok true; else key watchdog_restart_ok false; fi
     key watchdog_restart_seconds "$(v watchdog_restart_seconds)"
+    if [ -n "$(v can_start_rc)" ]; then
+      if zero can_check_config_rc can_start_rc canplayer_rc can_restarts && all localized_under_systemd can_alive_after_replay; then
+        key localized_under_systemd_ok true
+      else key localized_under_systemd_ok false; fi
+      key localized_status_text "$(awk '$1 == "localized_status_text" {$1=""; sub(/^ /, ""); print}' "$L/guest.txt")"
+      key can_scans_processed "$(v can_scans_processed)"
+    else
+      key localized_under_systemd_ok null
+    fi
     if all conffile_kept conffile_kept_edited binary_removed unit_removed dpkg_status_config_files conffile_purged; then
       key remove_keeps_conffile_ok true
     else key remove_keeps_conffile_ok false; fi

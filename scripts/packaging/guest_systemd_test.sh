@@ -1,6 +1,9 @@
 #!/bin/bash
-# guest_systemd_test.sh ROOT_TEMPLATE DEB MAP.mmap WORK RESULTS: installs the mmlfw package in a
-# fresh Debian guest that boots systemd, and starts, stops, stalls and removes it there (issue 61).
+# guest_systemd_test.sh ROOT_TEMPLATE DEB MAP.mmap WORK RESULTS [CAN_REPLAY ACES_MAP]: installs the
+# mmlfw package in a fresh Debian guest that boots systemd, and starts, stops, stalls and removes it
+# there (issue 61). With CAN_REPLAY (mml-candev log2can --fd of aces, candump format) and ACES_MAP
+# (aces with the relation table), the service also localizes on a vcan0 bus: the UML kernel's CAN
+# modules are copied into the guest root and canplayer (can-utils in the root) replays the scans.
 #   ROOT_TEMPLATE  a Debian bookworm root with systemd (debootstrap; scripts/packaging/deploy_check.sh
 #                  makes it), copied afresh to WORK/root for every run (the guest writes into it)
 #   DEB            the amd64 mmlfw package;  MAP.mmap a small compiled map for the service's config
@@ -10,13 +13,24 @@
 # as root and powers off. A serial laser on /dev/ptmx (no CAN modules in the guest root) keeps the
 # firmware's loop running with no scans.
 set -u
-TEMPLATE=$1 DEB=$2 MAP=$3 WORK=$4 RESULTS=$5
+TEMPLATE=$1 DEB=$2 MAP=$3 WORK=$4 RESULTS=$5 REPLAY=${6:-} ACES_MAP=${7:-}
 mkdir -p "$WORK" && WORK=$(cd "$WORK" && pwd) || exit 1  # hostfs needs an absolute root
 rm -rf "${WORK:?}"/*; mkdir -p "$WORK/uml"
 R=$WORK/root
 cp -a "$TEMPLATE" "$R" || { echo "guest_systemd_test: cannot copy $TEMPLATE" >&2; exit 1; }
 mkdir -p "$R/root/deploy"
 cp "$DEB" "$R/root/deploy/mmlfw.deb" && cp "$MAP" "$R/root/deploy/room.mmap" || exit 1
+if [ -n "$REPLAY" ] && [ -n "$ACES_MAP" ]; then
+  kver=$(ls /usr/lib/uml/modules 2>/dev/null | head -1)
+  if [ -n "$kver" ] && [ -x "$R/usr/bin/canplayer" ]; then
+    mkdir -p "$R/lib/modules/$kver/kernel/net" "$R/lib/modules/$kver/kernel/drivers/net"
+    cp -a "/usr/lib/uml/modules/$kver/kernel/net/can" "$R/lib/modules/$kver/kernel/net/"
+    cp -a "/usr/lib/uml/modules/$kver/kernel/drivers/net/can" "$R/lib/modules/$kver/kernel/drivers/net/"
+    cp "$REPLAY" "$R/root/deploy/aces.replay" && cp "$ACES_MAP" "$R/root/deploy/aces.mmap"
+  else
+    echo "guest_systemd_test: no UML CAN modules or no canplayer in the root: the CAN run is left out" >&2
+  fi
+fi
 
 cat > "$R/root/deploy/steps.sh" <<'STEPS'
 #!/bin/bash
@@ -71,6 +85,35 @@ res inactive_after_stop "$(ok test "$(systemctl is-active mmlfw)" = inactive)"
 res stop_result "$(show Result)"
 journalctl -u mmlfw --no-pager > /root/deploy/journal-run.txt 2>&1
 res summary_in_journal "$(ok grep -q 'mmlfw summary' /root/deploy/journal-run.txt)"
+# 4b. localize on the robot's bus under systemd: vcan0 (CAN FD), aces replayed by canplayer at
+#     twice its speed, mml-track on the aces map; STATUS= must reach `localized`.
+if [ -f /root/deploy/aces.replay ]; then
+  K=/lib/modules/$(uname -r)/kernel
+  for m in net/can/can.ko net/can/can-raw.ko drivers/net/can/dev/can-dev.ko drivers/net/can/vcan.ko; do insmod $K/$m; done
+  ip link add dev vcan0 type vcan && ip link set vcan0 mtu 72 && ip link set vcan0 up
+  cp /etc/mmlfw/mmlfw.conf /root/deploy/pty.conf
+  cp /root/deploy/aces.mmap /var/lib/mmlfw/maps/aces.mmap
+  printf 'laser = socketcan:vcan0\ncan_fd = true\nmap = /var/lib/mmlfw/maps/aces.mmap\nworkers = 2\nrealtime = true\narena_mib = 96\n' \
+    > /etc/mmlfw/mmlfw.conf
+  mmlfw --check-config /etc/mmlfw/mmlfw.conf > /root/deploy/check-can.out 2>&1; res can_check_config_rc $?
+  systemctl start mmlfw; res can_start_rc $?
+  timeout 150 canplayer -I /root/deploy/aces.replay vcan0=vcan0 & cp=$!
+  seen=""
+  while kill -0 $cp 2>/dev/null; do
+    st=$(show StatusText); case "$st" in localized*) seen=$st ;; esac
+    echo "$(date +%s.%N) $st" >> /root/deploy/status-can.txt
+    sleep 0.5
+  done
+  wait $cp; res canplayer_rc $?
+  res localized_under_systemd "$([ -n "$seen" ] && echo 1 || echo 0)"
+  res localized_status_text "\"$seen\""
+  res can_alive_after_replay "$(ok test "$(systemctl is-active mmlfw)" = active)"
+  res can_restarts "$(show NRestarts)"
+  systemctl stop mmlfw
+  journalctl -u mmlfw --no-pager > /root/deploy/journal-can.txt 2>&1
+  res can_scans_processed "$(grep -o '"scans_processed": [0-9]*' /root/deploy/journal-can.txt | tail -1 | grep -o '[0-9]*$')"
+  cp /root/deploy/pty.conf /etc/mmlfw/mmlfw.conf
+fi
 # 5. watchdog: the sensor loop stalls after 2 s (--test-stall-after, a drop-in); systemd must kill
 #    it on the watchdog timeout and restart it (Restart=on-failure).
 mkdir -p /etc/systemd/system/mmlfw.service.d
@@ -134,7 +177,7 @@ echo "guest_systemd_test: guest ran $(( $(date +%s) - t0 )) s (linux.uml exit $u
 if [ -s "$R/root/deploy/results" ]; then
   { echo "guest_seconds $(( $(date +%s) - t0 ))"; cat "$R/root/deploy/results"; } > "$RESULTS"
   cat "$RESULTS"
-  cp "$R"/root/deploy/*.log "$R"/root/deploy/*.txt "$R"/root/deploy/check.out "$WORK/" 2>/dev/null
+  cp "$R"/root/deploy/*.log "$R"/root/deploy/*.txt "$R"/root/deploy/check*.out "$WORK/" 2>/dev/null
   grep -q '^done 1' "$RESULTS"
 else
   echo "guest_systemd_test: the guest reported nothing" >&2
