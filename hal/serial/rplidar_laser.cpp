@@ -12,6 +12,7 @@ constexpr std::uint64_t kRplidarNsPerMs = 1000000ull;
 const char* rplidar_state_name(RplidarState s) {
   switch (s) {
     case RplidarState::kIdle: return "idle";
+    case RplidarState::kStopping: return "STOP";
     case RplidarState::kHealth: return "GET_HEALTH";
     case RplidarState::kInfo: return "GET_INFO";
     case RplidarState::kResetting: return "RESET";
@@ -44,10 +45,14 @@ bool RplidarLaser::start() {
   if (motor_ != nullptr && !motor_(motor_context_, true)) ++stats_.motor_control_failed;
   revolution_.reset();
   // STOP ends a stream a previous run left going (it has no answer); what is still in flight is
-  // skipped by the parser until GET_HEALTH's descriptor.
+  // skipped by the parser until GET_HEALTH's descriptor. GET_HEALTH follows stop_settle_ms later
+  // (tick), at once without a clock.
   parser_.expect(kRplidarAnsHealth);
+  state_ = RplidarState::kStopping;
+  if (!send(kRplidarCmdStop)) return false;
+  if (clock_ != nullptr && options_.stop_settle_ms > 0) return true;
   state_ = RplidarState::kHealth;
-  return send(kRplidarCmdStop) && send(kRplidarCmdGetHealth);
+  return send(kRplidarCmdGetHealth);
 }
 
 bool RplidarLaser::restart() {
@@ -106,7 +111,7 @@ void RplidarLaser::request_scan() {
 void RplidarLaser::on_event(const RplidarEvent& e) {
   switch (e.kind) {
     case RplidarEvent::Kind::kHealth:
-      if (state_ != RplidarState::kHealth) return;
+      if (state_ != RplidarState::kHealth && state_ != RplidarState::kStopping) return;
       health_ = e.health;
       if (e.health.status == kRplidarHealthError) {
         ++stats_.health_errors;
@@ -154,6 +159,11 @@ void RplidarLaser::tick() {
   switch (state_) {
     case RplidarState::kResetting:
       if (now - sent_ns_ >= options_.reset_settle_ms * kRplidarNsPerMs) start();
+      return;
+    case RplidarState::kStopping:
+      if (now - sent_ns_ < options_.stop_settle_ms * kRplidarNsPerMs) return;
+      state_ = RplidarState::kHealth;
+      send(kRplidarCmdGetHealth);
       return;
     case RplidarState::kStreaming:
       if (options_.silence_restart_ms == 0 || now - last_revolution_ns_ < options_.silence_restart_ms * kRplidarNsPerMs) return;

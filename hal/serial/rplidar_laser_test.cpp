@@ -173,7 +173,9 @@ TEST(RplidarLaser, HealthErrorIsResetAndAskedAgain) {
   RplidarLaser laser;
   laser.init(&dev, &clock, RplidarOptions{});
   ASSERT_TRUE(laser.start());
-  EXPECT_FALSE(poll_until_ready(&laser, &clock, 20));
+  EXPECT_EQ(laser.state(), RplidarState::kStopping);  // GET_HEALTH after stop_settle_ms
+  EXPECT_EQ(dev.commands.size(), 1u);
+  EXPECT_FALSE(poll_until_ready(&laser, &clock, 40));
   EXPECT_EQ(laser.state(), RplidarState::kResetting);
   EXPECT_EQ(laser.stats().health_errors, 1u);
   clock.t += 1'000'000'000;  // the device boots (its banner is skipped)

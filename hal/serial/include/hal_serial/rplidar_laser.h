@@ -1,6 +1,7 @@
 // RplidarLaser: Slamtec RPLIDAR (A1/A2/A3, S1/S2) driver on any hal::SerialPort, after the
 // protocol document and SDK (hal_serial/rplidar_protocol.h). Start-up, one request at a time:
-//   motor on → STOP → GET_HEALTH (error: RESET, wait reset_settle_ms, again) → GET_INFO →
+//   motor on → STOP (stop_settle_ms: a unit still streaming may miss a request sent at once; the
+//   protocol document asks for a pause after STOP, community drivers wait 10-100 ms) → GET_HEALTH (error: RESET, wait reset_settle_ms, again) → GET_INFO →
 //   [SET_MOTOR_PWM for A2/A3] → SCAN | FORCE_SCAN | EXPRESS_SCAN (legacy capsules) → streaming;
 // samples are assembled into revolutions and resampled onto a regular grid (rplidar_revolution.h).
 // A request not answered within answer_timeout_ms, or a stream without a revolution for
@@ -28,6 +29,7 @@ struct RplidarOptions {
   RplidarScanMode mode = RplidarScanMode::kScan;
   RplidarRevolutionOptions revolution;
   std::uint16_t motor_pwm = 0;              // A2/A3: SET_MOTOR_PWM duty 0..1023 (0: not sent; A1: DTR)
+  std::uint32_t stop_settle_ms = 20;        // after STOP before the next request (see start())
   std::uint32_t answer_timeout_ms = 500;
   std::uint32_t reset_settle_ms = 1000;     // after RESET the device boots and prints a banner
   std::uint32_t silence_restart_ms = 2000;  // ≥ 10 revolutions of an A1 at 5.5 Hz
@@ -36,7 +38,7 @@ struct RplidarOptions {
 // Switches the motor (true = run); false if the line could not be set.
 using RplidarMotorFn = bool (*)(void* context, bool on);
 
-enum class RplidarState : std::uint8_t { kIdle, kHealth, kInfo, kResetting, kRequestScan, kStreaming };
+enum class RplidarState : std::uint8_t { kIdle, kStopping, kHealth, kInfo, kResetting, kRequestScan, kStreaming };
 const char* rplidar_state_name(RplidarState s);
 
 struct RplidarStats {
