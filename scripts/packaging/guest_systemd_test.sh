@@ -178,6 +178,8 @@ if [ -s "$R/root/deploy/results" ]; then
   { echo "guest_seconds $(( $(date +%s) - t0 ))"; cat "$R/root/deploy/results"; } > "$RESULTS"
   cat "$RESULTS"
   cp "$R"/root/deploy/*.log "$R"/root/deploy/*.txt "$R"/root/deploy/check*.out "$WORK/" 2>/dev/null
+  # The guest's root copy (~290 MB) is kept only when the steps did not finish (to look into).
+  grep -q '^done 1' "$RESULTS" && rm -rf "$R"
   grep -q '^done 1' "$RESULTS"
 else
   echo "guest_systemd_test: the guest reported nothing" >&2
