@@ -14,6 +14,8 @@ void OdometryConsistency::advance(const Se2f& delta, const Eigen::Matrix3f& q) {
     const Eigen::Matrix3f g = k.motion.jacobian_compose_second();
     k.motion = k.motion.compose(delta);
     k.motion_cov = f * k.motion_cov * f.transpose() + g * q * g.transpose();
+    k.path_m += std::hypot(delta.x, delta.y);
+    k.turn_rad += std::fabs(delta.theta);
   }
 }
 
@@ -34,6 +36,8 @@ void OdometryConsistency::push(const Se2f& pose, const Eigen::Matrix3f& cov, flo
   k.bias_theta2 = bias_theta_rad * bias_theta_rad;
   k.motion = Se2f();
   k.motion_cov.setZero();
+  k.path_m = 0.0f;
+  k.turn_rad = 0.0f;
   head_ = (head_ + 1) % window_;
   if (count_ < window_) ++count_;
 }
@@ -47,8 +51,12 @@ float OdometryConsistency::max_chi2(const Se2f& pose, const Eigen::Matrix3f& cov
     const Eigen::Matrix3f j1 = k.pose.jacobian_compose_first(k.motion);
     const Eigen::Matrix3f j2 = k.pose.jacobian_compose_second();
     Eigen::Matrix3d c = (j1 * k.cov * j1.transpose() + j2 * k.motion_cov * j2.transpose() + cov).cast<double>();
-    const double bxy = static_cast<double>(k.bias_xy2) + static_cast<double>(bias_xy_m) * bias_xy_m;
-    const double bth = static_cast<double>(k.bias_theta2) + static_cast<double>(bias_theta_rad) * bias_theta_rad;
+    // The wheels' systematic error over this motion (header).
+    const double sys_th = static_cast<double>(scale_error_) * k.turn_rad;
+    const double sys_xy = static_cast<double>(scale_error_) * k.path_m * (1.0 + k.turn_rad);
+    const double bxy = static_cast<double>(k.bias_xy2) + static_cast<double>(bias_xy_m) * bias_xy_m + sys_xy * sys_xy;
+    const double bth = static_cast<double>(k.bias_theta2) + static_cast<double>(bias_theta_rad) * bias_theta_rad +
+                       sys_th * sys_th;
     c(0, 0) += bxy;
     c(1, 1) += bxy;
     c(2, 2) += bth;

@@ -12,6 +12,13 @@
 // with B the map-bias terms of the protection level (diagonal, one per end: the map error does not
 // average out). P_i and P are correlated positively through the shared map and chain, so adding them
 // bounds the variance of the difference from above: the test errs towards availability.
+// The wheels' systematic error (a scale error ε of the distance driven and of the angle turned,
+// TrackOptions::odom_scale_error; UMBmark's wheel-diameter and wheelbase errors) is not noise: over a
+// kept motion of path length D and accumulated turn A it adds (ε·A)² to the heading variance and
+// (ε·D + ε·A·D)² to the position's (the heading error acting over the path, a bound), the same
+// assumption the protection level makes (PL += ε·D_unpinned). Without it a base
+// whose wheels over-report 3 % failed this test at right poses every few metres (corpus seed 404,
+// poorly calibrated bases: each failure a large fault, the track waiting for MML for tens of metres).
 // A failed test is a contradiction of the pose by the odometry, exactly like a failed innovation test.
 // Fixed capacity; never allocates.
 #pragma once
@@ -29,7 +36,11 @@ class OdometryConsistency {
   static constexpr std::size_t kMaxWindow = 32;
 
   // `window` = fused poses kept (1..kMaxWindow; 0 disables the test).
-  void configure(std::size_t window) { window_ = window > kMaxWindow ? kMaxWindow : window; clear(); }
+  void configure(std::size_t window, float scale_error = 0.0f) {
+    window_ = window > kMaxWindow ? kMaxWindow : window;
+    scale_error_ = scale_error;
+    clear();
+  }
   void clear() { count_ = 0; head_ = 0; }
   std::size_t size() const { return count_; }
 
@@ -51,7 +62,10 @@ class OdometryConsistency {
     float bias_xy2 = 0.0f, bias_theta2 = 0.0f;
     Se2f motion;                     // odometry since this pose, in its robot frame
     Eigen::Matrix3f motion_cov;      // its noise
+    float path_m = 0.0f;             // distance the wheels report since this pose
+    float turn_rad = 0.0f;           // and the angle they report turned (absolute, accumulated)
   };
+  float scale_error_ = 0.0f;
   Kept kept_[kMaxWindow];
   std::size_t window_ = 0, count_ = 0, head_ = 0;  // head_ = next slot to write
 };

@@ -31,7 +31,7 @@ Status PoseTracker::init(const TrackOptions& options, const GlobalMap& map) {
   options_ = options;
   map_ = map;
   k_ = ProtectionFactors::for_risk(options.integrity_risk);
-  odometry_check_.configure(options.odometry_window);
+  odometry_check_.configure(options.odometry_window, options.odom_scale_error);
   initialized_ = true;
   reset();
   return Status::ok();
