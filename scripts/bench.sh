@@ -40,6 +40,25 @@ if [ "${1:-}" = deploy ]; then
   bash scripts/packaging/deploy_check.sh build/bench/deploy.json
   exit $?
 fi
+# peers (issue 58; only when named): LaMa's Loc2D and AMCL's core built from ../shared/peers (never
+# vendored) in their own build dir build/peers (-DMMLFW_BUILD_PEERS=ON, passed only here), beside
+# mml-track on intel, aces, fr079 (MMLFW_PEERS_DATASETS): build/bench/peers.json
+# (sim/eval/peers/README.md).
+if [ "${1:-}" = peers ]; then
+  PEERS_DIR=${MMLFW_PEERS_DIR:-$(cd "$ROOT/.." && pwd)/shared/peers}
+  if [ ! -d "$PEERS_DIR" ]; then
+    echo "bench.sh: no $PEERS_DIR: the peers are not built and not measured" >&2; exit 77
+  fi
+  cmake --preset release -B build/peers -DMMLFW_BUILD_PEERS=ON -DMMLFW_PEERS_DIR="$PEERS_DIR" >/dev/null
+  cmake --build build/peers --target bench_peers -j "$(nproc)"
+  if [ ! -x build/peers/bench/bench_peers ]; then
+    echo "bench.sh: bench_peers was not built (see the configure messages of build/peers)" >&2; exit 1
+  fi
+  echo "=== bench peers ==="
+  build/peers/bench/bench_peers build/bench/peers.json
+  echo "--- build/bench/peers.json"; cat build/bench/peers.json; echo
+  exit 0
+fi
 cmake --preset release >/dev/null
 cmake --build --preset release -j "$(nproc)"
 
