@@ -25,7 +25,7 @@ class FakeRplidar final : public hal::SerialPort {
  public:
   long read(std::uint8_t* buf, std::size_t len) override {
     const std::size_t n = std::min(len, in.size());
-    std::memcpy(buf, in.data(), n);
+    if (n > 0) std::memcpy(buf, in.data(), n);  // an empty container's data() may be null
     in.erase(in.begin(), in.begin() + static_cast<long>(n));
     return static_cast<long>(n);
   }
