@@ -61,6 +61,9 @@ bool map_distance_for_refine(const void* ctx, const pransam::Point<2>& p, float*
   (*grad)(1) = gy;
   return true;
 }
+bool in_unmapped_space(const void* ctx, const pransam::Point<2>& p) {
+  return static_cast<const UnmappedSpace*>(ctx)->contains(p(0), p(1));
+}
 }  // namespace
 
 Status MmlLocalizer::init(const MmlLocalizerConfig& config, const GlobalMap& map, const std::uint8_t* table_section,
@@ -84,6 +87,12 @@ Status MmlLocalizer::init(const MmlLocalizerConfig& config, const GlobalMap& map
   FW_RETURN_IF_ERROR(matcher_.init(mo, arena, pool));
   FW_RETURN_IF_ERROR(matcher_.set_model(map.points, map.num_points, "global map"));
   matcher_.set_refine_distance(&map_distance_for_refine, &map_);
+  if (config.mml.unmapped_space_min_area_m2 > 0.0f) {
+    UnmappedSpaceOptions uo;
+    uo.min_area_m2 = config.mml.unmapped_space_min_area_m2;
+    FW_RETURN_IF_ERROR(unmapped_.build(map, uo, arena));
+    if (unmapped_.unmapped_blocks() > 0) matcher_.set_unmapped_space(&in_unmapped_space, &unmapped_);
+  }
   if (config.mml.precomputed_table) {
     if (have_section) {
       pransam::RelationTableSection sec;

@@ -21,6 +21,7 @@
 #include "firmware/base/perf_counter.h"
 #include "firmware/base/worker_pool.h"
 #include "firmware/map/global_map.h"
+#include "firmware/map/unmapped_space.h"
 #include "firmware/mml/interpretation.h"
 #include "firmware/mml/local_map_correction.h"
 #include "firmware/mml/mml_options.h"
@@ -67,6 +68,13 @@ class MmlLocalizer final : public Localizer {
   const char* name() const override { return "mml"; }
   void reset() override;
   Status step(const hal::LaserScan& scan, const hal::Odometry& odom, hal::PoseEstimate* out) override;
+  // The hypothesis "the robot is in the map's unmapped space" (map/unmapped_space.h) beside the
+  // mapped poses: while on, pRANSAM counts a point there as contact. Off by default (the
+  // dissertation: unknown is a miss); mml-track holds it on while the robot has not been located
+  // since start-up or a carry (tracked_localizer.h). A no-op on a map without unmapped space.
+  void set_unmapped_hypothesis(bool on) { matcher_.set_unmapped_active(on); }
+  bool unmapped_hypothesis() const { return matcher_.unmapped_active(); }
+  const UnmappedSpace& unmapped_space() const { return unmapped_; }
 
   // For visualisation / evaluation.
   const Interpreter& interpreter() const { return interp_; }
@@ -147,6 +155,7 @@ class MmlLocalizer final : public Localizer {
   LocalMap local_map_;
   ScanMatchingOdometry front_end_;
   pransam::Matcher<2> matcher_;
+  UnmappedSpace unmapped_;  // labels in the start-up arena
   Interpreter interp_;
   InterpretResult last_;
 

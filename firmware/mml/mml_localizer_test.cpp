@@ -211,6 +211,67 @@ TEST(MmlLocalizerTest, StartInUnknownAreaNeverLocalizes) {
   if (::testing::Test::HasFailure() || std::getenv("MML_TRACE")) print_trace(rec);
 }
 
+// Two rooms of the same layout side by side; the map lacks the left one's inside (unmapped space,
+// map/unmapped_space.h) and the robot is switched on there. Its scans match the right room
+// perfectly; only "the robot is in the room the map lacks" explains them as well. With that
+// hypothesis (points in unmapped space are no evidence against a pose) MML never isolates the twin;
+// without it, it does (issue 56, corpus seed 505 #56).
+struct TwinInUnmappedSpace {
+  GridWorld world, mapped;
+  TwinInUnmappedSpace() {
+    world.w = 480;
+    world.h = 200;
+    world.occ.assign(world.w * world.h, 0);
+    world.box(0.2f, 0.2f, 23.8f, 9.8f);  // a corridor along the top (y 7.8–9.8 m) joins the rooms
+    for (float dx : {0.0f, 12.0f}) {
+      world.wall(0.2f + dx, 7.8f, 1.0f + dx, 7.8f);  // the room's wall to the corridor, a door 1–2 m
+      world.wall(2.0f + dx, 7.8f, 11.8f + dx, 7.8f);
+      world.wall(11.8f + dx, 0.2f, 11.8f + dx, 7.8f);
+      world.wall(0.2f + dx, 0.2f, 0.2f + dx, 7.8f);
+      world.wall(3.0f + dx, 0.2f, 3.0f + dx, 3.0f);
+      world.wall(7.0f + dx, 7.8f, 7.0f + dx, 5.0f);
+      world.box(8.5f + dx, 1.5f, 9.5f + dx, 2.2f);
+      world.wall(5.0f + dx, 4.0f, 6.5f + dx, 4.0f);
+    }
+    world.finish();
+    mapped = world;
+    for (std::uint32_t y = 0; y < mapped.h; ++y)
+      for (std::uint32_t x = 0; x < mapped.w; ++x) {
+        const float cx = (x + 0.5f) * mapped.res, cy = (y + 0.5f) * mapped.res;
+        if (cx > 0.4f && cx < 11.8f && cy > 0.4f && cy < 7.6f) mapped.occ[y * mapped.w + x] = 255;
+      }
+    mapped.finish();
+  }
+};
+
+int wrong_localized(const std::vector<testing::StepRecord>& rec) {
+  int n = 0;
+  for (const auto& r : rec) {
+    n += r.est.status == hal::LocalizationStatus::kLocalized && std::hypot(r.est.x - r.truth.x, r.est.y - r.truth.y) > 0.5f;
+  }
+  return n;
+}
+
+TEST(MmlLocalizerTest, StartInUnmappedTwinOfAMappedRoomNeverIsolatesTheTwin) {
+  static TwinInUnmappedSpace tw;
+  static OwnedGlobalMap gm(tw.mapped);
+  const auto path = testing::waypoint_path({{4.5f, 6.5f}, {4.5f, 2.0f}, {8.0f, 3.0f}, {10.5f, 6.5f}, {1.5f, 6.0f}, {1.5f, 1.5f}}, 0.1f);
+  Rig with;
+  ASSERT_TRUE(with.init(gm.map, test_config()).is_ok());
+  with.loc->set_unmapped_hypothesis(true);
+  EXPECT_TRUE(with.loc->unmapped_hypothesis());
+  EXPECT_GT(with.loc->unmapped_space().unmapped_blocks(), 1000u);  // the 11 × 7 m room, 0.25 m blocks
+  const auto rec = testing::drive(with.loc.get(), tw.world, path, 7, note_hook(with.loc.get()));
+  EXPECT_EQ(wrong_localized(rec), 0);
+  if (::testing::Test::HasFailure() || std::getenv("MML_TRACE")) print_trace(rec);
+  // The witness that the case is real: unknown cells as misses (the dissertation, and MML's default)
+  // isolate the twin.
+  Rig without;
+  ASSERT_TRUE(without.init(gm.map, test_config()).is_ok());
+  EXPECT_FALSE(without.loc->unmapped_hypothesis());
+  EXPECT_GT(wrong_localized(testing::drive(without.loc.get(), tw.world, path, 7)), 0);
+}
+
 TEST(MmlLocalizerTest, DeterministicAndResettable) {
   static GridWorld g = mcl::testing::unique_room();
   static OwnedGlobalMap gm(g);

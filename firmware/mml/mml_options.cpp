@@ -39,6 +39,7 @@ Status MmlOptions::validate() const {
     return Status::error(Errc::kInvalidArgument, "MmlOptions.alpha sums to %g, must be 1 (Eq. 5.4)", sum);
   }
   FW_RETURN_IF_ERROR(check_range("delta_r", delta_r, 0.0, 1.0));
+  FW_RETURN_IF_ERROR(check_range("unmapped_space_min_area_m2", unmapped_space_min_area_m2, 0.0, 60.0));
   FW_RETURN_IF_ERROR(check_range("min_cluster_hypotheses", min_cluster_hypotheses, 1, kMaxHypotheses));
   FW_RETURN_IF_ERROR(check_positive("xi_r2", xi_r2));
   FW_RETURN_IF_ERROR(check_positive("xi_med", xi_med));

@@ -126,6 +126,11 @@ struct MmlOptions {
 
   // --- Unknown regions (Sec. 5.6, Eq. 5.37).
   bool detect_unknown = true;
+  // Unmapped space = inner unknown regions of at least this area (m², map/unmapped_space.h): while
+  // MmlLocalizer::set_unmapped_hypothesis(true), a point there counts as contact in pRANSAM's
+  // quality (the robot may stand in a room the map lacks). 0 = none (the dissertation: unknown
+  // cells are misses). 1 m²: smaller unknown pockets (pillars, thick walls) cannot hold the robot.
+  float unmapped_space_min_area_m2 = 1.0f;
   std::uint32_t tau_up = 10;
   float outside_map_contact = 0.35f;   // Ω' below ⇒ outside-map
   float contact_distance_m = 0.15f;    // "contact" = a map point within this distance

@@ -198,6 +198,17 @@ class Matcher {
 
   const MatcherOptions& options() const { return options_; }
   const ContactField<D>& field() const { return field_; }
+  // Space the model set knows nothing about (the global map's unmapped space, map/unmapped_space.h):
+  // while set_unmapped_active(true), a point there counts as hard contact — it is no evidence
+  // against the hypothesis, because the robot may stand in that space and see anything there.
+  // `in_unmapped` is set once at start-up; the switch may change between match() calls.
+  using RegionFn = bool (*)(const void* ctx, const Point<D>& p);
+  void set_unmapped_space(RegionFn in_unmapped, const void* ctx) {
+    unmapped_fn_ = in_unmapped;
+    unmapped_ctx_ = ctx;
+  }
+  void set_unmapped_active(bool on) { unmapped_active_ = on && unmapped_fn_ != nullptr; }
+  bool unmapped_active() const { return unmapped_active_; }
   // Optional distance source for the refinement (MatchParams::refine_iterations) in place of the
   // contact field's float distance: a model that already has a distance field (the global map's)
   // need not keep a second one (ContactFieldOptions::keep_distance = false saves 4 bytes per cell).
@@ -270,6 +281,9 @@ class Matcher {
   ContactField<D> field_;
   DistanceFn refine_fn_ = nullptr;
   const void* refine_ctx_ = nullptr;
+  RegionFn unmapped_fn_ = nullptr;
+  const void* unmapped_ctx_ = nullptr;
+  bool unmapped_active_ = false;
   PointIndex<D> index_a_, index_b_;
   const Point<D>* model_ = nullptr;
   std::uint32_t model_n_ = 0;

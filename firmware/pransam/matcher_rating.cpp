@@ -1,4 +1,5 @@
-// Rating of a hypothesis (Eq. 4.7, with the early stop of Eq. 4.8) on the contact field.
+// Rating of a hypothesis (Eq. 4.7, with the early stop of Eq. 4.8) on the contact field; while the
+// unmapped-space hypothesis is active (matcher.h), a point in unmapped space counts as contact.
 #include "firmware/pransam/matcher.h"
 
 #include <cmath>
@@ -33,7 +34,9 @@ float Matcher<D>::rate(const Hypothesis<D>& h, float bound, std::uint32_t start,
   std::uint32_t idx = start;
   for (; k < n;) {
     const Point<D> p = h.rotation * scene_[scene_order_[idx]] + h.translation;
-    sum += lut[field_.contact(p)];
+    std::uint8_t c = field_.contact(p);
+    if (unmapped_active_ && c != 255 && unmapped_fn_(unmapped_ctx_, p)) c = 255;
+    sum += lut[c];
     ++k;
     if (++idx == n) idx = 0;
     // Eq. 4.8: Ω⁺(k) = mean + 1.96 / (2√k); give up once it cannot beat the bound.

@@ -92,6 +92,7 @@ void GlobalContext::run_job() {
   // out once, and hid 14-17 ms resets of RBSM's grid behind a 10 ms step p99).
   const std::uint64_t t0 = clock_ != nullptr ? clock_->now_ns() : 0;
   if (job_reset_) mml_->reset();
+  mml_->set_unmapped_hypothesis(job_unmapped_);
   job_status_ = mml_->step(job_scan_, job_odom_, &job_out_);
   if (clock_ != nullptr) {
     const std::uint64_t dt = clock_->now_ns() - t0;
@@ -192,6 +193,7 @@ Status GlobalContext::offer(const hal::LaserScan& scan, const hal::Odometry& odo
   job_index_ = cur;
   job_generation_ = generation_;
   job_reset_ = reset_pending_;
+  job_unmapped_ = unmapped_hypothesis_;
   reset_pending_ = false;
   ++jobs_;
   if (threaded_) {

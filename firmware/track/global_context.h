@@ -78,6 +78,9 @@ class GlobalContext {
   // Once per tracker step, before any step()/reset() of that scan.
   void tick();
   void reset();   // MML forgets everything before its next job
+  // MML's unmapped-space hypothesis (MmlLocalizer::set_unmapped_hypothesis) for the jobs offered
+  // from now on: it travels with each job, so a threaded MML sees it at the same scan as inline.
+  void set_unmapped_hypothesis(bool on) { unmapped_hypothesis_ = on; }
   void restart(); // reset() and the scan index back to 0 (TrackedLocalizer::reset)
   // See the header comment. `out` is always written. step() = collect() then offer().
   Status step(const hal::LaserScan& scan, const hal::Odometry& odom, hal::PoseEstimate* out);
@@ -122,6 +125,8 @@ class GlobalContext {
   hal::Odometry job_odom_;
   std::uint64_t job_index_ = 0, job_generation_ = 0;
   bool job_reset_ = false;   // MML resets before this job
+  bool job_unmapped_ = false;  // MML's unmapped-space hypothesis for this job
+  bool unmapped_hypothesis_ = false;
   bool reset_pending_ = false;
   Status job_status_;
   hal::PoseEstimate job_out_;

@@ -226,9 +226,30 @@ TrackStep PoseTracker::step(const Point2f* points, std::size_t n, const Se2f& od
   w.pred = pose_;
   w.pred_pl = protection_level(cov_, k_, bias_xy_m_, bias_theta_rad_);
   w.p_post = cov_;
+  const StepWork w0 = w;
+  const TrackStep out0 = out;
   out.alignment = align_from_prediction(points, n, w.pred, &out);
   judge_scan(odom_jump, &w, &out);
   if (w.v == ScanVerdict::kSupported && o.alias_check) check_aliases(points, n, &w, &out);
+  // A rival the scan fits significantly better, within what the prediction promises (its PL), is
+  // the fix Gauss-Newton missed from a prediction some degrees off (the white wheels' 4° per step),
+  // not a sign that the robot is elsewhere: the innovation test's own criterion (judge_scan). The
+  // scan is aligned again from the rival and judged again, once; beyond the prediction's PL the
+  // rival stays a contradiction (a large fault beyond the alert limits).
+  if (w.rival_better && o.refit_at_better_rival) {
+    const Se2f r = out.alias_rival;
+    const Eigen::Vector3f er(r.x - w.pred.x, r.y - w.pred.y, wrap_angle(r.theta - w.pred.theta));
+    if (!outside_bound(er, w.pred_pl)) {
+      const std::uint32_t searched = out.search_candidates;
+      w = w0;
+      out = out0;
+      out.search_candidates = searched;
+      out.refit_at_rival = true;
+      out.alignment = align_scan(map_, points, n, r, o.align);
+      judge_scan(odom_jump, &w, &out);
+      if (w.v == ScanVerdict::kSupported) check_aliases(points, n, &w, &out);
+    }
+  }
   const Update u = propose_update(odom, predict, &w, &out);
   out.verdict = w.v;
   apply_verdict(odom, w, u, &out);
@@ -354,6 +375,7 @@ void PoseTracker::check_aliases(const Point2f* points, std::size_t n, StepWork* 
   if (u.rival_cost < u.cost - o.alias_margin &&
       rival_significantly_better(map_, alias_points_, m, a.pose, u.rival, o.alias_clip_m, a.independent, o.alias_z)) {
     w->v = ScanVerdict::kContradicting;  // the scan says the robot is elsewhere
+    w->rival_better = true;
     out->large_fault = std::hypot(u.rival.x - a.pose.x, u.rival.y - a.pose.y) > o.alert_limit_m ||
                        std::fabs(wrap_angle(u.rival.theta - a.pose.theta)) > o.alert_limit_rad;
   } else if (!u.unique) {

@@ -87,6 +87,7 @@ struct TrackStep {
   bool valley_dropped = false;
   std::uint32_t search_candidates = 0;  // correlative pre-search (0 = not run: prediction tight)
   bool search_moved = false;            // the alignment started from the search's best pose
+  bool refit_at_rival = false;          // re-aligned from a better rival within the prediction's PL
   ScanAlignment alignment;
 };
 
@@ -129,6 +130,7 @@ class PoseTracker {
     // scan fits alike; its information along it is dropped before the update.
     bool valley = false;
     Eigen::Vector2f valley_axis = Eigen::Vector2f::Zero();
+    bool rival_better = false;  // the alias check's rival fits this scan significantly better
   };
   struct Update {
     bool fuse = false;

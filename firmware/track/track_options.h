@@ -159,6 +159,9 @@ struct TrackOptions {
   // the error and the status is not `localized` until the scans are unique again for
   // `recovery_steps` scans. The PL is a single-mode bound; this check is what makes it one.
   bool alias_check = true;
+  // A rival that fits significantly better and lies within the prediction's PL is the fix the
+  // alignment missed, not a fault: the scan is aligned again from it (pose_tracker.cpp).
+  bool refit_at_better_rival = true;
   // One valley, one mode (extension): on a trusted track (no contradiction since the last
   // recovery_steps unique scans, no fit drop at alias_credible_z), a rival at the fix's heading
   // joined to the fix by poses that fit as well (mml::in_same_cost_valley: a bare corridor whose

@@ -157,11 +157,19 @@ std::size_t wrong_localized(const CorpusRun& r) {
   return n;
 }
 
+std::size_t localized_steps(const CorpusRun& r) {
+  std::size_t n = 0;
+  for (const CorpusStep& s : r.steps) n += s.status == static_cast<std::uint8_t>(hal::LocalizationStatus::kLocalized);
+  return n;
+}
+
 // Corpus seed 101, draw 46 (a warehouse of identical racks, a 6 × 6 m block erased from the map on the
 // route): the track is lost in the block by faults, not by a clean outside-map exit, and MML then
-// isolates an aisle 34 m away, whose twin — the true place — the map lacks in part. The wheels, with
-// no sign of a carry, bind MML's fixes (TrackOptions::wheels_bind_mml_without_carry): 0 wrong
-// `localized` steps; without the rule the witness, 125.
+// isolates an aisle 34 m away, whose twin — the true place — the map lacks in part. Two rules each
+// keep it from `localized`: the wheels, with no sign of a carry, bind MML's fixes
+// (TrackOptions::wheels_bind_mml_without_carry), and — the faults in the block being such a sign —
+// MML holds the unmapped-space hypothesis again (map/unmapped_space.h). Without both, the witness:
+// 125 wrong steps.
 TEST(CorpusRunnerTest, WheelsBindMmlAfterAnUnmappedBlockInAWarehouse) {
   const CorpusDraw d = draw_corpus(101, 47)[46];
   ASSERT_TRUE(d.via_unknown) << describe_draw(d);
@@ -169,10 +177,48 @@ TEST(CorpusRunnerTest, WheelsBindMmlAfterAnUnmappedBlockInAWarehouse) {
   ro.timing = false;
   const CorpusRun with = run_draw(d, ro);
   ro.localizer_options["wheels_bind"] = "0";
+  const CorpusRun without_bind = run_draw(d, ro);
+  ro.localizer_options["off"] = "unmapped_space_contact";
+  const CorpusRun without_both = run_draw(d, ro);
+  ASSERT_TRUE(with.ok && without_bind.ok && without_both.ok) << with.error << without_bind.error << without_both.error;
+  EXPECT_EQ(wrong_localized(with), 0u);
+  EXPECT_EQ(wrong_localized(without_bind), 0u);
+  EXPECT_GT(wrong_localized(without_both), 0u);
+}
+
+// Seed 505 draw 56 (warehouse, TiM571): the robot is switched on inside a 6 × 6 m block erased from
+// the map; its scans match the twin cross-aisle 36 m east. MML holds the hypothesis "in the map's
+// unmapped space" until the robot is first located (map/unmapped_space.h): it waits until the east
+// wall tells the aisles apart, 0 wrong `localized` steps; without it the witness, 138.
+TEST(CorpusRunnerTest, SwitchedOnInUnmappedSpaceMmlDoesNotIsolateTheTwin) {
+  const CorpusDraw d = draw_corpus(505, 57)[56];
+  ASSERT_TRUE(d.via_unknown) << describe_draw(d);
+  CorpusRunOptions ro;
+  ro.timing = false;
+  const CorpusRun with = run_draw(d, ro);
+  ro.localizer_options["off"] = "unmapped_space_contact";
   const CorpusRun without = run_draw(d, ro);
   ASSERT_TRUE(with.ok && without.ok) << with.error << without.error;
   EXPECT_EQ(wrong_localized(with), 0u);
   EXPECT_GT(wrong_localized(without), 0u);
+}
+
+// Seed 505 draw 51 (lab, the white wheels: 4° per step): at scan 75 the prediction is 9.6° off, the
+// alignment stays in that minimum and the alias check finds the right pose, 9.6° away and fitting
+// significantly better, within the prediction's PL. As a contradiction beyond the 5° alert limit it
+// was a large fault, and the track waited 38 m for MML among look-alike rooms while right; aligned
+// again from the rival (TrackOptions::refit_at_better_rival) the track goes on.
+TEST(CorpusRunnerTest, ABetterRivalWithinThePredictionsBoundIsTheFixNotAFault) {
+  const CorpusDraw d = draw_corpus(505, 52)[51];
+  CorpusRunOptions ro;
+  ro.timing = false;
+  const CorpusRun with = run_draw(d, ro);
+  ro.localizer_options["off"] = "refit_at_better_rival";
+  const CorpusRun without = run_draw(d, ro);
+  ASSERT_TRUE(with.ok && without.ok) << with.error << without.error;
+  EXPECT_EQ(wrong_localized(with), 0u);
+  EXPECT_EQ(wrong_localized(without), 0u);
+  EXPECT_GT(localized_steps(with), 2 * localized_steps(without)) << describe_draw(d);
 }
 
 }  // namespace

@@ -554,6 +554,7 @@ bool run_localize_evaluation(const LocalizePlan& plan, BenchJson* json, std::str
   LocalizeRun run{plan, json, std::chrono::steady_clock::now(), {}, {}, {}, {}, {}, {}, {}, {},
                   mml_track_config(plan.mml_config, plan.seed)};
   run.mml_cfg.mml.pool_cluster_support = plan.pool_cluster_support;
+  if (!plan.unmapped_space) run.mml_cfg.mml.unmapped_space_min_area_m2 = 0.0f;
   run.mml_cfg.mml.keep_support_across_empty_steps = plan.keep_support_across_empty_steps;
   run.mml_cfg.mml.keep_support_across_contested_steps = plan.keep_support_across_contested_steps;
   std::filesystem::create_directories(plan.out_dir);

@@ -25,6 +25,7 @@ struct LocalizePlan {
   bool keep_support_across_contested_steps = true;  // --no-keep-contested: off (MmlOptions)
   bool keep_support_across_empty_steps = true;  // --no-keep-support: off (MmlOptions::keep_support_across_empty_steps)
   bool pool_cluster_support = true;  // --no-pool: mml-track's MML without the pooled support (mml_track_preset)
+  bool unmapped_space = true;  // --no-unmapped-space: unknown inner regions count as misses (map/unmapped_space.h)
   TrialOptions step_rule;            // min_move_m / min_turn_rad (the suite's step rule)
   // Whole-log runs: kidnapped starts drawn over the first `whole_start_fraction` of the log's path,
   // each run continues to the END of the log (whole_max_steps = 0) or to that many steps.

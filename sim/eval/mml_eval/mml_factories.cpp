@@ -208,12 +208,13 @@ static bool parse_odom_slip(const std::map<std::string, std::string>& options, f
 // off=NAME[+NAME...] → those rules of TrackOptions off (the ablations of issue 56: what each rule
 // buys on the generated corpus, `mml-eval --corpus N --opt off=NAME`).
 static bool parse_rules_off(const std::map<std::string, std::string>& options, fw::track::TrackOptions* to,
-                            std::string* err) {
+                            fw::mml::MmlOptions* mo, std::string* err) {
   using T = fw::track::TrackOptions;
   static const std::pair<const char*, bool T::*> kRules[] = {
       {"outside_map_needs_clean_exit", &T::outside_map_needs_clean_exit},
       {"wheels_bind_mml_without_carry", &T::wheels_bind_mml_without_carry},
       {"alias_check", &T::alias_check},
+      {"refit_at_better_rival", &T::refit_at_better_rival},
       {"alias_valley_is_one_mode", &T::alias_valley_is_one_mode},
       {"alias_valley_drops_information", &T::alias_valley_drops_information},
       {"confidence_extent_xy", &T::confidence_extent_xy},
@@ -232,7 +233,9 @@ static bool parse_rules_off(const std::map<std::string, std::string>& options, f
     const std::size_t plus = rest.find('+');
     const std::string name = rest.substr(0, plus);
     rest = plus == std::string::npos ? "" : rest.substr(plus + 1);
-    bool found = false;
+    // MML's: the unmapped-space hypothesis before the first fix (map/unmapped_space.h).
+    bool found = name == "unmapped_space_contact";
+    if (found) mo->unmapped_space_min_area_m2 = 0.0f;
     for (const auto& [rule, member] : kRules) {
       if (name == rule) {
         to->*member = false;
@@ -240,8 +243,8 @@ static bool parse_rules_off(const std::map<std::string, std::string>& options, f
       }
     }
     if (!found) {
-      std::string list;
-      for (const auto& r : kRules) list += (list.empty() ? "" : ", ") + std::string(r.first);
+      std::string list = "unmapped_space_contact";
+      for (const auto& r : kRules) list += ", " + std::string(r.first);
       *err = "localizer mml-track: option off='" + it->second + "': unknown rule '" + name + "' (rules: " + list + ")";
       return false;
     }
@@ -287,7 +290,7 @@ std::unique_ptr<fw::Localizer> make_track_localizer(const LocalizerContext& ctx,
   long wheels_bind = to.wheels_bind_mml_without_carry ? 1 : 0;
   if (!parse_int(ctx.options, "wheels_bind", 0, 1, &wheels_bind, "mml-track", err)) return nullptr;
   to.wheels_bind_mml_without_carry = wheels_bind == 1;
-  if (!parse_rules_off(ctx.options, &to, err)) return nullptr;
+  if (!parse_rules_off(ctx.options, &to, &cfg.mml, err)) return nullptr;
   static const std::vector<std::uint8_t> kEmpty;
   return wrap_hooks(OwnedLocalizer::make_track(*ctx.global_map, ctx.map_image ? *ctx.map_image : kEmpty, cfg, to,
                                                ctx.threads, err),
