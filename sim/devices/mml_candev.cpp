@@ -271,7 +271,26 @@ int run_score(const Args& a, const Numbers& n, const sim::CarmenLog& log, const 
 
 }  // namespace
 
+constexpr const char* kHelp =
+    "mml-candev: the CAN side of the simulator for hardware-in-the-loop runs.\n"
+    "  mml-candev log2can --dataset aces|--log PATH [--first N] [--count N] [--fd] [--iface vcan0]\n"
+    "                     [--speed S] [--corrupt-every K] [--drop-every K] [--dup-every K]\n"
+    "                     [--bus-off-at K --bus-off-burst N] [--invalid-every K] [--swap-every K]\n"
+    "                     [--silence-at K --silence-s S] [--odom-jump-at K --odom-jump-m M]\n"
+    "                     [--odom-reset-at K] [--time-jump-at K --time-jump-s S] --out replay.log\n"
+    "      a candump log that canplayer replays (canplayer -I replay.log); prints a JSON summary\n"
+    "  mml-candev live ... --iface vcan0   (the same options, no --out): sends the frames onto the\n"
+    "      SocketCAN interface with their timing\n"
+    "  mml-candev score --dataset aces|--log PATH --capture dump.log [--first N] [--count N]\n"
+    "                   [--bound M] [--json out.json]\n"
+    "      decodes mmlfw's POSE/HEALTH frames from candump -L output and scores them against the\n"
+    "      log's reference trajectory\n";
+
 static int run_main(int argc, char** argv) {
+  if (argc >= 2 && (std::string(argv[1]) == "--help" || std::string(argv[1]) == "-h")) {
+    std::fputs(kHelp, stdout);
+    return 0;
+  }
   if (argc < 2) return usage("missing command");
   const std::string cmd = argv[1];
   Args a;

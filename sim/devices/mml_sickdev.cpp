@@ -42,7 +42,22 @@ void sleep_until(double t) {
 }
 }  // namespace
 
+constexpr const char* kHelp =
+    "mml-sickdev: a SICK LMS2xx device model on a serial port (e.g. one end of a socat pty pair).\n"
+    "Waits for the host's continuous-output request, answers ACK + 0xA0, then streams the scans of\n"
+    "a CARMEN log as 0xB0 measured-value telegrams at --rate Hz; prints a JSON summary.\n"
+    "  mml-sickdev --device PATH --dataset aces|--log PATH [--first N] [--count N] [--rate 75]\n"
+    "              [--baud 500000] [--corrupt-every K] [--garbage-every K] [--wait 5]\n"
+    "              [--pause-at K --pause-s S]\n"
+    "  --corrupt-every K   flip a byte in every K-th telegram (bad CRC)\n"
+    "  --garbage-every K   random bytes before every K-th telegram\n"
+    "  --pause-at K --pause-s S   silent for S seconds before telegram K\n";
+
 static int run_main(int argc, char** argv) {
+  if (argc == 2 && (std::string(argv[1]) == "--help" || std::string(argv[1]) == "-h")) {
+    std::fputs(kHelp, stdout);
+    return 0;
+  }
   std::map<std::string, std::string> kv;
   for (int i = 1; i < argc; ++i) {
     std::string k = argv[i];
