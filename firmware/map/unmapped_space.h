@@ -2,11 +2,12 @@
 // never entered, a block erased from the map). The robot may be switched on there, and what its
 // scans show there is anything at all — a copy of a mapped place included. So a point that falls
 // there under a pose hypothesis is no evidence against that pose: while MML holds that hypothesis
-// (MmlLocalizer::set_unmapped_hypothesis; mml-track: until the robot is first located, or after a
-// carry) pRANSAM gives such a point contact, which keeps "the robot is in the unmapped room" beside
-// the mapped look-alike until the scans tell them apart (issue 56, corpus seed 505 #56: without it a
-// twin cross-aisle 36 m away was isolated while the robot stood in the erased block). Regions of at
-// least MmlOptions::unmapped_space_min_area_m2 count. The unknown margin around the building (connected to the image border) is outside
+// (MmlLocalizer::set_unmapped_hypothesis; mml-track: until the robot is first located) pRANSAM
+// gives such a point contact, which keeps "the robot is in the unmapped room" beside the mapped
+// look-alike until the scans tell them apart (issue 56, corpus seed 505 #56: without it a twin
+// cross-aisle 36 m away was isolated while the robot stood in the erased block). Regions of at
+// least MmlOptions::unmapped_space_min_area_m2 count. The unknown margin around the building
+// (connected to the image border) is outside
 // the map, not unmapped space; regions smaller than `min_area_m2` (pillars, the inside of thick
 // walls) cannot hold the robot or anything it walks around, and are left as misses.
 //

@@ -70,8 +70,8 @@ class MmlLocalizer final : public Localizer {
   Status step(const hal::LaserScan& scan, const hal::Odometry& odom, hal::PoseEstimate* out) override;
   // The hypothesis "the robot is in the map's unmapped space" (map/unmapped_space.h) beside the
   // mapped poses: while on, pRANSAM counts a point there as contact. Off by default (the
-  // dissertation: unknown is a miss); mml-track holds it on while the robot has not been located
-  // since start-up or a carry (tracked_localizer.h). A no-op on a map without unmapped space.
+  // dissertation: unknown is a miss); mml-track holds it on until the robot is first located
+  // (tracked_localizer.cpp). A no-op on a map without unmapped space.
   void set_unmapped_hypothesis(bool on) { matcher_.set_unmapped_active(on); }
   bool unmapped_hypothesis() const { return matcher_.unmapped_active(); }
   const UnmappedSpace& unmapped_space() const { return unmapped_; }
