@@ -104,6 +104,17 @@ TEST(PoseHintTest, DefaultHintWaitsForMml) {
   if (r.first_localized >= 0) EXPECT_EQ(r.status_after_hint, hal::HintStatus::kConfirmed);
 }
 
+// A hint that agrees with a `localized` track changes nothing (no interruption); one that contradicts
+// it restarts from the hint, never `localized` wrong.
+TEST(PoseHintTest, HintAgainstALocalizedTrack) {
+  HintRun r = run_with_hint(TrackOptions(), 60, Se2f(0.05f, 0.0f, 0.0f), 0.1f, 0.05f, 70);
+  EXPECT_EQ(r.first_localized, 0) << "the track was interrupted";
+  EXPECT_EQ(r.status_after_hint, hal::HintStatus::kConfirmed);
+  EXPECT_EQ(r.wrong_localized, 0);
+  r = run_with_hint(TrackOptions(), 60, Se2f(2.0f, 0.0f, 0.0f), 0.05f, 0.02f, 80);
+  EXPECT_EQ(r.wrong_localized, 0);
+}
+
 TEST(PoseHintTest, BadHintIsAnErrorNotACrash) {
   HintRig rig;
   ASSERT_TRUE(rig.init(TrackOptions()).is_ok());

@@ -39,7 +39,7 @@ void TrackedLocalizer::reset() {
   dead_reckoning_.clear();
   left_map_cleanly_ = true;
   carry_seen_ = false;
-  hint_pending_ = hint_track_ = false;
+  hint_pending_ = hint_track_ = hint_against_track_ = false;
   hint_status_ = hal::HintStatus::kNone;
   hints_ = hints_refused_ = 0;
 }
@@ -56,7 +56,19 @@ Status TrackedLocalizer::set_pose_hint(const hal::PoseHint& hint) {
   hint_ = hint;
   hint_pending_ = true;
   hint_status_ = hal::HintStatus::kPending;
+  // A confirmed track is checked against the hint on the next scan first (hint_agrees): a hint that
+  // agrees with it changes nothing.
+  hint_against_track_ = tracker_.active() && replay_lag_ == 0 && !unconfirmed_ && !hint_track_;
   return Status::ok();
+}
+
+// The hint, within its 3σ and the track's protection level of a `localized` track: it agrees.
+bool TrackedLocalizer::hint_agrees(const hal::PoseEstimate& out) const {
+  if (out.status != hal::LocalizationStatus::kLocalized) return false;
+  const float d = std::hypot(out.x - hint_.x, out.y - hint_.y);
+  const float dth = std::fabs(wrap_angle(out.theta - hint_.theta));
+  return d <= out.protection_xy_m + 3.0f * hint_.sigma_xy_m &&
+         dth <= out.protection_theta_rad + 3.0f * hint_.sigma_theta_rad;
 }
 
 // The operator says where the robot is: whatever runs gives way, and the hint enters as MML's fix
@@ -65,11 +77,20 @@ Status TrackedLocalizer::set_pose_hint(const hal::PoseHint& hint) {
 void TrackedLocalizer::start_from_hint(const Se2f& wheel, std::size_t n, hal::PoseEstimate* out) {
   hint_pending_ = false;
   ++hints_;
+  const bool had_track = tracker_.active();
   tracker_.stop();
   replay_lag_ = 0;
   dead_reckoning_.clear();
   hint_track_ = true;
-  await_mml_confirmation();  // unconfirmed_, a fresh local map for MML, the cross-check budget
+  if (had_track) {
+    // The operator contradicts a track: the robot may have been carried. MML's local map starts
+    // now (it holds no scan from before the doubt), as after a large fault.
+    await_mml_confirmation();
+  } else {
+    // MML was searching: its scans are as good as before the hint; it goes on, and its fix must
+    // land on the hinted pose (cross_check) for the hint to count.
+    cross_check_left_ = tracker_.options().cross_check_steps;
+  }
   unconfirmed_ = hint_needs_mml();
   hal::PoseEstimate g;
   g.x = hint_.x;
@@ -184,6 +205,16 @@ Status TrackedLocalizer::step(const hal::LaserScan& scan, const hal::Odometry& o
   if (mml_ == nullptr) return Status::error(Errc::kNotInitialized, "TrackedLocalizer: step() before init()");
   if (out == nullptr) return Status::error(Errc::kInvalidArgument, "TrackedLocalizer: null output");
   const Status s = step_scan(scan, odom, out);
+  if (hint_pending_ && hint_against_track_) {
+    // The hint was checked against this scan's confirmed track: agreeing, nothing changes; else it
+    // starts on the next scan (start_from_hint).
+    hint_against_track_ = false;
+    if (hint_agrees(*out)) {
+      hint_pending_ = false;
+      ++hints_;
+      hint_status_ = hal::HintStatus::kConfirmed;
+    }
+  }
   follow_hint(*out);
   return s;
 }
@@ -204,7 +235,7 @@ Status TrackedLocalizer::step_scan(const hal::LaserScan& scan, const hal::Odomet
     r.n = n;
     r.wheel = wheel;
   }
-  if (hint_pending_) {
+  if (hint_pending_ && !hint_against_track_) {
     *out = hal::PoseEstimate();
     out->timestamp_ns = scan.timestamp_ns;
     out->scan_id = scan.scan_id;

@@ -54,8 +54,10 @@ class TrackedLocalizer final : public Localizer {
   const char* name() const override { return "mml-track"; }
   void reset() override;
   Status step(const hal::LaserScan& scan, const hal::Odometry& odom, hal::PoseEstimate* out) override;
-  // An operator's hint (issue 60): on the next scan the track (or the search) in progress gives way
-  // to the hinted pose, which enters as MML's fix does (start_from_fix: confirmed on the scans before
+  // An operator's hint (issue 60). A `localized` track that agrees with it (within its protection
+  // level and the hint's 3σ, on the next scan) stays as it is (HintStatus kConfirmed). Otherwise,
+  // on the next scan the track (or the search) in progress gives way to the hinted pose, which
+  // enters as MML's fix does (start_from_fix: confirmed on the scans before
   // it and on its own, covariance from the hint's σ) — refused when the scans contradict it
   // (HintStatus kRefused, POSE reason fix-rejected). TrackOptions::hint_awaits_mml: the confirmed
   // track then waits for MML to isolate the same pose; an MML fix elsewhere replaces it.
@@ -121,7 +123,8 @@ class TrackedLocalizer final : public Localizer {
   // After a step: where the hinted track stands (HintStatus).
   void follow_hint(const hal::PoseEstimate& out);
   bool hint_needs_mml() const { return hint_track_ && tracker_.options().hint_awaits_mml; }
-  bool hint_pending_ = false, hint_track_ = false;
+  bool hint_agrees(const hal::PoseEstimate& out) const;
+  bool hint_pending_ = false, hint_track_ = false, hint_against_track_ = false;
   hal::PoseHint hint_;
   hal::HintStatus hint_status_ = hal::HintStatus::kNone;
   std::uint32_t hints_ = 0, hints_refused_ = 0;
