@@ -16,6 +16,13 @@ grep -q ' tx 120#' "$t/bb.log" || { echo "FAIL: no POSE frames in the black box"
 # shellcheck disable=SC2086
 "$sim" $args --replay-blackbox "$t/bb.log" | tee "$t/replay.txt"
 grep -q ': identical$' "$t/replay.txt"
+# A robot's black box is replayed from its map alone (no world): the same poses. The world's
+# wheel-noise option is given explicitly in both runs (a world run adds it itself, a map has no wheels).
+# shellcheck disable=SC2086
+"$sim" $args --transport can --opt odom_noise_per_step=0,0 --blackbox "$t/bb2.log" --out "$t/rec2" > /dev/null
+"$sim" --replay-blackbox "$t/bb2.log" --map "$t/rec2/map.yaml" --opt odom_noise_per_step=0,0 --timing none --quiet \
+  --no-pictures --out "$t/rep2" | tee "$t/replay2.txt"
+grep -q ': identical$' "$t/replay2.txt"
 # One received range byte flipped in the middle of the run (a scan's data segment): the replay sees
 # another input and must not claim identical poses (or the scan is dropped: fewer poses).
 awk 'BEGIN{n=0} / rx 118#/ {n++; if (n==4000) {sub(/#..../, "#0000FFFF")}} {print}' "$t/bb.log" > "$t/tampered.log"

@@ -356,6 +356,13 @@ bool parse_one_option(ArgCursor* cur, SimConfig* cfg, SimArgsAction* action, Giv
 // Exactly one source, and the log-only options only with a log.
 bool check_source_choice(const SimConfig& cfg, std::string* err) {
   const int sources = !cfg.world.empty() + !cfg.log_path.empty() + !cfg.dataset.empty();
+  if (sources == 0 && !cfg.blackbox.replay_path.empty()) {  // a robot's black box: its map is enough
+    if (cfg.map_yaml.empty() && cfg.localizer != "odom") {
+      *err = "--replay-blackbox without --world/--dataset/--log needs the robot's map (--map IMAGE.mmap or MAP.yaml)";
+      return false;
+    }
+    return true;
+  }
   if (sources == 0) {
     *err = "no input: give --world NAME, --dataset NAME or --log FILE (see --help)";
     return false;
@@ -445,8 +452,9 @@ run:
   --blackbox FILE         with --transport can: the firmware's black box (frames in and out, candump
                           format, hal/can/README.md) written to FILE after the run
   --replay-blackbox FILE  feed FILE's received frames back through the firmware's CanNode in lockstep
-                          (give the recording's --world/--dataset and options) and compare the POSE
-                          frames with FILE's; exit 0 when identical bit for bit, 1 otherwise
+                          and compare the POSE frames with FILE's; exit 0 when identical bit for bit,
+                          1 otherwise. Give the recording's --world/--dataset and options, or for a
+                          robot's black box its --map and localizer options (--opt) alone
   --quiet                 no progress line
   --no-pictures           skip run.svg / run.png
 synthetic world:

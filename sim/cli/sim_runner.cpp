@@ -220,9 +220,8 @@ bool load_world_source(const SimConfig& cfg, SimSource* src, SimSummary* sum, st
   return true;
 }
 
-bool load_log_source(const SimConfig& cfg, SimSource* src, SimSummary* sum, std::string* err) {
-  if (!load_log_frames(cfg, &src->log_frames, &sum->scans_restamped, err)) return false;
-  src->total = src->log_frames.size();
+// --map: a compiled map image (used as it is) or a ROS map_server YAML.
+bool load_map_file(const SimConfig& cfg, SimSource* src, std::string* err) {
   if (!cfg.map_yaml.empty()) {
     if (is_map_image_file(cfg.map_yaml)) {
       // A compiled map image (mml-mapc / mml-mapbuild): used as it is, relation table included.
@@ -234,6 +233,13 @@ bool load_log_source(const SimConfig& cfg, SimSource* src, SimSummary* sum, std:
     }
     src->have_grid = true;
   }
+  return true;
+}
+
+bool load_log_source(const SimConfig& cfg, SimSource* src, SimSummary* sum, std::string* err) {
+  if (!load_log_frames(cfg, &src->log_frames, &sum->scans_restamped, err)) return false;
+  src->total = src->log_frames.size();
+  if (!load_map_file(cfg, src, err)) return false;
   sum->source = cfg.dataset.empty() ? "log:" + std::filesystem::path(cfg.log_path).filename().string()
                                     : "dataset:" + cfg.dataset;
   return true;
@@ -767,13 +773,22 @@ bool replay_black_box(const SimConfig& cfg_in, SimResult* out, BlackBoxReplay* r
   std::vector<BlackBoxLine> lines;
   if (!read_black_box(cfg_in.blackbox.replay_path, &lines, err)) return false;
   SimConfig cfg;
-  if (!complete_config(cfg_in, &cfg, err)) return false;
+  // A robot's black box: its map (--map) and the localizer's options alone, no source to run.
+  const bool robot = cfg_in.world.empty() && cfg_in.log_path.empty() && cfg_in.dataset.empty() &&
+                     cfg_in.custom_world == nullptr;
+  if (robot) {
+    cfg = cfg_in;
+    if (!create_output_dir(cfg.out_dir, err)) return false;
+    if (cfg.localizer.empty()) cfg.localizer = default_localizer();
+  } else if (!complete_config(cfg_in, &cfg, err)) {
+    return false;
+  }
   cfg.transport.transport = Transport::kCan;  // the black box holds CAN frames
   cfg.transport.byte_fault_rate = 0;
   SimSummary& sum = out->summary;
   sum.localizer = cfg.localizer;
   SimSource src;
-  if (!load_source(cfg, &src, &sum, err)) return false;
+  if (robot ? !load_map_file(cfg, &src, err) : !load_source(cfg, &src, &sum, err)) return false;
   FirmwareMap map;
   if (!load_firmware_map(cfg, &src, &map, err)) return false;
   LocalizerHooks hooks;
