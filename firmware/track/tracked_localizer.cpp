@@ -72,8 +72,8 @@ bool TrackedLocalizer::hint_agrees(const hal::PoseEstimate& out) const {
 }
 
 // The operator says where the robot is: whatever runs gives way, and the hint enters as MML's fix
-// does (start_from_fix), so it passes the same checks. MML's search restarts from a fresh local map
-// (with hint_awaits_mml, the search that must isolate the same pose).
+// does (start_from_fix), so it passes the same checks. With hint_awaits_mml, MML's search (going on,
+// or restarted when the hint contradicts a track) must then isolate the same pose.
 void TrackedLocalizer::start_from_hint(const Se2f& wheel, std::size_t n, hal::PoseEstimate* out) {
   hint_pending_ = false;
   ++hints_;

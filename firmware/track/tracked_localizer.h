@@ -72,7 +72,8 @@ class TrackedLocalizer final : public Localizer {
   const mml::MmlLocalizer* global() const { return mml_; }
   GlobalContext& global_context() { return global_; }
   const GlobalContext& global_context() const { return global_; }
-  // Since reset: fixes accepted, MML fixes the tracker did not confirm, tracks given up.
+  // Since reset: fixes accepted (tracks started from a confirmed pose hint included), MML fixes the
+  // tracker did not confirm, tracks given up.
   std::uint32_t fixes() const { return fixes_; }
   std::uint32_t fix_rejections() const { return fix_rejections_; }
   // Fixes confirmed on the scans before them (TrackOptions::confirm_fix_on_past_scans), of fixes().
