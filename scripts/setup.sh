@@ -9,7 +9,7 @@ cd "$(dirname "$0")/.."
 
 PACKAGES=(
   build-essential g++ cmake ninja-build pkg-config git
-  libeigen3-dev libgtest-dev libbenchmark-dev zlib1g-dev libpng-dev
+  libeigen3-dev libgtest-dev libbenchmark-dev zlib1g-dev libpng-dev libyaml-cpp-dev
   g++-aarch64-linux-gnu g++-arm-linux-gnueabihf qemu-user
   can-utils socat iproute2 kmod busybox-static user-mode-linux
   binutils file python3

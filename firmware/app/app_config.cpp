@@ -81,7 +81,7 @@ constexpr const char* kKeys[] = {"laser",     "odometry",  "output",  "can_fd", 
                                  "mml_preset", "map",       "workers", "cores",            "realtime",
                                  "arena_mib", "step_deadline_ms", "health_period_ms", "laser_timeout_ms", "seed",
                                  "log_level", "global_context", "global_period_scans", "odom_noise",
-                                 "odom_noise_per_step", "odom_slip", "laser_mount"};
+                                 "odom_noise_per_step", "odom_slip", "laser_mount", "blackbox", "blackbox_frames"};
 constexpr int kNumKeys = static_cast<int>(sizeof(kKeys) / sizeof(kKeys[0]));
 
 // The config path as shown in messages: at most kShownPath characters, the end kept (the file
@@ -226,6 +226,29 @@ Status parse_laser_key(const char* name, int line, const char* key, char* v, App
   return Status::ok();
 }
 
+// blackbox = PATH | off, blackbox_frames = N (issue 60; kKeys lists them).
+Status parse_blackbox_key(const char* name, int line, const char* key, const char* v, AppConfig* out) {
+  if (!std::strcmp(key, "blackbox")) {
+    if (!std::strcmp(v, "off")) {
+      out->blackbox[0] = '\0';
+      return Status::ok();
+    }
+    if (!copy(out->blackbox, sizeof(out->blackbox), v)) {
+      return CFG_ERR("path longer than %zu characters", sizeof(out->blackbox) - 1);
+    }
+    return Status::ok();
+  }
+  if (!std::strcmp(key, "blackbox_frames")) {
+    long x = 0;
+    if (!parse_int(v, 0, AppConfig::kMaxBlackBoxFrames, &x)) {
+      return CFG_ERR("'%s' is not an integer in 0..%ld", v, AppConfig::kMaxBlackBoxFrames);
+    }
+    out->blackbox_frames = static_cast<std::uint32_t>(x);
+    return Status::ok();
+  }
+  return Status::error(Errc::kInvalidArgument, "config '%s' line %d: unknown key '%s'", name, line, key);
+}
+
 }  // namespace
 
 Status parse_app_config(const char* path, const char* text, std::size_t len, AppConfig* out) {
@@ -350,6 +373,8 @@ Status parse_app_config(const char* path, const char* text, std::size_t len, App
     } else if (!std::strcmp(key, "seed")) {
       if (!parse_int(v, 0, 0x7FFFFFFF, &x)) return CFG_ERR("'%s' is not a non-negative integer", v);
       out->seed = static_cast<std::uint64_t>(x);
+    } else if (!std::strncmp(key, "blackbox", 8)) {
+      FW_RETURN_IF_ERROR(parse_blackbox_key(name, line, key, v, out));
     } else if (!std::strncmp(key, "odom_", 5)) {
       FW_RETURN_IF_ERROR(parse_odometry_key(name, line, key, v, out));
     } else if (!std::strcmp(key, "log_level")) {

@@ -33,6 +33,11 @@
 //                    with status `fault`, cleared by the next scan [500 = a few scan periods]
 //   seed             random seed of the localizer    [1]
 //   log_level        debug | info | warning | error  [info]
+//   blackbox         PATH | off: the black box (hal/can/include/hal_can/black_box.h) is written to
+//                    PATH (a candump log, replaced atomically) on DUMP_LOG, on a fault and at exit;
+//                    CAN backends only [off]
+//   blackbox_frames  0..4194304 frames the black box keeps (80 bytes each, in the start-up arena when
+//                    blackbox is set; ~1000 frames/s on a classic bus, 180 beams at 10 Hz) [65536: 5 MiB]
 #pragma once
 
 #include <cstddef>
@@ -47,6 +52,7 @@ constexpr std::size_t kMaxCanInterfaceName = 15;
 
 struct AppConfig {
   static constexpr int kMaxCores = 16;
+  static constexpr long kMaxBlackBoxFrames = 4194304;
   char laser[128] = {0};
   float laser_mount_yaw_deg = 0.0f;  // laser_mount: yaw of the laser on the robot (degrees, CCW)
   bool laser_upside_down = false;
@@ -79,6 +85,8 @@ struct AppConfig {
   float odom_noise_per_step[2] = {0.0f, 0.0f};
   // Declared wheel slips: per 100 m driven, and the largest in metres (TrackOptions::odom_slip_per_100m).
   float odom_slip[2] = {0.0f, 1.0f};
+  char blackbox[256] = {0};             // empty = no black box file
+  std::uint32_t blackbox_frames = 65536;
 };
 
 // Parses `text` (len bytes); `path` is used in messages (abbreviated to its last 96 characters).

@@ -189,6 +189,25 @@ TEST(AppConfig, OdomNoiseKey) {
                   {"0.1,0.2,0.3,nan", "number 4 'nan'"}});
 }
 
+// blackbox = PATH | off and blackbox_frames (issue 60): off by default; the ring's size is bounded.
+TEST(AppConfig, BlackBoxKeys) {
+  AppConfig c;
+  ASSERT_TRUE(parse("laser = socketcan:vcan0\nlocalizer = odom\n", &c).is_ok());
+  EXPECT_EQ(c.blackbox[0], '\0');
+  EXPECT_EQ(c.blackbox_frames, 65536u);
+  ASSERT_TRUE(parse("laser = socketcan:vcan0\nlocalizer = odom\nblackbox = /var/lib/mmlfw/bb.log\nblackbox_frames = 1000\n",
+                    &c).is_ok());
+  EXPECT_STREQ(c.blackbox, "/var/lib/mmlfw/bb.log");
+  EXPECT_EQ(c.blackbox_frames, 1000u);
+  ASSERT_TRUE(parse("laser = socketcan:vcan0\nlocalizer = odom\nblackbox = off\n", &c).is_ok());
+  EXPECT_EQ(c.blackbox[0], '\0');
+  expect_refused("blackbox_frames", {{"-1", "line 3: key 'blackbox_frames': '-1' is not an integer in 0..4194304"},
+                                     {"99999999", "is not an integer"},
+                                     {"x", "is not an integer"}});
+  expect_refused("blackbox_size", {{"1", "unknown key 'blackbox_size'"}});
+  expect_refused("blackbox", {{std::string(300, 'a').c_str(), "path longer than 255 characters"}});
+}
+
 // odom_slip: declared wheel slips per 100 m and the largest (default none: 0, 1 m).
 TEST(AppConfig, OdomSlipKey) {
   AppConfig c;

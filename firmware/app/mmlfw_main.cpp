@@ -35,6 +35,7 @@
 
 #include "firmware/app/app_config.h"
 #include "firmware/app/memory_limits.h"
+#include "firmware/app/operator_io.h"
 #include "firmware/app/service_notify.h"
 #include "firmware/app/system.h"
 #include "firmware/base/arena.h"
@@ -57,6 +58,7 @@ fw::StartupArena g_arena;
 fw::WorkerPool g_pool;
 fw::LocalizationSystem g_system;  // the localizer objects themselves live in the arena
 fw::LocalizationLoop g_loop;
+fw::OperatorIo g_operator;  // commands from the bus, the black box (issue 60)
 fw::AppConfig g_config;
 hal_linux::SdNotify g_notify;
 fw::WatchdogFeed g_watchdog;
@@ -98,6 +100,9 @@ void print_help() {
       "  localizer = mml-track | mml | handoff | mcl | odom    map = IMAGE.mmap (mml-mapc)\n"
       "  workers, cores, realtime, global_context, global_period_scans, arena_mib, step_deadline_ms,\n"
       "  health_period_ms, laser_timeout_ms, seed, mml_preset, log_level, odom_noise, odom_noise_per_step, odom_slip\n"
+      "  blackbox = PATH | off, blackbox_frames = N   (the last frames in and out, written on DUMP_LOG, a fault, exit)\n"
+      "\n"
+      "Commands on the bus (DBC: SET_POSE_HINT, SELECT_MAP, DUMP_LOG; answered by COMMAND_REPLY; mml-ctl sends them).\n"
       "\n"
       "Under systemd (mmlfw.service, Type=notify): READY=1 after start-up, WATCHDOG=1 from the sensor\n"
       "loop while it keeps its deadline, STATUS= with the localization status (systemctl status mmlfw).\n"
@@ -349,6 +354,8 @@ int build_localizer(const Args& a, Startup* su) {
   if (su->board_ok) {
     st = g_loop.init(hal, g_system.localizer(), lo);
     if (!st) return fail("loop", st);
+    st = g_operator.init(c, g_arena, g_board, g_loop, g_system.localizer());
+    if (!st) return fail("operator commands / black box", st);
   }
   return 0;
 }
@@ -528,6 +535,7 @@ std::uint64_t run_loop(const Args& a) {
     }
     if (a.duration_s > 0 && static_cast<double>(now - t_start) * 1e-9 >= a.duration_s) g_stop = 1;
     notify_cycle(now);
+    g_operator.watch_faults(g_loop.health().fault_bits);
   }
   return step_errors;
 }
@@ -630,6 +638,7 @@ int main(int argc, char** argv) {
   if (const int rc = memory_budget(a, su); rc >= 0) return rc;
   const std::uint64_t step_errors = run_loop(a);
   g_notify.send("STOPPING=1");
+  g_operator.dump("exit");
   g_system.stop_global_context();  // before the pool it drives
   if (a.timing_report) print_timing_report(su);
   print_summary(step_errors);

@@ -64,6 +64,7 @@ class LocalizationSystem {
 
   bool built() const { return localizer_ != nullptr; }
   Localizer& localizer() { return *localizer_; }
+  const Localizer& localizer() const { return *localizer_; }
   const char* name() const { return localizer_ != nullptr ? localizer_->name() : "none"; }
   // The parts (null when the chosen system has none).
   mml::MmlLocalizer* mml() { return mml_; }

@@ -51,6 +51,7 @@ void LocalizationLoop::refresh_health(std::uint64_t now) {
   // Scans the source replaced by a newer one before the loop took them are lost too: HEALTH must
   // account for every scan that arrived (a serial SICK stream faster than a slow step skips some).
   health_.dropped_scans = loop_dropped_scans_ + hal_->laser->skipped_scans();
+  health_.hint_status = static_cast<std::uint8_t>(localizer_->hint_status());
 }
 
 void LocalizationLoop::check_laser_silence(std::uint64_t now) {
@@ -230,6 +231,7 @@ Status LocalizationLoop::spin_once() {
   stepped_ = false;
   const std::uint64_t now = hal_->clock->now_ns();
   const std::uint64_t t_start = perf_clock_->now_ns();
+  if (commands_ != nullptr) commands_->poll();
   {
     PerfScope scope(perf_poll_, *perf_clock_);
     drain_odometry();

@@ -26,6 +26,7 @@
 #include "firmware/base/perf_counter.h"
 #include "firmware/base/ring_buffer.h"
 #include "firmware/base/status.h"
+#include "firmware/runtime/command_handler.h"
 #include "firmware/runtime/localizer.h"
 #include "hal/hal.h"
 
@@ -78,6 +79,9 @@ class LocalizationLoop {
   Status spin_once();
   // Forgets odometry history, the pending scan and the localizer state (kidnapping / restart).
   void reset();
+  // Operator commands (hal.commands): carried out at the start of every spin_once, before the scan
+  // (command_handler.h). Null = commands are not read.
+  void set_command_handler(CommandHandler* handler) { commands_ = handler; }
 
   bool stepped() const { return stepped_; }
   // True while a scan waits for odometry.
@@ -113,6 +117,7 @@ class LocalizationLoop {
 
   hal::Hal* hal_ = nullptr;
   Localizer* localizer_ = nullptr;
+  CommandHandler* commands_ = nullptr;
   LocalizationLoopOptions options_;
   const hal::Clock* perf_clock_ = nullptr;
 

@@ -278,6 +278,16 @@ struct TrackOptions {
   // the truth with an RMS residual of 0.14 m and was published `localized` 0.50 m / 7.4° off; its
   // next scan was already ambiguous). false = MML's fix is `localized` on its first consistent scan.
   bool confirm_fix = true;
+  // An operator's pose hint (SET_POSE_HINT, TrackedLocalizer::set_pose_hint) enters as MML's fix
+  // would: the tracker confirms it on the scans before it and on its scan with every test of a fix
+  // (confirm_fix, confirm_fix_on_past_scans), within a window of its uncertainty (search caps: 1 m,
+  // 20°); a hint the scans contradict is refused. The tracker's tests are local: a hint in a room
+  // that looks like the one the robot is in fits as well as the truth. true = the hinted track is
+  // `localized` only once MML isolates the same pose (as after a large fault, reason
+  // track-awaiting-mml): a wrong hint never makes a wrong `localized`, a right one is no faster than
+  // MML. false = `localized` after the fix's confirmation (1–3 scans): fast, and safe only where
+  // the map has no look-alike of the hinted place (bench ops measures both).
+  bool hint_awaits_mml = true;
   // ... on the scans before the fix first (extension): MML isolated the pose from a local map of the
   // scans the robot has just seen, so those scans are already here. The recovery_steps scans before
   // the fix are replayed through the tracker from MML's pose carried back by the wheels' increments,

@@ -39,6 +39,87 @@ void TrackedLocalizer::reset() {
   dead_reckoning_.clear();
   left_map_cleanly_ = true;
   carry_seen_ = false;
+  hint_pending_ = hint_track_ = hint_against_track_ = false;
+  hint_status_ = hal::HintStatus::kNone;
+  hints_ = hints_refused_ = 0;
+}
+
+Status TrackedLocalizer::set_pose_hint(const hal::PoseHint& hint) {
+  if (mml_ == nullptr) return Status::error(Errc::kNotInitialized, "TrackedLocalizer: pose hint before init()");
+  if (!std::isfinite(hint.x) || !std::isfinite(hint.y) || !std::isfinite(hint.theta) || !(hint.sigma_xy_m > 0.0f) ||
+      !(hint.sigma_theta_rad > 0.0f) || !std::isfinite(hint.sigma_xy_m) || !std::isfinite(hint.sigma_theta_rad)) {
+    return Status::error(Errc::kInvalidArgument, "TrackedLocalizer: pose hint (%g, %g, %g, sigma %g m %g rad) not finite "
+                         "or without a positive uncertainty", static_cast<double>(hint.x), static_cast<double>(hint.y),
+                         static_cast<double>(hint.theta), static_cast<double>(hint.sigma_xy_m),
+                         static_cast<double>(hint.sigma_theta_rad));
+  }
+  hint_ = hint;
+  hint_pending_ = true;
+  hint_status_ = hal::HintStatus::kPending;
+  // A confirmed track is checked against the hint on the next scan first (hint_agrees): a hint that
+  // agrees with it changes nothing.
+  hint_against_track_ = tracker_.active() && replay_lag_ == 0 && !unconfirmed_ && !hint_track_;
+  return Status::ok();
+}
+
+// The hint, within its 3σ and the track's protection level of a `localized` track: it agrees.
+bool TrackedLocalizer::hint_agrees(const hal::PoseEstimate& out) const {
+  if (out.status != hal::LocalizationStatus::kLocalized) return false;
+  const float d = std::hypot(out.x - hint_.x, out.y - hint_.y);
+  const float dth = std::fabs(wrap_angle(out.theta - hint_.theta));
+  return d <= out.protection_xy_m + 3.0f * hint_.sigma_xy_m &&
+         dth <= out.protection_theta_rad + 3.0f * hint_.sigma_theta_rad;
+}
+
+// The operator says where the robot is: whatever runs gives way, and the hint enters as MML's fix
+// does (start_from_fix), so it passes the same checks. With hint_awaits_mml, MML's search (going on,
+// or restarted when the hint contradicts a track) must then isolate the same pose.
+void TrackedLocalizer::start_from_hint(const Se2f& wheel, std::size_t n, hal::PoseEstimate* out) {
+  hint_pending_ = false;
+  ++hints_;
+  const bool had_track = tracker_.active();
+  tracker_.stop();
+  replay_lag_ = 0;
+  dead_reckoning_.clear();
+  hint_track_ = true;
+  if (had_track) {
+    // The operator contradicts a track: the robot may have been carried. MML's local map starts
+    // now (it holds no scan from before the doubt), as after a large fault.
+    await_mml_confirmation();
+  } else {
+    // MML was searching: its scans are as good as before the hint; it goes on, and its fix must
+    // land on the hinted pose (cross_check) for the hint to count.
+    cross_check_left_ = tracker_.options().cross_check_steps;
+  }
+  unconfirmed_ = hint_needs_mml();
+  hal::PoseEstimate g;
+  g.x = hint_.x;
+  g.y = hint_.y;
+  g.theta = wrap_angle(hint_.theta);
+  g.cov[0] = g.cov[4] = hint_.sigma_xy_m * hint_.sigma_xy_m;
+  g.cov[8] = hint_.sigma_theta_rad * hint_.sigma_theta_rad;
+  g.status = hal::LocalizationStatus::kLocalized;
+  if (!start_from_fix(g, wheel, n, out)) {
+    ++hints_refused_;
+    hint_track_ = false;
+    unconfirmed_ = false;
+    hint_status_ = hal::HintStatus::kRefused;
+  }
+}
+
+void TrackedLocalizer::follow_hint(const hal::PoseEstimate& out) {
+  if (!hint_track_) return;
+  if (out.status == hal::LocalizationStatus::kLocalized) {
+    hint_status_ = hal::HintStatus::kConfirmed;
+    hint_track_ = false;
+  } else if (!tracker_.active() && replay_lag_ == 0) {
+    // Refused on its scan after a replay, or given up before it was ever `localized`.
+    hint_status_ = hint_status_ == hal::HintStatus::kPending ? hal::HintStatus::kRefused : hal::HintStatus::kLost;
+    if (hint_status_ == hal::HintStatus::kRefused) ++hints_refused_;
+    hint_track_ = false;
+  } else if (replay_lag_ == 0) {  // past its confirmation (a replay on the scans before it still runs)
+    hint_status_ = unconfirmed_ ? hal::HintStatus::kAwaitingMml : hal::HintStatus::kTracking;
+  }
 }
 
 // End-points within the tracker's range, evenly subsampled to at most align.max_points (beam order
@@ -121,9 +202,25 @@ void TrackedLocalizer::note_how_the_map_was_left(const TrackStep& ts, const Se2f
 }
 
 Status TrackedLocalizer::step(const hal::LaserScan& scan, const hal::Odometry& odom, hal::PoseEstimate* out) {
-  const hal::CompleteReasonOnExit reason_on_exit{out};  // every estimate says why it is not `localized`
   if (mml_ == nullptr) return Status::error(Errc::kNotInitialized, "TrackedLocalizer: step() before init()");
   if (out == nullptr) return Status::error(Errc::kInvalidArgument, "TrackedLocalizer: null output");
+  const Status s = step_scan(scan, odom, out);
+  if (hint_pending_ && hint_against_track_) {
+    // The hint was checked against this scan's confirmed track: agreeing, nothing changes; else it
+    // starts on the next scan (start_from_hint).
+    hint_against_track_ = false;
+    if (hint_agrees(*out)) {
+      hint_pending_ = false;
+      ++hints_;
+      hint_status_ = hal::HintStatus::kConfirmed;
+    }
+  }
+  follow_hint(*out);
+  return s;
+}
+
+Status TrackedLocalizer::step_scan(const hal::LaserScan& scan, const hal::Odometry& odom, hal::PoseEstimate* out) {
+  const hal::CompleteReasonOnExit reason_on_exit{out};  // every estimate says why it is not `localized`
   if (!std::isfinite(odom.x) || !std::isfinite(odom.y) || !std::isfinite(odom.theta)) {
     return Status::error(Errc::kInvalidArgument, "TrackedLocalizer: non-finite odometry at scan %u", scan.scan_id);
   }
@@ -145,6 +242,13 @@ Status TrackedLocalizer::step(const hal::LaserScan& scan, const hal::Odometry& o
     for (std::size_t k = 0; k < n; ++k) r.pts[k] = pts_[k];
     r.n = n;
     r.wheel = wheel;
+  }
+  if (hint_pending_ && !hint_against_track_) {
+    *out = hal::PoseEstimate();
+    out->timestamp_ns = scan.timestamp_ns;
+    out->scan_id = scan.scan_id;
+    start_from_hint(wheel, n, out);
+    return Status::ok();
   }
   if (replay_lag_ > 0) {  // MML's fix is being confirmed on the scans before it: this one joins them
     ++replay_lag_;
@@ -303,8 +407,12 @@ bool TrackedLocalizer::start_forward(const Se2f& fix, const Eigen::Matrix3f& cov
                                 : ts.status == hal::LocalizationStatus::kLocalized;
   if (accepted && !ts.lost) {
     ++fixes_;
-    unconfirmed_ = false;  // MML has just isolated this pose
+    unconfirmed_ = hint_needs_mml();  // MML has just isolated this pose (unless it is a hint's)
     publish_track(ts, out);
+    if (unconfirmed_) {
+      out->status = hal::LocalizationStatus::kAmbiguous;
+      out->reason = hal::StatusReason::kTrackAwaitingMml;
+    }
     return true;
   }
   ++fix_rejections_;
@@ -368,8 +476,12 @@ bool TrackedLocalizer::replay_past_scans(const Se2f& wheel, std::size_t n, hal::
   if (confirmed) {
     ++fixes_;
     ++fixes_on_past_scans_;
-    unconfirmed_ = false;
+    unconfirmed_ = hint_needs_mml();
     publish_track(ts, out);
+    if (unconfirmed_) {
+      out->status = hal::LocalizationStatus::kAmbiguous;
+      out->reason = hal::StatusReason::kTrackAwaitingMml;
+    }
     return true;
   }
   // Forward confirmation from MML's fix, carried to this scan by the wheels.
@@ -416,7 +528,8 @@ Status TrackedLocalizer::cross_check(const hal::LaserScan& scan, const hal::Odom
   // pose is `localized` until MML isolates the tracked pose from a fresh local map.
   // A waiting track whose scans showed no sign of a carry is held to the same test
   // (TrackOptions::wheels_bind_mml_without_carry): the robot is where the wheels carried it.
-  if (!unconfirmed_ || (tracker_.options().wheels_bind_mml_without_carry && !carry_seen_)) {
+  // A hinted track not yet `localized` is the operator's word against MML's: MML's fix replaces it.
+  if (!hint_track_ && (!unconfirmed_ || (tracker_.options().wheels_bind_mml_without_carry && !carry_seen_))) {
     const TrackOptions& o = tracker_.options();
     const Se2f mml_pose(g.x, g.y, g.theta);
     const bool scan_prefers_mml = rival_significantly_better(tracker_.map(), pts_, n, ts.pose, mml_pose, o.alias_clip_m,
@@ -431,7 +544,12 @@ Status TrackedLocalizer::cross_check(const hal::LaserScan& scan, const hal::Odom
       return Status::ok();
     }
   }
-  // The track sat in a look-alike.
+  // The track sat in a look-alike (or the hint named one).
+  if (hint_track_) {
+    hint_track_ = false;
+    hint_status_ = hal::HintStatus::kRefused;
+    ++hints_refused_;
+  }
   ++cross_check_switches_;
   ++tracks_lost_;
   *out = hal::PoseEstimate();

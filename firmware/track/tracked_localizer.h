@@ -54,6 +54,17 @@ class TrackedLocalizer final : public Localizer {
   const char* name() const override { return "mml-track"; }
   void reset() override;
   Status step(const hal::LaserScan& scan, const hal::Odometry& odom, hal::PoseEstimate* out) override;
+  // An operator's hint (issue 60). A `localized` track that agrees with it (within its protection
+  // level and the hint's 3σ, on the next scan) stays as it is (HintStatus kConfirmed). Otherwise,
+  // on the next scan the track (or the search) in progress gives way to the hinted pose, which
+  // enters as MML's fix does (start_from_fix: confirmed on the scans before
+  // it and on its own, covariance from the hint's σ) — refused when the scans contradict it
+  // (HintStatus kRefused, POSE reason fix-rejected). TrackOptions::hint_awaits_mml: the confirmed
+  // track then waits for MML to isolate the same pose; an MML fix elsewhere replaces it.
+  Status set_pose_hint(const hal::PoseHint& hint) override;
+  hal::HintStatus hint_status() const override { return hint_status_; }
+  std::uint32_t hints() const { return hints_; }
+  std::uint32_t hints_refused() const { return hints_refused_; }
 
   bool tracking() const { return tracker_.active(); }
   const PoseTracker& tracker() const { return tracker_; }
@@ -61,7 +72,8 @@ class TrackedLocalizer final : public Localizer {
   const mml::MmlLocalizer* global() const { return mml_; }
   GlobalContext& global_context() { return global_; }
   const GlobalContext& global_context() const { return global_; }
-  // Since reset: fixes accepted, MML fixes the tracker did not confirm, tracks given up.
+  // Since reset: fixes accepted (tracks started from a confirmed pose hint included), MML fixes the
+  // tracker did not confirm, tracks given up.
   std::uint32_t fixes() const { return fixes_; }
   std::uint32_t fix_rejections() const { return fix_rejections_; }
   // Fixes confirmed on the scans before them (TrackOptions::confirm_fix_on_past_scans), of fixes().
@@ -106,6 +118,17 @@ class TrackedLocalizer final : public Localizer {
   // tracker_.step, counting this scan's correlative pre-search candidates.
   TrackStep step_tracker(const Point2f* pts, std::size_t n, const Se2f& wheel, bool predict = true);
   std::uint32_t search_candidates_this_scan_ = 0, most_search_candidates_in_one_scan_ = 0;
+  Status step_scan(const hal::LaserScan& scan, const hal::Odometry& odom, hal::PoseEstimate* out);
+  // The pending hint replaces what runs and starts as a fix (set_pose_hint).
+  void start_from_hint(const Se2f& wheel, std::size_t n, hal::PoseEstimate* out);
+  // After a step: where the hinted track stands (HintStatus).
+  void follow_hint(const hal::PoseEstimate& out);
+  bool hint_needs_mml() const { return hint_track_ && tracker_.options().hint_awaits_mml; }
+  bool hint_agrees(const hal::PoseEstimate& out) const;
+  bool hint_pending_ = false, hint_track_ = false, hint_against_track_ = false;
+  hal::PoseHint hint_;
+  hal::HintStatus hint_status_ = hal::HintStatus::kNone;
+  std::uint32_t hints_ = 0, hints_refused_ = 0;
   Status cross_check(const hal::LaserScan& scan, const hal::Odometry& odom, const Se2f& wheel, std::size_t n,
                      const TrackStep& ts, hal::PoseEstimate* out);
   mml::MmlLocalizer* mml_ = nullptr;

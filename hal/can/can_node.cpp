@@ -32,6 +32,8 @@ int CanNode::pump() {
   hal::CanFrame f;
   while (n < kMaxFramesPerPump && bus_->receive(&f)) {
     ++n;
+    f.timestamp_ns = f.timestamp_ns / 1000 * 1000;  // µs, as the black box and candump keep it
+    if (black_box_ != nullptr) black_box_->record(f, f.timestamp_ns, false);
     switch (decoder_.feed(f)) {
       case Decoded::kScan: {
         // Keep the newest scans: a late localizer should see the present, not the past.
@@ -46,11 +48,24 @@ int CanNode::pump() {
         if (odoms_.push_overwrite(o)) ++odom_overflowed_;
         break;
       }
+      case Decoded::kCommand:
+        if (commands_queue_.push_overwrite(decoder_.command())) ++commands_overflowed_;
+        break;
       default:
         break;
     }
   }
   return n;
+}
+
+bool CanNode::Commands::poll(hal::Command* out) {
+  node_->pump();
+  return node_->commands_queue_.pop(out);
+}
+
+void CanNode::Sink::publish_reply(const hal::CommandReply& reply) {
+  encode_reply(reply, &node_->tx_[0]);
+  node_->send_frames(node_->tx_, 1);
 }
 
 bool CanNode::Laser::poll(hal::LaserScan* out) {
@@ -64,8 +79,10 @@ bool CanNode::Odom::poll(hal::Odometry* out) {
 }
 
 void CanNode::send_frames(const hal::CanFrame* frames, std::size_t n) {
+  const std::uint64_t now = black_box_ != nullptr && clock_ != nullptr ? clock_->now_ns() / 1000 * 1000 : 0;
   for (std::size_t i = 0; i < n; ++i) {
     if (!bus_ || !bus_->send(frames[i])) ++tx_failed_;
+    if (black_box_ != nullptr) black_box_->record(frames[i], now, true);
   }
 }
 
@@ -100,6 +117,7 @@ void CanNode::Sink::publish_health(const hal::Health& h) {
   r.rx_dropped = sat16(b ? b->rx_dropped : 0);
   r.error_frames = sat16(b ? b->error_frames : 0);
   r.fault_bits = h.fault_bits;
+  r.hint_status = h.hint_status;
   r.state = h.fault_bits ? 2
             : ((r.crc_errors || r.lost_segments || r.dropped_scans || r.bus_off || r.invalid_scans) ? 1 : 0);
   std::size_t n = 0;

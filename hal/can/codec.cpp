@@ -1,5 +1,7 @@
 #include "hal_can/codec.h"
 
+#include "record_frames.h"
+
 #include <cmath>
 #include <cstring>
 #include <limits>
@@ -33,7 +35,9 @@ std::int16_t clamp_i16(double v) {
   return static_cast<std::int16_t>(std::lround(v));
 }
 
-// Cuts a record payload into classic parts or one FD frame.
+}  // namespace
+
+// Cuts a record payload into classic parts or one FD frame (record_frames.h).
 Status emit_record(std::uint32_t base_id, std::size_t parts, std::uint8_t tag, const std::uint8_t* payload, bool fd,
                    hal::CanFrame* out, std::size_t capacity, std::size_t* count, const char* what) {
   const std::size_t need = fd ? 1 : parts;
@@ -63,6 +67,8 @@ Status emit_record(std::uint32_t base_id, std::size_t parts, std::uint8_t tag, c
   *count = need;
   return Status::ok();
 }
+
+namespace {
 
 std::uint32_t choose_range_unit_um(float range_max) {
   static const std::uint32_t kUnits[] = {1000, 2000, 5000, 10000, 50000};
@@ -273,6 +279,7 @@ Status encode_health(const HealthRecord& h, std::uint8_t tag, bool fd, hal::CanF
   put_u16(p + 25, h.rx_dropped);
   put_u32(p + 28, h.fault_bits);
   put_u16(p + 32, h.error_frames);
+  p[kHealthHintOffset] = h.hint_status;
   return emit_record(kHealthId, kHealthParts, tag, p, fd, out, capacity, count, "health");
 }
 
@@ -570,9 +577,11 @@ Decoded Decoder::feed(const hal::CanFrame& f) {
     health_.rx_dropped = get_u16(p + 25);
     health_.fault_bits = get_u32(p + 28);
     health_.error_frames = get_u16(p + 32);
+    health_.hint_status = p[kHealthHintOffset];
     ++stats_.health_ok;
     return Decoded::kHealth;
   }
+  if (id >= kPoseHintId && id <= kCommandReplyId) return feed_command(id, fd_id, f);
   ++stats_.unknown_ids;
   return Decoded::kNothing;
 }

@@ -154,11 +154,63 @@ TEST(Dbc, DescribesEveryFrameTheEncoderProduces) {
     h.crc_errors = 9;
     h.scans_processed = 100000;
     h.fault_bits = 0x40;
+    h.hint_status = static_cast<std::uint8_t>(hal::HintStatus::kRefused);
     ASSERT_TRUE(encode_health(h, 1, fd, f, kMaxParts, &n).is_ok());
+    EXPECT_EQ(sig(dbc, f, n, "HintStatus"), 5);
     EXPECT_EQ(sig(dbc, f, n, "BusOff"), 3);
     EXPECT_EQ(sig(dbc, f, n, "CrcErrors"), 9);
     EXPECT_EQ(sig(dbc, f, n, "ScansProcessed"), 100000);
     EXPECT_EQ(sig(dbc, f, n, "FaultBits"), 0x40);
+
+    // Operator commands (issue 60) and the reply.
+    hal::Command c;
+    c.kind = hal::CommandKind::kSetPoseHint;
+    c.seq = 9;
+    c.hint.x = -3.25f;
+    c.hint.y = 12.5f;
+    c.hint.theta = 1.25f;
+    c.hint.sigma_xy_m = 0.3f;
+    c.hint.sigma_theta_rad = 0.1f;
+    c.hint.map_id = 2;
+    ASSERT_TRUE(encode_command(c, fd, f, kMaxParts, &n).is_ok());
+    EXPECT_EQ(n, fd ? 1u : kPoseHintParts);
+    for (std::size_t i = 0; i < n; ++i) {
+      ASSERT_TRUE(dbc.count(f[i].id)) << std::hex << f[i].id;
+      EXPECT_EQ(f[i].len, dbc.at(f[i].id).dlc);
+    }
+    EXPECT_EQ(sig(dbc, f, n, "Tag"), 9);
+    EXPECT_EQ(sig(dbc, f, n, "MapId"), 2);
+    EXPECT_EQ(sig(dbc, f, n, "Flags"), 0);
+    EXPECT_NEAR(sig(dbc, f, n, "X"), -3.25, 1e-9);
+    EXPECT_NEAR(sig(dbc, f, n, "Y"), 12.5, 1e-9);
+    EXPECT_NEAR(sig(dbc, f, n, "Theta"), 1.25, 1e-6);
+    EXPECT_NEAR(sig(dbc, f, n, "SigmaXY"), 0.3, 1e-9);
+    EXPECT_NEAR(sig(dbc, f, n, "SigmaTheta"), 0.1, 1e-9);
+    c = hal::Command{};
+    c.kind = hal::CommandKind::kSelectMap;
+    c.seq = 4;
+    c.map_id = 7;
+    ASSERT_TRUE(encode_command(c, fd, f, kMaxParts, &n).is_ok());
+    ASSERT_EQ(n, 1u);
+    EXPECT_EQ(dbc.at(f[0].id).name, "SELECT_MAP");
+    EXPECT_EQ(f[0].len, dbc.at(f[0].id).dlc);
+    EXPECT_EQ(sig(dbc, f, n, "Seq"), 4);
+    EXPECT_EQ(sig(dbc, f, n, "MapId"), 7);
+    c.kind = hal::CommandKind::kDumpLog;
+    ASSERT_TRUE(encode_command(c, fd, f, kMaxParts, &n).is_ok());
+    EXPECT_EQ(dbc.at(f[0].id).name, "DUMP_LOG");
+    EXPECT_EQ(f[0].len, dbc.at(f[0].id).dlc);
+    hal::CommandReply rep;
+    rep.seq = 4;
+    rep.kind = hal::CommandKind::kSelectMap;
+    rep.result = hal::CommandResult::kUnknownMap;
+    rep.detail = 1;
+    encode_reply(rep, &f[0]);
+    EXPECT_EQ(dbc.at(f[0].id).name, "COMMAND_REPLY");
+    EXPECT_EQ(f[0].len, dbc.at(f[0].id).dlc);
+    EXPECT_EQ(sig(dbc, f, 1, "Command"), 2);
+    EXPECT_EQ(sig(dbc, f, 1, "Result"), 3);
+    EXPECT_EQ(sig(dbc, f, 1, "Detail"), 1);
 
     hal::LaserScan s;
     s.scan_id = 77;

@@ -267,10 +267,13 @@ Status Board::create(const BoardSpec& spec) {
     hal_socketcan::SocketCanOptions o;
     o.want_fd = spec.can_fd != 0;
     o.require_fd = spec.can_fd == 1;
-    // Only our message set: IDs 0x100..0x13F and their FD variants 0x500..0x53F.
+    // Only our message set: IDs 0x100..0x13F and their FD variants 0x500..0x53F, and the operator
+    // commands 0x140..0x14F / 0x540..0x54F (issue 60).
     o.filters[0] = {0x100, 0x7C0, false};
     o.filters[1] = {0x500, 0x7C0, false};
-    o.num_filters = 2;
+    o.filters[2] = {0x140, 0x7F0, false};
+    o.filters[3] = {0x540, 0x7F0, false};
+    o.num_filters = 4;
     FW_RETURN_IF_ERROR(bus_.open(can_iface, o));
     can_fd_ = bus_.fd_enabled();
     node_.init(&bus_, &clock_, can_fd_);
@@ -285,6 +288,8 @@ Status Board::create(const BoardSpec& spec) {
   hal_.laser = &mounted_laser_;
   hal_.odometry = std::strcmp(okind, "socketcan") == 0 ? &node_.odometry() : static_cast<hal::OdometrySource*>(&zero_odom_);
   hal_.pose_sink = std::strcmp(pkind, "socketcan") == 0 ? &node_.pose_sink() : static_cast<hal::PoseSink*>(&log_sink_pose_);
+  // Operator commands arrive where the poses go out (the robot's bus).
+  hal_.commands = std::strcmp(pkind, "socketcan") == 0 ? &node_.commands() : nullptr;
   char device[96] = "";
   if (serial_laser_ == &hokuyo_) {
     const hal_serial::ScipParameters& pp = hokuyo_.parameters();

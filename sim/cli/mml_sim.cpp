@@ -36,6 +36,17 @@ static int run_main(int argc, char** argv) {
     return 0;
   }
   sim::SimResult result;
+  if (!cfg.blackbox.replay_path.empty()) {  // issue 60: the black box fed back, poses compared
+    sim::BlackBoxReplay replay;
+    if (!sim::replay_black_box(cfg, &result, &replay, &err)) {
+      std::fprintf(stderr, "mml-sim: %s\n", err.c_str());
+      return 1;
+    }
+    std::printf("mml-sim replay-blackbox: %zu rx frames, %zu POSE frames recorded, %zu replayed: %s\n", replay.rx_frames,
+                replay.recorded_pose_frames, replay.replayed_pose_frames,
+                replay.identical ? "identical" : ("differ from frame " + std::to_string(replay.first_difference)).c_str());
+    return replay.identical ? 0 : 1;
+  }
   if (!sim::run_simulation(cfg, &result, &err)) {
     std::fprintf(stderr, "mml-sim: %s\n", err.c_str());
     return 1;

@@ -207,6 +207,55 @@ Parsed parse_transport_option(ArgCursor* cur, SimConfig* cfg) {
   return Parsed::kNotMine;
 }
 
+// "A,B,C" → three numbers within [lo, hi] each (the flag named in the error).
+bool parse_triple(const std::string& flag, const std::string& v, double lo, double hi, double out[3], std::string* err) {
+  std::string rest = v;
+  for (int i = 0; i < 3; ++i) {
+    const size_t comma = rest.find(',');
+    if ((i < 2) != (comma != std::string::npos)) {
+      *err = flag + ": '" + v + "' is not A,B,C";
+      return false;
+    }
+    if (!parse_double(flag, rest.substr(0, comma), lo, hi, &out[i], err)) return false;
+    rest = comma == std::string::npos ? "" : rest.substr(comma + 1);
+  }
+  return true;
+}
+
+// Issue 60: --hint-at, --hint-offset, --hint-pose, --hint-sigma, --blackbox, --replay-blackbox.
+Parsed parse_operator_option(ArgCursor* cur, SimConfig* cfg) {
+  const std::string& a = cur->flag();
+  std::string v;
+  unsigned long long n = 0;
+  double t[3] = {0, 0, 0};
+  if (a == "--hint-at") {
+    if (!cur->u64_value(100000000ull, &n)) return Parsed::kError;
+    if (n == 0) return fail_with(cur->err, "--hint-at: the scan index must be at least 1");
+    cfg->hint.at_scan = static_cast<size_t>(n);
+    return Parsed::kOk;
+  }
+  if (a == "--hint-offset" || a == "--hint-pose") {
+    if (!cur->value(&v) || !parse_triple(a, v, -1e6, 1e6, t, cur->err)) return Parsed::kError;
+    cfg->hint.absolute = a == "--hint-pose";
+    cfg->hint.pose = fw::Se2d(t[0], t[1], t[2] * 0.017453292519943295);
+    return Parsed::kOk;
+  }
+  if (a == "--hint-sigma") {
+    if (!cur->value(&v)) return Parsed::kError;
+    const size_t comma = v.find(',');
+    if (comma == std::string::npos) return fail_with(cur->err, "--hint-sigma: '" + v + "' is not M,DEG");
+    if (!parse_double(a, v.substr(0, comma), 0.001, 65, &cfg->hint.sigma_m, cur->err) ||
+        !parse_double(a, v.substr(comma + 1), 0.01, 360, &t[0], cur->err)) {
+      return Parsed::kError;
+    }
+    cfg->hint.sigma_rad = t[0] * 0.017453292519943295;
+    return Parsed::kOk;
+  }
+  if (a == "--blackbox") return ok_if(cur->value(&cfg->blackbox.record_path));
+  if (a == "--replay-blackbox") return ok_if(cur->value(&cfg->blackbox.replay_path));
+  return Parsed::kNotMine;
+}
+
 // Options of synthetic worlds alone: a log brings its own laser, route and map.
 Parsed parse_world_only_option(ArgCursor* cur, SimConfig* cfg) {
   const std::string& a = cur->flag();
@@ -298,6 +347,7 @@ bool parse_one_option(ArgCursor* cur, SimConfig* cfg, SimArgsAction* action, Giv
   if (p == Parsed::kNotMine) p = parse_source_option(cur, cfg, given);
   if (p == Parsed::kNotMine) p = parse_run_option(cur, cfg);
   if (p == Parsed::kNotMine) p = parse_transport_option(cur, cfg);
+  if (p == Parsed::kNotMine) p = parse_operator_option(cur, cfg);
   if (p == Parsed::kNotMine) p = parse_world_option(cur, cfg, given);
   if (p == Parsed::kNotMine) *cur->err = "unknown argument '" + cur->flag() + "' (see --help)";
   return p == Parsed::kOk;
@@ -306,6 +356,13 @@ bool parse_one_option(ArgCursor* cur, SimConfig* cfg, SimArgsAction* action, Giv
 // Exactly one source, and the log-only options only with a log.
 bool check_source_choice(const SimConfig& cfg, std::string* err) {
   const int sources = !cfg.world.empty() + !cfg.log_path.empty() + !cfg.dataset.empty();
+  if (sources == 0 && !cfg.blackbox.replay_path.empty()) {  // a robot's black box: its map is enough
+    if (cfg.map_yaml.empty() && cfg.localizer != "odom") {
+      *err = "--replay-blackbox without --world/--dataset/--log needs the robot's map (--map IMAGE.mmap or MAP.yaml)";
+      return false;
+    }
+    return true;
+  }
   if (sources == 0) {
     *err = "no input: give --world NAME, --dataset NAME or --log FILE (see --help)";
     return false;
@@ -389,6 +446,15 @@ run:
   --byte-fault-rate P     with --transport can|sick: drop or bit-flip each frame / telegram with
                           probability P (seeded by --seed); the firmware's decoder drops and counts
                           what it cannot use (summary.json, summary line)
+  --hint-at N             at scan N the operator sends a pose hint (SET_POSE_HINT; on the CAN wire with
+                          --transport can): the truth moved by --hint-offset DX,DY,DEG (default 0,0,0)
+                          or the pose --hint-pose X,Y,DEG, with --hint-sigma M,DEG (default 0.1,3)
+  --blackbox FILE         with --transport can: the firmware's black box (frames in and out, candump
+                          format, hal/can/README.md) written to FILE after the run
+  --replay-blackbox FILE  feed FILE's received frames back through the firmware's CanNode in lockstep
+                          and compare the POSE frames with FILE's; exit 0 when identical bit for bit,
+                          1 otherwise. Give the recording's --world/--dataset and options, or for a
+                          robot's black box its --map and localizer options (--opt) alone
   --quiet                 no progress line
   --no-pictures           skip run.svg / run.png
 synthetic world:

@@ -19,6 +19,7 @@
 #include "firmware/track/track_options.h"
 #include "hal/hal.h"
 #include "hal_linux/linux_clock.h"
+#include "hal_linux/black_box_file.h"
 #include "hal_sim/sim_hal.h"
 #include "sim/cli/log_frames.h"
 #include "sim/cli/reference_judge.h"
@@ -219,9 +220,8 @@ bool load_world_source(const SimConfig& cfg, SimSource* src, SimSummary* sum, st
   return true;
 }
 
-bool load_log_source(const SimConfig& cfg, SimSource* src, SimSummary* sum, std::string* err) {
-  if (!load_log_frames(cfg, &src->log_frames, &sum->scans_restamped, err)) return false;
-  src->total = src->log_frames.size();
+// --map: a compiled map image (used as it is) or a ROS map_server YAML.
+bool load_map_file(const SimConfig& cfg, SimSource* src, std::string* err) {
   if (!cfg.map_yaml.empty()) {
     if (is_map_image_file(cfg.map_yaml)) {
       // A compiled map image (mml-mapc / mml-mapbuild): used as it is, relation table included.
@@ -233,6 +233,13 @@ bool load_log_source(const SimConfig& cfg, SimSource* src, SimSummary* sum, std:
     }
     src->have_grid = true;
   }
+  return true;
+}
+
+bool load_log_source(const SimConfig& cfg, SimSource* src, SimSummary* sum, std::string* err) {
+  if (!load_log_frames(cfg, &src->log_frames, &sum->scans_restamped, err)) return false;
+  src->total = src->log_frames.size();
+  if (!load_map_file(cfg, src, err)) return false;
   sum->source = cfg.dataset.empty() ? "log:" + std::filesystem::path(cfg.log_path).filename().string()
                                     : "dataset:" + cfg.dataset;
   return true;
@@ -334,7 +341,37 @@ struct FirmwareRig {
   std::unique_ptr<fw::LocalizationLoop> loop = std::make_unique<fw::LocalizationLoop>();
   fw::LocalizationLoopOptions lo;
   TaskCtx task_ctx{nullptr, fw::Status::ok()};
+  // Issue 60: operator commands (on the CAN wire with --transport can, else straight to the loop)
+  // and the black box on the CanNode with the outputs teed into it.
+  DirectCommands direct_commands;
+  fw::CommandHandler commands;
+  BlackBoxRecorder black_box;
+  std::uint8_t command_seq = 0;
 };
+
+// Issue 60: commands reach the loop's handler; the black box records the CanNode's traffic and the
+// published poses (--blackbox, --replay-blackbox).
+bool wire_operator(const SimConfig& cfg, fw::Localizer& localizer, FirmwareRig* rig, std::string* err) {
+  hal::Hal& hal = rig->sim_hal->hal;
+  const bool can = rig->topt.transport == Transport::kCan;
+  const bool black_box = !cfg.blackbox.record_path.empty() || !cfg.blackbox.replay_path.empty();
+  if (black_box && !can) {
+    *err = "--blackbox / --replay-blackbox record the firmware's CAN traffic: they need --transport can";
+    return false;
+  }
+  hal.commands = can ? &rig->transport->commands() : static_cast<hal::CommandSource*>(&rig->direct_commands);
+  rig->commands.init(&hal, &localizer, fw::CommandHandlerOptions());
+  rig->loop->set_command_handler(&rig->commands);
+  if (black_box) {
+    BlackBoxRecorder& r = rig->black_box;
+    r.storage.resize(cfg.blackbox.frames);
+    r.box.init(r.storage.data(), r.storage.size());
+    rig->transport->attach_black_box(&r.box);
+    r.tee = std::make_unique<BlackBoxTee>(hal.pose_sink, &r.box);
+    hal.pose_sink = r.tee.get();
+  }
+  return true;
+}
 
 // --transport can|sick: the loop reads the firmware's CanNode on the hal/sim loopback bus or its
 // SickLaser on a hal/sim serial port instead of the rings (sim/devices/sensor_transport.h), on the
@@ -355,6 +392,7 @@ bool wire_firmware(const SimConfig& cfg, fw::Localizer& localizer, FirmwareRig* 
     *err = s.message();
     return false;
   }
+  if (!wire_operator(cfg, localizer, rig, err)) return false;
   rig->task_ctx = {rig->loop.get(), fw::Status::ok()};
   rig->sim_hal->tasks.add_task("localization", [](void* c) {
     auto* tc = static_cast<TaskCtx*>(c);
@@ -396,6 +434,7 @@ class FrameLoop {
       if (k == 0) t_first_ = frame_.t;
       if (cfg_.paced) wait_for_frame_time();
       note_frame_info();
+      if (cfg_.hint.at_scan == k + 1) send_hint();
       feed_sensors();
       if (frame_.scan.timestamp_ns > rig_.sim_hal->clock.now_ns()) rig_.sim_hal->clock.set_ns(frame_.scan.timestamp_ns);
       rig_.sim_hal->tasks.run_once();
@@ -459,6 +498,18 @@ class FrameLoop {
     }
     info_[frame_.scan.scan_id] = {frame_.t,           frame_.has_truth, truth,             frame_.truth_bound_m,
                                   frame_.truth_bound_rad, frame_.travelled_m, frame_.kidnapped, in_unknown};
+  }
+
+  // --hint-at: the operator's hint for this scan (from its truth), before the scan's data.
+  void send_hint() {
+    const hal::Command c = hint_command(cfg_.hint, frame_.truth, rig_.command_seq++);
+    sum_.hint_step = static_cast<long>(out_->steps.size());
+    std::string why;
+    if (rig_.topt.transport == Transport::kCan) {
+      if (!rig_.transport->send_command(c, frame_.scan.timestamp_ns, &why)) sum_.hint_reply = "not sent: " + why;
+    } else {
+      rig_.direct_commands.push(c);
+    }
   }
 
   // With --transport can|sick (or --sensor-resolution can|sick) the simulated sensors report what
@@ -625,6 +676,20 @@ void print_run_report(const SimConfig& cfg, const FirmwareRig& rig, const SimSum
   std::fputs(summary_story(sum).c_str(), stderr);
 }
 
+// --blackbox FILE: the ring as the firmware writes it (hal_linux/black_box_file.h).
+bool write_black_box(const SimConfig& cfg, const FirmwareRig& rig, SimSummary* sum, std::string* err) {
+  const fw::CommandCounters& cc = rig.commands.counters();
+  if (sum->hint_step >= 0 && sum->hint_reply.empty()) {
+    sum->hint_reply = cc.accepted > 0 ? "accepted" : cc.refused > 0 ? "refused" : "no reply";
+  }
+  if (cfg.blackbox.record_path.empty()) return true;
+  sum->blackbox_frames = rig.black_box.box.size();
+  const fw::Status s = hal_linux::write_black_box_file(rig.black_box.box, cfg.blackbox.record_path.c_str(),
+                                                       &sum->blackbox_bytes);
+  if (!s.is_ok()) *err = s.message();
+  return s.is_ok();
+}
+
 // steps.csv, summary.json, the map (map.yaml/.pgm) and the pictures, into --out.
 bool write_outputs(const SimConfig& cfg, const SimSource& src, const SimResult& r, std::string* err) {
   if (cfg.out_dir.empty()) return true;
@@ -694,7 +759,72 @@ bool run_simulation(const SimConfig& cfg_in, SimResult* out, std::string* err) {
   collect_loop_counters(rig, frames.ring_drops(), wall_s, &sum);
   summarize_steps(out->steps, &sum);
   if (cfg.progress) print_run_report(cfg, rig, sum);
+  if (!write_black_box(cfg, rig, &sum, err)) return false;
   return write_outputs(cfg, src, *out, err);
+}
+
+}  // namespace sim
+
+namespace sim {
+
+bool replay_black_box(const SimConfig& cfg_in, SimResult* out, BlackBoxReplay* replay, std::string* err) {
+  *out = SimResult();
+  *replay = BlackBoxReplay();
+  std::vector<BlackBoxLine> lines;
+  if (!read_black_box(cfg_in.blackbox.replay_path, &lines, err)) return false;
+  SimConfig cfg;
+  // A robot's black box: its map (--map) and the localizer's options alone, no source to run.
+  const bool robot = cfg_in.world.empty() && cfg_in.log_path.empty() && cfg_in.dataset.empty() &&
+                     cfg_in.custom_world == nullptr;
+  if (robot) {
+    cfg = cfg_in;
+    if (!create_output_dir(cfg.out_dir, err)) return false;
+    if (cfg.localizer.empty()) cfg.localizer = default_localizer();
+  } else if (!complete_config(cfg_in, &cfg, err)) {
+    return false;
+  }
+  cfg.transport.transport = Transport::kCan;  // the black box holds CAN frames
+  cfg.transport.byte_fault_rate = 0;
+  SimSummary& sum = out->summary;
+  sum.localizer = cfg.localizer;
+  SimSource src;
+  if (robot ? !load_map_file(cfg, &src, err) : !load_source(cfg, &src, &sum, err)) return false;
+  FirmwareMap map;
+  if (!load_firmware_map(cfg, &src, &map, err)) return false;
+  LocalizerHooks hooks;
+  std::unique_ptr<fw::Localizer> localizer = build_localizer(cfg, src, map, &hooks, err);
+  if (!localizer) return false;
+  FirmwareRig rig;
+  if (!wire_firmware(cfg, *localizer, &rig, &sum, err)) return false;
+  // Lockstep: each received frame at its receive time, one loop cycle after it (the firmware's
+  // loop runs as soon as input is pending). Sent frames are what is compared, not fed.
+  for (const BlackBoxLine& l : lines) {
+    if (l.tx) continue;
+    ++replay->rx_frames;
+    if (l.frame.timestamp_ns > rig.sim_hal->clock.now_ns()) rig.sim_hal->clock.set_ns(l.frame.timestamp_ns);
+    if (!rig.transport->inject_frame(l.frame)) {
+      *err = "--replay-blackbox: the loopback bus refused a frame";
+      return false;
+    }
+    rig.sim_hal->tasks.run_once();
+    if (!rig.task_ctx.status.is_ok()) ++sum.step_errors;
+    hal::PoseEstimate e;
+    while (rig.sim_hal->pose_sink.pop(&e)) {
+      StepRecord r;
+      r.step = static_cast<std::uint32_t>(out->steps.size());
+      r.estimate = e;
+      r.has_pose = estimate_has_pose(e);
+      out->steps.push_back(r);
+    }
+  }
+  sum.steps = out->steps.size();
+  const std::vector<hal::CanFrame> recorded = pose_frames(lines);
+  const std::vector<hal::CanFrame> replayed = pose_frames(rig.black_box.box);
+  replay->recorded_pose_frames = recorded.size();
+  replay->replayed_pose_frames = replayed.size();
+  replay->identical = !recorded.empty() && same_frames(recorded, replayed, &replay->first_difference);
+  if (!cfg.out_dir.empty() && !write_steps_csv(cfg.out_dir + "/steps.csv", out->steps, err)) return false;
+  return true;
 }
 
 }  // namespace sim

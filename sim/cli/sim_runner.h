@@ -15,6 +15,7 @@
 #include "firmware/base/se2.h"
 #include "hal/msg/pose_estimate.h"
 #include "sim/cli/localizer_factory.h"
+#include "sim/cli/operator_sim.h"
 #include "sim/devices/sensor_transport.h"
 #include "sim/io/carmen_log.h"
 #include "sim/world/map_changes.h"
@@ -69,6 +70,10 @@ struct SimConfig {
   std::string out_dir;         // empty: no files
   SyntheticRunOptions synthetic;
   RasterOptions raster;
+  // Issue 60: an operator's pose hint at a scan (--hint-at, --hint-offset / --hint-pose,
+  // --hint-sigma) and the black box (--blackbox FILE, --replay-blackbox FILE), operator_sim.h.
+  HintOptions hint;
+  BlackBoxOptions blackbox;
 };
 
 // The placeholder a localizer leaves in a PoseEstimate before it has any pose: x = y = θ = 0 with a
@@ -166,6 +171,11 @@ struct SimSummary {
   // broken odometry records).
   std::string transport = "none";
   TransportStats transport_stats;
+  // Issue 60: the step at which the hint was sent (-1 = none) and the firmware's reply to it; the
+  // black box written (--blackbox): frames kept, bytes of the file.
+  long hint_step = -1;
+  std::string hint_reply;
+  std::size_t blackbox_frames = 0, blackbox_bytes = 0;
 };
 
 struct SimResult {
@@ -183,6 +193,11 @@ std::string wheel_noise_beyond_alpha(const SimConfig& cfg);
 
 // Runs the whole simulation; false with *err naming the bad input (world, log, map, localizer).
 bool run_simulation(const SimConfig& cfg, SimResult* out, std::string* err);
+// --replay-blackbox: the map and localizer of `cfg` (the recording's --world / --dataset and
+// options), the file's rx frames fed through the firmware's CanNode in lockstep (the simulation
+// clock set to each frame's receive time, one loop cycle per frame); the POSE frames published
+// are compared with the file's tx POSE frames. `out` holds the replay's steps.
+bool replay_black_box(const SimConfig& cfg, SimResult* out, BlackBoxReplay* replay, std::string* err);
 
 // Output writers (also used by tests).
 bool write_steps_csv(const std::string& path, const std::vector<StepRecord>& steps, std::string* err);

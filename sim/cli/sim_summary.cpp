@@ -38,6 +38,10 @@ void reset_derived_fields(SimSummary* s) {
   s->transport_stats = keep.transport_stats;
   s->step_errors = keep.step_errors;
   s->scans_restamped = keep.scans_restamped;
+  s->hint_step = keep.hint_step;  // issue 60: what the run sent and wrote, not derived from the steps
+  s->hint_reply = keep.hint_reply;
+  s->blackbox_frames = keep.blackbox_frames;
+  s->blackbox_bytes = keep.blackbox_bytes;
   s->deadline_misses = keep.deadline_misses;
 }
 

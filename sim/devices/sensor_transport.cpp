@@ -321,6 +321,21 @@ void SensorTransport::send_scan(const hal::LaserScan& scan) {
   transmit(parts_->frames, n, scan.timestamp_ns);
 }
 
+bool SensorTransport::send_command(const hal::Command& command, std::uint64_t t_ns, std::string* err) {
+  std::size_t n = 0;
+  const fw::Status s = hal_can::encode_command(command, options_.fd, parts_->frames, hal_can::kMaxParts, &n);
+  if (!s.is_ok()) {
+    *err = s.message();
+    return false;
+  }
+  transmit(parts_->frames, n, t_ns);
+  return true;
+}
+
+bool SensorTransport::inject_frame(const hal::CanFrame& frame) { return parts_->bus.send(frame); }
+hal::CommandSource& SensorTransport::commands() { return parts_->node.commands(); }
+void SensorTransport::attach_black_box(hal_can::BlackBox* box) { parts_->node.attach_black_box(box); }
+
 hal::LaserScanSource& SensorTransport::laser() {
   if (options_.transport == Transport::kSick) return parts_->sick_laser;
   return parts_->laser;

@@ -110,6 +110,15 @@ class SensorTransport {
   void send_odometry(const hal::Odometry& odom);
   void send_scan(const hal::LaserScan& scan);
 
+  // kCan: an operator command on the wire (hal/can codec), stamped t_ns (issue 60); false with *err
+  // when the encoder refuses it (a NaN hint): the firmware never sees what the wire cannot carry.
+  bool send_command(const hal::Command& command, std::uint64_t t_ns, std::string* err);
+  // kCan: a frame as it was received (a black box replay): onto the loopback bus, unchanged.
+  bool inject_frame(const hal::CanFrame& frame);
+  // kCan: the CanNode's command queue, and its black box (null = none).
+  hal::CommandSource& commands();
+  void attach_black_box(hal_can::BlackBox* box);
+
   // The sources the localization loop reads for kCan (the CanNode's) and kSick (the SickLaser's scans).
   hal::LaserScanSource& laser();
   hal::OdometrySource& odometry();

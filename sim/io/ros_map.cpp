@@ -15,6 +15,8 @@
 #include <map>
 #include <sstream>
 
+#include <yaml-cpp/yaml.h>
+
 namespace sim {
 namespace {
 
@@ -23,13 +25,6 @@ std::string trim(const std::string& s) {
   while (b < e && std::isspace(static_cast<unsigned char>(s[b]))) ++b;
   while (e > b && std::isspace(static_cast<unsigned char>(s[e - 1]))) --e;
   return s.substr(b, e - b);
-}
-
-std::string unquote(const std::string& s) {
-  if (s.size() >= 2 && ((s.front() == '"' && s.back() == '"') || (s.front() == '\'' && s.back() == '\''))) {
-    return s.substr(1, s.size() - 2);
-  }
-  return s;
 }
 
 bool parse_double(const std::string& text, double* out) {
@@ -243,76 +238,73 @@ bool validate_ros_map(const RosMap& m, const std::string& name, std::string* err
   return true;
 }
 
+namespace {
+
+// map_server's YAML through yaml-cpp (Debian's libyaml-cpp-dev): every valid file loads (block-style
+// `origin` lists, quoted keys, comments, flow or block style); a syntax error is the library's,
+// with its line and column; a field given twice is an error too (the library keeps both).
+bool load_yaml_fields(const std::string& yaml_path, const std::string& text, std::map<std::string, YAML::Node>* kv,
+                      std::string* error) {
+  YAML::Node root;
+  try {
+    root = YAML::Load(text);
+  } catch (const YAML::Exception& e) {
+    return fail(error, yaml_path + ":" + std::to_string(e.mark.line + 1) + ":" + std::to_string(e.mark.column + 1) +
+                           ": YAML: " + e.msg);
+  }
+  if (!root.IsMap()) return fail(error, yaml_path + ": expected 'key: value' fields (a YAML mapping)");
+  for (const auto& it : root) {
+    if (!it.first.IsScalar()) {
+      return fail(error, yaml_path + ":" + std::to_string(it.first.Mark().line + 1) + ": a key that is not a name");
+    }
+    const std::string key = it.first.Scalar();
+    if (kv->count(key) != 0) {
+      return fail(error, yaml_path + ":" + std::to_string(it.first.Mark().line + 1) + ": duplicate field '" + key + "'");
+    }
+    (*kv)[key] = it.second;
+  }
+  return true;
+}
+
+// A scalar field's text ("" for a list, a map or null: no scalar field accepts those).
+std::string scalar_of(const YAML::Node& n) { return n.IsScalar() ? n.Scalar() : std::string(); }
+
+bool parse_origin(const std::string& yaml_path, const YAML::Node& o, double origin[3], std::string* error) {
+  if (!o.IsSequence()) {
+    return fail(error, yaml_path + ": field 'origin': expected [x, y, yaw], got '" + scalar_of(o) + "'");
+  }
+  if (o.size() != 3) {
+    return fail(error, yaml_path + ": field 'origin': expected 3 numbers [x, y, yaw], got " + std::to_string(o.size()));
+  }
+  for (std::size_t i = 0; i < 3; ++i) {
+    if (!parse_double(scalar_of(o[i]), &origin[i])) {
+      return fail(error, yaml_path + ": field 'origin': component " + std::to_string(i) + " not a number: '" +
+                             scalar_of(o[i]) + "'");
+    }
+  }
+  return true;
+}
+
+}  // namespace
+
 bool read_ros_map(const std::string& yaml_path, RosMap* out, std::string* error) {
   std::string text;
   if (!read_regular_file(yaml_path, kMaxTextConfigBytes, &text, error)) return false;
-  std::map<std::string, std::string> kv;
-  std::istringstream in(text);
-  std::string line;
-  int line_no = 0;
-  while (std::getline(in, line)) {
-    ++line_no;
-    // Strip comments outside quotes.
-    bool in_q = false;
-    char q = 0;
-    for (std::size_t i = 0; i < line.size(); ++i) {
-      const char ch = line[i];
-      if (in_q) {
-        if (ch == q) in_q = false;
-      } else if (ch == '"' || ch == '\'') {
-        in_q = true;
-        q = ch;
-      } else if (ch == '#') {
-        line.resize(i);
-        break;
-      }
-    }
-    const std::string t = trim(line);
-    if (t.empty() || t == "---") continue;
-    const std::size_t colon = t.find(':');
-    if (colon == std::string::npos) {
-      return fail(error, yaml_path + ":" + std::to_string(line_no) + ": expected 'key: value', got '" + t + "'");
-    }
-    const std::string key = trim(t.substr(0, colon));
-    const std::string value = trim(t.substr(colon + 1));
-    if (kv.count(key) != 0) return fail(error, yaml_path + ":" + std::to_string(line_no) + ": duplicate field '" + key + "'");
-    kv[key] = value;
-  }
+  std::map<std::string, YAML::Node> node;
+  if (!load_yaml_fields(yaml_path, text, &node, error)) return false;
   RosMap m;
   m.yaml_path = yaml_path;
   for (const char* key : {"image", "resolution", "origin", "negate", "occupied_thresh", "free_thresh"}) {
-    if (kv.count(key) == 0) return fail(error, yaml_path + ": missing field '" + std::string(key) + "'");
+    if (node.count(key) == 0) return fail(error, yaml_path + ": missing field '" + std::string(key) + "'");
   }
-  m.image = unquote(kv["image"]);
+  std::map<std::string, std::string> kv;
+  for (const auto& [key, n] : node) kv[key] = scalar_of(n);
+  m.image = kv["image"];
   if (m.image.empty()) return fail(error, yaml_path + ": field 'image': empty");
   if (!parse_double(kv["resolution"], &m.resolution)) {
     return fail(error, yaml_path + ": field 'resolution': not a number: '" + kv["resolution"] + "'");
   }
-  {
-    std::string o = kv["origin"];
-    if (o.size() < 2 || o.front() != '[' || o.back() != ']') {
-      return fail(error, yaml_path + ": field 'origin': expected [x, y, yaw], got '" + o + "'");
-    }
-    o = o.substr(1, o.size() - 2);
-    std::vector<std::string> parts;
-    std::size_t start = 0;
-    while (true) {
-      const std::size_t comma = o.find(',', start);
-      parts.push_back(o.substr(start, comma == std::string::npos ? std::string::npos : comma - start));
-      if (comma == std::string::npos) break;
-      start = comma + 1;
-    }
-    if (parts.size() != 3) {
-      return fail(error, yaml_path + ": field 'origin': expected 3 numbers [x, y, yaw], got " +
-                             std::to_string(parts.size()));
-    }
-    for (int i = 0; i < 3; ++i) {
-      if (!parse_double(parts[i], &m.origin[i])) {
-        return fail(error, yaml_path + ": field 'origin': component " + std::to_string(i) + " not a number: '" +
-                               trim(parts[i]) + "'");
-      }
-    }
-  }
+  if (!parse_origin(yaml_path, node["origin"], m.origin, error)) return false;
   {
     const std::string n = kv["negate"];
     if (n == "0" || n == "false" || n == "False") {
@@ -329,7 +321,7 @@ bool read_ros_map(const std::string& yaml_path, RosMap* out, std::string* error)
   if (!parse_double(kv["free_thresh"], &m.free_thresh)) {
     return fail(error, yaml_path + ": field 'free_thresh': not a number: '" + kv["free_thresh"] + "'");
   }
-  if (kv.count("mode") != 0) m.mode = unquote(kv["mode"]);
+  if (kv.count("mode") != 0) m.mode = kv["mode"];
   // Validate fields before touching the image, so the message is about the YAML.
   m.width = 1;
   m.height = 1;

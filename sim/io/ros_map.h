@@ -1,7 +1,9 @@
 // ROS map_server maps: a PGM image (P2 ASCII or P5 binary, 8-bit, any maxval 1..255) plus its YAML
 // description (image, resolution, origin, negate, occupied_thresh, free_thresh, mode). Read, write
 // (bit-exact round trip of what we write), validate with errors naming file and field, and convert
-// to an occupancy grid / occupied-cell point cloud with the map_server semantics.
+// to an occupancy grid / occupied-cell point cloud with the map_server semantics. The YAML is read
+// with yaml-cpp (issue 60): every valid map_server file loads; a syntax error names the library's
+// line and column.
 // (Owner: maps; compiled into library sim_map.)
 #pragma once
 

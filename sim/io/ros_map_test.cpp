@@ -157,6 +157,22 @@ TEST_F(RosMapTest, GridToRosMapAndBackPreservesClasses) {
   EXPECT_EQ(back.cells, g.cells);
 }
 
+// Issue 60: what the hand-written line parser refused and map_server accepts: a block-style origin
+// list, quoted keys, a document marker, comments everywhere.
+TEST_F(RosMapTest, ReadsEveryValidMapServerYaml) {
+  write_text("m.pgm", "P5\n2 1\n255\n\x01\x02");
+  write_text("m.yaml",
+             "%YAML 1.1\n---\n# a map\n'image': m.pgm\n\"resolution\": 0.1  # m\norigin:\n  - -1.5\n  - 2\n  # no yaw\n"
+             "  - 0.0\nnegate: 0\noccupied_thresh: 0.65\nfree_thresh: 0.196\nmode: trinary\n");
+  RosMap m;
+  std::string err;
+  ASSERT_TRUE(read_ros_map(path("m.yaml"), &m, &err)) << err;
+  EXPECT_EQ(m.image, "m.pgm");
+  EXPECT_EQ(m.resolution, 0.1);
+  EXPECT_EQ(m.origin[0], -1.5);
+  EXPECT_EQ(m.origin[1], 2.0);
+}
+
 struct BadYamlCase {
   const char* yaml;
   const char* expect;  // substring of the error
@@ -183,7 +199,9 @@ TEST_F(RosMapTest, MalformedYamlNamesFileAndField) {
       {"image: missing.pgm\nresolution: 0.05\norigin: [0, 0, 0]\n", "does not exist"},
       {"image: ok.pgm\nresolution: 0.05\norigin: [0, 0, 0]\nmode: fuzzy\n", "field 'mode'"},
       {"image: ok.pgm\nresolution: 0.05\nresolution: 0.1\norigin: [0, 0, 0]\n", "duplicate field 'resolution'"},
-      {"image: ok.pgm\nresolution 0.05\norigin: [0, 0, 0]\n", "expected 'key: value'"},
+      {"image: ok.pgm\nresolution 0.05\norigin: [0, 0, 0]\n", "bad.yaml:3:7: YAML: illegal map value"},
+      {"image: ok.pgm\nresolution: [0.05\norigin: [0, 0, 0]\n", "bad.yaml:3:"},  // the library's line:column
+      {"- image: ok.pgm\n", "expected 'key: value'"},
   };
   for (const BadYamlCase& c : cases) {
     std::string text = c.yaml;

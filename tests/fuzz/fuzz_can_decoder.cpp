@@ -31,13 +31,30 @@ void check_delivered_scan(const hal::LaserScan& s, std::uint32_t unit_um) {
   }
 }
 
+// Issue 60: an operator command the decoder delivers is one the runtime can check: a known kind, a
+// hint's numbers finite and its σ not negative; a reply's codes within their enums.
+void check_delivered_command(const hal::Command& c) {
+  check(c.kind == hal::CommandKind::kSetPoseHint || c.kind == hal::CommandKind::kSelectMap ||
+            c.kind == hal::CommandKind::kDumpLog,
+        "command kind");
+  if (c.has_hint) {
+    check(std::isfinite(c.hint.x) && std::isfinite(c.hint.y) && std::isfinite(c.hint.theta), "hint finite");
+    check(c.hint.sigma_xy_m >= 0.0f && c.hint.sigma_theta_rad >= 0.0f, "hint sigma");
+  }
+}
+
 struct Feeder {
   hal_can::Decoder decoder;
   std::uint64_t now_ns = 1'000'000'000;
   std::uint32_t last_unit_um = 1000;
   void feed(hal::CanFrame f) {
     f.timestamp_ns = now_ns;
-    if (decoder.feed(f) == hal_can::Decoded::kScan) check_delivered_scan(decoder.scan(), last_unit_um);
+    const hal_can::Decoded d = decoder.feed(f);
+    if (d == hal_can::Decoded::kScan) check_delivered_scan(decoder.scan(), last_unit_um);
+    if (d == hal_can::Decoded::kCommand) check_delivered_command(decoder.command());
+    if (d == hal_can::Decoded::kReply) {
+      check(static_cast<std::uint8_t>(decoder.reply().result) < hal::kCommandResultCount, "reply result");
+    }
   }
 };
 

@@ -177,6 +177,36 @@ void can_seeds(const Source& src) {
       ops.u8(fuzz::kCanTimeout);
       ops.u32(600);
     }
+    // Issue 60: the operator's commands and the reply, as raw frames.
+    hal::Command cmds[3];
+    cmds[0].kind = hal::CommandKind::kSetPoseHint;
+    cmds[0].has_hint = true;
+    cmds[0].hint.x = 3.5f;
+    cmds[0].hint.y = -1.25f;
+    cmds[0].hint.theta = 0.5f;
+    cmds[0].hint.sigma_xy_m = 0.2f;
+    cmds[0].hint.sigma_theta_rad = 0.1f;
+    cmds[1].kind = hal::CommandKind::kSelectMap;
+    cmds[1].map_id = 1;
+    cmds[2].kind = hal::CommandKind::kDumpLog;
+    std::vector<hal::CanFrame> cf(hal_can::kMaxParts + 1);
+    std::size_t cn = 0;
+    for (const hal::Command& c : cmds) {
+      const fw::Status st = hal_can::encode_command(c, fd, cf.data(), hal_can::kMaxParts, &cn);
+      if (!st) die(std::string("encode_command: ") + st.message());
+      hal::CommandReply rep;
+      rep.kind = c.kind;
+      hal_can::encode_reply(rep, &cf[cn++]);
+      for (std::size_t i = 0; i < cn; ++i) {
+        const hal::CanFrame& f = cf[i];
+        raw.u8(fuzz::kCanRawFrame);
+        raw.u16(static_cast<std::uint16_t>(f.id));
+        raw.u8(static_cast<std::uint8_t>((f.fd ? 1 : 0) | (f.brs ? 4 : 0)));
+        raw.u8(f.len);
+        raw.bytes(f.data, f.len);
+        raw.u16(100);
+      }
+    }
     put("can_decoder", fd ? "raw_fd" : "raw_classic", raw.data());
     put("can_decoder", fd ? "ops_fd" : "ops_classic", ops.data());
   }

@@ -43,6 +43,15 @@ while read -r name iface config replay; do
   t1=$(date +%s.%N)
   echo "$prc" > "$d/canplayer.rc"
   echo "$t0 $t1" > "$d/replay_times"
+  # Issue 60: the operator's commands with mml-ctl (replies decoded from the bus), scenario fd.
+  if [ "$name" = fd ] && [ -x "$B/sim/mml-ctl" ]; then
+    {
+      timeout 10 "$B/sim/mml-ctl" --iface "$iface" --fd --seq 1 hint 1 2 0 0.2 5; echo "rc $?"
+      timeout 10 "$B/sim/mml-ctl" --iface "$iface" --seq 2 hint 1 2 0 0.2 5 --map 7; echo "rc $?"
+      timeout 10 "$B/sim/mml-ctl" --iface "$iface" --seq 3 select-map 3; echo "rc $?"
+      timeout 10 "$B/sim/mml-ctl" --iface "$iface" --seq 4 dump-log; echo "rc $?"
+    } > "$d/ctl.log" 2>&1
+  fi
   # Let the firmware finish the scans still queued, then stop it the way a robot does.
   sleep 2
   kill -TERM $fpid

@@ -99,6 +99,7 @@ write_config() {  # write_config FILE IFACE FD [MAP]
 write_config "$W/fd.conf" vcan0 true "$TABLE_MAP"
 write_config "$W/classic.conf" vcan1 false
 write_config "$W/fault.conf" vcan0 true
+echo "blackbox = $W/fd/blackbox.log" >> "$W/fd.conf"  # issue 60: written on DUMP_LOG and at exit
 "$CANDEV" log2can --dataset $DS --count "$SCANS" --fd --speed "$SPEED" --out "$W/fd.replay" > "$W/fd.sent.json" || exit 1
 "$CANDEV" log2can --dataset $DS --count "$CLASSIC_SCANS" --speed "$SPEED" --out "$W/classic.replay" > "$W/classic.sent.json" || exit 1
 "$CANDEV" log2can --dataset $DS --first 1000 --count 120 --fd --speed "$SPEED" --corrupt-every 10 --drop-every 13 \
@@ -184,6 +185,13 @@ group=classic
 check "classic: runs on a classic-only bus (no FD frames in the capture)" bash -c "! grep -q '##' '$W/classic/capture.log'"
 group=fd
 check "fd: pose frames are CAN FD" grep -q '520##' "$W/fd/capture.log"
+# Issue 60: commands answered on the bus (mml-ctl in the guest), the black box written.
+check "fd: SET_POSE_HINT accepted" grep -q "seq 1 SET_POSE_HINT: accepted" "$W/fd/ctl.log"
+check "fd: a hint for an unknown map refused" grep -q "seq 2 SET_POSE_HINT: unknown-map" "$W/fd/ctl.log"
+check "fd: SELECT_MAP of an unknown map refused" grep -q "seq 3 SELECT_MAP: unknown-map" "$W/fd/ctl.log"
+check "fd: DUMP_LOG done" grep -q "seq 4 DUMP_LOG: done" "$W/fd/ctl.log"
+check "fd: the black box holds the scans received, the poses sent and the commands" \
+  bash -c "grep -q ' rx 518##' '$W/fd/blackbox.log' && grep -q ' tx 520##' '$W/fd/blackbox.log' && grep -q ' rx 149#04' '$W/fd/blackbox.log'"
 if [ "$USES_MML" = 1 ]; then
   check "fd: mmlfw used the image's precomputed relation table" grep -q "precomputed relation table" "$W/fd/mmlfw.log"
   check "classic: mmlfw filled the relation table at start-up" grep -q "filling it at start-up" "$W/classic/mmlfw.log"

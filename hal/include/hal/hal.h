@@ -17,6 +17,7 @@ struct Hal {
   LaserScanSource* laser = nullptr;
   OdometrySource* odometry = nullptr;
   PoseSink* pose_sink = nullptr;
+  CommandSource* commands = nullptr;  // optional: operator commands (hal/msg/command.h)
   TaskRunner* tasks = nullptr;
 };
 

@@ -5,6 +5,7 @@
 
 #include <cstdint>
 
+#include "hal/msg/command.h"
 #include "hal/msg/health.h"
 #include "hal/msg/laser_scan.h"
 #include "hal/msg/odometry.h"
@@ -39,6 +40,15 @@ class PoseSink {
   virtual ~PoseSink() = default;
   virtual void publish(const PoseEstimate& estimate) = 0;
   virtual void publish_health(const Health& health) = 0;
+  // The answer to an operator command (COMMAND_REPLY on CAN); sinks without a reply channel drop it.
+  virtual void publish_reply(const CommandReply& reply) { (void)reply; }
+};
+
+// Operator commands (SET_POSE_HINT, SELECT_MAP, DUMP_LOG) as they arrive.
+class CommandSource {
+ public:
+  virtual ~CommandSource() = default;
+  virtual bool poll(Command* out) = 0;
 };
 
 }  // namespace hal

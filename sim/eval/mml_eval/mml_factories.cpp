@@ -225,6 +225,7 @@ static bool parse_rules_off(const std::map<std::string, std::string>& options, f
       {"alias_rival_must_be_credible", &T::alias_rival_must_be_credible},
       {"alias_trust_needs_steady_fit", &T::alias_trust_needs_steady_fit},
       {"confirm_fix", &T::confirm_fix},
+      {"hint_awaits_mml", &T::hint_awaits_mml},
       {"confirm_fix_on_past_scans", &T::confirm_fix_on_past_scans}};
   const auto it = options.find("off");
   if (it == options.end()) return true;

@@ -58,6 +58,10 @@ class OwnedLocalizer : public fw::Localizer {
   fw::Status step(const hal::LaserScan& scan, const hal::Odometry& odom, hal::PoseEstimate* out) override {
     return system_.localizer().step(scan, odom, out);
   }
+  fw::Status set_pose_hint(const hal::PoseHint& hint) override { return system_.localizer().set_pose_hint(hint); }
+  hal::HintStatus hint_status() const override {
+    return system_.built() ? system_.localizer().hint_status() : hal::HintStatus::kNone;
+  }
   // Hypotheses (best clusters of the last MML step) for pictures; empty while tracking and for MCL.
   void hypotheses(std::vector<HypothesisPoint>* out) const;
   fw::LocalizationSystem& system() { return system_; }

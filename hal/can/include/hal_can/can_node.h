@@ -9,6 +9,7 @@
 #include "hal/can_bus.h"
 #include "hal/clock.h"
 #include "hal/sensor_io.h"
+#include "hal_can/black_box.h"
 #include "hal_can/codec.h"
 
 namespace hal_can {
@@ -18,8 +19,9 @@ class CanNode {
   static constexpr std::size_t kScanQueue = 4;
   static constexpr std::size_t kOdomQueue = 256;
   static constexpr int kMaxFramesPerPump = 4096;
+  static constexpr std::size_t kCommandQueue = 4;
 
-  CanNode() : laser_(this), odom_(this), sink_(this) {}
+  CanNode() : laser_(this), odom_(this), sink_(this), commands_(this) {}
   CanNode(const CanNode&) = delete;
   CanNode& operator=(const CanNode&) = delete;
 
@@ -32,6 +34,12 @@ class CanNode {
   hal::LaserScanSource& laser() { return laser_; }
   hal::OdometrySource& odometry() { return odom_; }
   hal::PoseSink& pose_sink() { return sink_; }
+  // Operator commands (SET_POSE_HINT, SELECT_MAP, DUMP_LOG); replies go out through pose_sink().
+  hal::CommandSource& commands() { return commands_; }
+  // Every frame received (receive time, kept to the µs as candump logs it) and sent from now on is
+  // recorded in `box` (black_box.h); null = none.
+  void attach_black_box(BlackBox* box) { black_box_ = box; }
+  std::uint32_t commands_overflowed() const { return commands_overflowed_; }
 
   const DecoderStats& decoder_stats() const { return decoder_.stats(); }
   // Current estimate of (local monotonic ns − sender ns), see map_time().
@@ -62,6 +70,14 @@ class CanNode {
     explicit Sink(CanNode* n) : node_(n) {}
     void publish(const hal::PoseEstimate& estimate) override;
     void publish_health(const hal::Health& health) override;
+    void publish_reply(const hal::CommandReply& reply) override;
+   private:
+    CanNode* node_;
+  };
+  class Commands final : public hal::CommandSource {
+   public:
+    explicit Commands(CanNode* n) : node_(n) {}
+    bool poll(hal::Command* out) override;
    private:
     CanNode* node_;
   };
@@ -81,12 +97,16 @@ class CanNode {
   Decoder decoder_;
   fw::RingBuffer<hal::LaserScan, kScanQueue> scans_;
   fw::RingBuffer<hal::Odometry, kOdomQueue> odoms_;
+  fw::RingBuffer<hal::Command, kCommandQueue> commands_queue_;
+  std::uint32_t commands_overflowed_ = 0;
+  BlackBox* black_box_ = nullptr;
   std::uint32_t scans_overflowed_ = 0, odom_overflowed_ = 0, tx_failed_ = 0, poses_sent_ = 0;
   std::uint8_t pose_tag_ = 0, health_tag_ = 0;
   hal::CanFrame tx_[kMaxParts];
   Laser laser_;
   Odom odom_;
   Sink sink_;
+  Commands commands_;
 };
 
 }  // namespace hal_can

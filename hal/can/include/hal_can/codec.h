@@ -8,6 +8,7 @@
 
 #include "firmware/base/status.h"
 #include "hal/can_bus.h"
+#include "hal/msg/command.h"
 #include "hal/msg/health.h"
 #include "hal/msg/laser_scan.h"
 #include "hal/msg/odometry.h"
@@ -56,6 +57,7 @@ struct HealthRecord {
   std::uint32_t scans_processed = 0;
   std::uint16_t rx_dropped = 0, error_frames = 0;
   std::uint32_t fault_bits = 0;
+  std::uint8_t hint_status = 0;  // hal::HintStatus (payload byte 34)
 };
 
 // Number of frames a scan takes. Classic: 4 + ceil(n/3) + 1; FD: 1 + ceil(n/31) + 1.
@@ -71,6 +73,15 @@ fw::Status encode_pose(const hal::PoseEstimate& pose, std::uint8_t tag, bool fd,
                        std::size_t capacity, std::size_t* count);
 fw::Status encode_health(const HealthRecord& health, std::uint8_t tag, bool fd, hal::CanFrame* out,
                          std::size_t capacity, std::size_t* count);
+
+// Operator commands (robot → fw) and replies (fw → robot), hal/msg/command.h. SET_POSE_HINT (and
+// SELECT_MAP with a hint) is a 3-part record whose tag is the command's seq; SELECT_MAP without a
+// hint and DUMP_LOG are single classic frames (valid on an FD bus too). The encoder refuses a
+// non-finite hint or one beyond the wire's range (±2147 km, σ in (0, 65.534] m and (0, 6.5534] rad)
+// with a message naming the field: a hint is never silently clamped into another one.
+fw::Status encode_command(const hal::Command& command, bool fd, hal::CanFrame* out, std::size_t capacity,
+                          std::size_t* count);
+void encode_reply(const hal::CommandReply& reply, hal::CanFrame* out);
 
 // Protection level ↔ u16 wire code (POSE part 5; `lsb_per_unit` = kProtectionXyPerMetre or
 // kProtectionThetaPerRad). Encoding rounds up, maps NaN / ≤ 0 to 0 (no bound) and saturates at
@@ -96,9 +107,11 @@ struct DecoderStats {
   std::uint32_t invalid_by_defect[kNumScanDefects] = {};  // per ScanDefect
   ScanDefect last_defect = ScanDefect::kNone;
   std::uint32_t odometry_ok = 0, poses_ok = 0, health_ok = 0;
+  std::uint32_t commands_ok = 0, replies_ok = 0;
+  std::uint32_t malformed_commands = 0;  // command frames too short or with impossible fields (also in malformed)
 };
 
-enum class Decoded : std::uint8_t { kNothing, kScan, kOdometry, kPose, kHealth };
+enum class Decoded : std::uint8_t { kNothing, kScan, kOdometry, kPose, kHealth, kCommand, kReply };
 
 class Decoder {
  public:
@@ -116,6 +129,8 @@ class Decoder {
   const hal::Odometry& odometry() const { return odom_; }
   const hal::PoseEstimate& pose() const { return pose_; }
   const HealthRecord& health() const { return health_; }
+  const hal::Command& command() const { return command_; }
+  const hal::CommandReply& reply() const { return reply_; }
   std::uint64_t pose_time_us() const { return pose_time_us_; }
   const DecoderStats& stats() const { return stats_; }
   // Abandons an unfinished transfer older than the timeout (call when the bus is quiet).
@@ -134,10 +149,13 @@ class Decoder {
   void scan_segment(const hal::CanFrame& f, bool fd);
   bool scan_end(const hal::CanFrame& f);
   void drop_scan(std::uint32_t missing_segments);
+  // command_codec.cpp: the command and reply frames (kNothing when `id` is none of them).
+  Decoded feed_command(std::uint32_t id, bool fd_id, const hal::CanFrame& f);
+  Decoded command_malformed();
 
   Options options_;
   DecoderStats stats_;
-  Record odom_rec_, start_rec_, pose_rec_, health_rec_;
+  Record odom_rec_, start_rec_, pose_rec_, health_rec_, hint_rec_;
 
   // Scan transfer in progress.
   bool scan_active_ = false;
@@ -156,6 +174,8 @@ class Decoder {
   hal::PoseEstimate pose_;
   std::uint64_t pose_time_us_ = 0;
   HealthRecord health_;
+  hal::Command command_;
+  hal::CommandReply reply_;
 };
 
 }  // namespace hal_can

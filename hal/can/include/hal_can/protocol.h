@@ -29,9 +29,15 @@ constexpr std::uint32_t kScanDataId = 0x118;   // classic; FD 0x518
 constexpr std::uint32_t kScanEndId = 0x119;    // 8 bytes on both buses
 constexpr std::uint32_t kPoseId = 0x120;       // 6 parts 0x120..0x125; FD 0x520
 constexpr std::uint32_t kHealthId = 0x130;     // 5 parts 0x130..0x134; FD 0x530
+// Operator commands (issue 60; hal/msg/command.h), after everything the localization needs.
+constexpr std::uint32_t kPoseHintId = 0x140;      // SET_POSE_HINT: 3 parts 0x140..0x142; FD 0x540 (24 B)
+constexpr std::uint32_t kSelectMapId = 0x148;     // SELECT_MAP: [seq u8][map id u8] (2 bytes)
+constexpr std::uint32_t kDumpLogId = 0x149;       // DUMP_LOG: [seq u8] (1 byte)
+constexpr std::uint32_t kCommandReplyId = 0x14F;  // COMMAND_REPLY (fw → robot): [seq][command][result][detail]
 
 constexpr std::size_t kPartBytes = 7;
 constexpr std::size_t kOdomParts = 4, kScanStartParts = 4, kPoseParts = 6, kHealthParts = 5;
+constexpr std::size_t kPoseHintParts = 3;
 constexpr std::size_t kMaxParts = 6;
 constexpr std::size_t kMaxRecordBytes = kMaxParts * kPartBytes;  // 42
 
@@ -45,6 +51,11 @@ constexpr std::size_t kPoseLayoutOffset = 34;
 constexpr std::uint8_t kPoseLayout = 2;
 constexpr std::size_t kPoseReasonOffset = 41;
 constexpr std::size_t kPoseLegacyParts = 5;  // layout 0
+// HEALTH payload byte 34 (the last byte of part 4, reserved 0 before): the last pose hint's
+// verification (hal::HintStatus). SET_POSE_HINT flags bit 0: select the hint's map first (SELECT_MAP
+// with a hint).
+constexpr std::size_t kHealthHintOffset = 34;
+constexpr std::uint8_t kHintFlagSelectMap = 0x01;
 
 // Protection level on the wire (POSE part 5): u16, rounded *up* (a bound must not shrink);
 // 0 = no bound, kProtectionSaturated = "at least the largest code" (decodes as +infinity).

@@ -36,6 +36,8 @@ struct Health {
   // Scans that arrived intact (checksum right) but with impossible content (CAN: bad geometry;
   // SICK: impossible measured-values telegram), rejected by the laser source.
   std::uint32_t invalid_scans = 0;
+  // The last pose hint's verification (hal::HintStatus as u8; HEALTH.HintStatus on CAN).
+  std::uint8_t hint_status = 0;
 };
 
 }  // namespace hal

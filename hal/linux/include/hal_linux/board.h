@@ -91,6 +91,12 @@ class Board {
 
   bool can_fd() const { return can_fd_; }
   const hal_can::CanNode* can_node() const { return node_used_ ? &node_ : nullptr; }
+  // The black box records the CAN node's traffic (false: no CAN node on this board).
+  bool attach_black_box(hal_can::BlackBox* box) {
+    if (!node_used_) return false;
+    node_.attach_black_box(box);
+    return true;
+  }
   const hal_socketcan::SocketCanBus* can_bus() const { return bus_.is_open() ? &bus_ : nullptr; }
   const hal_serial::SickLaser* sick() const { return serial_laser_ == &sick_ ? &sick_ : nullptr; }
   const hal_serial::HokuyoLaser* hokuyo() const { return serial_laser_ == &hokuyo_ ? &hokuyo_ : nullptr; }

@@ -1,0 +1,58 @@
+#include "firmware/app/operator_io.h"
+
+#include "firmware/base/memory_report.h"
+#include "hal_linux/black_box_file.h"
+
+namespace fw {
+
+Status OperatorIo::init(const AppConfig& c, StartupArena& arena, hal_linux::Board& board, LocalizationLoop& loop,
+                        Localizer& localizer) {
+  config_ = &c;
+  hal_ = &board.hal();
+  if (c.blackbox[0] && c.blackbox_frames > 0) {
+    if (board.can_node() == nullptr) {
+      hal_->log->log(hal::LogLevel::kWarning, "mmlfw: blackbox '%s': this board has no CAN node; nothing recorded",
+                     c.blackbox);
+    } else {
+      Result<hal_can::BlackBoxEntry*> r = arena.allocate_array<hal_can::BlackBoxEntry>(c.blackbox_frames, "black box");
+      if (!r) return Status::error(r.status().code(), "blackbox_frames = %u: %s", c.blackbox_frames, r.status().message());
+      FW_RETURN_IF_ERROR(MemoryReport::instance().add(
+          {"hal", "black box (CAN frames in and out)", sizeof(hal_can::BlackBoxEntry) * c.blackbox_frames,
+           c.blackbox_frames, nullptr}));
+      box_.init(*r, c.blackbox_frames);
+      board.attach_black_box(&box_);
+    }
+  }
+  CommandHandlerOptions o;
+  o.active_map_id = 0;  // one map per mmlfw (README "Commands": SELECT_MAP of another id is unknown-map)
+  if (box_.enabled()) {
+    o.dump = &OperatorIo::dump_command;
+    o.dump_ctx = this;
+  }
+  handler_.init(hal_, &localizer, o);
+  loop.set_command_handler(&handler_);
+  return Status::ok();
+}
+
+Status OperatorIo::dump_command(void* self) { return static_cast<OperatorIo*>(self)->dump("DUMP_LOG"); }
+
+Status OperatorIo::dump(const char* why) {
+  if (!box_.enabled()) return Status::ok();
+  std::size_t bytes = 0;
+  const Status s = hal_linux::write_black_box_file(box_, config_->blackbox, &bytes);
+  if (!s) {
+    hal_->log->log(hal::LogLevel::kError, "mmlfw: %s: %s", why, s.message());
+  } else {
+    hal_->log->log(hal::LogLevel::kInfo, "mmlfw: %s: black box '%s' written (%zu frames, %zu bytes, %llu overwritten)", why,
+                   config_->blackbox, box_.size(), bytes, static_cast<unsigned long long>(box_.overwritten()));
+  }
+  return s;
+}
+
+void OperatorIo::watch_faults(std::uint32_t fault_bits) {
+  const std::uint32_t risen = fault_bits & ~faults_seen_;
+  faults_seen_ = fault_bits;
+  if (risen != 0) dump("fault");
+}
+
+}  // namespace fw

@@ -1,0 +1,40 @@
+// mmlfw's operator side (issue 60): the commands of the bus (SET_POSE_HINT, SELECT_MAP, DUMP_LOG;
+// firmware/runtime/command_handler.h) and the black box (hal_can/black_box.h) — its ring carved
+// from the start-up arena, attached to the board's CAN node, written (hal_linux/black_box_file.h)
+// on DUMP_LOG, when a fault bit rises and at exit.
+#pragma once
+
+#include <cstdint>
+
+#include "firmware/app/app_config.h"
+#include "firmware/base/arena.h"
+#include "firmware/runtime/command_handler.h"
+#include "firmware/runtime/localization_loop.h"
+#include "hal_can/black_box.h"
+#include "hal_linux/board.h"
+
+namespace fw {
+
+class OperatorIo {
+ public:
+  // Start-up: the black box (config blackbox, blackbox_frames; a serial board has none: a warning)
+  // and the command handler on the loop. Errors name the part.
+  Status init(const AppConfig& config, StartupArena& arena, hal_linux::Board& board, LocalizationLoop& loop,
+              Localizer& localizer);
+  // Writes the black box now (DUMP_LOG, exit); logs the bytes or the error.
+  Status dump(const char* why);
+  // Every loop cycle: a fault bit that was clear is set → one dump.
+  void watch_faults(std::uint32_t fault_bits);
+  const hal_can::BlackBox& black_box() const { return box_; }
+  const CommandHandler& commands() const { return handler_; }
+
+ private:
+  static Status dump_command(void* self);
+  const AppConfig* config_ = nullptr;
+  hal::Hal* hal_ = nullptr;
+  hal_can::BlackBox box_;
+  CommandHandler handler_;
+  std::uint32_t faults_seen_ = 0;
+};
+
+}  // namespace fw
