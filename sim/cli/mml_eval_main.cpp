@@ -15,6 +15,7 @@
 //            [--kidnap-datasets intel,fr079,aces] [--no-unknown] [--seed 1] [--threads 2] [--out DIR]
 //            [--no-pool]   (MML best-cluster support not pooled over consistent steps: Eq. 5.17 per step)
 //            [--no-unmapped-space]   (inner unknown regions count as misses: firmware/map/unmapped_space.h)
+//            [--no-refit]   (a better alias rival within the prediction's PL is a fault: TrackOptions::refit_at_better_rival)
 //   --help prints the usage.
 //   --steps 0 = whole-log runs continue to the end of the log (else at most that many steps).
 //   --global ref|live|live-deadline: mml-track's global search schedule (mml_systems.h; issue 14)
@@ -53,7 +54,7 @@ const char kUsage[] =
     "       mml-eval --localize [--datasets intel,fr101] [--whole-runs 3] [--steps 0] [--fix-trials 10]\n"
     "                [--fix-steps 200] [--mcl-trials 10] [--mcl-datasets intel,fr079] [--kidnap-runs 2]\n"
     "                [--kidnap-datasets intel,fr079,aces] [--no-unknown] [--seed 1] [--threads 2] [--out DIR]\n"
-    "                [--no-pool] [--no-unmapped-space] [--global ref|live|live-deadline] [--odom-noise TT,TR,RR,RT]\n"
+    "                [--no-pool] [--no-unmapped-space] [--no-refit] [--global ref|live|live-deadline] [--odom-noise TT,TR,RR,RT]\n"
     "                [--odom-noise-per-step M,DEG] [--no-confirm-fix] [--no-confirm-on-past-scans]\n"
     "                [--no-steady-fit-trust] [--valley-one-mode] [--no-valley-one-mode] [--keep-valley-information]\n"
     "                [--no-cover-unfused] [--confidence-cap-pred-pl]\n"
@@ -154,6 +155,7 @@ static int run_main(int argc, char** argv) {
     else if (a == "--pool") lp.pool_cluster_support = true;
     else if (a == "--no-pool") lp.pool_cluster_support = false;
     else if (a == "--no-unmapped-space") lp.unmapped_space = false;
+    else if (a == "--no-refit") lp.track.refit_at_better_rival = false;
     else if (a == "--keep-support") lp.keep_support_across_empty_steps = true;
     else if (a == "--no-keep-support") lp.keep_support_across_empty_steps = false;
     else if (a == "--keep-contested") lp.keep_support_across_contested_steps = true;
