@@ -31,6 +31,8 @@ if [ "${1:-}" = fuzz ]; then
   bash tests/fuzz/bench_fuzz.sh build/fuzz build/bench/fuzz.json
   exit $?
 fi
+# global (issue 58; part of "all"): bench_global, the global step in mml-eval --global ref / live-deadline on
+# the bench logs and the corpus's largest buildings (build/bench/global.json, firmware/runtime/README.md).
 # deploy (issue 61; only when named): the Debian packages of the release, aarch64 and armhf presets
 # (own build dirs build/deploy-*), lintian, the systemd unit, --check-config, the watchdog, and an
 # install/start/stop/watchdog/remove run in a user-mode Linux guest booting systemd

@@ -25,6 +25,8 @@ class PerfCounter {
   const char* name() const { return name_; }
 
   void add_ns(std::uint64_t elapsed_ns);
+  std::uint64_t count() const { return count_; }
+  std::uint64_t total_ns() const { return total_ns_; }  // of every sample since reset
   // Percentiles over the last kWindow samples; count/mean/max over all samples.
   PerfStats stats() const;
   void reset();

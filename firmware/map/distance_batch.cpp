@@ -42,7 +42,14 @@ __attribute__((always_inline)) inline void sample_kernel(const GlobalMap& map, c
   const float max_fy = static_cast<float>(map.geometry.height) - 1.0f;
   alignas(32) float px[kDistanceBatch], py[kDistanceBatch], ax[kDistanceBatch], ay[kDistanceBatch];
   alignas(32) std::int32_t ix[kDistanceBatch], iy[kDistanceBatch];
-  alignas(32) float c00[kDistanceBatch], c10[kDistanceBatch], c01[kDistanceBatch], c11[kDistanceBatch];
+  // The corners in one block (c00 = cs[0], c10 = cs[1], c01 = cs[2], c11 = cs[3]): one base address
+  // for the four stores of the look-up loop, where four arrays kept the compiler reloading their
+  // addresses from the stack at every point.
+  alignas(32) float cs[4][kDistanceBatch];
+  float* const c00 = cs[0];
+  float* const c10 = cs[1];
+  float* const c01 = cs[2];
+  float* const c11 = cs[3];
   alignas(32) std::int32_t inside[kDistanceBatch];
   for (std::size_t i = 0; i < n; ++i) {
     px[i] = points[i].x();

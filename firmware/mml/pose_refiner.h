@@ -9,6 +9,7 @@
 #include <cstddef>
 
 #include "firmware/base/se2.h"
+#include "firmware/map/distance_batch.h"
 #include "firmware/map/global_map.h"
 
 namespace fw {
@@ -32,11 +33,19 @@ struct RefineResult {
   float inlier_ratio = 0.0f;
   float rms_m = 0.0f;
   bool accepted = false;
+  // The truncated cost at `pose` clipped at options.clip_m, as mml::truncated_scan_cost gives it
+  // (pose_uniqueness.h; same samples, same order, same bits), taken from the pass that sampled
+  // `pose` — so the alias check, which scores every rival it refines, samples each once less.
+  // cost_valid false (map invalid, no points): call truncated_scan_cost.
+  float cost = 1.0f;
+  bool cost_valid = false;
 };
 
-// `points` in the robot frame. Never allocates.
+// `points` in the robot frame. Never allocates. `build`: which build of the distance samples and of the
+// normal equations' sums runs (distance_batch.h; kScalar = point by point, the reference the tests
+// compare with) — every build gives the same bits.
 RefineResult refine_pose(const GlobalMap& map, const Point2f* points, std::size_t n, const Se2f& initial,
-                         const RefineOptions& options);
+                         const RefineOptions& options, DistanceBatchBuild build = DistanceBatchBuild::kBest);
 
 }  // namespace mml
 }  // namespace fw

@@ -29,8 +29,13 @@ float truncated_scan_cost(const GlobalMap& map, const Point2f* points, std::size
 
 bool in_same_cost_valley(const GlobalMap& map, const Point2f* points, std::size_t n, const Se2f& pose,
                          const Se2f& rival, float clip_m, float step_m, float margin) {
-  const float cost_pose = truncated_scan_cost(map, points, n, pose, clip_m);
-  const float cost_rival = truncated_scan_cost(map, points, n, rival, clip_m);
+  return in_same_cost_valley(map, points, n, pose, truncated_scan_cost(map, points, n, pose, clip_m), rival,
+                             truncated_scan_cost(map, points, n, rival, clip_m), clip_m, step_m, margin);
+}
+
+bool in_same_cost_valley(const GlobalMap& map, const Point2f* points, std::size_t n, const Se2f& pose,
+                         float cost_pose, const Se2f& rival, float cost_rival, float clip_m, float step_m,
+                         float margin) {
   if (std::fabs(cost_pose - cost_rival) > margin) return false;  // one end fits worse: not one valley
   const float ceiling = std::fmax(cost_pose, cost_rival) + margin;
   const float dx = rival.x - pose.x, dy = rival.y - pose.y, dth = wrap_angle(rival.theta - pose.theta);
@@ -87,6 +92,7 @@ UniquenessResult check_pose_uniqueness(const GlobalMap& map, const Point2f* poin
     // of the candidate's cost), so a far rival costs one short path, not one from the candidate;
     // after a rival outside it, that direction's further rivals all count.
     Se2f valley_end[2] = {pose, pose};
+    float valley_end_cost[2] = {r.cost, r.cost};  // their truncated costs
     bool valley_open[2] = {true, true};
     for (float step = o.shift_step_m; step <= o.max_shift_m + 1e-4f; step += o.shift_step_m) {
       for (int sign = -1; sign <= 1; sign += 2) {
@@ -94,14 +100,17 @@ UniquenessResult check_pose_uniqueness(const GlobalMap& map, const Point2f* poin
         const RefineResult rr = refine_pose(map, points, n, seed, ro);
         ++r.rivals_tried;
         if (std::hypot(rr.pose.x - pose.x, rr.pose.y - pose.y) < o.min_separation_m) continue;
-        const float cost = truncated_scan_cost(map, points, n, rr.pose, o.clip_m);
+        // The refinement's own pass at rr.pose gives its cost (RefineResult::cost, the same bits).
+        const float cost = rr.cost_valid ? rr.cost : truncated_scan_cost(map, points, n, rr.pose, o.clip_m);
         // Only a rival that would break uniqueness is tested for one valley (the path costs a
         // truncated cost per sample); a better one never is (in_same_cost_valley needs alike costs).
         if (o.valley_is_one_mode && cost <= r.cost + o.margin) {
           const int d = sign > 0 ? 1 : 0;
           if (valley_open[d] && std::fabs(wrap_angle(rr.pose.theta - pose.theta)) < o.min_separation_rad &&
-              in_same_cost_valley(map, points, n, valley_end[d], rr.pose, o.clip_m, o.valley_step_m, o.margin)) {
+              in_same_cost_valley(map, points, n, valley_end[d], valley_end_cost[d], rr.pose, cost, o.clip_m,
+                                  o.valley_step_m, o.margin)) {
             valley_end[d] = rr.pose;
+            valley_end_cost[d] = cost;
             ++r.same_valley_rivals;
             const float dx = rr.pose.x - pose.x, dy = rr.pose.y - pose.y, dist = std::hypot(dx, dy);
             if (dist > r.valley_extent_m) {
@@ -131,7 +140,7 @@ UniquenessResult check_pose_uniqueness(const GlobalMap& map, const Point2f* poin
         if (std::fabs(wrap_angle(rr.pose.theta - pose.theta)) < o.min_separation_rad &&
             std::hypot(rr.pose.x - pose.x, rr.pose.y - pose.y) < o.min_separation_m)
           continue;
-        const float cost = truncated_scan_cost(map, points, n, rr.pose, o.clip_m);
+        const float cost = rr.cost_valid ? rr.cost : truncated_scan_cost(map, points, n, rr.pose, o.clip_m);
         if (cost < r.rival_cost) {
           r.rival_cost = cost;
           r.rival = rr.pose;

@@ -64,6 +64,10 @@ float truncated_scan_cost(const GlobalMap& map, const Point2f* points, std::size
 // of them explains) is a separate look-alike. Never allocates.
 bool in_same_cost_valley(const GlobalMap& map, const Point2f* points, std::size_t n, const Se2f& pose,
                          const Se2f& rival, float clip_m, float step_m, float margin);
+// The same with the two ends' truncated costs already known (truncated_scan_cost's values at clip_m).
+bool in_same_cost_valley(const GlobalMap& map, const Point2f* points, std::size_t n, const Se2f& pose,
+                         float cost_pose, const Se2f& rival, float cost_rival, float clip_m, float step_m,
+                         float margin);
 
 UniquenessResult check_pose_uniqueness(const GlobalMap& map, const Point2f* points, std::size_t n, const Se2f& pose,
                                        const UniquenessOptions& options);

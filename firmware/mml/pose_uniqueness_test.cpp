@@ -4,6 +4,7 @@
 
 #include <cmath>
 
+#include "firmware/map/paired_fit_test.h"
 #include "firmware/mml/mml_test_util.h"
 #include "firmware/scan/scan_points.h"
 
@@ -181,6 +182,37 @@ TEST(PoseUniquenessTest, EmptyInputIsHandled) {
   EXPECT_TRUE(r.unique);
   EXPECT_EQ(r.rivals_tried, 0u);
   EXPECT_FLOAT_EQ(truncated_scan_cost(gm.map, nullptr, 0, Se2f(), 0.15f), 1.0f);
+}
+
+
+// Issue 58: the paired test against a pose sampled once (PairedFitReference, the confidence extent's)
+// gives rival_significantly_better's verdict at every shift and turn; with more end-points than it
+// holds it falls back to the same function.
+TEST(PairedFitReferenceTest, SameVerdictAsThePairedTest) {
+  static GridWorld g = periodic_corridor();
+  static testing::OwnedGlobalMap gm(g);
+  static Point2f pts[2 * 1081];
+  const Se2f fix(10.0f, 1.5f, 0.1f);
+  std::size_t n = scan_points_at(g, fix, pts);
+  for (std::size_t i = 0; i < n; ++i) pts[n + i] = pts[i];  // the scan twice: more than the reference holds
+  n *= 2;
+  ASSERT_GT(n, PairedFitReference::kMaxPoints);  // the fallback is exercised below
+  int better = 0, not_better = 0;
+  for (const std::size_t m : {std::size_t{2}, std::size_t{90}, std::size_t{180}, n}) {
+    const PairedFitReference ref(gm.map, pts, m, fix, 0.15f);
+    for (float s = -1.0f; s <= 1.0f; s += 0.05f) {
+      for (const float dth : {0.0f, 0.02f, -0.05f}) {
+        const Se2f r(fix.x + s, fix.y + 0.3f * s, fix.theta + dth);
+        for (const float z : {1.645f, 3.09f}) {
+          const bool want = rival_significantly_better(gm.map, pts, m, r, fix, 0.15f, 20, z);
+          EXPECT_EQ(ref.fixed_better_than(r, 20, z), want) << m << " " << s << " " << dth << " " << z;
+          (want ? better : not_better)++;
+        }
+      }
+    }
+  }
+  EXPECT_GT(better, 0);
+  EXPECT_GT(not_better, 0);
 }
 
 }  // namespace

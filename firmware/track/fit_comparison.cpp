@@ -16,13 +16,14 @@ ConfidenceExtent confidence_extent(const GlobalMap& map, const Point2f* pts, std
   const Sym2Eigen ev = sym2_eigen(info_xx, info_xy, info_yy);
   // The weak axis (least information) and its normal; both directions of each.
   const float ax[2][2] = {{ev.vmin_x, ev.vmin_y}, {-ev.vmin_y, ev.vmin_x}};
+  const PairedFitReference at_fix(map, pts, n, fix, o.clip_m);  // the fix's costs, sampled once
   for (int axis = 0; axis < 2; ++axis) {
     const auto& a = ax[axis];
     for (const float sign : {1.0f, -1.0f}) {
       float open = 0.0f;
       for (float s = o.step_m; s <= o.max_xy_m + 1e-6f; s += o.step_m) {
         const Se2f r(fix.x + sign * s * a[0], fix.y + sign * s * a[1], fix.theta);
-        if (rival_significantly_better(map, pts, n, r, fix, o.clip_m, independent, o.z)) break;
+        if (at_fix.fixed_better_than(r, independent, o.z)) break;
         open = s;
       }
       e.xy_m = std::fmax(e.xy_m, open);
@@ -33,7 +34,7 @@ ConfidenceExtent confidence_extent(const GlobalMap& map, const Point2f* pts, std
     float open = 0.0f;
     for (float t = o.step_rad; t <= o.max_rad + 1e-7f; t += o.step_rad) {
       const Se2f r(fix.x, fix.y, wrap_angle(fix.theta + sign * t));
-      if (rival_significantly_better(map, pts, n, r, fix, o.clip_m, independent, o.z)) break;
+      if (at_fix.fixed_better_than(r, independent, o.z)) break;
       open = t;
     }
     e.theta_rad = std::fmax(e.theta_rad, open);

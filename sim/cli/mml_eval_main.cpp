@@ -54,7 +54,8 @@ const char kUsage[] =
     "       mml-eval --localize [--datasets intel,fr101] [--whole-runs 3] [--steps 0] [--fix-trials 10]\n"
     "                [--fix-steps 200] [--mcl-trials 10] [--mcl-datasets intel,fr079] [--kidnap-runs 2]\n"
     "                [--kidnap-datasets intel,fr079,aces] [--no-unknown] [--seed 1] [--threads 2] [--out DIR]\n"
-    "                [--no-pool] [--no-unmapped-space] [--no-refit] [--global ref|live|live-deadline] [--odom-noise TT,TR,RR,RT]\n"
+    "                [--no-pool] [--no-unmapped-space] [--no-refit] [--global ref|live|live-deadline] [--global-period 1..8]\n"
+    "                [--odom-noise TT,TR,RR,RT]\n"
     "                [--odom-noise-per-step M,DEG] [--no-confirm-fix] [--no-confirm-on-past-scans]\n"
     "                [--no-steady-fit-trust] [--valley-one-mode] [--no-valley-one-mode] [--keep-valley-information]\n"
     "                [--no-cover-unfused] [--confidence-cap-pred-pl]\n"
@@ -191,6 +192,7 @@ static int run_main(int argc, char** argv) {
       else if (m == "live-deadline") sim::mmleval::set_eval_global_mode(sim::mmleval::EvalGlobalMode::kLiveDeadline);
       else std::exit(usage(("bad value for --global: '" + m + "' (ref, live, live-deadline)").c_str()));
     }
+    else if (a == "--global-period") sim::mmleval::set_eval_global_period(static_cast<std::uint32_t>(next(1, 8)));
     else if (a == "--whole-runs") lp.whole_runs = next(0, 1000);
     else if (a == "--fix-trials") lp.fix_trials = next(0, 1000);
     else if (a == "--fix-steps") lp.fix_steps = next(1, 100000);

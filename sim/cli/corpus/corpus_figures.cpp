@@ -100,7 +100,7 @@ double binomial_ucb95(std::size_t k, std::size_t n) {
 
 CorpusFigures corpus_figures(const std::vector<const CorpusRun*>& runs) {
   CorpusFigures f;
-  std::vector<double> avail, gaps, to_fix, em, ed, ms, plxy, plth;
+  std::vector<double> avail, gaps, to_fix, em, ed, ms, gms, plxy, plth;
   for (const CorpusRun* r : runs) {
     ++f.runs;
     if (!r->ok) {
@@ -118,6 +118,7 @@ CorpusFigures corpus_figures(const std::vector<const CorpusRun*>& runs) {
     }
     for (const CorpusStep& s : r->steps) {
       ++f.steps;
+      if (s.mode == static_cast<std::uint8_t>(LocalizationMode::kGlobal)) gms.push_back(s.step_ms);
       if (tracking(s)) {
         ++f.tracking_steps;
         ms.push_back(s.step_ms);
@@ -166,6 +167,9 @@ CorpusFigures corpus_figures(const std::vector<const CorpusRun*>& runs) {
   f.pl_theta_deg_p50 = quantile(plth, 0.5);
   f.track_step_ms_p50 = quantile(ms, 0.5);
   f.track_step_ms_p99 = quantile(ms, 0.99);
+  f.global_step_ms_p50 = quantile(gms, 0.5);
+  f.global_step_ms_p99 = quantile(gms, 0.99);
+  f.global_step_ms_max = quantile(gms, 1.0);
   return f;
 }
 
@@ -206,6 +210,9 @@ void add_figures(const std::string& p, const CorpusFigures& f, bool with_timing,
   if (with_timing) {
     j->add(p + "track_step_ms_p50", f.track_step_ms_p50);
     j->add(p + "track_step_ms_p99", f.track_step_ms_p99);
+    j->add(p + "global_step_ms_p50", f.global_step_ms_p50);
+    j->add(p + "global_step_ms_p99", f.global_step_ms_p99);
+    j->add(p + "global_step_ms_max", f.global_step_ms_max);
   }
 }
 

@@ -34,6 +34,8 @@ struct CorpusFigures {
   double track_err_m_p50 = 0, track_err_m_p95 = 0, track_err_deg_p50 = 0, track_err_deg_p95 = 0;
   double pl_xy_m_p50 = 0, pl_theta_deg_p50 = 0;
   double track_step_ms_p50 = 0, track_step_ms_p99 = 0;
+  // Steps in global mode (MML searching, run inline on the scan): issue 58's bound on the global step.
+  double global_step_ms_p50 = 0, global_step_ms_p99 = 0, global_step_ms_max = 0;
   // Kidnapped runs: carried once after their first fix; re-fixed = `localized` again after the carry.
   std::size_t kidnap_runs = 0, kidnap_refixed = 0;
 };

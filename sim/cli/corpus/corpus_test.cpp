@@ -86,6 +86,26 @@ TEST(CorpusFiguresTest, AvailabilityGapsAndKidnapsFromTheSteps) {
   EXPECT_EQ(c.pl_exceed_xy, 1u);  // 0.6 m against 0.2 m
 }
 
+// Issue 58: the global step's figures come from the steps in global mode only.
+TEST(CorpusFiguresTest, GlobalStepTimesFromTheGlobalSteps) {
+  using S = hal::LocalizationStatus;
+  CorpusRun r;
+  r.ok = true;
+  for (int i = 0; i < 100; ++i) {
+    CorpusStep g = step(0.1f * i, S::kSearching, NAN);  // global mode
+    g.step_ms = static_cast<float>(i + 1);              // 1 .. 100 ms
+    r.steps.push_back(g);
+  }
+  CorpusStep t = step(11, S::kLocalized, 0.02f);  // a tracked step slower than any global one
+  t.step_ms = 500.0f;
+  r.steps.push_back(t);
+  const CorpusFigures c = corpus_figures({&r});
+  EXPECT_NEAR(c.global_step_ms_p50, 50.5, 1.0);
+  EXPECT_NEAR(c.global_step_ms_p99, 99.0, 1.01);
+  EXPECT_DOUBLE_EQ(c.global_step_ms_max, 100.0);
+  EXPECT_DOUBLE_EQ(c.track_step_ms_p99, 500.0);
+}
+
 TEST(CorpusRunTest, RecordsRoundTripAndTruncationIsAnError) {
   CorpusRun r;
   r.ok = true;

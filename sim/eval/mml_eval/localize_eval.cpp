@@ -193,6 +193,9 @@ struct LocalizeRun {
   std::vector<SystemSummary> rows;
   std::ostringstream notes, refnotes, plnotes, mclnotes;
   std::vector<double> track_ms_all;
+  // The same steps less their inline global step (StepLog::global_ms): the sensor context's share,
+  // what mmlfw's sensor thread runs (the global step runs on the global context there).
+  std::vector<double> track_sensor_ms_all;
   std::vector<TrialResult> kidnap_all;
   MetricBounds kidnap_bounds;
   fw::mml::MmlLocalizerConfig mml_cfg;
@@ -424,10 +427,26 @@ bool evaluate_dataset(LocalizeRun& run, const std::string& name, const DatasetFi
   run_fix_trials(run, ds, *loc, b, starts, fopt, &all, &fix);
   SystemSummary s = summarize(ds.name, "mml-track", all, loc->static_bytes() / (1024.0 * 1024.0), b);
   run.rows.push_back(s);
+  std::vector<double> track_ms, sensor_ms, global_ms;
   for (const auto& t : all)
-    for (const auto& st : t.steps)
-      if (st.mode == hal::LocalizationMode::kTracking) run.track_ms_all.push_back(st.step_ms);
+    for (const auto& st : t.steps) {
+      if (st.global_ms > 0.0) global_ms.push_back(st.global_ms);  // a global step ran on this scan
+      if (st.mode == hal::LocalizationMode::kTracking) {
+        track_ms.push_back(st.step_ms);
+        sensor_ms.push_back(st.step_ms - st.global_ms);
+      }
+    }
+  run.track_ms_all.insert(run.track_ms_all.end(), track_ms.begin(), track_ms.end());
+  run.track_sensor_ms_all.insert(run.track_sensor_ms_all.end(), sensor_ms.begin(), sensor_ms.end());
   add_dataset_figures(json, ds.key, s);
+  json->add(ds.key + "_track_step_ms_p50", percentile(track_ms, 50));
+  json->add(ds.key + "_track_step_ms_p99", percentile(track_ms, 99));
+  json->add(ds.key + "_track_sensor_step_ms_p50", percentile(sensor_ms, 50));
+  json->add(ds.key + "_track_sensor_step_ms_p99", percentile(sensor_ms, 99));
+  // MML's global steps themselves (inline, GlobalContext's timer; issue 58: p99 ≤ 100 ms).
+  json->add(ds.key + "_global_step_ms_p50", percentile(global_ms, 50));
+  json->add(ds.key + "_global_step_ms_p99", percentile(global_ms, 99));
+  json->add(ds.key + "_global_step_ms_max", percentile(global_ms, 100));
 
   if (std::find(plan.mcl_datasets.begin(), plan.mcl_datasets.end(), ds.name) != plan.mcl_datasets.end() &&
       plan.mcl_trials > 0) {
@@ -551,7 +570,7 @@ void write_localize_report(LocalizeRun& run) {
 }  // namespace
 
 bool run_localize_evaluation(const LocalizePlan& plan, BenchJson* json, std::string* err) {
-  LocalizeRun run{plan, json, std::chrono::steady_clock::now(), {}, {}, {}, {}, {}, {}, {}, {},
+  LocalizeRun run{plan, json, std::chrono::steady_clock::now(), {}, {}, {}, {}, {}, {}, {}, {}, {},
                   mml_track_config(plan.mml_config, plan.seed)};
   run.mml_cfg.mml.pool_cluster_support = plan.pool_cluster_support;
   if (!plan.unmapped_space) run.mml_cfg.mml.unmapped_space_min_area_m2 = 0.0f;
@@ -578,6 +597,8 @@ bool run_localize_evaluation(const LocalizePlan& plan, BenchJson* json, std::str
   if (plan.run_unknown && !run_unknown_area(run, err)) return false;
   json->add("track_step_ms_p50", percentile(run.track_ms_all, 50));
   json->add("track_step_ms_p99", percentile(run.track_ms_all, 99));
+  json->add("track_sensor_step_ms_p50", percentile(run.track_sensor_ms_all, 50));
+  json->add("track_sensor_step_ms_p99", percentile(run.track_sensor_ms_all, 99));
   json->add("localize_eval_seconds", seconds_since(run.t_all));
   write_localize_report(run);
   return true;

@@ -1,4 +1,5 @@
 #include "sim/eval/mml_eval/mml_eval.h"
+#include "sim/eval/mml_eval/mml_systems.h"
 #include "sim/eval/mml_eval/unmapped_scan.h"
 
 #include "sim/viz/font5x7.h"
@@ -418,6 +419,15 @@ bool moved_enough(const OdometryFeed& feed, const fw::Se2d& od, const TrialOptio
   return !(dm < opt.min_move_m && dt < opt.min_turn_rad);
 }
 
+// mml-track's inline global steps so far, ms (their GlobalContext clock: OwnedLocalizer::make sets it);
+// 0 for any other localizer.
+double inline_global_ms(fw::Localizer& loc) {
+  auto* owned = dynamic_cast<OwnedLocalizer*>(&loc);
+  fw::track::TrackedLocalizer* t = owned != nullptr ? owned->tracked() : nullptr;
+  if (t == nullptr || t->global_context().threaded()) return 0.0;
+  return static_cast<double>(t->global_context().perf_step().total_ns()) * 1e-6;
+}
+
 // One localizer step on scan i with the fed odometry od; *step_ms is its wall time.
 fw::Status step_localizer(fw::Localizer& loc, const LoadedDataset& ds, std::size_t i, const fw::Se2d& od,
                           hal::PoseEstimate* est, double* step_ms) {
@@ -571,6 +581,7 @@ TrialResult run_trial(fw::Localizer& loc, const LoadedDataset& ds, std::size_t s
     feed.have_last = true;
     hal::PoseEstimate est;
     double step_ms = 0;
+    const double global_before_ms = inline_global_ms(loc);
     const fw::Status s = step_localizer(loc, ds, i, od, &est, &step_ms);
     if (!s.is_ok()) {
       tr.error = std::string("scan ") + std::to_string(i) + ": " + s.message();
@@ -578,6 +589,7 @@ TrialResult run_trial(fw::Localizer& loc, const LoadedDataset& ds, std::size_t s
     }
     ++feed.seg_steps;
     StepLog st = make_step_log(ds, i, est, od, feed.segment, travelled, step_ms, matched_points);
+    st.global_ms = inline_global_ms(loc) - global_before_ms;
     judge_against_map(ds, i, est, &st);
     if (region) {
       st.in_region = st.truth.x >= region[0] && st.truth.x <= region[2] && st.truth.y >= region[1] && st.truth.y <= region[3];

@@ -150,6 +150,9 @@ struct StepLog {
   hal::StatusReason reason = hal::StatusReason::kNone;  // why not `localized` (published with the pose)
   std::size_t segment = 0;  // 1 after a kidnap
   double step_ms = 0;
+  // Of step_ms, the global step run inline on this scan (mml-track's GlobalContext, timed by its
+  // clock; 0 for other localizers): what mmlfw runs on the global context, not the sensor context.
+  double global_ms = 0;
   fw::Se2d estimate, truth;
   fw::Se2d odom;            // odometry fed to the localizer
   bool in_region = false;  // inside the erased region (unknown-area runs)

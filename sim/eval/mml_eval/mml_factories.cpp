@@ -260,11 +260,26 @@ static bool parse_rules_off(const std::map<std::string, std::string>& options, f
 // valley=0|1 (TrackOptions::alias_valley_is_one_mode; default 1, as TrackOptions);
 // outside_clean=0|1 (TrackOptions::outside_map_needs_clean_exit; default 1, as TrackOptions);
 // wheels_bind=0|1 (TrackOptions::wheels_bind_mml_without_carry; default 1, as TrackOptions);
-// odom_slip=RATE,MAX (declared wheel slips, as mmlfw's config key); off=RULE[+RULE...] (ablation).
+// odom_slip=RATE,MAX (declared wheel slips, as mmlfw's config key); off=RULE[+RULE...] (ablation);
+// global=ref|live|live-deadline (the global search's schedule, mml_systems.h EvalGlobalMode; default ref);
+// global_period=1..8 (with live / live-deadline: mmlfw's global_period_scans; default 1).
 std::unique_ptr<fw::Localizer> make_track_localizer(const LocalizerContext& ctx, std::string* err) {
-  const std::string bad = check_keys("mml-track", ctx.options, {"config", "correct", "reduce", "pool", "keep", "contested", "rivals", "alert", "odom_noise", "odom_noise_per_step", "valley", "outside_clean", "wheels_bind", "odom_slip", "off"});
+  const std::string bad = check_keys("mml-track", ctx.options, {"config", "correct", "reduce", "pool", "keep", "contested", "rivals", "alert", "odom_noise", "odom_noise_per_step", "valley", "outside_clean", "wheels_bind", "odom_slip", "off", "global", "global_period"});
   if (!bad.empty()) { *err = bad; return nullptr; }
   if (ctx.global_map == nullptr) { *err = "localizer mml-track: needs a global map"; return nullptr; }
+  const auto g = ctx.options.find("global");
+  if (g != ctx.options.end()) {  // mml-eval's --global, for mml-sim and the corpus (a setting of the process)
+    if (g->second == "ref") set_eval_global_mode(EvalGlobalMode::kReference);
+    else if (g->second == "live") set_eval_global_mode(EvalGlobalMode::kLive);
+    else if (g->second == "live-deadline") set_eval_global_mode(EvalGlobalMode::kLiveDeadline);
+    else {
+      *err = "localizer mml-track: option global='" + g->second + "' (expected ref, live or live-deadline)";
+      return nullptr;
+    }
+  }
+  long period = 1;  // global_period=N: mmlfw's global_period_scans (with global=live or live-deadline)
+  if (!parse_int(ctx.options, "global_period", 1, 8, &period, "mml-track", err)) return nullptr;
+  if (ctx.options.count("global_period") > 0) set_eval_global_period(static_cast<std::uint32_t>(period));
   long config = 3;
   if (!parse_int(ctx.options, "config", 1, 4, &config, "mml-track", err)) return nullptr;
   auto cfg = mml_track_config(static_cast<int>(config), ctx.seed);

@@ -38,6 +38,7 @@ const std::uint8_t* table_section(const std::vector<std::uint8_t>& image, std::s
   return fw::find_section(image.data(), image.size(), fw::MapSectionType::kRelationTable2D, len);
 }
 EvalGlobalMode g_global_mode = EvalGlobalMode::kReference;
+std::uint32_t g_global_period = 0;  // 0 = the execution-context table's
 
 class MonotonicClock final : public hal::Clock {
  public:
@@ -51,6 +52,7 @@ MonotonicClock g_mono_clock;
 }  // namespace
 
 void set_eval_global_mode(EvalGlobalMode mode) { g_global_mode = mode; }
+void set_eval_global_period(std::uint32_t period_scans) { g_global_period = period_scans; }
 
 std::unique_ptr<OwnedLocalizer> OwnedLocalizer::make(const fw::SystemSpec& spec, const fw::GlobalMap& map,
                                                      const std::vector<std::uint8_t>& image, int threads,
@@ -62,15 +64,18 @@ std::unique_ptr<OwnedLocalizer> OwnedLocalizer::make(const fw::SystemSpec& spec,
     std::size_t len = 0;
     const std::uint8_t* sec = table_section(image, &len);
     fw::SystemSpec sp = spec;
-    const fw::track::GlobalScheduleOptions live = fw::track::live_global_schedule();
+    const fw::track::GlobalScheduleOptions live = fw::track::live_global_schedule(g_global_period);
     const bool track = sp.localizer != nullptr && std::string(sp.localizer) == "mml-track";
     if (track && g_global_mode != EvalGlobalMode::kReference) {
       sp.global_schedule = &live;
       sp.anytime_global = true;
     }
     s = o->system_.build(sp, map, sec, len, o->arena_, o->pool_.get());
+    // The inline global steps are timed (GlobalContext::perf_step, StepLog::global_ms): timing only,
+    // the steps' results do not depend on it.
+    if (s.is_ok() && track && o->system_.tracked() != nullptr) o->system_.tracked()->global_context().set_clock(&g_mono_clock);
     if (s.is_ok() && track && g_global_mode == EvalGlobalMode::kLiveDeadline && o->system_.mml() != nullptr) {
-      o->system_.mml()->set_deadline_mode(&g_mono_clock, fw::kGlobalContext.deadline_ns);
+      o->system_.mml()->set_deadline_mode(&g_mono_clock, fw::track::global_context_for(g_global_period).deadline_ns);
     }
   }
   if (!s.is_ok()) {

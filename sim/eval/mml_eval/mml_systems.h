@@ -50,6 +50,9 @@ using fw::mcl::mcl_tracking_options;
 //   kLiveDeadline   kLive + pRANSAM deadline mode at the global context's deadline (time-dependent)
 enum class EvalGlobalMode { kReference, kLive, kLiveDeadline };
 void set_eval_global_mode(EvalGlobalMode mode);
+// kLive / kLiveDeadline: MML on every n-th scan, its result n scans later, its deadline n scan periods
+// — mmlfw's config key global_period_scans (1..8; default 1, the execution-context table's).
+void set_eval_global_period(std::uint32_t period_scans);
 
 class OwnedLocalizer : public fw::Localizer {
  public:
