@@ -229,7 +229,7 @@ TrackStep PoseTracker::step(const Point2f* points, std::size_t n, const Se2f& od
   const StepWork w0 = w;
   const TrackStep out0 = out;
   out.alignment = align_from_prediction(points, n, w.pred, &out);
-  judge_scan(odom_jump, &w, &out);
+  judge_scan(points, n, odom_jump, &w, &out);
   if (w.v == ScanVerdict::kSupported && o.alias_check) check_aliases(points, n, &w, &out);
   // A rival the scan fits significantly better, within what the prediction promises (its PL), is
   // the fix Gauss-Newton missed from a prediction some degrees off (the white wheels' 4° per step),
@@ -246,7 +246,7 @@ TrackStep PoseTracker::step(const Point2f* points, std::size_t n, const Se2f& od
       out.search_candidates = searched;
       out.refit_at_rival = true;
       out.alignment = align_scan(map_, points, n, r, o.align);
-      judge_scan(odom_jump, &w, &out);
+      judge_scan(points, n, odom_jump, &w, &out);
       if (w.v == ScanVerdict::kSupported) check_aliases(points, n, &w, &out);
     }
   }
@@ -266,7 +266,7 @@ TrackStep PoseTracker::step(const Point2f* points, std::size_t n, const Se2f& od
 
 // (3) Verdict of this scan on the pose: outside the map, uninformative, a poor fit, or a fix that
 // fails the innovation test against the prediction (a fault; large beyond the alert limits).
-void PoseTracker::judge_scan(bool odom_jump, StepWork* w, TrackStep* out) {
+void PoseTracker::judge_scan(const Point2f* points, std::size_t n, bool odom_jump, StepWork* w, TrackStep* out) {
   const TrackOptions& o = options_;
   const ScanAlignment& a = out->alignment;
   if (odom_jump) {
@@ -339,9 +339,14 @@ void PoseTracker::judge_scan(bool odom_jump, StepWork* w, TrackStep* out) {
     // Beyond an alert limit: the robot may be somewhere else (the aces kidnap into a twin corridor
     // showed as 0.27 m and 6° at the first scan: the target fits the map next to the prediction).
     const float exy = std::hypot(w->e(0), w->e(1));
-    // A heading-only fault is one too: a local recovery of it (heading_fault_local_recovery, for
-    // mit-killian's over-reported turns) bought nothing on the generated corpus and was removed.
     out->large_fault = exy > o.alert_limit_m || std::fabs(w->e(2)) > o.alert_limit_rad;
+    if (out->large_fault && o.heading_fault_local_recovery && exy <= w->pred_pl.xy_m && exy <= o.alert_limit_m) {
+      // Heading only (track_options.h): the scan must prefer its fix to the prediction significantly.
+      const std::size_t m = subsample_alias_points(points, n);
+      out->heading_fault = rival_significantly_better(map_, alias_points_, m, pred, a.pose, o.alias_clip_m,
+                                                      a.independent, o.alias_z);
+      out->large_fault = !out->heading_fault;
+    }
   } else {
     w->p_post = post.cast<float>();
   }

@@ -67,6 +67,8 @@ struct TrackStep {
   // that drove out of the map still sees the mapped walls behind it where the map has them; one
   // carried away from a place near the map's edge does not (tracked_localizer.h).
   bool known_part_contradicts = false;
+  // A fault in heading only, recovered by the track (TrackOptions::heading_fault_local_recovery).
+  bool heading_fault = false;
   // The alias check found a rival that fits this scan as well as the fix and lies beyond the alert
   // limits: the track may already follow the wrong one of two look-alikes (a kidnap into a place
   // that fits near the old pose), which no later local test can tell (tracked_localizer.h).
@@ -139,7 +141,7 @@ class PoseTracker {
     float bias_xy = 0.0f, bias_theta = 0.0f;  // the map bias this scan shows
   };
   void predict_to(const Se2f& odom);
-  void judge_scan(bool odom_jump, StepWork* w, TrackStep* out);
+  void judge_scan(const Point2f* points, std::size_t n, bool odom_jump, StepWork* w, TrackStep* out);
   void check_aliases(const Point2f* points, std::size_t n, StepWork* w, TrackStep* out);
   Update propose_update(const Se2f& odom, bool predict, StepWork* w, TrackStep* out);
   void apply_verdict(const Se2f& odom, const StepWork& w, const Update& u, TrackStep* out);

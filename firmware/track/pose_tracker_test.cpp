@@ -417,29 +417,51 @@ TEST(PoseTrackerTest, OdometryFaultRecoversOnlyAfterConsistentScans) {
 }
 
 // Wheels that report a 14° turn the robot never made (mit-killian's odometry over-reports turns this
-// way): the scan fix lies where the prediction put the robot, turned back. A fault beyond the heading
-// alert limit is a large fault, whatever the position says (its local recovery was removed with issue
-// 56: it bought nothing on the generated corpus): never `localized` on that scan.
-TEST(PoseTrackerTest, HeadingOnlyFaultIsALargeFault) {
-  PoseTracker t;
-  TrackOptions o;
-  o.odom_rot_per_rad = o.odom_rot_per_m = 0.05f;  // a good model: 14° is far outside its bound
-  ASSERT_TRUE(t.init(o, room_map().map).is_ok());
-  RandomStream rng(23, 0);
-  Se2f truth(5.0f, 3.0f, 0.3f);
-  t.start(truth, small_cov(), Se2f());
-  auto pts = testing::scan_at(room(), truth, &rng);
-  t.step(pts.data(), pts.size(), Se2f(), false);
-  const Se2f odom = Se2f().compose(Se2f(0.1f, 0.0f, 0.2443f));  // 14° of turn reported, none made
-  truth = truth.compose(Se2f(0.1f, 0.0f, 0.0f));
-  pts = testing::scan_at(room(), truth, &rng);
-  const TrackStep fault = t.step(pts.data(), pts.size(), odom);
-  EXPECT_EQ(fault.verdict, ScanVerdict::kContradicting);
-  EXPECT_NE(fault.status, hal::LocalizationStatus::kLocalized);
-  EXPECT_TRUE(fault.large_fault);
+// way): the scan fix lies where the prediction put the robot, turned back, and the scan fits there
+// significantly better than at the predicted heading. A heading-only fault: contradicting (never
+// `localized` on that scan) but not a large fault, so the track recovers by itself after
+// recovery_steps consistent scans instead of waiting for MML. With local recovery off, the same scan
+// is a large fault.
+TEST(PoseTrackerTest, HeadingOnlyFaultRecoversWithoutGlobalConfirmation) {
+  for (const bool local : {true, false}) {
+    PoseTracker t;
+    TrackOptions o;
+    o.heading_fault_local_recovery = local;
+    o.odom_rot_per_rad = o.odom_rot_per_m = 0.05f;  // a good model: 14° is far outside its bound
+    ASSERT_TRUE(t.init(o, room_map().map).is_ok());
+    RandomStream rng(23, 0);
+    Se2f truth(5.0f, 3.0f, 0.3f);
+    t.start(truth, small_cov(), Se2f());
+    auto pts = testing::scan_at(room(), truth, &rng);
+    t.step(pts.data(), pts.size(), Se2f(), false);
+    Se2f odom = Se2f().compose(Se2f(0.1f, 0.0f, 0.2443f));  // 14° of turn reported, none made
+    truth = truth.compose(Se2f(0.1f, 0.0f, 0.0f));
+    pts = testing::scan_at(room(), truth, &rng);
+    const TrackStep fault = t.step(pts.data(), pts.size(), odom);
+    EXPECT_EQ(fault.verdict, ScanVerdict::kContradicting) << local;
+    EXPECT_NE(fault.status, hal::LocalizationStatus::kLocalized) << local;
+    EXPECT_EQ(fault.heading_fault, local);
+    EXPECT_EQ(fault.large_fault, !local);
+    if (!local) continue;
+    for (std::uint32_t i = 0; i < o.recovery_steps + 2; ++i) {
+      odom = odom.compose(Se2f(0.1f, 0.0f, 0.0f));
+      truth = truth.compose(Se2f(0.1f, 0.0f, 0.0f));
+      pts = testing::scan_at(room(), truth, &rng);
+      const TrackStep s = t.step(pts.data(), pts.size(), odom);
+      EXPECT_EQ(s.verdict, ScanVerdict::kSupported) << i;
+      EXPECT_FALSE(s.large_fault) << i;
+      if (s.status == hal::LocalizationStatus::kLocalized) {
+        EXPECT_GE(i + 1, o.recovery_steps) << "too early";
+        EXPECT_LT(err_xy(s.pose, truth), s.pl.xy_m) << i;
+        EXPECT_LT(std::fabs(wrap_angle(s.pose.theta - truth.theta)), s.pl.theta_rad) << i;
+      }
+      if (i + 1 == o.recovery_steps + 2) EXPECT_EQ(s.status, hal::LocalizationStatus::kLocalized);
+    }
+  }
 }
 
-// The same turn reported while the robot was also carried 0.4 m sideways: a large fault (MML must confirm).
+// The same turn reported while the robot was also carried 0.4 m sideways: inside the alert limit but
+// beyond the prediction's protection level, so not heading-only: a large fault (MML must confirm).
 TEST(PoseTrackerTest, HeadingFaultWithAPositionJumpStaysALargeFault) {
   PoseTracker t;
   TrackOptions o;
@@ -456,6 +478,7 @@ TEST(PoseTrackerTest, HeadingFaultWithAPositionJumpStaysALargeFault) {
   const TrackStep s = t.step(pts.data(), pts.size(), odom);
   EXPECT_NE(s.status, hal::LocalizationStatus::kLocalized);
   EXPECT_EQ(s.verdict, ScanVerdict::kContradicting);
+  EXPECT_FALSE(s.heading_fault);
   EXPECT_TRUE(s.large_fault);
 }
 

@@ -23,6 +23,11 @@ std::string validate_wheel_errors(const OdometryNoiseOptions& o) {
   if (!odom_in_range(o.slip_events_per_100m, 0, 100)) return "odometry slip_events_per_100m must be in [0, 100]";
   if (!odom_in_range(o.slip_min_m, 0, 10)) return "odometry slip_min_m must be in [0, 10] m";
   if (!odom_in_range(o.slip_max_m, o.slip_min_m, 10)) return "odometry slip_max_m must be in [slip_min_m, 10] m";
+  if (!odom_in_range(o.turn_spin_events_per_rad, 0, 10)) return "odometry turn_spin_events_per_rad must be in [0, 10]";
+  if (!odom_in_range(o.turn_spin_min_deg, 0, 90)) return "odometry turn_spin_min_deg must be in [0, 90]";
+  if (!odom_in_range(o.turn_spin_max_deg, o.turn_spin_min_deg, 90)) {
+    return "odometry turn_spin_max_deg must be in [turn_spin_min_deg, 90]";
+  }
   return {};
 }
 }  // namespace
@@ -82,6 +87,14 @@ fw::Se2d OdometrySimulator::wheel_motion(const fw::Se2d& u, double fraction_of_s
     if (draw < opt_.slip_events_per_100m / 100.0 * d) {
       x += opt_.slip_min_m + (opt_.slip_max_m - opt_.slip_min_m) * wheel_rng_.uniform01();
       ++slip_events_;
+    }
+  }
+  if (opt_.turn_spin_events_per_rad > 0 && std::fabs(u.theta) > 1e-9) {
+    // Poisson events along the turn: probability rate·|Δθ| per sample, over-reporting the turn.
+    if (wheel_rng_.uniform01() < opt_.turn_spin_events_per_rad * std::fabs(u.theta)) {
+      const double deg = opt_.turn_spin_min_deg + (opt_.turn_spin_max_deg - opt_.turn_spin_min_deg) * wheel_rng_.uniform01();
+      turn += (u.theta > 0 ? 1.0 : -1.0) * deg * M_PI / 180.0;
+      ++turn_spin_events_;
     }
   }
   return fw::Se2d(x, y, turn);

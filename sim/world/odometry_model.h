@@ -14,7 +14,10 @@
 //   - skid-steer: the base turns less than its wheels report, by a fraction s drawn per turn in
 //     [turn_slip_min, turn_slip_max] (reported = turned / (1 − s)), and slides sideways (σ per metre);
 //   - wheel-slip events: at a rate per 100 m driven, the wheels report slip_min_m–slip_max_m of
-//     forward motion that did not happen, at once (one sample).
+//     forward motion that did not happen, at once (one sample);
+//   - turn-spin events: at a rate per radian turned, the wheels report turn_spin_min_deg–
+//     turn_spin_max_deg more of the turn than the base made, at once (a wheel spinning or a caster
+//     dragging through a turn; mit-killian's raw odometry reports 23° where the robot turned 5°).
 #pragma once
 
 #include <string>
@@ -42,11 +45,15 @@ struct OdometryNoiseOptions {
   double slip_events_per_100m = 0.0; // wheel-slip events per 100 m driven
   double slip_min_m = 0.3;           // forward motion the wheels report falsely in one event
   double slip_max_m = 1.0;
+  double turn_spin_events_per_rad = 0.0;  // turn-spin events per radian turned
+  double turn_spin_min_deg = 8.0;         // turn the wheels over-report in one event
+  double turn_spin_max_deg = 20.0;
 
   // True when any issue-55 term is on.
   bool wheel_errors() const {
     return sigma_trans_per_m > 0 || sigma_rot_per_rad > 0 || sigma_rot_deg_per_m > 0 || scale_dist != 0 ||
-           scale_turn != 0 || turn_slip_max > 0 || sigma_lateral_per_m > 0 || slip_events_per_100m > 0;
+           scale_turn != 0 || turn_slip_max > 0 || sigma_lateral_per_m > 0 || slip_events_per_100m > 0 ||
+           turn_spin_events_per_rad > 0;
   }
 
   std::string validate() const;
@@ -64,6 +71,8 @@ class OdometrySimulator {
   const fw::Se2d& odom_pose() const { return odom_; }
   // Wheel-slip events so far (issue 55; for tests and reports).
   int slip_events() const { return slip_events_; }
+  // Turn-spin events so far (issue 56's turn-scale wheel error).
+  int turn_spin_events() const { return turn_spin_events_; }
 
  private:
   // The motion the wheels report for the true motion u (the issue-55 terms; u when all are off).
@@ -77,6 +86,7 @@ class OdometrySimulator {
   int turn_sign_ = 0;           // sign of the turn in progress (0: not turning)
   double turn_slip_ = 0.0;      // its slip fraction
   int slip_events_ = 0;
+  int turn_spin_events_ = 0;
 };
 
 }  // namespace sim

@@ -1,4 +1,4 @@
-// The five odometry profiles of issue 55. Every profile but "white" has no white (per-step) noise:
+// The odometry profiles of issues 55 and 56. Every profile but "white" has no white (per-step) noise:
 // encoders of a base at rest report no motion, so all its error follows the motion (per scan step,
 // as the tracker's α model, odometry_model.h). The tracker keys are what an integrator configures
 // from the base's spec sheet: its nominal noise as the α model (TT, TR, RR, RT: σ_trans = TT·|Δs| +
@@ -98,6 +98,25 @@ OdometryProfile slip_events() {
   return p;
 }
 
+// A calibrated differential drive whose wheels now and then over-report a turn: at 0.25 events
+// per radian turned (about one right-angle turn in three), 8–20° more than the base turned, at
+// once — a wheel spinning or a caster dragging through the turn. mit-killian's raw odometry does
+// this (23° reported where the robot turned 5°), and no other profile had a turn-scale error, so
+// the corpus could not say what a rule for it buys (issue 56). No key declares it: a scan with
+// walls sees the heading, so the fault is the innovation test's to find, not the PL's to cover.
+OdometryProfile turn_spin() {
+  OdometryProfile p;
+  p.name = "turn-spin";
+  p.description = "calibrated differential drive that over-reports turns: 0.25 events per rad turned, 8-20 deg each";
+  p.wheels = calibrated_wheels();
+  p.wheels.turn_spin_events_per_rad = 0.25;
+  p.wheels.turn_spin_min_deg = 8.0;
+  p.wheels.turn_spin_max_deg = 20.0;
+  p.tracker_odom_noise = kCalibratedAlpha;
+  p.tracker_odom_noise_per_step = "0,0";
+  return p;
+}
+
 // The dissertation's white model (Sec. 5.7.1): 4 cm on x and y and 4° per scan step, whatever the
 // motion (the OdometryNoiseOptions defaults). The keys are those mml-sim's wheel_noise_beyond_alpha
 // hands over for it: the default α (empty), and per step what the α model misses on the nominal
@@ -116,7 +135,7 @@ OdometryProfile white() {
 
 const std::vector<OdometryProfile>& odometry_profiles() {
   static const std::vector<OdometryProfile> all = {diff_calibrated(), diff_poor(), skid_steer(), slip_events(),
-                                                   white()};
+                                                   white(), turn_spin()};
   return all;
 }
 

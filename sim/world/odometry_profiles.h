@@ -15,7 +15,7 @@
 namespace sim {
 
 struct OdometryProfile {
-  std::string name;         // "diff-calibrated", "diff-poor", "skid-steer", "slip-events", "white"
+  std::string name;         // "diff-calibrated", "diff-poor", "skid-steer", "slip-events", "white", "turn-spin"
   std::string description;
   OdometryNoiseOptions wheels;
   // mml-track's odometry keys as an integrator sets them for this base ("TT,TR,RR,RT", "M,DEG" and

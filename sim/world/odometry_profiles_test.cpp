@@ -65,8 +65,8 @@ OdometryNoiseOptions quiet() {
 }
 
 TEST(OdometryProfiles, EveryProfileValidatesAndStatesTrackerKeys) {
-  const char* names[] = {"diff-calibrated", "diff-poor", "skid-steer", "slip-events", "white"};
-  ASSERT_EQ(odometry_profiles().size(), 5u);
+  const char* names[] = {"diff-calibrated", "diff-poor", "skid-steer", "slip-events", "white", "turn-spin"};
+  ASSERT_EQ(odometry_profiles().size(), 6u);
   for (const char* n : names) {
     const OdometryProfile* p = find_odometry_profile(n);
     ASSERT_NE(p, nullptr) << n;
@@ -108,6 +108,9 @@ TEST(OdometryWheelErrors, ValidateNamesEveryNewField) {
   bad([](OdometryNoiseOptions* o) { o->slip_events_per_100m = -1; }, "slip_events_per_100m");
   bad([](OdometryNoiseOptions* o) { o->slip_min_m = -1; }, "slip_min_m");
   bad([](OdometryNoiseOptions* o) { o->slip_max_m = 0.1; }, "slip_max_m");
+  bad([](OdometryNoiseOptions* o) { o->turn_spin_events_per_rad = -1; }, "turn_spin_events_per_rad");
+  bad([](OdometryNoiseOptions* o) { o->turn_spin_min_deg = NAN; }, "turn_spin_min_deg");
+  bad([](OdometryNoiseOptions* o) { o->turn_spin_max_deg = 5; }, "turn_spin_max_deg");
   EXPECT_EQ(OdometryNoiseOptions().validate(), "");
 }
 
@@ -256,6 +259,32 @@ TEST(OdometryWheelErrors, SlipEventsHaveTheirRateAndSize) {
   OdometrySimulator still(opt, 1);
   drive(opt, 13, spins(10000, 0.5), 4, &still);
   EXPECT_EQ(still.slip_events(), 0);
+}
+
+// Turn-spin events (issue 56): at 0.25 per radian turned, 8–20° more than the base turned, in the
+// turn's direction; a straight drive has none.
+TEST(OdometryWheelErrors, TurnSpinEventsOverReportTurnsAtTheirRate) {
+  OdometryNoiseOptions opt = quiet();
+  opt.turn_spin_events_per_rad = 0.25;
+  OdometrySimulator sim(opt, 1);
+  // 0.2 rad per step, one sample: 20,000 steps = 4,000 rad turned, 1,000 events expected.
+  const auto drv = drive(opt, 14, spins(20000, 0.2), 1, &sim);
+  std::vector<double> sizes;
+  for (const StepError& e : drv) {
+    const double extra = fw::wrap_angle(e.reported.theta - e.truth.theta) / kDeg;
+    if (std::fabs(extra) > 1e-6) sizes.push_back(extra);
+  }
+  EXPECT_EQ(static_cast<int>(sizes.size()), sim.turn_spin_events());
+  EXPECT_NEAR(sizes.size(), 1000.0, 100.0);  // Poisson sd 31.6
+  for (double x : sizes) EXPECT_TRUE(x >= 8.0 - 1e-6 && x <= 20.0 + 1e-6) << x;
+  EXPECT_NEAR(mean(sizes), 14.0, 0.5);
+  OdometrySimulator straight_on(opt, 1);
+  drive(opt, 15, straight(10000, 0.3), 4, &straight_on);
+  EXPECT_EQ(straight_on.turn_spin_events(), 0);
+  // The profile: the calibrated wheels plus the events, declared by no key.
+  const OdometryProfile& p = *find_odometry_profile("turn-spin");
+  EXPECT_DOUBLE_EQ(p.wheels.turn_spin_events_per_rad, 0.25);
+  EXPECT_EQ(p.tracker_odom_slip, "");
 }
 
 }  // namespace

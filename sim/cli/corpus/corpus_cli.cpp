@@ -5,6 +5,7 @@
 #include <cstring>
 #include <string>
 
+#include "sim/cli/corpus/corpus_draw.h"
 #include "sim/cli/corpus/corpus_runner.h"
 
 namespace sim::corpus {
@@ -12,7 +13,7 @@ namespace sim::corpus {
 namespace {
 
 int bad(const std::string& what) {
-  std::fprintf(stderr, "mml-eval: %s\nusage: mml-eval --corpus N [--seed S] [--jobs J] [--out DIR] [--pictures K] [--no-timing] [--draw K] [--opt KEY=VALUE]...\n",
+  std::fprintf(stderr, "mml-eval: %s\nusage: mml-eval --corpus N [--seed S] [--jobs J] [--out DIR] [--pictures K] [--no-timing] [--draw K] [--opt KEY=VALUE]... [--list]\n",
                what.c_str());
   return 2;
 }
@@ -35,13 +36,17 @@ bool wants_corpus(int argc, char** argv) {
 
 int corpus_main(int argc, char** argv) {
   CorpusOptions opt;
-  bool one_draw = false;
+  bool one_draw = false, list = false;
   for (int i = 1; i < argc; ++i) {
     const std::string a = argv[i];
     const char* v = i + 1 < argc ? argv[i + 1] : nullptr;
     unsigned long long n = 0;
     if (a == "--no-timing") {
       opt.timing = false;
+      continue;
+    }
+    if (a == "--list") {  // the draws, one line each, without running them (to pick an ablation's subset)
+      list = true;
       continue;
     }
     if (a != "--corpus" && a != "--seed" && a != "--jobs" && a != "--out" && a != "--pictures" && a != "--draw" && a != "--opt") {
@@ -77,6 +82,11 @@ int corpus_main(int argc, char** argv) {
   if (one_draw) {
     opt.runs = 1;
     opt.jobs = 1;
+  }
+  if (list) {
+    const std::vector<CorpusDraw> draws = draw_corpus(opt.seed, opt.first_draw + opt.runs, opt.draws);
+    for (std::size_t k = opt.first_draw; k < draws.size(); ++k) std::printf("%s\n", describe_draw(draws[k]).c_str());
+    return 0;
   }
   BenchJson json;
   std::string err;
