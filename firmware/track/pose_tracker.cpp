@@ -589,7 +589,7 @@ void PoseTracker::publish(const Point2f* points, std::size_t n, const StepWork& 
     out->status = hal::LocalizationStatus::kLocalized;
     out->reason = hal::StatusReason::kNone;
   }
-  out->lost = faulty_ >= o.max_faulty_steps || outside_ >= o.max_outside_steps || !(out->pl.xy_m <= o.lost_limit_m) ||
+  out->lost = faulty_ >= o.max_faulty_steps || outside_ >= o.max_faulty_steps || !(out->pl.xy_m <= o.lost_limit_m) ||
               !pose_.vector().allFinite();
   if (out->lost) active_ = false;
 }

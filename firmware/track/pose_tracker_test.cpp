@@ -221,7 +221,7 @@ TEST(PoseTrackerTest, UnmappedSpaceIsOutsideMap) {
   t.start(inside, small_cov(), Se2f());
   int outside = 0;
   bool lost = false;
-  for (std::uint32_t i = 0; i < o.max_outside_steps && !lost; ++i) {
+  for (std::uint32_t i = 0; i < o.max_faulty_steps && !lost; ++i) {
     const auto pts = testing::scan_at(world, inside, &rng);
     const TrackStep s = t.step(pts.data(), pts.size(), Se2f(), i > 0);
     EXPECT_NE(s.status, hal::LocalizationStatus::kLocalized);

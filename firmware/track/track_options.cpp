@@ -71,7 +71,6 @@ Status TrackOptions::validate() const {
   FW_RETURN_IF_ERROR(check_range("innovation_chi2", innovation_chi2, 0.1f, 1e6f));
   FW_RETURN_IF_ERROR(check_range("outside_map_fraction", outside_map_fraction, 0.0f, 1.0f));
   FW_RETURN_IF_ERROR(check_count("max_faulty_steps", max_faulty_steps, 1, 10000));
-  FW_RETURN_IF_ERROR(check_count("max_outside_steps", max_outside_steps, 1, 10000));
   FW_RETURN_IF_ERROR(check_count("cross_check_steps", cross_check_steps, 0, 1000000));
   FW_RETURN_IF_ERROR(check_count("odometry_window", odometry_window, 0, 32));
   FW_RETURN_IF_ERROR(check_count("recovery_steps", recovery_steps, 0, 10000));

@@ -124,8 +124,9 @@ struct TrackOptions {
   // scan while the wheels say the robot drives on. 0 = off; at most 32.
   std::uint32_t odometry_window = 16;
   float outside_map_fraction = 0.5f;      // end-points in unknown space beyond this: outside the map
-  std::uint32_t max_faulty_steps = 5;     // consecutive contradicting scans → back to global mode
-  std::uint32_t max_outside_steps = 5;    // consecutive outside-map scans → back to global mode
+  // Consecutive contradicting scans, or consecutive outside-map scans, before the track is given up
+  // (global mode): one persistence for both (they were two equal fields; issue 56's fewer knobs).
+  std::uint32_t max_faulty_steps = 5;
   // `outside-map` is said from the scan at the tracked or dead-reckoned pose only if no scan of the
   // track since MML last vouched for it failed to continue the scan before it (scan_continuity.h: a
   // carried robot does not see what it saw a scan ago; one driving into unmapped space does). After

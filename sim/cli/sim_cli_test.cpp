@@ -536,6 +536,25 @@ StepRecord rec(std::uint32_t step, hal::LocalizationStatus st, double err_m, dou
   return r;
 }
 
+// A robot carried after its fix: the steps from the carry to the re-fix are left out of the
+// availability, as the corpus leaves them out (a carry not noticed, `localized` on, ends it at once).
+TEST(SimSummary, CarriedStepsAreLeftOutOfTheAvailability) {
+  using S = hal::LocalizationStatus;
+  std::vector<StepRecord> v;
+  for (std::uint32_t i = 0; i < 5; ++i) v.push_back(rec(i, S::kLocalized, 0.01));  // 0-4
+  v.push_back(rec(5, S::kAmbiguous, 9.0));  // 5: carried, noticed
+  v.back().kidnapped = true;
+  for (std::uint32_t i = 6; i < 9; ++i) v.push_back(rec(i, S::kSearching, 9.0));  // 6-8: searching
+  v.push_back(rec(9, S::kLocalized, 0.02));  // 9: re-fix
+  v.push_back(rec(10, S::kAmbiguous, 0.02));  // 10: withheld, counted
+  SimSummary s;
+  summarize_steps(v, &s);
+  EXPECT_EQ(s.carried_steps, 4u);       // 5-8
+  EXPECT_EQ(s.availability_steps, 6u);  // 1-4, 9, 10
+  EXPECT_EQ(s.availability_localized, 5u);
+  EXPECT_NE(availability_text(s).find("4 carried until the re-fix left out"), std::string::npos) << availability_text(s);
+}
+
 // The figures of the summary from hand-made steps: first fix, availability (the unknown area left
 // out), integrity failures (position or heading), protection level exceedances, kidnap detection
 // and re-fix, final error.

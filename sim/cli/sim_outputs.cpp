@@ -118,6 +118,7 @@ bool write_summary_json(const std::string& path, const SimSummary& s, std::strin
   std::fprintf(f, "  \"first_localized_pl_xy_m\": %s,\n", num(s.first_localized_pl_xy_m).c_str());
   std::fprintf(f, "  \"availability\": %s,\n  \"availability_steps\": %zu,\n  \"availability_localized_steps\": %zu,\n",
                num(s.availability).c_str(), s.availability_steps, s.availability_localized);
+  std::fprintf(f, "  \"availability_carried_steps\": %zu,\n", s.carried_steps);
   std::fprintf(f, "  \"unavailable_by_reason\": {");
   for (std::size_t k = 1; k < hal::kStatusReasonCount; ++k) {
     std::fprintf(f, "%s\"%s\": %zu", k > 1 ? ", " : "", hal::reason_name(static_cast<hal::StatusReason>(k)),

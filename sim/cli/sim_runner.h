@@ -131,7 +131,10 @@ struct SimSummary {
   // Availability: share of the steps after the first fix that are `localized`. Steps whose truth
   // lies in the world's unknown area (not in the map: nothing to localize on) are left out when
   // known (built-in worlds with the unknown area erased); unknown_area_steps counts them.
-  std::size_t availability_steps = 0, availability_localized = 0, unknown_area_steps = 0;
+  // From a kidnap until the next `localized` step the robot was carried: those steps
+  // (carried_steps) are left out too, as the corpus leaves them out (silence while carried is right;
+  // the re-fix has its own figures below).
+  std::size_t availability_steps = 0, availability_localized = 0, unknown_area_steps = 0, carried_steps = 0;
   double availability = NAN;
   // The availability steps that were not `localized`, by the reason published with them
   // (hal::StatusReason): where the availability went.

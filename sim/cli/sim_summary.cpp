@@ -80,11 +80,15 @@ bool follow_kidnap(const std::vector<StepRecord>& steps, std::size_t i, bool loc
   return undetected_kidnap;
 }
 
-// Availability over the steps after the first fix (the unknown area left out).
-void count_availability(const StepRecord& r, bool loc, SimSummary* s) {
+// Availability over the steps after the first fix (the unknown area left out, and the steps from a
+// carry until the next `localized` one: silence while carried is right; the corpus's rule,
+// corpus_figures.cpp).
+void count_availability(const StepRecord& r, bool loc, bool carried, SimSummary* s) {
   if (s->first_localized_step < 0) return;
   if (r.in_unknown) {
     ++s->unknown_area_steps;
+  } else if (carried) {
+    ++s->carried_steps;
   } else {
     ++s->availability_steps;
     if (loc) {
@@ -215,6 +219,7 @@ void summarize_steps(const std::vector<StepRecord>& steps, SimSummary* s) {
   if (steps.empty()) return;
 
   StepSamples x;
+  bool carried = false;
   for (std::size_t i = 0; i < steps.size(); ++i) {
     const StepRecord& r = steps[i];
     const long step = static_cast<long>(i);
@@ -223,7 +228,9 @@ void summarize_steps(const std::vector<StepRecord>& steps, SimSummary* s) {
     const int k = static_cast<int>(r.estimate.status);
     if (k >= 0 && k < 5) ++s->status_counts[k];
     const bool undetected_kidnap = follow_kidnap(steps, i, loc, &x, s);
-    count_availability(r, loc, s);
+    if (r.kidnapped) carried = true;
+    if (loc) carried = false;
+    count_availability(r, loc, carried, s);
     if (loc) score_localized_step(r, step, undetected_kidnap, &x, s);
     note_final_pose(r, step, s);
   }

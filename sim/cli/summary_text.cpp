@@ -32,6 +32,7 @@ std::string availability_text(const SimSummary& s) {
   std::string t = fmt("availability %.1f %% (%zu/%zu steps after the fix", 100.0 * s.availability,
                       s.availability_localized, s.availability_steps);
   if (s.unknown_area_steps > 0) t += fmt(", %zu in unknown area left out", s.unknown_area_steps);
+  if (s.carried_steps > 0) t += fmt(", %zu carried until the re-fix left out", s.carried_steps);
   t += ")";
   // Where it went (the reason published with each step that was not `localized`).
   const std::string why = reason_list(s.unavailable_by_reason);
