@@ -114,7 +114,8 @@ Status MapSet::init(const MapSetSpec& spec, StartupArena& arena, WorkerPool* poo
     if (!r || *r != s.block) return Status::error(Errc::kInvalidArgument, "map %d: slot moved while carved", id);
     s.bytes = need;
     s.arena.seal();  // a map's slot never allocates again (a reload builds in the spare)
-    FW_RETURN_IF_ERROR(MemoryReport::instance().add({kSlotNames[id], "map + localizer (start-up arena)", need, 0, nullptr}));
+    // The slot's row says what it keeps (its arena registered the whole rest while it was built).
+    FW_RETURN_IF_ERROR(MemoryReport::instance().add({kSlotNames[id], "startup arena", need, need, nullptr}));
     if (need > largest) largest = need;
     count_ = id + 1;
   }
@@ -123,7 +124,7 @@ Status MapSet::init(const MapSetSpec& spec, StartupArena& arena, WorkerPool* poo
     const std::size_t bytes = round_up(largest + largest / 4, 4096);
     const Status st = carve(slots_[spare_], arena, bytes, spare_);
     if (!st) return Status::error(st.code(), "map_reload: the spare slot (%zu bytes): %s", bytes, st.message());
-    FW_RETURN_IF_ERROR(MemoryReport::instance().add({kSlotNames[spare_], "spare for reloads (start-up arena)", bytes, 0, nullptr}));
+
   }
   active_ = 0;
   return Status::ok();

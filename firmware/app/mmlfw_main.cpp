@@ -419,7 +419,10 @@ int memory_budget(const Args& a, const Startup& su) {
       fw::check_memory_fits(footprint, fw::read_memory_limits(), "arena_mib + static objects + table");
   // The arena must hold its peak (the map loader's distance check is start-up scratch), not just
   // what stays allocated.
-  const std::size_t arena_need = g_arena.peak_used() > g_arena.used() ? g_arena.peak_used() : g_arena.used();
+  // With maps, each slot holds its own peak (map_set.h) and the arena's peak is the slots' carving
+  // (a slot takes the rest of the arena while it is built): what stays allocated is the need.
+  const std::size_t arena_need = g_maps.count() > 0 ? g_arena.used()
+                                 : g_arena.peak_used() > g_arena.used() ? g_arena.peak_used() : g_arena.used();
   if (!a.preflight()) {
     if (!memory_status) g_board.hal().log->log(hal::LogLevel::kWarning, "mmlfw: memory: %s", memory_status.message());
     return -1;
