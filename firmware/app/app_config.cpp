@@ -250,8 +250,15 @@ Status parse_blackbox_key(const char* name, int line, const char* key, const cha
   return Status::error(Errc::kInvalidArgument, "config '%s' line %d: unknown key '%s'", name, line, key);
 }
 
-// map.N = PATH (N = 1 .. kMaxMaps - 1), map_reload = true|false (issue 60, several maps).
+// map = PATH (id 0), map.N = PATH (N = 1 .. kMaxMaps - 1), map_reload = true|false (issue 60).
 Status parse_map_key(const char* name, int line, const char* key, const char* v, AppConfig* out) {
+  if (!std::strcmp(key, "map")) {
+    if (!copy(out->map, sizeof(out->map), v)) return CFG_ERR("path longer than %zu characters", sizeof(out->map) - 1);
+    return Status::ok();
+  }
+  if (std::strncmp(key, "map.", 4) != 0 && std::strcmp(key, "map_reload") != 0) {
+    return Status::error(Errc::kInvalidArgument, "config '%s' line %d: unknown key '%s'", name, line, key);
+  }
   if (!std::strcmp(key, "map_reload")) {
     if (!parse_bool(v, &out->map_reload)) return CFG_ERR("'%s' is not true or false", v);
     return Status::ok();
@@ -372,10 +379,8 @@ Status parse_app_config(const char* path, const char* text, std::size_t len, App
     } else if (!std::strcmp(key, "mml_preset")) {
       if (!parse_int(v, 1, 4, &x)) return CFG_ERR("'%s' is not a configuration 1..4 (Tables 5.1-5.4)", v);
       out->mml_preset = static_cast<int>(x);
-    } else if (!std::strncmp(key, "map.", 4) || !std::strcmp(key, "map_reload")) {
+    } else if (!std::strncmp(key, "map", 3)) {
       FW_RETURN_IF_ERROR(parse_map_key(name, line, key, v, out));
-    } else if (!std::strcmp(key, "map")) {
-      if (!copy(out->map, sizeof(out->map), v)) return CFG_ERR("path longer than %zu characters", sizeof(out->map) - 1);
     } else if (!std::strcmp(key, "workers")) {
       if (!parse_int(v, 1, 16, &x)) return CFG_ERR("'%s' is not an integer in 1..16", v);
       out->workers = static_cast<int>(x);

@@ -51,6 +51,7 @@ Status MapSet::load_into(Slot& s, int id, const char* path, WorkerPool* pool) {
   FW_RETURN_IF_ERROR(s.image.open(path));
   FW_RETURN_IF_ERROR(load_map_image(s.image.data(), s.image.size(), s.arena, &s.map, path));
   s.table = find_section(s.image.data(), s.image.size(), MapSectionType::kRelationTable2D, &s.table_len);
+  s.image_had_table = s.table != nullptr;
   const Status st = s.system.build(spec_, s.map, s.table, s.table_len, s.arena, pool);
   if (!st) return Status::error(st.code(), "map %d '%s': %s", id, path, st.message());
   // The map lives in the arena now; the copy of the image stays only where MML reads its relation
@@ -78,6 +79,7 @@ void MapSet::clear(Slot& s) {
   s.map = GlobalMap{};
   s.table = nullptr;
   s.table_len = 0;
+  s.image_had_table = false;
   s.arena.~StartupArena();
   new (&s.arena) StartupArena();
 }

@@ -65,7 +65,8 @@ class MapSet : public MapSelector {
   LocalizationSystem& system(int id) { return slots_[slot_of_[id]].system; }
   const GlobalMap& map(int id) const { return slots_[slot_of_[id]].map; }
   const char* path(int id) const { return paths_[id]; }
-  bool has_table(int id) const { return slots_[slot_of_[id]].table != nullptr; }
+  // The image has a precomputed relation table section (used in place or not).
+  bool has_table(int id) const { return slots_[slot_of_[id]].image_had_table; }
   // Bytes of map `id`'s slot (its map, scratch peak and localizer) and of the spare (0 = none).
   std::size_t slot_bytes(int id) const { return slots_[slot_of_[id]].bytes; }
   std::size_t spare_bytes() const { return spare_ >= 0 ? slots_[spare_].bytes : 0; }
@@ -82,6 +83,7 @@ class MapSet : public MapSelector {
     GlobalMap map{};
     const std::uint8_t* table = nullptr;
     std::size_t table_len = 0;
+    bool image_had_table = false;
     LocalizationSystem system;
   };
   Status load_into(Slot& s, int id, const char* path, WorkerPool* pool);

@@ -104,6 +104,7 @@ void print_help() {
       "  laser_mount = YAW_DEG[, upside-down]   (how the laser sits on the robot; default 0)\n"
       "  odometry = socketcan:IFACE | none    output = socketcan:IFACE | log    can_fd = auto|true|false\n"
       "  localizer = mml-track | mml | handoff | mcl | odom    map = IMAGE.mmap (mml-mapc)\n"
+      "  map.1 .. map.3 = IMAGE.mmap (more maps, one per floor: SELECT_MAP switches), map_reload = true|false\n"
       "  workers, cores, realtime, global_context, global_period_scans, arena_mib, step_deadline_ms,\n"
       "  health_period_ms, laser_timeout_ms, seed, mml_preset, log_level, odom_noise, odom_noise_per_step, odom_slip\n"
       "  blackbox = PATH | off, blackbox_frames = N   (the last frames in and out, written on DUMP_LOG, a fault, exit)\n"
@@ -308,8 +309,8 @@ fw::Status build_systems(const fw::SystemSpec& sys, Startup* su) {
     st = g_maps.init(ms, g_arena, &g_pool, hal.log);
     if (!st) fail("map", st);
     for (int id = 0; st && id < g_maps.count(); ++id) {
-      if (!g_maps.has_table(id) && std::strcmp(c.localizer, "mcl") && c.mml_preset != 1)
-        hal.log->log(hal::LogLevel::kInfo, "mmlfw: map %d has no relation table (or it is not used); filled at start-up", id);
+      if (!g_maps.has_table(id) && std::strcmp(c.localizer, "odom") && std::strcmp(c.localizer, "mcl") && c.mml_preset != 1)
+        hal.log->log(hal::LogLevel::kInfo, "mmlfw: map %d image has no relation table; filling it at start-up", id);
     }
   }
   if (!st) return st;
