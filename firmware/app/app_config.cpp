@@ -81,7 +81,8 @@ constexpr const char* kKeys[] = {"laser",     "odometry",  "output",  "can_fd", 
                                  "mml_preset", "map",       "workers", "cores",            "realtime",
                                  "arena_mib", "step_deadline_ms", "health_period_ms", "laser_timeout_ms", "seed",
                                  "log_level", "global_context", "global_period_scans", "odom_noise",
-                                 "odom_noise_per_step", "odom_slip", "laser_mount", "blackbox", "blackbox_frames"};
+                                 "odom_noise_per_step", "odom_slip", "laser_mount", "blackbox", "blackbox_frames",
+                                 "map.1", "map.2", "map.3", "map_reload"};
 constexpr int kNumKeys = static_cast<int>(sizeof(kKeys) / sizeof(kKeys[0]));
 
 // The config path as shown in messages: at most kShownPath characters, the end kept (the file
@@ -249,7 +250,57 @@ Status parse_blackbox_key(const char* name, int line, const char* key, const cha
   return Status::error(Errc::kInvalidArgument, "config '%s' line %d: unknown key '%s'", name, line, key);
 }
 
+// map = PATH (id 0), map.N = PATH (N = 1 .. kMaxMaps - 1), map_reload = true|false (issue 60).
+Status parse_map_key(const char* name, int line, const char* key, const char* v, AppConfig* out) {
+  if (!std::strcmp(key, "map")) {
+    if (!copy(out->map, sizeof(out->map), v)) return CFG_ERR("path longer than %zu characters", sizeof(out->map) - 1);
+    return Status::ok();
+  }
+  if (std::strncmp(key, "map.", 4) != 0 && std::strcmp(key, "map_reload") != 0) {
+    return Status::error(Errc::kInvalidArgument, "config '%s' line %d: unknown key '%s'", name, line, key);
+  }
+  if (!std::strcmp(key, "map_reload")) {
+    if (!parse_bool(v, &out->map_reload)) return CFG_ERR("'%s' is not true or false", v);
+    return Status::ok();
+  }
+  long id = 0;
+  if (!parse_int(key + 4, 1, AppConfig::kMaxMaps - 1, &id)) {
+    return CFG_ERR("not a map key: map 0 is 'map', more maps are 'map.1' .. 'map.%d' (at most %d maps)",
+                   AppConfig::kMaxMaps - 1, AppConfig::kMaxMaps);
+  }
+  char* dst = out->more_maps[id - 1];
+  if (!copy(dst, sizeof(out->more_maps[0]), v)) return CFG_ERR("path longer than %zu characters", sizeof(out->more_maps[0]) - 1);
+  return Status::ok();
+}
+
+// Map ids are consecutive from 0, so an id names the same map in every config of a fleet.
+Status check_map_ids(const char* name, const AppConfig& c) {
+  for (int id = 1; id < AppConfig::kMaxMaps; ++id) {
+    if (!c.more_maps[id - 1][0]) continue;
+    if (!map_path(c, id - 1)[0]) {
+      return Status::error(Errc::kInvalidArgument, "config '%s': key 'map.%d' is set but '%s' is not (map ids are consecutive from 0 = 'map')",
+                           name, id, id == 1 ? "map" : (id == 2 ? "map.1" : "map.2"));
+    }
+  }
+  if (c.map_reload && !c.map[0]) {
+    return Status::error(Errc::kInvalidArgument, "config '%s': key 'map_reload' needs a map (key 'map')", name);
+  }
+  return Status::ok();
+}
+
 }  // namespace
+
+int map_count(const AppConfig& c) {
+  int n = 0;
+  while (n < AppConfig::kMaxMaps && map_path(c, n)[0]) ++n;
+  return n;
+}
+
+const char* map_path(const AppConfig& c, int id) {
+  if (id == 0) return c.map;
+  if (id < 0 || id >= AppConfig::kMaxMaps) return "";
+  return c.more_maps[id - 1];
+}
 
 Status parse_app_config(const char* path, const char* text, std::size_t len, AppConfig* out) {
   *out = AppConfig{};
@@ -328,8 +379,8 @@ Status parse_app_config(const char* path, const char* text, std::size_t len, App
     } else if (!std::strcmp(key, "mml_preset")) {
       if (!parse_int(v, 1, 4, &x)) return CFG_ERR("'%s' is not a configuration 1..4 (Tables 5.1-5.4)", v);
       out->mml_preset = static_cast<int>(x);
-    } else if (!std::strcmp(key, "map")) {
-      if (!copy(out->map, sizeof(out->map), v)) return CFG_ERR("path longer than %zu characters", sizeof(out->map) - 1);
+    } else if (!std::strncmp(key, "map", 3)) {
+      FW_RETURN_IF_ERROR(parse_map_key(name, line, key, v, out));
     } else if (!std::strcmp(key, "workers")) {
       if (!parse_int(v, 1, 16, &x)) return CFG_ERR("'%s' is not an integer in 1..16", v);
       out->workers = static_cast<int>(x);
@@ -393,6 +444,7 @@ Status parse_app_config(const char* path, const char* text, std::size_t len, App
     return Status::error(Errc::kInvalidArgument, "config '%s': key 'cores' lists %d CPUs for %d workers", name,
                          out->num_cores, out->workers);
   }
+  FW_RETURN_IF_ERROR(check_map_ids(name, *out));
   if (std::strcmp(out->localizer, "odom") && !out->map[0]) {
     return Status::error(Errc::kInvalidArgument, "config '%s': key 'map' is required for localizer '%s' (localizer = odom runs without a map)", name,
                          out->localizer);

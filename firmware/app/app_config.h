@@ -16,7 +16,13 @@
 //   can_fd           auto | true | false                 [auto: FD when the interface MTU is 72]
 //   localizer        mml-track | mml | handoff | mcl | odom   [mml-track] (firmware/app/system.h)
 //   mml_preset       1..4 MML configuration C1..C4 (firmware/mml/mml_presets.h)  [3]
-//   map              path of the compiled map image (mml-mapc / mml-mapbuild)   (required for mml)
+//   map              path of the compiled map image (mml-mapc / mml-mapbuild)   (required for mml);
+//                    map id 0 (SELECT_MAP, SET_POSE_HINT's map id)
+//   map.1 .. map.3   more map images, ids 1..3 (one per floor or site; consecutive ids, `map` first):
+//                    all are loaded at start-up into the arena, SELECT_MAP switches (firmware/app/map_set.h)
+//   map_reload       true | false  keep one spare map slot (as large as the largest map, +25 %) so
+//                    that SELECT_MAP with the reload flag can read a map's image from disk again,
+//                    check it and build it beside the one in use [false]
 //   workers          1..16 worker threads, created once  [2]
 //   cores            comma list of CPU ids for worker i  [0,1,...]; pinned to (core mod online CPUs)
 //   realtime         true | false  SCHED_FIFO + mlockall for every thread of the execution-context
@@ -52,6 +58,7 @@ constexpr std::size_t kMaxCanInterfaceName = 15;
 
 struct AppConfig {
   static constexpr int kMaxCores = 16;
+  static constexpr int kMaxMaps = 4;  // map + map.1 .. map.3
   static constexpr long kMaxBlackBoxFrames = 4194304;
   char laser[128] = {0};
   float laser_mount_yaw_deg = 0.0f;  // laser_mount: yaw of the laser on the robot (degrees, CCW)
@@ -62,6 +69,8 @@ struct AppConfig {
   char localizer[16] = "mml-track";
   int mml_preset = 3;
   char map[256] = {0};
+  char more_maps[kMaxMaps - 1][256] = {};  // map.1 .. map.3; empty = not set
+  bool map_reload = false;
   int workers = 2;
   int cores[kMaxCores] = {0};
   int num_cores = 0;         // 0 = default (worker i → core i)
@@ -88,6 +97,10 @@ struct AppConfig {
   char blackbox[256] = {0};             // empty = no black box file
   std::uint32_t blackbox_frames = 65536;
 };
+
+// Map ids: 0 is `map`, i ≥ 1 is `map.i`. map_count: how many are set (ids are consecutive).
+int map_count(const AppConfig& c);
+const char* map_path(const AppConfig& c, int id);  // "" when not set
 
 // Parses `text` (len bytes); `path` is used in messages (abbreviated to its last 96 characters).
 Status parse_app_config(const char* path, const char* text, std::size_t len, AppConfig* out);

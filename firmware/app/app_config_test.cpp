@@ -317,3 +317,47 @@ TEST(AppConfig, LaserMountKey) {
 
 }  // namespace
 }  // namespace fw
+
+namespace fw {
+namespace {
+
+// Several maps (issue 60): map = id 0, map.1 .. map.3 = ids 1..3, consecutive; map_reload.
+TEST(AppConfig, SeveralMapsByIdAndTheirErrors) {
+  AppConfig c;
+  Status s = parse("laser = socketcan:vcan0\nmap = a.mmap\nmap.1 = b.mmap\nmap.2 = c.mmap\nmap_reload = true\n", &c);
+  ASSERT_TRUE(s.is_ok()) << s.message();
+  EXPECT_EQ(map_count(c), 3);
+  EXPECT_STREQ(map_path(c, 0), "a.mmap");
+  EXPECT_STREQ(map_path(c, 1), "b.mmap");
+  EXPECT_STREQ(map_path(c, 2), "c.mmap");
+  EXPECT_STREQ(map_path(c, 3), "");
+  EXPECT_STREQ(map_path(c, 9), "");
+  EXPECT_TRUE(c.map_reload);
+  s = parse("laser = socketcan:vcan0\nmap = a.mmap\n", &c);
+  ASSERT_TRUE(s.is_ok()) << s.message();
+  EXPECT_EQ(map_count(c), 1);  // the one-map config as before
+  EXPECT_FALSE(c.map_reload);
+  struct Bad {
+    const char* text;
+    const char* must_contain;
+  } bad[] = {
+      {"map = a.mmap\nmap.0 = b.mmap\n", "line 3: key 'map.0': not a map key: map 0 is 'map'"},
+      {"map = a.mmap\nmap.4 = b.mmap\n", "key 'map.4': not a map key"},
+      {"map = a.mmap\nmap.x = b.mmap\n", "key 'map.x': not a map key"},
+      {"map = a.mmap\nmap.2 = c.mmap\n", "key 'map.2' is set but 'map.1' is not"},
+      {"map.1 = b.mmap\n", "key 'map.1' is set but 'map' is not"},
+      {"map = a.mmap\nmap.1 = b.mmap\nmap.1 = c.mmap\n", "key 'map.1' set again (first set on line 3)"},
+      {"map = a.mmap\nmap_reload = sometimes\n", "key 'map_reload': 'sometimes' is not true or false"},
+  };
+  for (const Bad& b : bad) {
+    s = parse(std::string("laser = socketcan:vcan0\n") + b.text, &c);
+    ASSERT_FALSE(s.is_ok()) << b.text;
+    EXPECT_NE(std::strstr(s.message(), b.must_contain), nullptr) << s.message();
+  }
+  s = parse("laser = socketcan:vcan0\nlocalizer = odom\nmap_reload = true\n", &c);
+  ASSERT_FALSE(s.is_ok());
+  EXPECT_NE(std::strstr(s.message(), "'map_reload' needs a map"), nullptr) << s.message();
+}
+
+}  // namespace
+}  // namespace fw

@@ -76,6 +76,14 @@ good ok "map '.*room.mmap' 120x80 cells at 0.050 m"
 conf ok_odom "${base[@]}" localizer=odom arena_mib=8
 good ok_odom "localizer odom"
 
+# Several maps (issue 60): each in its own slot, listed by id; a broken map.1 is named.
+conf two_maps "${base[@]}" "map = $W/room.mmap" "map.1 = $W/room.mmap" map_reload=true arena_mib=128
+good two_maps "map '.*room.mmap' 120x80 cells at 0.050 m (slot [0-9.]* MiB), map.1 '.*room.mmap' 120x80 cells at 0.050 m (slot [0-9.]* MiB), reload spare [0-9.]* MiB"
+conf bad_map1 "${base[@]}" "map = $W/room.mmap" "map.1 = $W/crc_grid.mmap" arena_mib=128
+bad bad_map1 "crc_grid.mmap: occupancy section CRC mismatch"
+conf gap_map2 "${base[@]}" "map = $W/room.mmap" "map.2 = $W/room.mmap" arena_mib=128
+bad gap_map2 "key 'map.2' is set but 'map.1' is not"
+
 # --- bad configs ----------------------------------------------------------------------------------
 bad no_such_config "config '.*no_such_config.conf': No such file or directory"
 conf unknown_key "${base[@]}" "map = $W/room.mmap" "bogus = 1"

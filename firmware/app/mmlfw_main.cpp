@@ -34,6 +34,7 @@
 #include <cstring>
 
 #include "firmware/app/app_config.h"
+#include "firmware/app/map_set.h"
 #include "firmware/app/memory_limits.h"
 #include "firmware/app/operator_io.h"
 #include "firmware/app/service_notify.h"
@@ -56,7 +57,12 @@ namespace {
 hal_linux::Board g_board;
 fw::StartupArena g_arena;
 fw::WorkerPool g_pool;
-fw::LocalizationSystem g_system;  // the localizer objects themselves live in the arena
+fw::LocalizationSystem g_system;  // without a map (localizer = odom); its objects live in the arena
+fw::MapSet g_maps;  // map, map.1 ..: one slot of the arena each, with its localizer (issue 60)
+// The system the loop steps: the active map's (SELECT_MAP switches), or the map-less one.
+fw::LocalizationSystem& active_system() { return g_maps.count() > 0 ? g_maps.active() : g_system; }
+// Told by the command handler after a switch: the loop steps the new map's localizer.
+void on_map_switch(void* loop, fw::Localizer& localizer) { static_cast<fw::LocalizationLoop*>(loop)->set_localizer(localizer); }
 fw::LocalizationLoop g_loop;
 fw::OperatorIo g_operator;  // commands from the bus, the black box (issue 60)
 fw::AppConfig g_config;
@@ -98,6 +104,7 @@ void print_help() {
       "  laser_mount = YAW_DEG[, upside-down]   (how the laser sits on the robot; default 0)\n"
       "  odometry = socketcan:IFACE | none    output = socketcan:IFACE | log    can_fd = auto|true|false\n"
       "  localizer = mml-track | mml | handoff | mcl | odom    map = IMAGE.mmap (mml-mapc)\n"
+      "  map.1 .. map.3 = IMAGE.mmap (more maps, one per floor: SELECT_MAP switches), map_reload = true|false\n"
       "  workers, cores, realtime, global_context, global_period_scans, arena_mib, step_deadline_ms,\n"
       "  health_period_ms, laser_timeout_ms, seed, mml_preset, log_level, odom_noise, odom_noise_per_step, odom_slip\n"
       "  blackbox = PATH | off, blackbox_frames = N   (the last frames in and out, written on DUMP_LOG, a fault, exit)\n"
@@ -126,9 +133,10 @@ namespace {
 void trace_step(hal::Hal& hal) {
   const hal::PoseEstimate& e = g_loop.last_estimate();
   const hal::Odometry& od = g_loop.last_odometry();
-  const fw::mml::MmlLocalizer* mml = g_system.mml();
-  if (e.mode == hal::LocalizationMode::kTracking && g_system.tracked() != nullptr) {
-    const fw::track::TrackStep& t = g_system.tracked()->tracker().last();
+  fw::LocalizationSystem& sys = active_system();
+  const fw::mml::MmlLocalizer* mml = sys.mml();
+  if (e.mode == hal::LocalizationMode::kTracking && sys.tracked() != nullptr) {
+    const fw::track::TrackStep& t = sys.tracked()->tracker().last();
     hal.log->log(hal::LogLevel::kDebug,
                  "step scan %u t %llu odom %.4f %.4f %.4f status %s pose %.3f %.3f %.3f track %s inliers %u/%u "
                  "unknown %u chi2 %.2f pl %.3f m %.4f rad unsupported %u reason %s",
@@ -139,7 +147,7 @@ void trace_step(hal::Hal& hal) {
     return;
   }
   // MML's state belongs to the global thread when it runs there: not read from here.
-  const bool mml_threaded = g_system.tracked() != nullptr && g_system.tracked()->global_context().threaded();
+  const bool mml_threaded = sys.tracked() != nullptr && sys.tracked()->global_context().threaded();
   if (mml == nullptr || mml_threaded) {
     hal.log->log(hal::LogLevel::kDebug, "step scan %u t %llu odom %.4f %.4f %.4f status %s pose %.3f %.3f %.3f", e.scan_id,
                  static_cast<unsigned long long>(e.timestamp_ns), od.x, od.y, od.theta, hal::status_name(e.status), e.x, e.y,
@@ -176,11 +184,7 @@ struct Startup {
   fw::Status board_status;
   bool board_ok = false;
   bool lock_refused = false;
-  fw::GlobalMap map{};
-  fw::MapImageFile image;
-  const std::uint8_t* table = nullptr;
-  std::size_t table_len = 0;
-  bool table_in_use = false;
+  std::size_t table_copy = 0;  // image pages kept for relation tables read in place (all maps)
   bool global_thread = false;
   fw::track::GlobalScheduleOptions live;
   fw::ExecutionContext global_ctx;
@@ -264,22 +268,6 @@ int prepare_memory_and_sensor_context(const Args& a, Startup* su) {
   return 0;
 }
 
-// The map image into the arena, and its relation table section if it has one. 0 = go on.
-int load_map(Startup* su) {
-  const fw::AppConfig& c = g_config;
-  if (!c.map[0]) return 0;
-  fw::Status st = su->image.open(c.map);
-  if (!st) return fail("map", st);
-  st = fw::load_map_image(su->image.data(), su->image.size(), g_arena, &su->map, c.map);
-  if (!st) return fail("map", st);
-  su->table = fw::find_section(su->image.data(), su->image.size(), fw::MapSectionType::kRelationTable2D, &su->table_len);
-  g_board.hal().log->log(hal::LogLevel::kInfo, "mmlfw: map '%s' %ux%u cells at %.3f m, %u points%s", c.map,
-                         su->map.geometry.width, su->map.geometry.height,
-                         static_cast<double>(su->map.geometry.resolution), su->map.num_points,
-                         su->table ? ", precomputed relation table" : "");
-  return 0;
-}
-
 // Worker threads, created once and pinned (the table's worker core first, then round). 0 = go on.
 int start_workers(const Args& a) {
   const fw::AppConfig& c = g_config;
@@ -303,13 +291,44 @@ int start_workers(const Args& a) {
   return 0;
 }
 
+// Every map of the config with its system (firmware/app/map_set.h), or the map-less system (odom);
+// then the global context threads (one per map) or the inline clock. Prints the failure; ok = go on.
+fw::Status build_systems(const fw::SystemSpec& sys, Startup* su) {
+  const fw::AppConfig& c = g_config;
+  hal::Hal& hal = g_board.hal();
+  fw::Status st;
+  if (fw::map_count(c) == 0) {
+    st = g_system.build(sys, fw::GlobalMap{}, nullptr, 0, g_arena, &g_pool);
+    if (!st) fail("localizer", st);
+  } else {
+    fw::MapSetSpec ms;
+    ms.count = fw::map_count(c);
+    for (int id = 0; id < ms.count; ++id) ms.paths[id] = fw::map_path(c, id);
+    ms.reload = c.map_reload;
+    ms.system = sys;
+    st = g_maps.init(ms, g_arena, &g_pool, hal.log);
+    if (!st) fail("map", st);
+    for (int id = 0; st && id < g_maps.count(); ++id) {
+      if (!g_maps.has_table(id) && std::strcmp(c.localizer, "odom") && std::strcmp(c.localizer, "mcl") && c.mml_preset != 1)
+        hal.log->log(hal::LogLevel::kInfo, "mmlfw: map %d image has no relation table; filling it at start-up", id);
+    }
+  }
+  if (!st) return st;
+  su->table_copy = g_maps.table_copy_bytes();
+  if (g_maps.count() > 0) {
+    st = g_maps.start_global_contexts(su->global_thread, c.realtime, hal.clock, su->global_ctx);
+  } else if (su->global_thread) {
+    st = g_system.start_global_context(c.realtime, hal.clock, su->global_ctx);
+  }
+  if (!st) fail("global context", st);
+  return st;
+}
+
 // The one start-up builder (firmware/app/system.h), as mml-sim, mml-eval and the replays use it;
 // the global context thread; the image kept only where the relation table is read in place. 0 = go on.
 int build_localizer(const Args& a, Startup* su) {
   const fw::AppConfig& c = g_config;
   hal::Hal& hal = g_board.hal();
-  if (!su->table && c.map[0] && std::strcmp(c.localizer, "odom") && std::strcmp(c.localizer, "mcl") && c.mml_preset != 1)
-    hal.log->log(hal::LogLevel::kInfo, "mmlfw: map image has no relation table; filling it at start-up");
   fw::SystemSpec sys;
   sys.localizer = c.localizer;
   sys.mml_preset = c.mml_preset;
@@ -330,31 +349,17 @@ int build_localizer(const Args& a, Startup* su) {
     sys.global_schedule = &su->live;
     sys.anytime_global = true;
   }
-  fw::Status st = g_system.build(sys, su->map, su->table, su->table_len, g_arena, &g_pool);
-  if (!st) return fail("localizer", st);
-  if (su->global_thread) {
-    st = g_system.start_global_context(c.realtime, hal.clock, su->global_ctx);
-    if (!st) return fail("global context", st);
-  } else if (g_system.tracked() != nullptr) {
-    g_system.tracked()->global_context().set_clock(hal.clock);
-  }
-  // The map now lives in the arena. The image is a start-up copy (map_image_file.h: the file on
-  // disk may be truncated or replaced while the firmware runs); a relation table section in use is
-  // read in place from that copy, so only its pages are kept.
-  su->table_in_use = su->table != nullptr && g_system.table_in_use();
-  if (su->table_in_use) {
-    st = su->image.retain(su->table, su->table_len);
-    if (!st) return fail("map", st);
-  } else {
-    su->image.close();
-  }
+  fw::Status st = build_systems(sys, su);
+  if (!st) return 1;
   fw::LocalizationLoopOptions lo;
   lo.step_deadline_ns = static_cast<std::uint64_t>(c.step_deadline_ms * 1e6);
   lo.laser_timeout_ns = static_cast<std::uint64_t>(c.laser_timeout_ms) * 1000000ull;
   if (su->board_ok) {
-    st = g_loop.init(hal, g_system.localizer(), lo);
+    st = g_loop.init(hal, active_system().localizer(), lo);
     if (!st) return fail("loop", st);
-    st = g_operator.init(c, g_arena, g_board, g_loop, g_system.localizer());
+    fw::OperatorMaps maps;
+    if (g_maps.count() > 0) maps = {&g_maps, &on_map_switch, &g_loop};
+    st = g_operator.init(c, g_arena, g_board, g_loop, active_system().localizer(), maps);
     if (!st) return fail("operator commands / black box", st);
   }
   return 0;
@@ -403,24 +408,28 @@ int memory_budget(const Args& a, const Startup& su) {
   mr.add({"hal", "board (sockets, CAN node rings, SICK/Hokuyo/RPLIDAR drivers)", sizeof(g_board), 0, nullptr});
   mr.add({"runtime", "localization loop (odometry ring, pending scan, perf)", sizeof(g_loop), 0, nullptr});
   mr.add({"runtime", "worker pool", sizeof(g_pool), static_cast<std::size_t>(c.workers), nullptr});
-  if (su.table_in_use) mr.add({"map", "relation table (image copy)", su.table_len, 0, nullptr});
+  if (su.table_copy > 0) mr.add({"map", "relation tables (image copies, all maps)", su.table_copy, 0, nullptr});
   g_arena.seal();
   // The map/pransam/mml regions are carved from the arena (listed for the breakdown), so the
   // footprint is the arena plus the static objects plus the relation table kept from the image.
   // (The localizer objects are in the arena: system.h.)
-  const std::size_t statics = sizeof(g_board) + sizeof(g_loop) + sizeof(g_pool) + sizeof(g_system);
-  const std::size_t table_copy = su.table_in_use ? su.image.mapped_bytes() : 0;
+  const std::size_t statics = sizeof(g_board) + sizeof(g_loop) + sizeof(g_pool) + sizeof(g_system) + sizeof(g_maps);
+  const std::size_t table_copy = su.table_copy;
   const std::uint64_t footprint = static_cast<std::uint64_t>(g_arena.capacity()) + statics + table_copy;
   const fw::Status memory_status =
       fw::check_memory_fits(footprint, fw::read_memory_limits(), "arena_mib + static objects + table");
   // The arena must hold its peak (the map loader's distance check is start-up scratch), not just
   // what stays allocated.
-  const std::size_t arena_need = g_arena.peak_used() > g_arena.used() ? g_arena.peak_used() : g_arena.used();
+  // With maps, each slot holds its own peak (map_set.h) and the arena's peak is the slots' carving
+  // (a slot takes the rest of the arena while it is built): what stays allocated is the need.
+  const std::size_t arena_need = g_maps.count() > 0 ? g_arena.used()
+                                 : g_arena.peak_used() > g_arena.used() ? g_arena.peak_used() : g_arena.used();
   if (!a.preflight()) {
     if (!memory_status) g_board.hal().log->log(hal::LogLevel::kWarning, "mmlfw: memory: %s", memory_status.message());
     return -1;
   }
   g_system.stop_global_context();
+  g_maps.stop_global_contexts();
   g_pool.stop();
   if (a.check_config) {
     const int problems = print_check_problems(a, su, &memory_status, 0);
@@ -428,17 +437,20 @@ int memory_budget(const Args& a, const Startup& su) {
       std::printf("mmlfw: check-config '%s': ok, static memory %.1f MiB (arena_mib %u reserved, %.1f MiB of it used at "
                   "the peak; static objects %.1f MiB; relation table copy %.1f MiB); localizer %s",
                   a.config_path, footprint / 1048576.0, c.arena_mib, arena_need / 1048576.0, statics / 1048576.0,
-                  table_copy / 1048576.0, g_system.localizer().name());
-      if (c.map[0]) {
-        std::printf(", map '%s' %ux%u cells at %.3f m", c.map, su.map.geometry.width, su.map.geometry.height,
-                    static_cast<double>(su.map.geometry.resolution));
+                  table_copy / 1048576.0, active_system().localizer().name());
+      for (int id = 0; id < g_maps.count(); ++id) {
+        const fw::GlobalMap& m = g_maps.map(id);
+        std::printf(", map%s%.0d '%s' %ux%u cells at %.3f m (slot %.1f MiB)", id ? "." : "", id, g_maps.path(id),
+                    m.geometry.width, m.geometry.height, static_cast<double>(m.geometry.resolution),
+                    g_maps.slot_bytes(id) / 1048576.0);
       }
+      if (g_maps.spare_bytes() > 0) std::printf(", reload spare %.1f MiB", g_maps.spare_bytes() / 1048576.0);
       std::printf(", board %s\n", g_board.describe());
     }
     return problems == 0 ? 0 : 1;
   }
   std::printf("mmlfw memory report (config '%s', localizer %s, arena used %zu of %zu bytes)\n", a.config_path,
-              g_system.localizer().name(), g_arena.used(), g_arena.capacity());
+              active_system().localizer().name(), g_arena.used(), g_arena.capacity());
   mr.print(stdout);
   std::printf("footprint: arena reserved %.3f MiB (used %.3f MiB) + static objects %.3f MiB + relation table "
               "(image copy) %.3f MiB = %.3f MiB (%.3f MiB with the arena trimmed to its peak use)\n",
@@ -507,7 +519,8 @@ std::uint64_t run_loop(const Args& a) {
   sigaction(SIGTERM, &sa, nullptr);
   signal(SIGPIPE, SIG_IGN);
 
-  hal.log->log(hal::LogLevel::kInfo, "mmlfw: running (localizer %s, %d workers)", g_system.localizer().name(), c.workers);
+  hal.log->log(hal::LogLevel::kInfo, "mmlfw: running (localizer %s, %d workers, %d map(s))", active_system().localizer().name(), c.workers,
+               g_maps.count());
   const std::uint64_t t_start = hal.clock->now_ns();
   const std::uint64_t health_period = static_cast<std::uint64_t>(c.health_period_ms) * 1000000ull;
   std::uint64_t last_health = t_start;
@@ -557,11 +570,11 @@ void print_timing_report(const Startup& su) {
   row("sensor", g_loop.perf_step().name(), g_loop.perf_step().stats(), sensor_ms);
   row("sensor", g_loop.perf_publish().name(), g_loop.perf_publish().stats(), 0);
   row("sensor", g_loop.perf_total().name(), g_loop.perf_total().stats(), 0);
-  if (const fw::track::TrackedLocalizer* t = g_system.tracked()) {
+  if (const fw::track::TrackedLocalizer* t = active_system().tracked()) {
     const fw::track::GlobalContext& gc = t->global_context();
     row(su.global_thread ? "global" : "sensor", "global.step", gc.step_stats(),
         su.global_thread ? su.global_ctx.deadline_ns * 1e-6 : 0);
-    if (const fw::mml::MmlLocalizer* m = g_system.mml(); m != nullptr && su.global_thread) {
+    if (const fw::mml::MmlLocalizer* m = active_system().mml(); m != nullptr && su.global_thread) {
       // The global step's stages (timed in deadline mode; read after the global thread stopped).
       row("global", m->front_end_perf().name(), m->front_end_perf().stats(), 0);
       row("global", m->match_perf().name(), m->match_perf().stats(), 0);
@@ -632,7 +645,6 @@ int main(int argc, char** argv) {
   Startup& su = g_startup;
   if (const int rc = open_board(a, &su)) return rc;
   if (const int rc = prepare_memory_and_sensor_context(a, &su)) return stage_failed(a, su, rc);
-  if (const int rc = load_map(&su)) return stage_failed(a, su, rc);
   if (const int rc = start_workers(a)) return stage_failed(a, su, rc);
   if (const int rc = build_localizer(a, &su)) return stage_failed(a, su, rc);
   if (const int rc = memory_budget(a, su); rc >= 0) return rc;
@@ -640,6 +652,7 @@ int main(int argc, char** argv) {
   g_notify.send("STOPPING=1");
   g_operator.dump("exit");
   g_system.stop_global_context();  // before the pool it drives
+  g_maps.stop_global_contexts();
   if (a.timing_report) print_timing_report(su);
   print_summary(step_errors);
   g_pool.stop();

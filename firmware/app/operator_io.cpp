@@ -6,7 +6,7 @@
 namespace fw {
 
 Status OperatorIo::init(const AppConfig& c, StartupArena& arena, hal_linux::Board& board, LocalizationLoop& loop,
-                        Localizer& localizer) {
+                        Localizer& localizer, const OperatorMaps& maps) {
   config_ = &c;
   hal_ = &board.hal();
   if (c.blackbox[0] && c.blackbox_frames > 0) {
@@ -24,7 +24,10 @@ Status OperatorIo::init(const AppConfig& c, StartupArena& arena, hal_linux::Boar
     }
   }
   CommandHandlerOptions o;
-  o.active_map_id = 0;  // one map per mmlfw (README "Commands": SELECT_MAP of another id is unknown-map)
+  o.active_map_id = 0;  // map 0 is active after start-up
+  o.maps = maps.selector;
+  o.on_switch = maps.on_switch;
+  o.switch_ctx = maps.ctx;
   if (box_.enabled()) {
     o.dump = &OperatorIo::dump_command;
     o.dump_ctx = this;

@@ -15,12 +15,20 @@
 
 namespace fw {
 
+// Several maps (map_set.h): SELECT_MAP switches through `selector`; `on_switch(ctx, localizer)` hands
+// the new map's localizer to the loop. Empty = one map (SELECT_MAP of map 0 only).
+struct OperatorMaps {
+  MapSelector* selector = nullptr;
+  void (*on_switch)(void* ctx, Localizer& localizer) = nullptr;
+  void* ctx = nullptr;
+};
+
 class OperatorIo {
  public:
   // Start-up: the black box (config blackbox, blackbox_frames; a serial board has none: a warning)
   // and the command handler on the loop. Errors name the part.
   Status init(const AppConfig& config, StartupArena& arena, hal_linux::Board& board, LocalizationLoop& loop,
-              Localizer& localizer);
+              Localizer& localizer, const OperatorMaps& maps = {});
   // Writes the black box now (DUMP_LOG, exit); logs the bytes or the error.
   Status dump(const char* why);
   // Every loop cycle: a fault bit that was clear is set → one dump.

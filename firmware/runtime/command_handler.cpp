@@ -46,13 +46,45 @@ hal::CommandResult CommandHandler::hint(const hal::PoseHint& h) {
     if (hal_ != nullptr && hal_->log != nullptr) hal_->log->log(hal::LogLevel::kWarning, "command: %s", s.message());
     return hal::CommandResult::kInvalidArgument;
   }
-  if (h.map_id != options_.active_map_id) return hal::CommandResult::kUnknownMap;
+  if (h.map_id != active_map()) return hal::CommandResult::kUnknownMap;
   const Status t = localizer_->set_pose_hint(h);
   if (!t) {
     if (hal_ != nullptr && hal_->log != nullptr) hal_->log->log(hal::LogLevel::kWarning, "command: %s", t.message());
     return t.code() == Errc::kUnsupported ? hal::CommandResult::kUnsupported : hal::CommandResult::kInvalidArgument;
   }
   return hal::CommandResult::kAccepted;
+}
+
+// A switch (or a reload) that fails leaves the active map and its localizer as they were.
+hal::CommandResult CommandHandler::select_map(const hal::Command& c) {
+  if (localizer_ == nullptr) return hal::CommandResult::kUnsupported;
+  if (options_.maps == nullptr) {
+    if (c.map_id != options_.active_map_id) return hal::CommandResult::kUnknownMap;
+    if (c.reload) return hal::CommandResult::kUnsupported;  // nothing to reload into
+    // The same map again: a fresh start on it (nothing `localized` survives a map selection).
+    localizer_->reset();
+    return c.has_hint ? hint(c.hint) : hal::CommandResult::kDone;
+  }
+  Result<Localizer*> r = options_.maps->select(c.map_id, c.reload);
+  if (!r) {
+    if (hal_ != nullptr && hal_->log != nullptr) {
+      hal_->log->log(hal::LogLevel::kWarning, "command: SELECT_MAP %u%s: %s", c.map_id, c.reload ? " reload" : "",
+                     r.status().message());
+    }
+    switch (r.status().code()) {
+      case Errc::kNotFound: return hal::CommandResult::kUnknownMap;
+      case Errc::kCorruptData:
+      case Errc::kIoError: return hal::CommandResult::kMapInvalid;
+      case Errc::kUnsupported: return hal::CommandResult::kUnsupported;
+      default: return hal::CommandResult::kFailed;
+    }
+  }
+  localizer_ = *r;
+  if (options_.on_switch != nullptr) options_.on_switch(options_.switch_ctx, *localizer_);
+  if (hal_ != nullptr && hal_->log != nullptr) {
+    hal_->log->log(hal::LogLevel::kInfo, "command: SELECT_MAP: map %u active%s", c.map_id, c.reload ? " (reloaded)" : "");
+  }
+  return c.has_hint ? hint(c.hint) : hal::CommandResult::kDone;
 }
 
 hal::CommandReply CommandHandler::handle(const hal::Command& c) {
@@ -67,15 +99,7 @@ hal::CommandReply CommandHandler::handle(const hal::Command& c) {
       r.result = localizer_ != nullptr ? hint(c.hint) : hal::CommandResult::kUnsupported;
       break;
     case hal::CommandKind::kSelectMap:
-      if (c.map_id != options_.active_map_id) {
-        r.result = hal::CommandResult::kUnknownMap;
-      } else if (localizer_ == nullptr) {
-        r.result = hal::CommandResult::kUnsupported;
-      } else {
-        // The same map again: a fresh start on it (nothing `localized` survives a map selection).
-        localizer_->reset();
-        r.result = c.has_hint ? hint(c.hint) : hal::CommandResult::kDone;
-      }
+      r.result = select_map(c);
       break;
     case hal::CommandKind::kDumpLog:
       r.result = options_.dump == nullptr            ? hal::CommandResult::kUnsupported
@@ -86,6 +110,7 @@ hal::CommandReply CommandHandler::handle(const hal::Command& c) {
       r.result = hal::CommandResult::kMalformed;
       break;
   }
+  r.detail = active_map();  // after the command: the map now in use
   if (r.result == hal::CommandResult::kAccepted || r.result == hal::CommandResult::kDone) {
     ++counters_.accepted;
   } else {

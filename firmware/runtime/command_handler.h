@@ -4,9 +4,12 @@
 // code, never a crash) and answered through PoseSink::publish_reply:
 //   SET_POSE_HINT  → Localizer::set_pose_hint; `accepted` means it will be verified on the next
 //                    scan, the verdict follows in HEALTH.HintStatus and POSE.Reason
-//   SELECT_MAP     → only the active map is loaded (map id options.active_map_id): selecting it
-//                    restarts the localizer (the tracker drops `localized`, the global search
-//                    starts again) and takes its hint if given; another id is `unknown-map`
+//   SELECT_MAP     → with options.maps (several maps, firmware/runtime/map_selector.h): the map
+//                    set switches to that map's localizer (reset: the tracker drops `localized`,
+//                    the global search runs on the new map), reloading its image first when asked
+//                    (a missing or broken file: `map-invalid`, the map in use stays); then its hint
+//                    if given. Without: only the active map (options.active_map_id) — selecting it
+//                    restarts the localizer, another id is `unknown-map`
 //   DUMP_LOG       → options.dump (the app writes the black box); `done` or `failed`
 #pragma once
 
@@ -14,6 +17,7 @@
 
 #include "firmware/base/status.h"
 #include "firmware/runtime/localizer.h"
+#include "firmware/runtime/map_selector.h"
 #include "hal/hal.h"
 
 namespace fw {
@@ -23,6 +27,11 @@ struct CommandHandlerOptions {
   // DUMP_LOG: writes the black box; null = no black box (the reply is `unsupported`).
   Status (*dump)(void* ctx) = nullptr;
   void* dump_ctx = nullptr;
+  // Several maps: SELECT_MAP switches through it (and active_map_id follows it); null = one map.
+  MapSelector* maps = nullptr;
+  // Told the new localizer after a switch (the loop steps it from then on); null = nobody.
+  void (*on_switch)(void* ctx, Localizer& localizer) = nullptr;
+  void* switch_ctx = nullptr;
 };
 
 struct CommandCounters {
@@ -45,6 +54,8 @@ class CommandHandler {
 
  private:
   hal::CommandResult hint(const hal::PoseHint& h);
+  hal::CommandResult select_map(const hal::Command& c);
+  std::uint8_t active_map() const { return options_.maps != nullptr ? options_.maps->active_id() : options_.active_map_id; }
   hal::Hal* hal_ = nullptr;
   Localizer* localizer_ = nullptr;
   CommandHandlerOptions options_;

@@ -94,6 +94,67 @@ TEST(CommandHandlerTest, SelectMapAndDumpLog) {
   EXPECT_EQ(h.handle(c).result, hal::CommandResult::kMalformed);
 }
 
+// Several maps: a fake MapSelector with two localizers (the MapSet itself: sim/cli/map_switch_test).
+class TwoMaps final : public MapSelector {
+ public:
+  Result<Localizer*> select(std::uint8_t id, bool reload) override {
+    if (id > 1) return Status::error(Errc::kNotFound, "map %u: no such map", id);
+    if (reload && broken) return Status::error(Errc::kCorruptData, "b.mmap: occupancy section CRC mismatch");
+    active = id;
+    loc[id].reset();
+    return &loc[id];
+  }
+  std::uint8_t active_id() const override { return active; }
+  HintedLocalizer loc[2];
+  std::uint8_t active = 0;
+  bool broken = false;
+};
+
+TEST(CommandHandlerTest, SelectMapSwitchesThroughTheSelector) {
+  TwoMaps maps;
+  Localizer* stepped = &maps.loc[0];
+  CommandHandlerOptions o;
+  o.maps = &maps;
+  o.on_switch = [](void* ctx, Localizer& l) { *static_cast<Localizer**>(ctx) = &l; };
+  o.switch_ctx = &stepped;
+  CommandHandler h;
+  h.init(nullptr, &maps.loc[0], o);
+  hal::Command c;
+  c.kind = hal::CommandKind::kSelectMap;
+  c.map_id = 1;
+  hal::CommandReply r = h.handle(c);
+  EXPECT_EQ(r.result, hal::CommandResult::kDone);
+  EXPECT_EQ(r.detail, 1);
+  EXPECT_EQ(stepped, &maps.loc[1]);
+  EXPECT_EQ(maps.loc[1].resets, 1);
+  // A hint now refers to map 1; one for map 0 is unknown-map.
+  hal::Command hc = hint(1.0f, 0.2f);
+  hc.hint.map_id = 0;
+  EXPECT_EQ(h.handle(hc).result, hal::CommandResult::kUnknownMap);
+  hc.hint.map_id = 1;
+  EXPECT_EQ(h.handle(hc).result, hal::CommandResult::kAccepted);
+  EXPECT_EQ(maps.loc[1].hints, 1);
+  EXPECT_EQ(maps.loc[0].hints, 0);
+  // Unknown id, broken reload: refused, map 1 stays and is not reset.
+  c.map_id = 5;
+  r = h.handle(c);
+  EXPECT_EQ(r.result, hal::CommandResult::kUnknownMap);
+  EXPECT_EQ(r.detail, 1);
+  maps.broken = true;
+  c.map_id = 0;
+  c.reload = true;
+  r = h.handle(c);
+  EXPECT_EQ(r.result, hal::CommandResult::kMapInvalid);
+  EXPECT_EQ(r.detail, 1);
+  EXPECT_EQ(stepped, &maps.loc[1]);
+  EXPECT_EQ(maps.loc[1].resets, 1);
+  // Without a selector a reload cannot be done.
+  CommandHandler one;
+  one.init(nullptr, &maps.loc[0], CommandHandlerOptions());
+  c.map_id = 0;
+  EXPECT_EQ(one.handle(c).result, hal::CommandResult::kUnsupported);
+}
+
 TEST(CommandHandlerTest, LocalizersWithoutHintsAndNoBlackBoxSaySo) {
   PlainLocalizer loc;
   CommandHandler h;

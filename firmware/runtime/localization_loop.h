@@ -82,6 +82,9 @@ class LocalizationLoop {
   // Operator commands (hal.commands): carried out at the start of every spin_once, before the scan
   // (command_handler.h). Null = commands are not read.
   void set_command_handler(CommandHandler* handler) { commands_ = handler; }
+  // SELECT_MAP of another map (command_handler.h): the next steps go to that map's localizer. The
+  // odometry history stays (the wheels are the same robot on every floor); the pending scan too.
+  void set_localizer(Localizer& localizer) { localizer_ = &localizer; }
 
   bool stepped() const { return stepped_; }
   // True while a scan waits for odometry.

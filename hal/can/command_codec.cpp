@@ -46,9 +46,11 @@ fw::Status encode_command(const hal::Command& c, bool fd, hal::CanFrame* out, st
   if (capacity < 1) return fw::Status::error(fw::Errc::kCapacityExceeded, "encode command: no room for a frame");
   if (c.kind == hal::CommandKind::kDumpLog || (c.kind == hal::CommandKind::kSelectMap && !c.has_hint)) {
     const bool dump = c.kind == hal::CommandKind::kDumpLog;
-    single_frame(dump ? kDumpLogId : kSelectMapId, dump ? 1 : 2, &out[0]);
+    // SELECT_MAP is 3 bytes since the reload flag (older firmware reads the first 2 of it).
+    single_frame(dump ? kDumpLogId : kSelectMapId, dump ? 1 : 3, &out[0]);
     out[0].data[0] = c.seq;
     out[0].data[1] = dump ? 0 : c.map_id;
+    if (!dump && c.reload) out[0].data[2] = kSelectMapFlagReload;
     *count = 1;
     return fw::Status::ok();
   }
@@ -67,6 +69,7 @@ fw::Status encode_command(const hal::Command& c, bool fd, hal::CanFrame* out, st
   std::uint8_t p[kHintPayload] = {};
   p[0] = c.kind == hal::CommandKind::kSelectMap ? c.map_id : h.map_id;
   p[1] = c.kind == hal::CommandKind::kSelectMap ? kHintFlagSelectMap : 0;
+  if (c.kind == hal::CommandKind::kSelectMap && c.reload) p[1] |= kHintFlagReload;
   put_u32(p + 2, static_cast<std::uint32_t>(x));
   put_u32(p + 7, static_cast<std::uint32_t>(y));
   put_u16(p + 11, sxy);
@@ -95,12 +98,14 @@ Decoded Decoder::feed_command(std::uint32_t id, bool fd_id, const hal::CanFrame&
                             : feed_part(&hint_rec_, kPoseHintParts, id - kPoseHintId, f);
     if (!done) return Decoded::kNothing;
     const std::uint8_t* p = hint_rec_.bytes;
-    if ((p[1] & ~kHintFlagSelectMap) != 0) return command_malformed();  // reserved flags
+    // Reserved flags, or reload without select (a hint alone never reloads a map).
+    if ((p[1] & ~(kHintFlagSelectMap | kHintFlagReload)) != 0 || p[1] == kHintFlagReload) return command_malformed();
     command_ = hal::Command{};
     command_.timestamp_ns = f.timestamp_ns;
     command_.seq = hint_rec_.tag;
     command_.kind = (p[1] & kHintFlagSelectMap) ? hal::CommandKind::kSelectMap : hal::CommandKind::kSetPoseHint;
     command_.map_id = p[0];
+    command_.reload = (p[1] & kHintFlagReload) != 0;
     command_.has_hint = true;
     hal::PoseHint& h = command_.hint;
     h.map_id = p[0];
@@ -124,6 +129,10 @@ Decoded Decoder::feed_command(std::uint32_t id, bool fd_id, const hal::CanFrame&
     command_.kind = dump ? hal::CommandKind::kDumpLog : hal::CommandKind::kSelectMap;
     command_.seq = f.data[0];
     command_.map_id = dump ? 0 : f.data[1];
+    if (!dump && f.len >= 3) {
+      if ((f.data[2] & ~kSelectMapFlagReload) != 0) return command_malformed();  // reserved flags
+      command_.reload = (f.data[2] & kSelectMapFlagReload) != 0;
+    }
     ++stats_.commands_ok;
     return Decoded::kCommand;
   }

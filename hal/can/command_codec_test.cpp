@@ -71,6 +71,24 @@ TEST(CommandCodec, SelectMapWithAndWithoutHintAndDumpLog) {
   ASSERT_EQ(d.feed(f[0]), Decoded::kCommand);
   EXPECT_FALSE(d.command().has_hint);
   EXPECT_EQ(d.command().map_id, 2);
+  EXPECT_FALSE(d.command().reload);
+  // The reload flag: on the plain frame (byte 2) and in a hint record (flags bit 1).
+  c.reload = true;
+  ASSERT_TRUE(encode_command(c, false, f, kMaxParts, &n).is_ok());
+  ASSERT_EQ(d.feed(f[0]), Decoded::kCommand);
+  EXPECT_TRUE(d.command().reload);
+  f[0].data[2] = 0x80;  // a reserved flag
+  EXPECT_EQ(d.feed(f[0]), Decoded::kNothing);
+  f[0].len = 2;         // an older sender's 2-byte frame: no reload
+  ASSERT_EQ(d.feed(f[0]), Decoded::kCommand);
+  EXPECT_FALSE(d.command().reload);
+  c.has_hint = true;
+  ASSERT_TRUE(encode_command(c, true, f, kMaxParts, &n).is_ok());
+  for (std::size_t i = 0; i < n; ++i) got = d.feed(f[i]);
+  ASSERT_EQ(got, Decoded::kCommand);
+  EXPECT_TRUE(d.command().reload);
+  EXPECT_TRUE(d.command().has_hint);
+  c.reload = false;
   c.kind = hal::CommandKind::kDumpLog;
   c.seq = 99;
   ASSERT_TRUE(encode_command(c, true, f, kMaxParts, &n).is_ok());

@@ -196,6 +196,18 @@ TEST(Dbc, DescribesEveryFrameTheEncoderProduces) {
     EXPECT_EQ(f[0].len, dbc.at(f[0].id).dlc);
     EXPECT_EQ(sig(dbc, f, n, "Seq"), 4);
     EXPECT_EQ(sig(dbc, f, n, "MapId"), 7);
+    EXPECT_EQ(sig(dbc, f, n, "Reload"), 0);
+    c.reload = true;
+    ASSERT_TRUE(encode_command(c, fd, f, kMaxParts, &n).is_ok());
+    EXPECT_EQ(sig(dbc, f, n, "Reload"), 1);
+    EXPECT_EQ(sig(dbc, f, n, "MapId"), 7);
+    c.has_hint = true;  // a hint with select and reload: Flags 3
+    c.hint.sigma_xy_m = 0.3f;
+    c.hint.sigma_theta_rad = 0.1f;
+    ASSERT_TRUE(encode_command(c, fd, f, kMaxParts, &n).is_ok());
+    EXPECT_EQ(sig(dbc, f, n, "Flags"), 3);
+    c.has_hint = false;
+    c.reload = false;
     c.kind = hal::CommandKind::kDumpLog;
     ASSERT_TRUE(encode_command(c, fd, f, kMaxParts, &n).is_ok());
     EXPECT_EQ(dbc.at(f[0].id).name, "DUMP_LOG");
@@ -211,6 +223,9 @@ TEST(Dbc, DescribesEveryFrameTheEncoderProduces) {
     EXPECT_EQ(sig(dbc, f, 1, "Command"), 2);
     EXPECT_EQ(sig(dbc, f, 1, "Result"), 3);
     EXPECT_EQ(sig(dbc, f, 1, "Detail"), 1);
+    rep.result = hal::CommandResult::kMapInvalid;
+    encode_reply(rep, &f[0]);
+    EXPECT_EQ(sig(dbc, f, 1, "Result"), 7);
 
     hal::LaserScan s;
     s.scan_id = 77;

@@ -6,6 +6,14 @@
 //                     (TrackOptions::hint_awaits_mml) and `_fast` (off=hint_awaits_mml).
 //                     scans_to_localized: the hint's scan counts as 1 (worst case over the hints).
 //                     integrity failures: `localized` steps after the hint beyond 0.5 m / 5°.
+//   map_switch_*      a lift ride (issue 60, several maps; sim/cli/map_switch_scenario.h): localized
+//                     on one built-in world, carried to another, SELECT_MAP of its map; both ways
+//                     (small office <-> large office), seeds 1-4. map_switch_s: robot time from the
+//                     SELECT_MAP to the first `localized` pose on the new map (median, max);
+//                     map_switch_select_cpu_s: CPU time of the switch itself (max); _steps_cpu_s: of
+//                     the new map's steps until that pose (median); integrity failures: `localized`
+//                     on the new map beyond 0.5 m / 5° (0 required); map_reload_corrupt_refused: a
+//                     corrupted image refused by a reload, the map in use still localizing.
 //   blackbox_*        a 300-scan run with --transport can recorded, written, replayed through the
 //                     CanNode in lockstep; replay_identical = the POSE frames match bit for bit.
 // Argument: the JSON path.
@@ -16,6 +24,7 @@
 #include <string>
 #include <vector>
 
+#include "sim/cli/map_switch_scenario.h"
 #include "sim/cli/sim_runner.h"
 #include "sim/common/bench_json.h"
 
@@ -207,14 +216,89 @@ void black_box_figures(sim::BenchJson* j) {
   std::filesystem::remove_all(dir);
 }
 
+double median(std::vector<double> v) {
+  if (v.empty()) return NAN;
+  std::sort(v.begin(), v.end());
+  return v[v.size() / 2];
+}
+
+void map_switch_figures(sim::BenchJson* j) {
+  const std::string dir = std::filesystem::temp_directory_path() / "mmlfw_bench_map_switch";
+  std::filesystem::create_directories(dir);
+  std::vector<double> secs, steps_cpu;
+  double select_cpu_max = 0, secs_max = 0;
+  long failures = 0, runs = 0, localized_runs = 0, scans_max = 0;
+  std::size_t slot_max = 0;
+  const char* worlds[2][2] = {{"small-office", "large-office"}, {"large-office", "small-office"}};
+  for (const auto& w : worlds) {
+    for (std::uint64_t seed = 1; seed <= 4; ++seed) {
+      sim::MapSwitchOptions o;
+      o.dir = dir;
+      o.world_a = w[0];
+      o.world_b = w[1];
+      o.seed = seed;
+      o.scans_a = std::string(w[0]) == "large-office" ? 150 : 80;
+      o.scans_b = 200;
+      sim::MapSwitchResult r;
+      std::string err;
+      if (!sim::run_map_switch(o, &r, &err)) {
+        std::fprintf(stderr, "bench ops: map switch %s -> %s seed %llu failed: %s\n", w[0], w[1],
+                     static_cast<unsigned long long>(seed), err.c_str());
+        continue;
+      }
+      ++runs;
+      failures += r.integrity_failures;
+      select_cpu_max = std::max(select_cpu_max, r.select_cpu_s);
+      slot_max = std::max({slot_max, r.slot_bytes_a, r.slot_bytes_b});
+      std::fprintf(stderr, "bench ops: map switch %s -> %s seed %llu: A localized %d, reply %s, first localized on B "
+                   "after %ld scans (%.1f s, steps %.3f s CPU), switch %.6f s CPU, %ld wrong\n", w[0], w[1],
+                   static_cast<unsigned long long>(seed), r.localized_on_a ? 1 : 0,
+                   hal::command_result_name(r.switch_reply), r.scans_to_localized, r.seconds_to_localized,
+                   r.steps_cpu_s, r.select_cpu_s, r.integrity_failures);
+      if (r.scans_to_localized < 0) continue;
+      ++localized_runs;
+      secs.push_back(r.seconds_to_localized);
+      steps_cpu.push_back(r.steps_cpu_s);
+      secs_max = std::max(secs_max, r.seconds_to_localized);
+      scans_max = std::max(scans_max, r.scans_to_localized);
+    }
+  }
+  j->add("map_switch_s", median(secs));
+  j->add("map_switch_s_max", secs_max);
+  j->add_int("map_switch_scans_max", scans_max);
+  j->add("map_switch_select_cpu_s", select_cpu_max);
+  j->add("map_switch_steps_cpu_s", median(steps_cpu));
+  j->add_int("map_switch_integrity_failures", failures);
+  j->add_int("map_switch_runs", runs);
+  j->add_int("map_switch_localized_runs", localized_runs);
+  j->add("map_slot_mib_max", slot_max / 1048576.0);
+  // The corrupt reload: refused, named, the map in use still localizing.
+  sim::MapSwitchOptions o;
+  o.dir = dir;
+  o.reload_slot = true;
+  o.scans_after_corrupt = 60;
+  sim::MapSwitchResult r;
+  std::string err;
+  const bool ok = sim::run_map_switch(o, &r, &err);
+  std::fprintf(stderr, "bench ops: corrupt reload: reply %s, '%s', active map %u, %ld localized of %zu after it\n",
+               hal::command_result_name(r.corrupt_reply), ok ? r.corrupt_message.c_str() : err.c_str(),
+               r.active_after_corrupt, r.localized_after_corrupt, o.scans_after_corrupt);
+  j->add_bool("map_reload_corrupt_refused", ok && r.corrupt_reply == hal::CommandResult::kMapInvalid &&
+                                                r.active_after_corrupt == 1 && r.localized_after_corrupt > 0);
+  j->add_int("map_switch_integrity_failures_after_corrupt_reload", r.integrity_failures);
+  std::filesystem::remove_all(dir);
+}
+
 }  // namespace
 
 int main(int argc, char** argv) {
   if (argc < 2) {
-    std::fprintf(stderr, "usage: bench_ops OUT.json\n");
+    std::fprintf(stderr, "usage: bench_ops OUT.json [--only-map-switch]\n");
     return 2;
   }
   sim::BenchJson j;
+  map_switch_figures(&j);
+  if (argc > 2 && std::string(argv[2]) == "--only-map-switch") return j.write(argv[1]) ? 0 : 1;
   black_box_figures(&j);
   baseline_figure(&j);
   hint_figures(&j);

@@ -53,7 +53,10 @@ bool flag_value(const std::vector<std::string>& args, std::size_t* i, std::strin
 std::string ctl_usage() {
   return "usage: mml-ctl [--iface can0] [--fd] [--seq N] [--timeout-ms MS] [--print] COMMAND\n"
          "  hint X Y THETA_DEG [SIGMA_M SIGMA_DEG] [--map ID]   SET_POSE_HINT (sigma default 0.2 m, 5 deg)\n"
-         "  select-map ID [X Y THETA_DEG [SIGMA_M SIGMA_DEG]]   SELECT_MAP, optionally with a hint\n"
+         "  select-map ID [X Y THETA_DEG [SIGMA_M SIGMA_DEG]] [--reload]   SELECT_MAP, optionally with a hint;\n"
+         "                                                      --reload: the firmware reads the map's image\n"
+         "                                                      from disk again first (checked; a broken one is\n"
+         "                                                      refused, the map in use stays)\n"
          "  dump-log                                            DUMP_LOG: write the black box now\n"
          "Sends the command on IFACE (SocketCAN) and prints the firmware's COMMAND_REPLY (exit 0 when\n"
          "accepted or done, 1 when refused or no reply within the timeout). --print: only print the\n"
@@ -69,6 +72,8 @@ bool parse_ctl_args(const std::vector<std::string>& args, CtlArgs* out, std::str
     std::string v;
     if (a == "--fd") {
       out->fd = true;
+    } else if (a == "--reload") {
+      out->command.reload = true;
     } else if (a == "--print") {
       out->print = true;
     } else if (a == "--iface" || a == "--map" || a == "--seq" || a == "--timeout-ms") {
@@ -89,6 +94,10 @@ bool parse_ctl_args(const std::vector<std::string>& args, CtlArgs* out, std::str
     return false;
   }
   hal::Command& c = out->command;
+  if (c.reload && pos[0] != "select-map") {
+    *err = "--reload goes with select-map only";
+    return false;
+  }
   c.seq = static_cast<std::uint8_t>(seq);
   out->timeout_ms = static_cast<int>(timeout);
   if (pos[0] == "hint") {

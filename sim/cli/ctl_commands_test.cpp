@@ -35,7 +35,12 @@ TEST(CtlCommands, SelectMapAndDumpLog) {
   ASSERT_TRUE(parse_ctl_args({"select-map", "2"}, &a, &err)) << err;
   std::vector<hal::CanFrame> f;
   ASSERT_TRUE(ctl_frames(a, &f, &err));
-  EXPECT_EQ(cansend_arg("can0", f[0]), "can0 148#0002");
+  EXPECT_EQ(cansend_arg("can0", f[0]), "can0 148#000200");
+  ASSERT_TRUE(parse_ctl_args({"select-map", "1", "--reload"}, &a, &err)) << err;
+  ASSERT_TRUE(ctl_frames(a, &f, &err));
+  EXPECT_EQ(cansend_arg("can0", f[0]), "can0 148#000101");
+  EXPECT_FALSE(parse_ctl_args({"--reload", "dump-log"}, &a, &err));
+  EXPECT_NE(err.find("--reload goes with select-map only"), std::string::npos) << err;
   ASSERT_TRUE(parse_ctl_args({"select-map", "1", "3", "4", "0"}, &a, &err)) << err;
   EXPECT_TRUE(a.command.has_hint);
   ASSERT_TRUE(parse_ctl_args({"--print", "dump-log"}, &a, &err)) << err;

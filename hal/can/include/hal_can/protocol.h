@@ -31,7 +31,7 @@ constexpr std::uint32_t kPoseId = 0x120;       // 6 parts 0x120..0x125; FD 0x520
 constexpr std::uint32_t kHealthId = 0x130;     // 5 parts 0x130..0x134; FD 0x530
 // Operator commands (issue 60; hal/msg/command.h), after everything the localization needs.
 constexpr std::uint32_t kPoseHintId = 0x140;      // SET_POSE_HINT: 3 parts 0x140..0x142; FD 0x540 (24 B)
-constexpr std::uint32_t kSelectMapId = 0x148;     // SELECT_MAP: [seq u8][map id u8] (2 bytes)
+constexpr std::uint32_t kSelectMapId = 0x148;     // SELECT_MAP: [seq u8][map id u8][flags u8] (3 bytes; 2 from older senders)
 constexpr std::uint32_t kDumpLogId = 0x149;       // DUMP_LOG: [seq u8] (1 byte)
 constexpr std::uint32_t kCommandReplyId = 0x14F;  // COMMAND_REPLY (fw → robot): [seq][command][result][detail]
 
@@ -56,6 +56,10 @@ constexpr std::size_t kPoseLegacyParts = 5;  // layout 0
 // with a hint).
 constexpr std::size_t kHealthHintOffset = 34;
 constexpr std::uint8_t kHintFlagSelectMap = 0x01;
+// SET_POSE_HINT flags bit 1 (with bit 0 only): reload the map's image from disk before selecting it.
+constexpr std::uint8_t kHintFlagReload = 0x02;
+// SELECT_MAP byte 2 (optional: a 2-byte frame is flags 0): bit 0 reload the map's image from disk.
+constexpr std::uint8_t kSelectMapFlagReload = 0x01;
 
 // Protection level on the wire (POSE part 5): u16, rounded *up* (a bound must not shrink);
 // 0 = no bound, kProtectionSaturated = "at least the largest code" (decodes as +infinity).

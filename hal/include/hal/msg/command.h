@@ -33,8 +33,9 @@ enum class CommandResult : std::uint8_t {
   kUnsupported = 4,      // this localizer or configuration cannot do it (e.g. a hint to `mcl`)
   kFailed = 5,           // tried and failed (DUMP_LOG: the file could not be written)
   kMalformed = 6,        // the command's frames did not make a valid command
+  kMapInvalid = 7,       // SELECT_MAP reload: the image on disk is missing or broken; the map in use stays
 };
-constexpr std::uint8_t kCommandResultCount = 7;
+constexpr std::uint8_t kCommandResultCount = 8;
 inline const char* command_result_name(CommandResult r) {
   switch (r) {
     case CommandResult::kAccepted: return "accepted";
@@ -44,6 +45,7 @@ inline const char* command_result_name(CommandResult r) {
     case CommandResult::kUnsupported: return "unsupported";
     case CommandResult::kFailed: return "failed";
     case CommandResult::kMalformed: return "malformed";
+    case CommandResult::kMapInvalid: return "map-invalid";
   }
   return "unknown";
 }
@@ -84,6 +86,7 @@ struct Command {
   CommandKind kind = CommandKind::kNone;
   std::uint8_t seq = 0;            // echoed in the reply
   std::uint8_t map_id = 0;         // kSelectMap
+  bool reload = false;             // kSelectMap: read the map's image from disk again first (checked)
   bool has_hint = false;           // kSetPoseHint (always), kSelectMap (optional)
   PoseHint hint;
 };
