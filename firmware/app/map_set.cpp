@@ -52,7 +52,9 @@ Status MapSet::load_into(Slot& s, int id, const char* path, WorkerPool* pool) {
   FW_RETURN_IF_ERROR(load_map_image(s.image.data(), s.image.size(), s.arena, &s.map, path));
   s.table = find_section(s.image.data(), s.image.size(), MapSectionType::kRelationTable2D, &s.table_len);
   s.image_had_table = s.table != nullptr;
-  const Status st = s.system.build(spec_, s.map, s.table, s.table_len, s.arena, pool);
+  FW_RETURN_IF_ERROR(fresh_work_arena());
+  const Status st = s.system.build(spec_, s.map, s.table, s.table_len, s.arena, pool, work_block_ ? &work_ : nullptr);
+  if (work_.peak_used() > work_peak_) work_peak_ = work_.peak_used();
   if (!st) return Status::error(st.code(), "map %d '%s': %s", id, path, st.message());
   // The map lives in the arena now; the copy of the image stays only where MML reads its relation
   // table in place (only those pages are kept).
@@ -69,6 +71,15 @@ Status MapSet::load_into(Slot& s, int id, const char* path, WorkerPool* pool) {
               s.map.geometry.width, s.map.geometry.height, static_cast<double>(s.map.geometry.resolution),
               s.map.num_points, s.table != nullptr ? ", precomputed relation table" : "");
   }
+  return Status::ok();
+}
+
+// Every build starts at the block's base: the maps' systems get the same working memory.
+Status MapSet::fresh_work_arena() {
+  if (work_block_ == nullptr) return Status::ok();
+  work_.~StartupArena();
+  new (&work_) StartupArena();
+  FW_RETURN_IF_ERROR(work_.init(work_block_, work_bytes_, "shared work"));
   return Status::ok();
 }
 
@@ -92,6 +103,13 @@ Status MapSet::init(const MapSetSpec& spec, StartupArena& arena, WorkerPool* poo
   spec_ = spec.system;
   pool_ = pool;
   log_ = log;
+  // Before the slots: the working memory every map's MML shares (sized by the config alone).
+  work_bytes_ = round_up(LocalizationSystem::working_bytes(spec_), kSlotAlignment);
+  if (work_bytes_ > 0) {
+    Result<void*> w = arena.allocate(work_bytes_, kSlotAlignment, "maps' shared working memory");
+    if (!w) return Status::error(w.status().code(), "maps: the shared working memory: %s", w.status().message());
+    work_block_ = *w;
+  }
   std::size_t largest = 0;
   for (int id = 0; id < spec.count; ++id) {
     if (spec.paths[id] == nullptr || !spec.paths[id][0]) {
@@ -129,25 +147,46 @@ Status MapSet::init(const MapSetSpec& spec, StartupArena& arena, WorkerPool* poo
 
   }
   active_ = 0;
+  // The last map built wrote the working memory last: map 0 starts on it wiped.
+  if (count_ > 1) activate(0);
   return Status::ok();
+}
+
+// `id` becomes the active map, its localizer reset on wiped working memory (another map's MML has
+// used it since). A threaded global search serves it from now on.
+void MapSet::activate(std::uint8_t id) {
+  active_ = id;
+  LocalizationSystem& now = active();
+  now.mark_working_memory_foreign();
+  now.localizer().reset();
+  if (threaded_ && now.tracked() != nullptr) global_thread_.serve(&now.tracked()->global_context());
+}
+
+Status MapSet::attach_global(LocalizationSystem& sys) {
+  if (!threaded_) {
+    if (sys.tracked() != nullptr) sys.tracked()->global_context().set_clock(clock_);
+    return Status::ok();
+  }
+  return sys.attach_global_thread(&global_thread_, clock_, global_ctx_);
 }
 
 Status MapSet::start_global_contexts(bool threaded, bool realtime, const hal::Clock* clock,
                                      const ExecutionContext& context) {
-  for (int id = 0; id < count_; ++id) {
-    LocalizationSystem& sys = system(id);
-    if (threaded) {
-      FW_RETURN_IF_ERROR(sys.start_global_context(realtime, clock, context));
-    } else if (sys.tracked() != nullptr) {
-      sys.tracked()->global_context().set_clock(clock);
-    }
-  }
+  clock_ = clock;
+  global_ctx_ = context;
+  // The one global thread, created here at start-up: it serves the active map (a reloaded one too).
+  if (threaded) FW_RETURN_IF_ERROR(global_thread_.start(context, realtime));
   threaded_ = threaded;
+  for (int id = 0; id < count_; ++id) FW_RETURN_IF_ERROR(attach_global(system(id)));
+  LocalizationSystem& now = active();
+  if (threaded_ && now.tracked() != nullptr) global_thread_.serve(&now.tracked()->global_context());
   return Status::ok();
 }
 
 void MapSet::stop_global_contexts() {
+  global_thread_.stop();  // after its job, if any; then the contexts let go of it
   for (Slot& s : slots_) s.system.stop_global_context();
+  threaded_ = false;
 }
 
 std::size_t MapSet::table_copy_bytes() const {
@@ -160,18 +199,21 @@ Status MapSet::reload_into_spare(std::uint8_t id) {
   if (spare_ < 0) {
     return Status::error(Errc::kUnsupported, "map %u '%s': reload needs map_reload = true (a spare slot)", id, paths_[id]);
   }
-  if (threaded_) {
-    return Status::error(Errc::kUnsupported, "map %u '%s': reload needs global_context = inline (a rebuilt map's "
-                         "global thread would be created after start-up)", id, paths_[id]);
-  }
   Slot& s = slots_[spare_];
   clear(s);
   FW_RETURN_IF_ERROR(s.arena.init(s.block, s.bytes, kSlotNames[spare_]));
-  const Status st = load_into(s, id, paths_[id], pool_);
+  FW_RETURN_IF_ERROR(fresh_work_arena());  // its peak then says whether the build wrote it
+  Status st = load_into(s, id, paths_[id], pool_);
+  if (st) st = attach_global(s.system);  // no thread is created: the global one serves it once active
   if (!st) {
     clear(s);  // the spare keeps nothing of a failed reload
+    // A build that got as far as MML wrote the shared working memory: the active map's search
+    // starts again on it wiped (the map itself stays).
+    const bool restarted = work_block_ != nullptr && work_.peak_used() > 0;
+    if (restarted) activate(active_);
     // The loader's messages name the file; say what stays.
-    return Status::error(st.code(), "reload of map %u refused, the loaded map stays: %s", id, st.message());
+    return Status::error(st.code(), "reload of map %u refused, the loaded map stays%s: %s", id,
+                         restarted ? " (its search restarted)" : "", st.message());
   }
   s.arena.seal();
   const int old = slot_of_[id];
@@ -191,10 +233,8 @@ Result<Localizer*> MapSet::select(std::uint8_t id, bool reload) {
   // The old map's state goes (its late global results are dropped by the reset's generation), and
   // the new one starts from nothing: the robot is somewhere on that map, not where it was.
   old.localizer().reset();
-  active_ = id;
-  Localizer& now = active().localizer();
-  now.reset();
-  return &now;
+  activate(id);
+  return &active().localizer();
 }
 
 }  // namespace fw

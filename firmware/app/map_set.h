@@ -5,18 +5,28 @@
 // map at start-up (pRANSAM's relation table filled or read from the image, the unmapped-space
 // labels, the distance fields, MML's fixed arrays sized to the map); rebuilding it at a switch
 // would take the start-up's seconds and allocations in the middle of a lift ride. So every map
-// gets a slot of the start-up arena holding its GlobalMap and its LocalizationSystem, built once;
-// a switch is a pointer swap and a reset (microseconds), and the memory is the sum of the slots
-// (mmlfw --memory-report lists each; the arena must hold them all).
+// gets a slot of the start-up arena holding its GlobalMap and what its system derives from it,
+// built once; a switch is a pointer swap and a reset (microseconds).
+//
+// Shared working memory: most of MML's memory is working memory sized by the config, not by the
+// map (RBSM's end-point grid, pRANSAM's R_A and worker buffers, ...: MmlLocalizer::init's `work`),
+// and only the active map's MML runs. So it is one block of the start-up arena, carved once before
+// the slots (sized by LocalizationSystem::working_bytes) and given to every map's system; a
+// switch tells the new map's MML that another one wrote it (mark_working_memory_foreign) and
+// resets it, so its search starts on wiped memory. The slots keep only the per-map parts.
+//
+// Global search on a thread (global_context = thread): one `global` thread, created and pinned at
+// start-up, serves whichever map is active (GlobalThread::serve); a switch first waits for the old
+// map's running global step (it also shares the worker pool and the working memory).
 //
 // Reload (config map_reload = true): one spare slot, as large as the largest map's slot plus 25 %,
 // receives a map's image read from disk again. It is checked (size, CRC, version, every section:
-// map_image.h) and its system built in the spare; only when all of that succeeded does the spare
-// become that map's slot (and the old slot the spare). A missing, truncated or corrupt file, or a
-// map too large for the spare, leaves every map as it was and the error names the file and the
-// problem. A reload rebuilds a system, so it takes start-up time (seconds on a large map) in the
-// sensor context, and it needs the global search inline (global_context = inline): a rebuilt
-// mml-track with its own global thread would create a thread after start-up.
+// map_image.h) and its system built in the spare (attached to the global thread when there is
+// one: no thread is created); only when all of that succeeded does the spare become that map's
+// slot (and the old slot the spare). A missing, truncated or corrupt file, or a map too large for
+// the spare, leaves every map as it was and the error names the file and the problem; a build that
+// failed after it had written the shared working memory also restarts the active map's search. A
+// reload rebuilds a system, so it takes start-up time (seconds on a large map) in the sensor context.
 #pragma once
 
 #include <cstddef>
@@ -27,6 +37,7 @@
 #include "firmware/map/global_map.h"
 #include "firmware/map/map_image_file.h"
 #include "firmware/runtime/map_selector.h"
+#include "firmware/track/global_thread.h"
 #include "hal/clock.h"
 #include "hal/log_sink.h"
 
@@ -51,8 +62,8 @@ class MapSet : public MapSelector {
   // Start-up: every map into its own slot carved from `arena`, its system built there; map 0 active.
   // Errors name the map (id and file) and the problem. `log` (may be null) gets one line per map.
   Status init(const MapSetSpec& spec, StartupArena& arena, WorkerPool* pool, hal::LogSink* log);
-  // mml-track with the global search on threads: one per map, started here at start-up (the maps
-  // not selected wait for jobs). Inline: `clock` times the global steps.
+  // mml-track with the global search on a thread: one, started here at start-up, serving the
+  // active map (a reloaded map too). Inline: `clock` times the global steps.
   Status start_global_contexts(bool threaded, bool realtime, const hal::Clock* clock, const ExecutionContext& context);
   void stop_global_contexts();
 
@@ -70,6 +81,9 @@ class MapSet : public MapSelector {
   // Bytes of map `id`'s slot (its map, scratch peak and localizer) and of the spare (0 = none).
   std::size_t slot_bytes(int id) const { return slots_[slot_of_[id]].bytes; }
   std::size_t spare_bytes() const { return spare_ >= 0 ? slots_[spare_].bytes : 0; }
+  // Bytes of the working memory the maps' systems share (0 = none: no MML), and its peak use.
+  std::size_t shared_work_bytes() const { return work_bytes_; }
+  std::size_t shared_work_peak() const { return work_peak_; }
   // Image copies kept because a relation table is read in place (whole pages), all maps.
   std::size_t table_copy_bytes() const;
   std::uint32_t reloads() const { return reloads_; }
@@ -87,6 +101,9 @@ class MapSet : public MapSelector {
     LocalizationSystem system;
   };
   Status load_into(Slot& s, int id, const char* path, WorkerPool* pool);
+  Status fresh_work_arena();
+  Status attach_global(LocalizationSystem& sys);
+  void activate(std::uint8_t id);
   Status carve(Slot& s, StartupArena& arena, std::size_t bytes, int index);
   void clear(Slot& s);
   Status reload_into_spare(std::uint8_t id);
@@ -102,6 +119,14 @@ class MapSet : public MapSelector {
   hal::LogSink* log_ = nullptr;
   bool threaded_ = false;
   std::uint32_t reloads_ = 0;
+  // The shared working memory: one block of the start-up arena; each build starts at its base.
+  StartupArena work_;
+  void* work_block_ = nullptr;
+  std::size_t work_bytes_ = 0, work_peak_ = 0;
+  // The one global thread (threaded_) and what a system attached to it needs.
+  track::GlobalThread global_thread_;
+  const hal::Clock* clock_ = nullptr;
+  ExecutionContext global_ctx_ = kGlobalContext;
 };
 
 }  // namespace fw

@@ -292,7 +292,8 @@ int start_workers(const Args& a) {
 }
 
 // Every map of the config with its system (firmware/app/map_set.h), or the map-less system (odom);
-// then the global context threads (one per map) or the inline clock. Prints the failure; ok = go on.
+// then the global context thread (one, serving the active map) or the inline clock. Prints the
+// failure; ok = go on.
 fw::Status build_systems(const fw::SystemSpec& sys, Startup* su) {
   const fw::AppConfig& c = g_config;
   hal::Hal& hal = g_board.hal();
@@ -445,6 +446,9 @@ int memory_budget(const Args& a, const Startup& su) {
                     g_maps.slot_bytes(id) / 1048576.0);
       }
       if (g_maps.spare_bytes() > 0) std::printf(", reload spare %.1f MiB", g_maps.spare_bytes() / 1048576.0);
+      if (g_maps.shared_work_bytes() > 0) {
+        std::printf(", MML working memory shared by the maps %.1f MiB", g_maps.shared_work_bytes() / 1048576.0);
+      }
       std::printf(", board %s\n", g_board.describe());
     }
     return problems == 0 ? 0 : 1;

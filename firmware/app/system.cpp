@@ -35,14 +35,40 @@ Status LocalizationSystem::start_global_context(bool realtime, const hal::Clock*
   return tracked_->global_context().start_thread(context, realtime, clock);
 }
 
+Status LocalizationSystem::attach_global_thread(track::GlobalThread* thread, const hal::Clock* clock,
+                                                const ExecutionContext& context) {
+  if (tracked_ == nullptr) return Status::ok();
+  return tracked_->global_context().attach_thread(thread, context, clock);
+}
+
 void LocalizationSystem::stop_global_context() {
   if (tracked_ != nullptr) tracked_->global_context().stop_thread();
 }
 
 bool LocalizationSystem::table_in_use() const { return mml_ != nullptr && mml_->using_precomputed_table(); }
 
+namespace {
+bool uses_mml(const char* name) { return std::strcmp(name, "mcl") != 0 && std::strcmp(name, "odom") != 0; }
+
+// MML's config for the spec before it is fitted to a map (the fit changes the contact field only,
+// which is the map's part, never the working memory).
+mml::MmlLocalizerConfig spec_mml_config(const SystemSpec& spec, bool tracked) {
+  mml::MmlLocalizerConfig mc = spec.mml != nullptr ? *spec.mml
+                               : tracked ? mml::mml_track_preset(spec.mml_preset, spec.seed)
+                                         : mml::mml_preset(spec.mml_preset, spec.seed);
+  if (spec.anytime_global) mc.rbsm.grid.recenter_step_cells = kAnytimeRecenterCells;
+  return mc;
+}
+}  // namespace
+
+std::size_t LocalizationSystem::working_bytes(const SystemSpec& spec) {
+  const char* name = spec.localizer != nullptr ? spec.localizer : kDefaultLocalizer;
+  if (!is_known_localizer(name) || !uses_mml(name)) return 0;
+  return mml::MmlLocalizer::working_bytes(spec_mml_config(spec, std::strcmp(name, "mml-track") == 0));
+}
+
 Status LocalizationSystem::build(const SystemSpec& spec, const GlobalMap& map, const std::uint8_t* table_section,
-                                 std::size_t table_len, StartupArena& arena, WorkerPool* pool) {
+                                 std::size_t table_len, StartupArena& arena, WorkerPool* pool, StartupArena* work) {
   if (built()) return Status::error(Errc::kInvalidArgument, "localization system: already built");
   const char* name = spec.localizer != nullptr ? spec.localizer : kDefaultLocalizer;
   if (!is_known_localizer(name)) {
@@ -66,16 +92,12 @@ Status LocalizationSystem::build(const SystemSpec& spec, const GlobalMap& map, c
   const bool want_mcl = std::strcmp(name, "mcl") == 0 || std::strcmp(name, "handoff") == 0;
   if (want_mml) {
     const bool tracked = std::strcmp(name, "mml-track") == 0;
-    const mml::MmlLocalizerConfig base = spec.mml != nullptr ? *spec.mml
-                                         : tracked ? mml::mml_track_preset(spec.mml_preset, spec.seed)
-                                                   : mml::mml_preset(spec.mml_preset, spec.seed);
     // pRANSAM's contact field must cover this map (it is sized from the map, not the preset).
-    mml::MmlLocalizerConfig mc = mml::fit_contact_field_to_map(base, map);
-    if (spec.anytime_global) mc.rbsm.grid.recenter_step_cells = kAnytimeRecenterCells;
+    const mml::MmlLocalizerConfig mc = mml::fit_contact_field_to_map(spec_mml_config(spec, tracked), map);
     Result<mml::MmlLocalizer*> r = emplace<mml::MmlLocalizer>(arena, "MmlLocalizer");
     if (!r) return r.status();
     mml_ = *r;
-    const Status s = mml_->init(mc, map, table_section, table_len, arena, pool);
+    const Status s = mml_->init(mc, map, table_section, table_len, arena, pool, work);
     if (!s) return Status::error(s.code(), "localizer mml: %s", s.message());
   }
   if (want_mcl) {

@@ -59,8 +59,17 @@ class LocalizationSystem {
 
   // `table_section` (may be null): the map image's precomputed relation table, read in place.
   // `pool` (may be null): worker threads for RBSM / pRANSAM / MCL. Errors name the part that failed.
+  // `work` (optional): where MML's working memory goes (MmlLocalizer::init; several maps share one
+  // block: map_set.h). Null = `arena`.
   Status build(const SystemSpec& spec, const GlobalMap& map, const std::uint8_t* table_section,
-               std::size_t table_len, StartupArena& arena, WorkerPool* pool);
+               std::size_t table_len, StartupArena& arena, WorkerPool* pool, StartupArena* work = nullptr);
+  // Bytes the `work` block of build() needs for this spec (0: the localizer has no MML).
+  static std::size_t working_bytes(const SystemSpec& spec);
+  // Another system has used the shared working memory since this one's last reset: the next reset
+  // of MML wipes all of it (MmlLocalizer::mark_working_memory_foreign). Before localizer().reset().
+  void mark_working_memory_foreign() {
+    if (mml_ != nullptr) mml_->mark_working_memory_foreign();
+  }
 
   bool built() const { return localizer_ != nullptr; }
   Localizer& localizer() { return *localizer_; }
@@ -80,6 +89,9 @@ class LocalizationSystem {
   // `clock` times the global steps. Other localizers: nothing to start (ok).
   Status start_global_context(bool realtime, const hal::Clock* clock,
                               const ExecutionContext& context = kGlobalContext);
+  // The same on a global thread created and shared by the caller (MapSet: one thread, whichever
+  // map is active); creates no thread. Other localizers: nothing to attach (ok).
+  Status attach_global_thread(track::GlobalThread* thread, const hal::Clock* clock, const ExecutionContext& context);
   void stop_global_context();
   // True when MML reads the map image's relation table in place (keep the image mapped).
   bool table_in_use() const;

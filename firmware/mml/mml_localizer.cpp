@@ -66,8 +66,19 @@ bool in_unmapped_space(const void* ctx, const pransam::Point<2>& p) {
 }
 }  // namespace
 
+std::size_t MmlLocalizer::working_bytes(const MmlLocalizerConfig& c) {
+  constexpr std::size_t a = 64;  // worst alignment padding per allocation
+  std::size_t n = Rbsm::required_arena_bytes(c.rbsm) + c.local_map.point_capacity * sizeof(Point2f) + a;
+  n += pransam::Matcher<2>::working_bytes(c.matcher);
+  n += c.mml.max_local_map_points * sizeof(Point2f) + a + kMaxHypotheses * sizeof(PoseHypothesis) + a;
+  if (c.mml.reduce_observations) {
+    n += (c.mml.reduction_max_observations + 2) * std::size_t{c.mml.reduction_observation_points} * sizeof(Point2f) + a;
+  }
+  return n;
+}
+
 Status MmlLocalizer::init(const MmlLocalizerConfig& config, const GlobalMap& map, const std::uint8_t* table_section,
-                          std::size_t table_len, StartupArena& arena, WorkerPool* pool) {
+                          std::size_t table_len, StartupArena& arena, WorkerPool* pool, StartupArena* work) {
   FW_RETURN_IF_ERROR(config.validate());
   if (!map.valid() || map.points == nullptr || map.num_points < 3) {
     return Status::error(Errc::kInvalidArgument, "MmlLocalizer: global map is empty (%u occupied points)", map.num_points);
@@ -75,8 +86,10 @@ Status MmlLocalizer::init(const MmlLocalizerConfig& config, const GlobalMap& map
   config_ = config;
   map_ = map;
   FW_RETURN_IF_ERROR(interp_.init(config.mml));
-  FW_RETURN_IF_ERROR(rbsm_.init(config.rbsm, arena, pool));
-  FW_RETURN_IF_ERROR(local_map_.init(config.local_map, arena));
+  // Same order of allocations as with one arena: a single localizer's layout is unchanged.
+  StartupArena& wk = work != nullptr ? *work : arena;
+  FW_RETURN_IF_ERROR(rbsm_.init(config.rbsm, wk, pool));
+  FW_RETURN_IF_ERROR(local_map_.init(config.local_map, wk));
   FW_RETURN_IF_ERROR(front_end_.init(config.front_end, &rbsm_, &local_map_));
   pransam::MatcherOptions mo = config.matcher;
   // The model capacity is the map's point count when the map is larger than the default: sized once
@@ -84,7 +97,7 @@ Status MmlLocalizer::init(const MmlLocalizerConfig& config, const GlobalMap& map
   mo.max_model_points = std::max(mo.max_model_points, map.num_points);
   const bool have_section = config.mml.precomputed_table && table_section != nullptr && table_len > 0;
   mo.allocate_model_table = !have_section;
-  FW_RETURN_IF_ERROR(matcher_.init(mo, arena, pool));
+  FW_RETURN_IF_ERROR(matcher_.init(mo, arena, pool, work));
   FW_RETURN_IF_ERROR(matcher_.set_model(map.points, map.num_points, "global map"));
   matcher_.set_refine_distance(&map_distance_for_refine, &map_);
   if (config.mml.unmapped_space_min_area_m2 > 0.0f) {
@@ -108,17 +121,17 @@ Status MmlLocalizer::init(const MmlLocalizerConfig& config, const GlobalMap& map
     }
   }
   scene_capacity_ = config.mml.max_local_map_points;
-  Result<Point2f*> sp = arena.allocate_array<Point2f>(scene_capacity_, "mml local map points");
+  Result<Point2f*> sp = wk.allocate_array<Point2f>(scene_capacity_, "mml local map points");
   if (!sp) return sp.status();
   scene_ = *sp;
-  Result<PoseHypothesis*> hp = arena.allocate_array<PoseHypothesis>(kMaxHypotheses, "mml hypotheses");
+  Result<PoseHypothesis*> hp = wk.allocate_array<PoseHypothesis>(kMaxHypotheses, "mml hypotheses");
   if (!hp) return hp.status();
   hyps_ = *hp;
   rule_ = ReductionRule(config.mml);
   if (config.mml.reduce_observations) {
     const std::size_t per = config.mml.reduction_observation_points;
     const std::size_t slots = config.mml.reduction_max_observations + 2;
-    Result<Point2f*> rp = arena.allocate_array<Point2f>(slots * per, "mml reduced observations");
+    Result<Point2f*> rp = wk.allocate_array<Point2f>(slots * per, "mml reduced observations");
     if (!rp) return rp.status();
     for (std::size_t i = 0; i < config.mml.reduction_max_observations; ++i) red_[i].pts = *rp + i * per;
     pending_prev_.pts = *rp + (slots - 2) * per;

@@ -63,8 +63,20 @@ class MmlLocalizer final : public Localizer {
  public:
   // `table_section` (optional, may be null): a precomputed relation table section of the map image
   // (pransam relation_table_io.h) used when config.mml.precomputed_table is set.
+  // `work` (optional): the working memory — RBSM's end-point grid and particles, the local map,
+  // pRANSAM's R_A, scene index and worker buffers, the scene and hypothesis arrays — whose size
+  // depends on the config alone. Several localizers of which one runs at a time (one per map:
+  // firmware/app/map_set.h) give the same block; the map's parts stay in `arena`. Null = `arena`.
   Status init(const MmlLocalizerConfig& config, const GlobalMap& map, const std::uint8_t* table_section,
-              std::size_t table_len, StartupArena& arena, WorkerPool* pool);
+              std::size_t table_len, StartupArena& arena, WorkerPool* pool, StartupArena* work = nullptr);
+  // Upper bound of what init() takes from `work` (alignment included).
+  static std::size_t working_bytes(const MmlLocalizerConfig& config);
+  // Another localizer has used the shared working memory since this one's last reset(): the next
+  // reset() wipes all of it (RBSM's grid, R_A), not only what this one wrote. Call before reset().
+  void mark_working_memory_foreign() {
+    rbsm_.grid().mark_storage_foreign();
+    matcher_.mark_working_memory_foreign();
+  }
   const char* name() const override { return "mml"; }
   void reset() override;
   Status step(const hal::LaserScan& scan, const hal::Odometry& odom, hal::PoseEstimate* out) override;

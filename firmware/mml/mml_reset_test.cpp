@@ -165,6 +165,75 @@ TEST(MmlResetTest, ResetGivesAFreshStartOnAWorkerPool) {
   pool.stop();
 }
 
+// Several maps share one MML working memory (firmware/app/map_set.h): localizer 1 runs A, then
+// localizer 2 (same config, its own map part, the same `work` block) runs B, then localizer 1 is
+// told its working memory was used by another (mark_working_memory_foreign) and reset: A again
+// must publish bit-identically what it published first. Without the mark, B's end-points stay in
+// RBSM's grid (localizer 1's reset clears only what it wrote), and A's local map differs.
+std::vector<Output> shared_work_run(const MmlLocalizerConfig& cfg, bool mark, std::vector<Output>* first) {
+  static GridWorld g = mcl::testing::unique_room();
+  static OwnedGlobalMap gm(g);
+  StartupArena own, work;
+  EXPECT_TRUE(own.init_mapped(128u << 20, false, "mml-shared-own").is_ok());
+  const std::size_t work_bytes = MmlLocalizer::working_bytes(cfg);
+  EXPECT_TRUE(work.init_mapped(work_bytes, false, "mml-shared-work").is_ok());
+  auto l1 = std::make_unique<MmlLocalizer>();
+  auto l2 = std::make_unique<MmlLocalizer>();
+  Status st = l1->init(cfg, gm.map, nullptr, 0, own, nullptr, &work);
+  EXPECT_TRUE(st.is_ok()) << st.message();
+  const std::size_t used_by_one = work.used();
+  // The bound is what a map set carves: it must hold one localizer's working memory, and not much more.
+  EXPECT_LE(used_by_one, work_bytes);
+  EXPECT_GT(used_by_one + 4096, work_bytes);
+  work.rewind(0);
+  st = l2->init(cfg, gm.map, nullptr, 0, own, nullptr, &work);
+  EXPECT_TRUE(st.is_ok()) << st.message();
+  EXPECT_EQ(work.used(), used_by_one) << "both localizers lay out the same working memory";
+  l1->mark_working_memory_foreign();  // l2's init wrote it last
+  l1->reset();
+  const auto a = testing::waypoint_path({{1.5f, 1.5f}, {1.5f, 6.5f}, {4.5f, 6.5f}}, 0.1f);
+  const auto b = testing::waypoint_path({{2.0f, 5.0f}, {2.5f, 5.0f}, {2.5f, 6.5f}, {0.8f, 6.5f}}, 0.1f);
+  Se2f odom;
+  *first = drive(l1.get(), g, a, 7, &odom);
+  l2->mark_working_memory_foreign();
+  l2->reset();
+  odom = Se2f();
+  drive(l2.get(), g, b, 8, &odom);
+  if (mark) l1->mark_working_memory_foreign();
+  l1->reset();
+  odom = Se2f();
+  return drive(l1.get(), g, a, 7, &odom);
+}
+
+// The shipped 51.2 m end-point window: a reset clears only the dirty box of the 12 x 8 m room.
+MmlLocalizerConfig shared_work_config() {
+  MmlLocalizerConfig c = reset_test_config(false);
+  c.rbsm.grid.size_log2 = 10;
+  return c;
+}
+
+TEST(MmlResetTest, SharedWorkingMemoryGivesAFreshStartAfterAnotherLocalizer) {
+  std::vector<Output> first;
+  const auto again = shared_work_run(shared_work_config(), true, &first);
+  int localized = 0;
+  for (const Output& o : first) localized += o.est.status == hal::LocalizationStatus::kLocalized;
+  EXPECT_GT(localized, 5);
+  expect_identical(first, again);
+}
+
+// The test above can fail: without the mark, the other localizer's end-points stay in the grid.
+TEST(MmlResetTest, SharedWorkingMemoryWithoutTheMarkKeepsTheOtherLocalizersState) {
+  std::vector<Output> first;
+  const auto again = shared_work_run(shared_work_config(), false, &first);
+  ASSERT_EQ(first.size(), again.size());
+  bool differs = false;
+  for (std::size_t i = 0; i < first.size() && !differs; ++i) {
+    differs = first[i].local_map_points != again[i].local_map_points || first[i].est.x != again[i].est.x ||
+              first[i].est.status != again[i].est.status;
+  }
+  EXPECT_TRUE(differs) << "a reset without the mark must not be clean here (else the test above proves nothing)";
+}
+
 }  // namespace
 }  // namespace mml
 }  // namespace fw

@@ -81,7 +81,19 @@ void add_stats(MatchStats* s, const MatchStats& ws) {
 }  // namespace
 
 template <int D>
-Status Matcher<D>::init(const MatcherOptions& options, StartupArena& arena, WorkerPool* pool) {
+std::size_t Matcher<D>::working_bytes(const MatcherOptions& o) {
+  constexpr std::size_t a = 64;  // worst alignment padding per allocation
+  const std::size_t scene = o.max_scene_points;
+  std::size_t n = kNumSlots * sizeof(Triple) + a;                // R_A
+  n += 2 * (scene * 4 + a) + (static_cast<std::size_t>(o.max_index_cells) + 1) * 4 + a;  // scene index
+  n += scene * 4 + a + kMaxTouched * 4 + a;                                      // order, touched A
+  n += static_cast<std::size_t>(o.num_workers) *
+       (o.max_batch * sizeof(InsertRecord) + a + o.collect_capacity * sizeof(Hypothesis<D>) + a);
+  return n + o.collect_capacity * sizeof(Hypothesis<D>) + a;                     // merged
+}
+
+template <int D>
+Status Matcher<D>::init(const MatcherOptions& options, StartupArena& arena, WorkerPool* pool, StartupArena* work) {
   if (options.num_workers < 1 || options.num_workers > kMaxLogicalWorkers) {
     return Status::error(Errc::kInvalidArgument, "pransam options: num_workers %d outside [1, %d]",
                          options.num_workers, kMaxLogicalWorkers);
@@ -94,33 +106,36 @@ Status Matcher<D>::init(const MatcherOptions& options, StartupArena& arena, Work
   }
   options_ = options;
   pool_ = pool;
-  FW_RETURN_IF_ERROR(table_a_.allocate(arena, D == 2 ? "R_A (2d)" : "R_A (3d)"));
+  // The same order of allocations as with one arena, so a single localizer's layout is unchanged.
+  StartupArena& wk = work != nullptr ? *work : arena;
+  FW_RETURN_IF_ERROR(table_a_.allocate(wk, D == 2 ? "R_A (2d)" : "R_A (3d)"));
   if (options.allocate_model_table) FW_RETURN_IF_ERROR(table_b_.allocate(arena, D == 2 ? "R_B (2d)" : "R_B (3d)"));
   FW_RETURN_IF_ERROR(field_.init(options.field, arena));
-  FW_RETURN_IF_ERROR(index_a_.init(options.max_scene_points, options.max_index_cells, arena, "scene index"));
+  FW_RETURN_IF_ERROR(index_a_.init(options.max_scene_points, options.max_index_cells, wk, "scene index"));
   FW_RETURN_IF_ERROR(index_b_.init(options.max_model_points, options.max_index_cells, arena, "model index"));
-  Result<std::uint32_t*> order = arena.allocate_array<std::uint32_t>(options.max_scene_points, "pransam order");
+  Result<std::uint32_t*> order = wk.allocate_array<std::uint32_t>(options.max_scene_points, "pransam order");
   if (!order) return order.status();
   scene_order_ = *order;
-  Result<std::uint32_t*> ta = arena.allocate_array<std::uint32_t>(kMaxTouched, "pransam touched A");
+  Result<std::uint32_t*> ta = wk.allocate_array<std::uint32_t>(kMaxTouched, "pransam touched A");
   Result<std::uint32_t*> tb = arena.allocate_array<std::uint32_t>(kMaxTouched, "pransam touched B");
   if (!ta) return ta.status();
   if (!tb) return tb.status();
   touched_[0] = *ta;
   touched_[1] = *tb;
+  // The worker states hold pointers into the buffers: they belong to this matcher (the arena).
   Result<WorkerState*> ws = arena.allocate_array<WorkerState>(static_cast<std::size_t>(options.num_workers),
                                                               "pransam workers");
   if (!ws) return ws.status();
   workers_ = *ws;
   for (int w = 0; w < options.num_workers; ++w) {
-    Result<InsertRecord*> ins = arena.allocate_array<InsertRecord>(options.max_batch, "pransam inserts");
-    Result<Hypothesis<D>*> col = arena.allocate_array<Hypothesis<D>>(options.collect_capacity, "pransam collected");
+    Result<InsertRecord*> ins = wk.allocate_array<InsertRecord>(options.max_batch, "pransam inserts");
+    Result<Hypothesis<D>*> col = wk.allocate_array<Hypothesis<D>>(options.collect_capacity, "pransam collected");
     if (!ins) return ins.status();
     if (!col) return col.status();
     workers_[w].inserts = *ins;
     workers_[w].collected = *col;
   }
-  Result<Hypothesis<D>*> merged = arena.allocate_array<Hypothesis<D>>(options.collect_capacity, "pransam merged");
+  Result<Hypothesis<D>*> merged = wk.allocate_array<Hypothesis<D>>(options.collect_capacity, "pransam merged");
   if (!merged) return merged.status();
   merged_ = *merged;
   const std::size_t per_worker = sizeof(WorkerState) + options.max_batch * sizeof(InsertRecord) +

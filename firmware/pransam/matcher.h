@@ -168,7 +168,16 @@ class Matcher {
   Matcher& operator=(const Matcher&) = delete;
 
   // Allocates everything. `pool` may be null (inline, one thread) and must outlive the matcher.
-  Status init(const MatcherOptions& options, StartupArena& arena, WorkerPool* pool);
+  // `work` (optional): where the working memory goes — R_A, the scene index and order, R_A's
+  // touched list, the workers' insert and hypothesis buffers — sized by the options alone, so
+  // several matchers of which only one runs at a time may share it (firmware/app/map_set.h); the
+  // model's parts (R_B, contact field, model index) stay in `arena`. Null = all in `arena`.
+  Status init(const MatcherOptions& options, StartupArena& arena, WorkerPool* pool, StartupArena* work = nullptr);
+  // Upper bound of what init() takes from `work` (alignment included).
+  static std::size_t working_bytes(const MatcherOptions& options);
+  // Another matcher has written the shared working memory since this one last reset: the next
+  // reset() empties R_A whole (its touched list only knows this matcher's writes).
+  void mark_working_memory_foreign() { touched_overflow_[0] = true; }
 
   // Sets the model set B (non-owning). Builds the contact field and the sampler index and clears
   // the online R_B. Drops any precomputed table.

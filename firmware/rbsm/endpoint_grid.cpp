@@ -148,7 +148,12 @@ void EndpointGrid::clear() {
   if (!initialized()) return;
   const std::int64_t w = static_cast<std::int64_t>(dirty_x1_) - dirty_x0_ + 1;
   const std::int64_t h = static_cast<std::int64_t>(dirty_y1_) - dirty_y0_ + 1;
-  if (w > 0 && h > 0) {
+  if (storage_foreign_) {
+    // The whole storage, the zero sentinel line included (init()'s state).
+    std::memset(occupancy_, 0, static_cast<std::size_t>(side_) * side_);
+    std::memset(lookup_, 0, static_cast<std::size_t>(sub_mask_ + 1) * (sub_mask_ + 1) + 64);
+    storage_foreign_ = false;
+  } else if (w > 0 && h > 0) {
     if (w * h * 2 >= static_cast<std::int64_t>(side_) * side_ || sub_shift_ < 6) {
       std::memset(occupancy_, 0, static_cast<std::size_t>(side_) * side_);
       std::memset(lookup_, 0, static_cast<std::size_t>(sub_mask_ + 1) * (sub_mask_ + 1));

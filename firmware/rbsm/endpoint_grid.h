@@ -53,6 +53,10 @@ class EndpointGrid {
   // Removes every point (only the region ever written is cleared) and returns the window to its
   // state after init(): not centred, so the next follow()/insert() centres it afresh.
   void clear();
+  // The grid's storage was written by another grid since this one last cleared it (several maps
+  // share RBSM's working memory: firmware/app/map_set.h): the next clear() wipes all of it, since
+  // the dirty box only knows what this grid wrote.
+  void mark_storage_foreign() { storage_foreign_ = true; }
   // Centres the window on (x, y) (world, m); call once before the first insert.
   void center_on(float x, float y);
   // Re-centres when (x, y) is more than recenter_fraction of the side away from the centre;
@@ -140,6 +144,7 @@ class EndpointGrid {
   std::int32_t origin_cx_ = 0, origin_cy_ = 0;
   bool centered_ = false;
   bool recentring_ = false;  // an incremental re-centre is under way
+  bool storage_foreign_ = false;
   std::size_t occupied_count_ = 0;
   // Bounding box (global cells) of everything written since the last clear().
   std::int32_t dirty_x0_ = 0, dirty_y0_ = 0, dirty_x1_ = -1, dirty_y1_ = -1;

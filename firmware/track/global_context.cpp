@@ -1,7 +1,6 @@
 #include "firmware/track/global_context.h"
 
 #include "firmware/base/se2.h"
-#include "firmware/runtime/rt_thread.h"
 
 namespace fw {
 namespace track {
@@ -37,54 +36,45 @@ Status GlobalContext::init(mml::MmlLocalizer* mml, const GlobalScheduleOptions& 
   return Status::ok();
 }
 
+Status GlobalContext::attach_thread(GlobalThread* thread, const ExecutionContext& context, const hal::Clock* clock) {
+  if (mml_ == nullptr) return Status::error(Errc::kNotInitialized, "global context: thread attached before init()");
+  if (threaded_) return Status::error(Errc::kInvalidArgument, "global context: thread already started");
+  if (thread == nullptr || !thread->running()) {
+    return Status::error(Errc::kInvalidArgument, "global context: the attached thread is not running");
+  }
+  FW_RETURN_IF_ERROR(schedule_.validate(true));
+  clock_ = clock;
+  // Anytime global search: pRANSAM's iterations are cut so the step fits the context's window.
+  if (clock != nullptr) mml_->set_deadline_mode(clock, context.deadline_ns);
+  thread_ = thread;
+  threaded_ = true;
+  return Status::ok();
+}
+
 Status GlobalContext::start_thread(const ExecutionContext& context, bool realtime, const hal::Clock* clock) {
   if (mml_ == nullptr) return Status::error(Errc::kNotInitialized, "global context: start_thread() before init()");
   if (threaded_) return Status::error(Errc::kInvalidArgument, "global context: thread already started");
   FW_RETURN_IF_ERROR(schedule_.validate(true));
-  clock_ = clock;
-  stopping_ = false;
-  // Anytime global search: pRANSAM's iterations are cut so the step fits the context's window.
-  if (clock != nullptr) mml_->set_deadline_mode(clock, context.deadline_ns);
-  const int rc = pthread_create(&thread_, nullptr, &GlobalContext::thread_main, this);
-  if (rc != 0) return Status::error(Errc::kIoError, "global context: pthread_create failed (%d)", rc);
-  threaded_ = true;
-  char warning[160];
-  const Status s = apply_execution_context(thread_, context, realtime, warning);
-  if (!s) {
-    stop_thread();
-    return s;
-  }
-  return Status::ok();
+  FW_RETURN_IF_ERROR(own_thread_.start(context, realtime));
+  own_thread_.serve(this);
+  const Status s = attach_thread(&own_thread_, context, clock);
+  if (!s) own_thread_.stop();
+  return s;
 }
 
 void GlobalContext::stop_thread() {
   if (!threaded_) return;
-  pthread_mutex_lock(&mutex_);
-  stopping_ = true;
-  pthread_cond_broadcast(&cv_);
-  pthread_mutex_unlock(&mutex_);
-  pthread_join(thread_, nullptr);
+  if (thread_ == &own_thread_) own_thread_.stop();
+  thread_ = nullptr;
   threaded_ = false;
   // A job queued but never run is dropped; a finished one stays for the next step() (inline now).
   Slot s = slot_.load();
   if (s == Slot::kQueued || s == Slot::kRunning) slot_.store(Slot::kIdle);
 }
 
-void* GlobalContext::thread_main(void* self) {
-  static_cast<GlobalContext*>(self)->thread_loop();
-  return nullptr;
-}
-
-void GlobalContext::thread_loop() {
-  for (;;) {
-    pthread_mutex_lock(&mutex_);
-    while (!stopping_ && slot_.load(std::memory_order_acquire) != Slot::kQueued) pthread_cond_wait(&cv_, &mutex_);
-    const bool stop = stopping_;
-    pthread_mutex_unlock(&mutex_);
-    if (stop) return;
-    slot_.store(Slot::kRunning, std::memory_order_release);
-    run_job();
-  }
+void GlobalContext::run_queued_job() {
+  slot_.store(Slot::kRunning, std::memory_order_release);
+  run_job();
 }
 
 void GlobalContext::run_job() {
@@ -197,10 +187,8 @@ Status GlobalContext::offer(const hal::LaserScan& scan, const hal::Odometry& odo
   reset_pending_ = false;
   ++jobs_;
   if (threaded_) {
-    pthread_mutex_lock(&mutex_);
     slot_.store(Slot::kQueued, std::memory_order_release);
-    pthread_cond_signal(&cv_);
-    pthread_mutex_unlock(&mutex_);
+    thread_->notify();
     return result_status;
   }
   run_job();

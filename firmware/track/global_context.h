@@ -29,6 +29,7 @@
 #include "firmware/base/status.h"
 #include "firmware/mml/mml_localizer.h"
 #include "firmware/runtime/execution_contexts.h"
+#include "firmware/track/global_thread.h"
 #include "hal/clock.h"
 
 namespace fw {
@@ -70,6 +71,11 @@ class GlobalContext {
   // global steps (perf_step()) and puts MML in deadline mode (pRANSAM's iterations set by the time
   // left in the context's deadline, Sec. 4.4.3); null = neither.
   Status start_thread(const ExecutionContext& context, bool realtime, const hal::Clock* clock);
+  // The same on a thread created elsewhere at start-up and shared (GlobalThread::serve picks the
+  // context it runs: several maps, firmware/app/map_set.h). Creates no thread, so it may be called
+  // after start-up (a map rebuilt by a reload). `thread` must outlive the attachment.
+  Status attach_thread(GlobalThread* thread, const ExecutionContext& context, const hal::Clock* clock);
+  // Own thread: stopped and joined. Attached: detached (the thread stays).
   void stop_thread();
   bool threaded() const { return threaded_; }
   // Inline: the clock that times global steps (perf_step()); null = not timed.
@@ -107,8 +113,9 @@ class GlobalContext {
   PerfStats step_stats() const;
 
  private:
-  static void* thread_main(void* self);
-  void thread_loop();
+  friend class GlobalThread;
+  bool job_queued() const { return slot_.load(std::memory_order_acquire) == Slot::kQueued; }
+  void run_queued_job();  // GlobalThread: the queued job, on that thread
   void run_job();  // on whichever thread executes MML
   void take_result(const hal::LaserScan& scan, const hal::Odometry& odom, hal::PoseEstimate* out);
 
@@ -133,10 +140,8 @@ class GlobalContext {
   std::atomic<Slot> slot_{Slot::kIdle};
 
   bool threaded_ = false;
-  bool stopping_ = false;
-  pthread_t thread_{};
-  pthread_mutex_t mutex_ = PTHREAD_MUTEX_INITIALIZER;
-  pthread_cond_t cv_ = PTHREAD_COND_INITIALIZER;
+  GlobalThread own_thread_;            // start_thread()
+  GlobalThread* thread_ = nullptr;     // the thread running the jobs (own or attached)
   mutable pthread_mutex_t stats_mutex_ = PTHREAD_MUTEX_INITIALIZER;
   PerfCounter perf_step_{"global.step"};
 };

@@ -77,6 +77,31 @@ bool wrong(const hal::PoseEstimate& e, const fw::Se2d& truth) {
   return std::hypot(dx, dy) > kIntegrityLimitM || std::fabs(dth) * 180.0 / M_PI > kIntegrityLimitDeg;
 }
 
+// Threaded global search: wait until the active map's global step is done (at most ~2 s), as if
+// every global step finished within its window (the next scan then takes its result).
+void wait_global_idle(fw::MapSet& maps) {
+  fw::track::TrackedLocalizer* t = maps.active().tracked();
+  if (t == nullptr || !t->global_context().threaded()) return;
+  for (int i = 0; i < 20000 && t->global_context().job_in_flight(); ++i) {
+    const timespec ts{0, 100000};
+    nanosleep(&ts, nullptr);
+  }
+}
+
+// `n` scans of `steps` from `from` on the active localizer: localized scans and wrong ones.
+void drive_steps(fw::Localizer*& loc, fw::MapSet& maps, const std::vector<Step>& steps, std::size_t from, std::size_t n,
+             long* localized, long* wrong_steps) {
+  hal::PoseEstimate e;
+  for (std::size_t i = from; i < from + n && i < steps.size(); ++i) {
+    const Step& s = steps[i];
+    const bool ok = loc->step(s.scan, s.odom, &e).is_ok();
+    wait_global_idle(maps);
+    if (!ok || e.status != hal::LocalizationStatus::kLocalized) continue;
+    ++*localized;
+    if (wrong(e, s.truth)) ++*wrong_steps;
+  }
+}
+
 bool flip_byte(const std::string& path, std::size_t at, std::string* err) {
   std::vector<std::uint8_t> bytes;
   if (!read_file_bytes(path, &bytes, err)) return false;
@@ -109,8 +134,16 @@ bool run_map_switch(const MapSwitchOptions& opt, MapSwitchResult* out, std::stri
   if (!make_steps(opt.world_a, opt.seed, opt.scans_a, 1'000'000'000ull, &steps_a, err)) return false;
   // Floor B's run starts after A's (the same clock; the lift ride takes 10 s).
   const std::uint64_t b_start = steps_a.back().scan.timestamp_ns + 10'000'000'000ull;
-  const std::size_t b_scans = opt.scans_b + opt.scans_after_corrupt;
+  const bool back_to_a = opt.scans_after_reload > 0;
+  const std::size_t b_scans = opt.scans_b + (back_to_a ? 0 : opt.scans_after_corrupt);
   if (!make_steps(opt.world_b, opt.seed + 1, b_scans, b_start, &steps_b, err)) return false;
+  // The ride back to floor A (another run there, after B's).
+  std::vector<Step> steps_a2;
+  const std::uint64_t a2_start = steps_b.back().scan.timestamp_ns + 10'000'000'000ull;
+  if (back_to_a && !make_steps(opt.world_a, opt.seed + 2, opt.scans_after_reload + opt.scans_after_corrupt, a2_start,
+                               &steps_a2, err)) {
+    return false;
+  }
 
   // The firmware's side: start-up as mmlfw does it (map_set.h), then only steps and commands.
   auto arena = std::make_unique<fw::StartupArena>();
@@ -121,8 +154,10 @@ bool run_map_switch(const MapSwitchOptions& opt, MapSwitchResult* out, std::stri
   spec.paths[0] = path_a.c_str();
   spec.paths[1] = path_b.c_str();
   spec.reload = opt.reload_slot;
+  static const fw::track::GlobalScheduleOptions live = fw::track::live_global_schedule();
+  if (opt.threaded_global) spec.system.global_schedule = &live;
   if (st) st = maps->init(spec, *arena, nullptr, nullptr);
-  if (st) st = maps->start_global_contexts(false, false, nullptr, fw::kGlobalContext);
+  if (st) st = maps->start_global_contexts(opt.threaded_global, false, nullptr, fw::kGlobalContext);
   if (!st) {
     *err = std::string("map set: ") + st.message();
     return false;
@@ -130,6 +165,7 @@ bool run_map_switch(const MapSwitchOptions& opt, MapSwitchResult* out, std::stri
   arena->seal();
   out->slot_bytes_a = maps->slot_bytes(0);
   out->slot_bytes_b = maps->slot_bytes(1);
+  out->shared_work_bytes = maps->shared_work_bytes();
   fw::Localizer* loc = &maps->active().localizer();
   fw::CommandHandler handler;
   fw::CommandHandlerOptions ho;
@@ -140,7 +176,9 @@ bool run_map_switch(const MapSwitchOptions& opt, MapSwitchResult* out, std::stri
 
   hal::PoseEstimate e;
   for (const Step& s : steps_a) {
-    if (!loc->step(s.scan, s.odom, &e)) continue;
+    const bool ok = loc->step(s.scan, s.odom, &e).is_ok();
+    wait_global_idle(*maps);
+    if (!ok) continue;
     if (e.status != hal::LocalizationStatus::kLocalized) continue;
     out->localized_on_a = true;
     if (wrong(e, s.truth)) ++out->integrity_failures_a;
@@ -161,6 +199,7 @@ bool run_map_switch(const MapSwitchOptions& opt, MapSwitchResult* out, std::stri
     const double c1 = cpu_now_s();
     const bool ok = loc->step(s.scan, s.odom, &e).is_ok();
     steps_cpu += cpu_now_s() - c1;
+    wait_global_idle(*maps);
     if (!ok || e.status != hal::LocalizationStatus::kLocalized) continue;
     ++out->localized_steps_b;
     if (wrong(e, s.truth)) ++out->integrity_failures;
@@ -173,6 +212,20 @@ bool run_map_switch(const MapSwitchOptions& opt, MapSwitchResult* out, std::stri
   }
   (void)t_select;
   if (opt.after_b != nullptr) out->allocations = opt.after_b();
+  std::size_t next = opt.scans_b;
+  const std::vector<Step>* last_run = &steps_b;
+  if (back_to_a) {
+    // Back on floor A: A's good image read again into the spare and switched to, A searched afresh.
+    hal::Command reload = select;
+    reload.seq = 3;
+    reload.map_id = 0;
+    reload.reload = true;
+    out->reload_reply = handler.handle(reload).result;
+    drive_steps(loc, *maps, steps_a2, 0, opt.scans_after_reload, &out->localized_after_reload, &out->integrity_failures);
+    next = opt.scans_after_reload;
+    last_run = &steps_a2;
+  }
+  out->reloads = maps->reloads();
   if (opt.scans_after_corrupt == 0) return true;
 
   // The image of B replaced on disk by a broken one, then a reload asked for: refused, B stays.
@@ -184,12 +237,8 @@ bool run_map_switch(const MapSwitchOptions& opt, MapSwitchResult* out, std::stri
   reload.reload = true;
   out->corrupt_reply = handler.handle(reload).result;
   out->active_after_corrupt = maps->active_id();
-  for (std::size_t i = opt.scans_b; i < steps_b.size(); ++i) {
-    const Step& s = steps_b[i];
-    if (!loc->step(s.scan, s.odom, &e).is_ok() || e.status != hal::LocalizationStatus::kLocalized) continue;
-    ++out->localized_after_corrupt;
-    if (wrong(e, s.truth)) ++out->integrity_failures;
-  }
+  drive_steps(loc, *maps, *last_run, next, opt.scans_after_corrupt, &out->localized_after_corrupt, &out->integrity_failures);
+  out->reloads = maps->reloads();
   return true;
 }
 

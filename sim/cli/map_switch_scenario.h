@@ -21,6 +21,14 @@ struct MapSwitchOptions {
   std::size_t scans_b = 150;       // on floor B after SELECT_MAP
   std::uint64_t seed = 1;
   bool reload_slot = false;        // config map_reload = true (a spare slot)
+  // global_context = thread (the live schedule, one global thread for every map) instead of the
+  // inline reference schedule. The scenario waits for each global step before the next scan (a
+  // board whose global steps all finish within their window), so the run does not depend on timing.
+  bool threaded_global = false;
+  // After scans_b: the robot rides back to floor A and SELECT_MAP 0 with reload reads A's good
+  // image again (built in the spare slot), then this many scans of a new run on A; the corrupt
+  // reload of B below then happens with A in use (and the scans after it are A's).
+  std::size_t scans_after_reload = 0;
   // After scans_b: the image of B is corrupted on disk and a SELECT_MAP 1 with reload sent, then
   // `scans_after_corrupt` more scans on B (the old map must stay active and localizing).
   std::size_t scans_after_corrupt = 0;
@@ -45,6 +53,10 @@ struct MapSwitchResult {
   long localized_after_corrupt = 0;
   std::uint8_t active_after_corrupt = 255;
   long allocations = -1;           // what after_b returned, -1 = not counted
+  hal::CommandResult reload_reply = hal::CommandResult::kMalformed;  // the good reload
+  long localized_after_reload = 0;
+  std::uint32_t reloads = 0;       // MapSet::reloads() at the end
+  std::size_t shared_work_bytes = 0;
   std::size_t slot_bytes_a = 0, slot_bytes_b = 0;
 };
 
