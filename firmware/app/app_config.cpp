@@ -82,7 +82,7 @@ constexpr const char* kKeys[] = {"laser",     "odometry",  "output",  "can_fd", 
                                  "arena_mib", "step_deadline_ms", "health_period_ms", "laser_timeout_ms", "seed",
                                  "log_level", "global_context", "global_period_scans", "odom_noise",
                                  "odom_noise_per_step", "odom_slip", "laser_mount", "blackbox", "blackbox_frames",
-                                 "map.1", "map.2", "map.3", "map_reload"};
+                                 "blackbox_serial_chunks",                                 "map.1", "map.2", "map.3", "map_reload"};
 constexpr int kNumKeys = static_cast<int>(sizeof(kKeys) / sizeof(kKeys[0]));
 
 // The config path as shown in messages: at most kShownPath characters, the end kept (the file
@@ -227,7 +227,7 @@ Status parse_laser_key(const char* name, int line, const char* key, char* v, App
   return Status::ok();
 }
 
-// blackbox = PATH | off, blackbox_frames = N (issue 60; kKeys lists them).
+// blackbox = PATH | off, blackbox_frames = N, blackbox_serial_chunks = N (issue 60; kKeys lists them).
 Status parse_blackbox_key(const char* name, int line, const char* key, const char* v, AppConfig* out) {
   if (!std::strcmp(key, "blackbox")) {
     if (!std::strcmp(v, "off")) {
@@ -245,6 +245,14 @@ Status parse_blackbox_key(const char* name, int line, const char* key, const cha
       return CFG_ERR("'%s' is not an integer in 0..%ld", v, AppConfig::kMaxBlackBoxFrames);
     }
     out->blackbox_frames = static_cast<std::uint32_t>(x);
+    return Status::ok();
+  }
+  if (!std::strcmp(key, "blackbox_serial_chunks")) {
+    long x = 0;
+    if (!parse_int(v, 0, AppConfig::kMaxBlackBoxFrames, &x)) {
+      return CFG_ERR("'%s' is not an integer in 0..%ld", v, AppConfig::kMaxBlackBoxFrames);
+    }
+    out->blackbox_serial_chunks = static_cast<std::uint32_t>(x);
     return Status::ok();
   }
   return Status::error(Errc::kInvalidArgument, "config '%s' line %d: unknown key '%s'", name, line, key);

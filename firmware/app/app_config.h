@@ -41,9 +41,12 @@
 //   log_level        debug | info | warning | error  [info]
 //   blackbox         PATH | off: the black box (hal/can/include/hal_can/black_box.h) is written to
 //                    PATH (a candump log, replaced atomically) on DUMP_LOG, on a fault and at exit;
-//                    CAN backends only [off]
+//                    a serial laser's bytes go into the same file as "(T) rx laser HEX" lines
+//                    (hal/serial/README.md "Black box") [off]
 //   blackbox_frames  0..4194304 frames the black box keeps (80 bytes each, in the start-up arena when
 //                    blackbox is set; ~1000 frames/s on a classic bus, 180 beams at 10 Hz) [65536: 5 MiB]
+//   blackbox_serial_chunks 0..4194304 serial chunks of up to 64 bytes it keeps with a serial laser
+//                    (80 bytes each; a SICK LMS at 500 kBd, 361 values at 75 Hz, makes ~860/s) [65536: 5 MiB]
 #pragma once
 
 #include <cstddef>
@@ -96,6 +99,7 @@ struct AppConfig {
   float odom_slip[2] = {0.0f, 1.0f};
   char blackbox[256] = {0};             // empty = no black box file
   std::uint32_t blackbox_frames = 65536;
+  std::uint32_t blackbox_serial_chunks = 65536;
 };
 
 // Map ids: 0 is `map`, i ≥ 1 is `map.i`. map_count: how many are set (ids are consecutive).

@@ -204,6 +204,12 @@ TEST(AppConfig, BlackBoxKeys) {
   expect_refused("blackbox_frames", {{"-1", "line 3: key 'blackbox_frames': '-1' is not an integer in 0..4194304"},
                                      {"99999999", "is not an integer"},
                                      {"x", "is not an integer"}});
+  // A serial laser's ring (its chunks of up to 64 bytes).
+  EXPECT_EQ(c.blackbox_serial_chunks, 65536u);
+  ASSERT_TRUE(parse("laser = sick:/dev/ttyS0\nlocalizer = odom\nblackbox = /tmp/bb.log\nblackbox_serial_chunks = 2000\n",
+                    &c).is_ok());
+  EXPECT_EQ(c.blackbox_serial_chunks, 2000u);
+  expect_refused("blackbox_serial_chunks", {{"-1", "key 'blackbox_serial_chunks': '-1' is not an integer in 0..4194304"}});
   expect_refused("blackbox_size", {{"1", "unknown key 'blackbox_size'"}});
   expect_refused("blackbox", {{std::string(300, 'a').c_str(), "path longer than 255 characters"}});
 }

@@ -108,6 +108,7 @@ void print_help() {
       "  workers, cores, realtime, global_context, global_period_scans, arena_mib, step_deadline_ms,\n"
       "  health_period_ms, laser_timeout_ms, seed, mml_preset, log_level, odom_noise, odom_noise_per_step, odom_slip\n"
       "  blackbox = PATH | off, blackbox_frames = N   (the last frames in and out, written on DUMP_LOG, a fault, exit)\n"
+      "  blackbox_serial_chunks = N                   (a serial laser's bytes in and out, in the same file)\n"
       "\n"
       "Commands on the bus (DBC: SET_POSE_HINT, SELECT_MAP, DUMP_LOG; answered by COMMAND_REPLY; mml-ctl sends them).\n"
       "\n"

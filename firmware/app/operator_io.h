@@ -1,7 +1,8 @@
 // mmlfw's operator side (issue 60): the commands of the bus (SET_POSE_HINT, SELECT_MAP, DUMP_LOG;
-// firmware/runtime/command_handler.h) and the black box (hal_can/black_box.h) — its ring carved
-// from the start-up arena, attached to the board's CAN node, written (hal_linux/black_box_file.h)
-// on DUMP_LOG, when a fault bit rises and at exit.
+// firmware/runtime/command_handler.h) and the black box (hal_can/black_box.h, and with a serial
+// laser hal_serial/serial_black_box.h) — its rings carved from the start-up arena, attached to the
+// board's CAN node and serial laser port, written into one file (hal_linux/black_box_file.h) on
+// DUMP_LOG, when a fault bit rises and at exit.
 #pragma once
 
 #include <cstdint>
@@ -12,6 +13,7 @@
 #include "firmware/runtime/localization_loop.h"
 #include "hal_can/black_box.h"
 #include "hal_linux/board.h"
+#include "hal_serial/serial_black_box.h"
 
 namespace fw {
 
@@ -25,8 +27,9 @@ struct OperatorMaps {
 
 class OperatorIo {
  public:
-  // Start-up: the black box (config blackbox, blackbox_frames; a serial board has none: a warning)
-  // and the command handler on the loop. Errors name the part.
+  // Start-up: the black box (config blackbox, blackbox_frames for a CAN node, blackbox_serial_chunks
+  // for a serial laser; a board with neither: a warning) and the command handler on the loop.
+  // Errors name the part.
   Status init(const AppConfig& config, StartupArena& arena, hal_linux::Board& board, LocalizationLoop& loop,
               Localizer& localizer, const OperatorMaps& maps = {});
   // Writes the black box now (DUMP_LOG, exit); logs the bytes or the error.
@@ -34,13 +37,17 @@ class OperatorIo {
   // Every loop cycle: a fault bit that was clear is set → one dump.
   void watch_faults(std::uint32_t fault_bits);
   const hal_can::BlackBox& black_box() const { return box_; }
+  const hal_serial::SerialBlackBox& serial_black_box() const { return serial_box_; }
   const CommandHandler& commands() const { return handler_; }
 
  private:
   static Status dump_command(void* self);
+  Status init_black_box(const AppConfig& config, StartupArena& arena, hal_linux::Board& board);
+  bool recording() const { return box_.enabled() || serial_box_.enabled(); }
   const AppConfig* config_ = nullptr;
   hal::Hal* hal_ = nullptr;
   hal_can::BlackBox box_;
+  hal_serial::SerialBlackBox serial_box_;
   CommandHandler handler_;
   std::uint32_t faults_seen_ = 0;
 };

@@ -38,6 +38,32 @@ TEST(BlackBoxFile, WritesACandumpLogAndReplacesItWhole) {
   unlink(path.c_str());
 }
 
+TEST(BlackBoxFile, MergesTheSerialAndCanRingsByTime) {
+  std::vector<hal_can::BlackBoxEntry> cs(8);
+  hal_can::BlackBox can;
+  can.init(cs.data(), cs.size());
+  std::vector<hal_serial::SerialBlackBoxEntry> ss(8);
+  hal_serial::SerialBlackBox serial;
+  serial.init(ss.data(), ss.size());
+  hal::CanFrame f;
+  f.id = 0x110;
+  f.len = 1;
+  can.record(f, 2'000, false);
+  can.record(f, 5'000, false);
+  const std::uint8_t b[2] = {0x02, 0x80};
+  serial.record(b, 2, 1'000, true);
+  serial.record(b, 2, 2'000, false);  // same µs as a CAN frame: after it
+  const std::string path = ::testing::TempDir() + "/mmlfw_blackbox_merged.log";
+  ASSERT_TRUE(write_black_box_file(&can, &serial, path.c_str(), nullptr).is_ok());
+  std::ifstream in(path);
+  std::stringstream ss2;
+  ss2 << in.rdbuf();
+  EXPECT_EQ(ss2.str(),
+            "(0.000001) tx laser 0280\n(0.000002) rx 110#00\n(0.000002) rx laser 0280\n(0.000005) rx 110#00\n");
+  ASSERT_TRUE(write_black_box_file(nullptr, &serial, path.c_str(), nullptr).is_ok());
+  unlink(path.c_str());
+}
+
 TEST(BlackBoxFile, AnUnwritablePathIsAnErrorNamingIt) {
   hal_can::BlackBox box;
   const fw::Status s = write_black_box_file(box, "/nonexistent-dir/bb.log", nullptr);

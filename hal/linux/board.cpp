@@ -196,10 +196,13 @@ Status Board::open_serial_laser(const char* kind, const char* arg, std::uint32_t
   std::snprintf(serial_device_, sizeof(serial_device_), "%s", ls.device);
   serial_baud_ = ls.baud;
   serial_down_ = false;
+  // The drivers read and write through the recorder: the black box (attach_serial_black_box) sees
+  // the bytes exactly as the driver does; without one it only passes them through.
+  recording_port_.init(&port_, &clock_, nullptr);
   if (!std::strcmp(kind, "hokuyo")) {
     hal_serial::HokuyoOptions o;
     o.intensity = ls.intensity;
-    hokuyo_.init(&port_, &clock_, o);
+    hokuyo_.init(&recording_port_, &clock_, o);
     serial_laser_ = &hokuyo_;
   } else if (!std::strcmp(kind, "rplidar")) {
     hal_serial::RplidarOptions o;
@@ -207,11 +210,11 @@ Status Board::open_serial_laser(const char* kind, const char* arg, std::uint32_t
     if (!std::strcmp(ls.mode, "force")) o.mode = hal_serial::RplidarScanMode::kForceScan;
     o.motor_pwm = ls.motor_pwm;
     if (ls.beams > 0) o.revolution.beams = ls.beams;
-    rplidar_.init(&port_, &clock_, o);
+    rplidar_.init(&recording_port_, &clock_, o);
     rplidar_.set_motor_control(&Board::rplidar_motor, this);
     serial_laser_ = &rplidar_;
   } else {
-    sick_.init(&port_, &clock_, hal_serial::SickLaserOptions{});
+    sick_.init(&recording_port_, &clock_, hal_serial::SickLaserOptions{});
     serial_laser_ = &sick_;
   }
   if (!serial_laser_->start()) {

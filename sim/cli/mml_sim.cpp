@@ -42,7 +42,10 @@ static int run_main(int argc, char** argv) {
       std::fprintf(stderr, "mml-sim: %s\n", err.c_str());
       return 1;
     }
-    std::printf("mml-sim replay-blackbox: %zu rx frames, %zu POSE frames recorded, %zu replayed: %s\n", replay.rx_frames,
+    const std::string serial =
+        replay.rx_serial_lines > 0 ? std::to_string(replay.rx_serial_lines) + " rx serial chunks, " : std::string();
+    std::printf("mml-sim replay-blackbox: %zu rx frames, %s%zu POSE frames recorded, %zu replayed: %s\n", replay.rx_frames,
+                serial.c_str(),
                 replay.recorded_pose_frames, replay.replayed_pose_frames,
                 replay.identical ? "identical" : ("differ from frame " + std::to_string(replay.first_difference)).c_str());
     return replay.identical ? 0 : 1;

@@ -4,9 +4,11 @@
 #include <cstdlib>
 #include <cstring>
 #include <fstream>
+#include <utility>
 
 #include "hal_can/codec.h"
 #include "sim/devices/candump_log.h"
+#include "sim/devices/serial_log_line.h"
 
 namespace sim {
 
@@ -73,6 +75,21 @@ bool read_black_box(const std::string& path, std::vector<BlackBoxLine>* out, std
   while (std::getline(in, line)) {
     ++no;
     if (line.empty()) continue;
+    if (is_serial_log_line(line)) {
+      SerialLogLine sl;
+      std::string why;
+      if (!parse_serial_log_line(line, &sl, &why)) {
+        *err = path + ":" + std::to_string(no) + ": not a black box line (" + why + ")";
+        return false;
+      }
+      BlackBoxLine b;
+      b.serial = true;
+      b.tx = sl.tx;
+      b.frame.timestamp_ns = sl.t_ns;
+      b.bytes.swap(sl.bytes);
+      out->push_back(std::move(b));
+      continue;
+    }
     CanLogLine l;
     std::string why;
     std::uint64_t ns = 0;
@@ -93,7 +110,7 @@ bool read_black_box(const std::string& path, std::vector<BlackBoxLine>* out, std
 std::vector<hal::CanFrame> pose_frames(const std::vector<BlackBoxLine>& lines) {
   std::vector<hal::CanFrame> out;
   for (const BlackBoxLine& l : lines)
-    if (l.tx && is_pose_frame(l.frame)) out.push_back(l.frame);
+    if (l.tx && !l.serial && is_pose_frame(l.frame)) out.push_back(l.frame);
   return out;
 }
 

@@ -15,6 +15,7 @@
 #include "hal/msg/command.h"
 #include "hal/sensor_io.h"
 #include "hal_can/black_box.h"
+#include "hal_serial/serial_black_box.h"
 
 namespace sim {
 
@@ -26,9 +27,10 @@ struct HintOptions {
 };
 
 struct BlackBoxOptions {
-  std::string record_path;   // --blackbox FILE: written after the run (needs --transport can)
+  std::string record_path;   // --blackbox FILE: written after the run (needs --transport can or sick)
   std::string replay_path;   // --replay-blackbox FILE
   std::size_t frames = std::size_t{1} << 21;  // the ring (host: the whole run of a bench world)
+  std::size_t serial_chunks = std::size_t{1} << 21;  // --transport sick: the serial ring's entries
 };
 
 // The hint a run sends at its scan: `truth` moved by the options' offset, or their absolute pose.
@@ -57,19 +59,25 @@ class BlackBoxTee final : public hal::PoseSink {
   std::uint8_t tag_ = 0;
 };
 
-// Host storage for the ring.
+// Host storage for the rings (the serial one with --transport sick).
 struct BlackBoxRecorder {
   std::vector<hal_can::BlackBoxEntry> storage;
   hal_can::BlackBox box;
+  std::vector<hal_serial::SerialBlackBoxEntry> serial_storage;
+  hal_serial::SerialBlackBox serial;
   std::unique_ptr<BlackBoxTee> tee;
 };
 
-// One line of a black box file: the frame (timestamp_ns exact to the µs) and its direction.
+// One line of a black box file: the frame (timestamp_ns exact to the µs) and its direction, or
+// (serial) the bytes read from / written to the laser port at frame.timestamp_ns.
 struct BlackBoxLine {
   hal::CanFrame frame;
   bool tx = false;
+  bool serial = false;
+  std::vector<std::uint8_t> bytes;
 };
-// Reads a black box (candump -L lines with interface rx / tx); errors name the file and line.
+// Reads a black box (candump -L lines with interface rx / tx, and the serial lines "(T) rx laser
+// HEX" of sim/devices/serial_log_line.h); errors name the file and line.
 bool read_black_box(const std::string& path, std::vector<BlackBoxLine>* out, std::string* err);
 // POSE frames (0x120..0x125, 0x520) in order: of the file's tx lines / of a ring's tx entries.
 std::vector<hal::CanFrame> pose_frames(const std::vector<BlackBoxLine>& lines);
@@ -81,6 +89,7 @@ bool same_frames(const std::vector<hal::CanFrame>& a, const std::vector<hal::Can
 
 struct BlackBoxReplay {
   std::size_t rx_frames = 0, recorded_pose_frames = 0, replayed_pose_frames = 0;
+  std::size_t rx_serial_lines = 0;  // serial chunks fed to the laser driver
   std::size_t first_difference = 0;
   bool identical = false;
 };

@@ -353,10 +353,11 @@ struct FirmwareRig {
 // published poses (--blackbox, --replay-blackbox).
 bool wire_operator(const SimConfig& cfg, fw::Localizer& localizer, FirmwareRig* rig, std::string* err) {
   hal::Hal& hal = rig->sim_hal->hal;
-  const bool can = rig->topt.transport == Transport::kCan;
+  const bool can = rig->transport->carries_odometry();  // commands travel with the odometry
+  const bool sick = rig->topt.transport == Transport::kSick;
   const bool black_box = !cfg.blackbox.record_path.empty() || !cfg.blackbox.replay_path.empty();
   if (black_box && !can) {
-    *err = "--blackbox / --replay-blackbox record the firmware's CAN traffic: they need --transport can";
+    *err = "--blackbox / --replay-blackbox record the firmware's wires: they need --transport can or sick";
     return false;
   }
   hal.commands = can ? &rig->transport->commands() : static_cast<hal::CommandSource*>(&rig->direct_commands);
@@ -367,6 +368,11 @@ bool wire_operator(const SimConfig& cfg, fw::Localizer& localizer, FirmwareRig* 
     r.storage.resize(cfg.blackbox.frames);
     r.box.init(r.storage.data(), r.storage.size());
     rig->transport->attach_black_box(&r.box);
+    if (sick) {
+      r.serial_storage.resize(cfg.blackbox.serial_chunks);
+      r.serial.init(r.serial_storage.data(), r.serial_storage.size());
+      rig->transport->attach_serial_black_box(&r.serial);
+    }
     r.tee = std::make_unique<BlackBoxTee>(hal.pose_sink, &r.box);
     hal.pose_sink = r.tee.get();
   }
@@ -381,6 +387,9 @@ bool wire_firmware(const SimConfig& cfg, fw::Localizer& localizer, FirmwareRig* 
   hal::Hal& hal = rig->sim_hal->hal;
   rig->topt = cfg.transport;
   rig->topt.seed = cfg.seed;
+  // Issue 60: a black box with a serial laser records the odometry and commands on the CAN wire, as
+  // a robot with `odometry = socketcan:IFACE` gets them, so one file holds every input.
+  if (!cfg.blackbox.record_path.empty() || !cfg.blackbox.replay_path.empty()) rig->topt.sick_odometry_on_can = true;
   if (!rig->transport->init(rig->topt, &rig->sim_hal->clock, err)) return false;
   if (rig->topt.transport != Transport::kNone) hal.laser = &rig->transport->laser();
   if (rig->transport->carries_odometry()) hal.odometry = &rig->transport->odometry();
@@ -505,7 +514,7 @@ class FrameLoop {
     const hal::Command c = hint_command(cfg_.hint, frame_.truth, rig_.command_seq++);
     sum_.hint_step = static_cast<long>(out_->steps.size());
     std::string why;
-    if (rig_.topt.transport == Transport::kCan) {
+    if (rig_.transport->carries_odometry()) {
       if (!rig_.transport->send_command(c, frame_.scan.timestamp_ns, &why)) sum_.hint_reply = "not sent: " + why;
     } else {
       rig_.direct_commands.push(c);
@@ -684,8 +693,10 @@ bool write_black_box(const SimConfig& cfg, const FirmwareRig& rig, SimSummary* s
   }
   if (cfg.blackbox.record_path.empty()) return true;
   sum->blackbox_frames = rig.black_box.box.size();
-  const fw::Status s = hal_linux::write_black_box_file(rig.black_box.box, cfg.blackbox.record_path.c_str(),
-                                                       &sum->blackbox_bytes);
+  sum->blackbox_serial_chunks = rig.black_box.serial.size();
+  sum->blackbox_serial_bytes = rig.black_box.serial.bytes_recorded();
+  const fw::Status s = hal_linux::write_black_box_file(&rig.black_box.box, &rig.black_box.serial,
+                                                       cfg.blackbox.record_path.c_str(), &sum->blackbox_bytes);
   if (!s.is_ok()) *err = s.message();
   return s.is_ok();
 }
@@ -783,7 +794,10 @@ bool replay_black_box(const SimConfig& cfg_in, SimResult* out, BlackBoxReplay* r
   } else if (!complete_config(cfg_in, &cfg, err)) {
     return false;
   }
-  cfg.transport.transport = Transport::kCan;  // the black box holds CAN frames
+  // CAN frames alone: the CAN laser; serial lines too: the SICK driver on the serial port, the
+  // odometry and commands on the CAN wire (issue 60).
+  const bool serial = std::any_of(lines.begin(), lines.end(), [](const BlackBoxLine& l) { return l.serial; });
+  cfg.transport.transport = serial ? Transport::kSick : Transport::kCan;
   cfg.transport.byte_fault_rate = 0;
   SimSummary& sum = out->summary;
   sum.localizer = cfg.localizer;
@@ -800,10 +814,12 @@ bool replay_black_box(const SimConfig& cfg_in, SimResult* out, BlackBoxReplay* r
   // loop runs as soon as input is pending). Sent frames are what is compared, not fed.
   for (const BlackBoxLine& l : lines) {
     if (l.tx) continue;
-    ++replay->rx_frames;
+    ++(l.serial ? replay->rx_serial_lines : replay->rx_frames);
     if (l.frame.timestamp_ns > rig.sim_hal->clock.now_ns()) rig.sim_hal->clock.set_ns(l.frame.timestamp_ns);
-    if (!rig.transport->inject_frame(l.frame)) {
-      *err = "--replay-blackbox: the loopback bus refused a frame";
+    const bool fed = l.serial ? rig.transport->inject_serial(l.bytes.data(), l.bytes.size())
+                              : rig.transport->inject_frame(l.frame);
+    if (!fed) {
+      *err = l.serial ? "--replay-blackbox: the serial port refused bytes" : "--replay-blackbox: the loopback bus refused a frame";
       return false;
     }
     rig.sim_hal->tasks.run_once();

@@ -179,6 +179,8 @@ struct SimSummary {
   long hint_step = -1;
   std::string hint_reply;
   std::size_t blackbox_frames = 0, blackbox_bytes = 0;
+  // --transport sick: serial ring entries kept and bytes recorded (read and written).
+  std::size_t blackbox_serial_chunks = 0, blackbox_serial_bytes = 0;
 };
 
 struct SimResult {

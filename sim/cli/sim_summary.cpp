@@ -42,6 +42,8 @@ void reset_derived_fields(SimSummary* s) {
   s->hint_reply = keep.hint_reply;
   s->blackbox_frames = keep.blackbox_frames;
   s->blackbox_bytes = keep.blackbox_bytes;
+  s->blackbox_serial_chunks = keep.blackbox_serial_chunks;
+  s->blackbox_serial_bytes = keep.blackbox_serial_bytes;
   s->deadline_misses = keep.deadline_misses;
 }
 

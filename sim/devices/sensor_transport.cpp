@@ -189,6 +189,7 @@ struct SensorTransport::Parts {
   UnwrappedLaser laser{&node.laser()};
   hal::CanFrame frames[hal_can::kMaxScanFrames];
   hal_sim::SimSerialPort port;
+  hal_serial::RecordingSerialPort recording_port;  // between the driver and its port: the black box
   hal_serial::SickLaser sick;
   IndexedSickLaser sick_laser{&sick};
   std::uint8_t bytes[hal_serial::kMaxTelegramData + 16];
@@ -219,7 +220,8 @@ bool SensorTransport::init(const TransportOptions& options, const hal::Clock* cl
   }
   hal_serial::SickLaserOptions so;
   so.request_continuous = false;  // the simulated scanner streams from the start
-  parts_->sick.init(&parts_->port, clock, so);
+  parts_->recording_port.init(&parts_->port, clock, nullptr);
+  parts_->sick.init(&parts_->recording_port, clock, so);
   faults_.reseed(options.seed, kFaultStream);
   parts_->node.init(&parts_->bus, clock, options.fd);
   return true;
@@ -335,6 +337,12 @@ bool SensorTransport::send_command(const hal::Command& command, std::uint64_t t_
 bool SensorTransport::inject_frame(const hal::CanFrame& frame) { return parts_->bus.send(frame); }
 hal::CommandSource& SensorTransport::commands() { return parts_->node.commands(); }
 void SensorTransport::attach_black_box(hal_can::BlackBox* box) { parts_->node.attach_black_box(box); }
+void SensorTransport::attach_serial_black_box(hal_serial::SerialBlackBox* box) {
+  parts_->recording_port.set_black_box(box);
+}
+bool SensorTransport::inject_serial(const std::uint8_t* bytes, std::size_t n) {
+  return parts_->port.device_send(bytes, n);
+}
 
 hal::LaserScanSource& SensorTransport::laser() {
   if (options_.transport == Transport::kSick) return parts_->sick_laser;

@@ -37,6 +37,8 @@
 #include "hal/sensor_io.h"
 #include "hal_can/can_node.h"
 #include "hal_can/codec.h"
+#include "hal_serial/recording_serial_port.h"
+#include "hal_serial/serial_black_box.h"
 #include "hal_serial/sick_laser.h"
 #include "hal_sim/sim_can_bus.h"
 #include "hal_sim/sim_serial_port.h"
@@ -62,6 +64,10 @@ struct TransportOptions {
   // or of byte 8 (a range byte) of this SICK telegram (0-based count of frames / telegrams sent);
   // -1 = off.
   std::int64_t fault_frame = -1;
+  // kSick: odometry and operator commands on the CAN wire (the CanNode), as a robot with a serial
+  // laser and `odometry = socketcan:IFACE` has them; off, odometry goes straight into its ring.
+  // The black box turns it on (issue 60): a replay needs every input on a wire it recorded.
+  bool sick_odometry_on_can = false;
 };
 
 struct TransportStats {
@@ -101,8 +107,12 @@ class SensorTransport {
   // The simulated sensors' resolution (resolved at init) applied to a scan / an odometry sample.
   void to_sensor_resolution(hal::LaserScan* scan) const;
   void to_sensor_resolution(hal::Odometry* odom) const;
-  // Whether odometry travels on the transport (can) or straight into its ring (none, sick).
-  bool carries_odometry() const { return options_.transport == Transport::kCan; }
+  // Whether odometry and commands travel on the CAN wire (can; sick with sick_odometry_on_can) or
+  // straight into their ring / queue.
+  bool carries_odometry() const {
+    return options_.transport == Transport::kCan ||
+           (options_.transport == Transport::kSick && options_.sick_odometry_on_can);
+  }
 
   // kCan: encode and send (frames stamped with the message's time on the simulation clock: the
   // device transmits at the sample time, zero latency); kSick: scans only, as telegrams on the
@@ -118,6 +128,11 @@ class SensorTransport {
   // kCan: the CanNode's command queue, and its black box (null = none).
   hal::CommandSource& commands();
   void attach_black_box(hal_can::BlackBox* box);
+  // kSick: the bytes the SickLaser reads from (and writes to) its port recorded in `box` (null =
+  // none), and bytes as they were received (a black box replay) queued for it; false if the port
+  // is full.
+  void attach_serial_black_box(hal_serial::SerialBlackBox* box);
+  bool inject_serial(const std::uint8_t* bytes, std::size_t n);
 
   // The sources the localization loop reads for kCan (the CanNode's) and kSick (the SickLaser's scans).
   hal::LaserScanSource& laser();

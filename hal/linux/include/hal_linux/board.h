@@ -22,6 +22,8 @@
 #include "hal_linux/linux_clock.h"
 #include "hal_linux/stderr_log_sink.h"
 #include "hal_serial/hokuyo_laser.h"
+#include "hal_serial/recording_serial_port.h"
+#include "hal_serial/serial_black_box.h"
 #include "hal_serial/rplidar_laser.h"
 #include "hal_serial/serial_laser.h"
 #include "hal_serial/sick_laser.h"
@@ -97,6 +99,13 @@ class Board {
     node_.attach_black_box(box);
     return true;
   }
+  // The black box records the serial laser's bytes (false: no serial laser on this board). The
+  // start-up handshake is over by then; requests after a reopen or a device restart are recorded.
+  bool attach_serial_black_box(hal_serial::SerialBlackBox* box) {
+    if (serial_laser_ == nullptr) return false;
+    recording_port_.set_black_box(box);
+    return true;
+  }
   const hal_socketcan::SocketCanBus* can_bus() const { return bus_.is_open() ? &bus_ : nullptr; }
   const hal_serial::SickLaser* sick() const { return serial_laser_ == &sick_ ? &sick_ : nullptr; }
   const hal_serial::HokuyoLaser* hokuyo() const { return serial_laser_ == &hokuyo_ ? &hokuyo_ : nullptr; }
@@ -154,6 +163,7 @@ class Board {
   fw::Status await_handshake(const char* kind, std::uint32_t handshake_ms);
   static bool rplidar_motor(void* board, bool on);
   hal_serial::TermiosPort port_;
+  hal_serial::RecordingSerialPort recording_port_;  // what the serial drivers read and write through
   hal_serial::SickLaser sick_;
   hal_serial::HokuyoLaser hokuyo_;
   hal_serial::RplidarLaser rplidar_;
