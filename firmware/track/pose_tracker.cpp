@@ -230,9 +230,6 @@ TrackStep PoseTracker::step(const Point2f* points, std::size_t n, const Se2f& od
   const TrackStep out0 = out;
   out.alignment = align_from_prediction(points, n, w.pred, &out);
   judge_scan(points, n, odom_jump, &w, &out);
-  if (w.v == ScanVerdict::kContradicting && !out.heading_fault && !odom_jump && predict) {
-    try_turn_hypothesis(points, n, w0, out0, &w, &out);
-  }
   if (w.v == ScanVerdict::kSupported && o.alias_check) check_aliases(points, n, &w, &out);
   // A rival the scan fits significantly better, within what the prediction promises (its PL), is
   // the fix Gauss-Newton missed from a prediction some degrees off (the white wheels' 4° per step),
@@ -265,33 +262,6 @@ TrackStep PoseTracker::step(const Point2f* points, std::size_t n, const Se2f& od
   publish(points, n, w, &out);
   last_ = out;
   return out;
-}
-
-// (3b) The wheels misreported the turn (the corpus's turn-spin wheels, mit-killian's over-reported
-// turns): the scan contradicts the prediction, and Gauss-Newton from a prediction 8–20° off stops
-// short or slides (dev seed 5 #49: a fix 0.22 m off, then a wait of 30 m for MML while right). The
-// hypothesis is tested directly: a correlative search over the heading (the search's widest window)
-// at the predicted position (within its PL), aligned from its best pose and judged again. It is kept
-// only as a heading-only fault — judge_scan's own test: the fix within the prediction's position PL,
-// the scan fitting it significantly better than the prediction — else the first verdict stands.
-void PoseTracker::try_turn_hypothesis(const Point2f* points, std::size_t n, const StepWork& w0,
-                                      const TrackStep& out0, StepWork* w, TrackStep* out) {
-  const TrackOptions& o = options_;
-  if (!o.heading_fault_local_recovery || !o.search.enabled || n == 0) return;
-  CorrelativeWindow win;
-  win.xy_m = std::fmin(w0.pred_pl.xy_m, o.search.max_window_xy_m);
-  win.theta_rad = o.search.max_window_theta_rad;
-  const CorrelativeResult cr = correlative_search(map_, points, n, w0.pred, win, o.search, search_scratch_, kSearchScratch);
-  if (cr.candidates == 0 || !(cr.score > cr.seed_score)) return;
-  StepWork w1 = w0;
-  TrackStep out1 = out0;
-  out1.search_candidates = out->search_candidates + cr.candidates;
-  out1.turn_searched = true;
-  out1.alignment = align_scan(map_, points, n, cr.pose, o.align);
-  judge_scan(points, n, false, &w1, &out1);
-  if (!out1.heading_fault) return;
-  *w = w1;
-  *out = out1;
 }
 
 // (3) Verdict of this scan on the pose: outside the map, uninformative, a poor fit, or a fix that

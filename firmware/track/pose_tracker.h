@@ -90,7 +90,6 @@ struct TrackStep {
   std::uint32_t search_candidates = 0;  // correlative pre-search (0 = not run: prediction tight)
   bool search_moved = false;            // the alignment started from the search's best pose
   bool refit_at_rival = false;          // re-aligned from a better rival within the prediction's PL
-  bool turn_searched = false;           // the turn hypothesis was searched at the predicted position
   ScanAlignment alignment;
 };
 
@@ -143,8 +142,6 @@ class PoseTracker {
   };
   void predict_to(const Se2f& odom);
   void judge_scan(const Point2f* points, std::size_t n, bool odom_jump, StepWork* w, TrackStep* out);
-  void try_turn_hypothesis(const Point2f* points, std::size_t n, const StepWork& w0, const TrackStep& out0,
-                           StepWork* w, TrackStep* out);
   void check_aliases(const Point2f* points, std::size_t n, StepWork* w, TrackStep* out);
   Update propose_update(const Se2f& odom, bool predict, StepWork* w, TrackStep* out);
   void apply_verdict(const Se2f& odom, const StepWork& w, const Update& u, TrackStep* out);

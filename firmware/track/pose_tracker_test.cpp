@@ -970,38 +970,6 @@ TEST(PoseTrackerTest, BadOptionsNameTheField) {
   EXPECT_NE(std::string(o.validate().message()).find("odom_scale_error"), std::string::npos);
 }
 
-// Wheels that report 20° of turn the robot never made while it turns in place (the corpus's
-// turn-spin wheels): Gauss-Newton from the prediction stops 15° short, 0.26 m off, outside the
-// prediction's position PL — a large fault that waited for MML. The turn hypothesis (a heading
-// search at the predicted position, PoseTracker::try_turn_hypothesis) finds the right heading and the
-// scan is a heading-only fault the track recovers from itself. Without the search, the large fault.
-TEST(PoseTrackerTest, TurnOverReportedBeyondGaussNewtonsReachIsFoundByTheTurnSearch) {
-  for (const bool search : {true, false}) {
-    PoseTracker t;
-    TrackOptions o;
-    o.search.enabled = search;
-    o.odom_rot_per_rad = o.odom_rot_per_m = 0.05f;
-    ASSERT_TRUE(t.init(o, room_map().map).is_ok());
-    RandomStream rng(23, 0);
-    const Se2f truth(5.0f, 3.0f, 0.3f);
-    t.start(truth, small_cov(), Se2f());
-    auto pts = testing::scan_at(room(), truth, &rng);
-    t.step(pts.data(), pts.size(), Se2f(), false);
-    const Se2f odom(0.0f, 0.0f, 0.349066f);  // 20° reported, none made
-    pts = testing::scan_at(room(), truth, &rng);
-    const TrackStep s = t.step(pts.data(), pts.size(), odom);
-    EXPECT_EQ(s.verdict, ScanVerdict::kContradicting) << search;
-    EXPECT_NE(s.status, hal::LocalizationStatus::kLocalized) << search;
-    EXPECT_EQ(s.turn_searched, search);
-    EXPECT_EQ(s.heading_fault, search);
-    EXPECT_EQ(s.large_fault, !search);
-    if (search) {
-      EXPECT_LT(err_xy(s.alignment.pose, truth), 0.02f);
-      EXPECT_LT(std::fabs(wrap_angle(s.alignment.pose.theta - truth.theta)), 0.02f);
-    }
-  }
-}
-
 }  // namespace
 }  // namespace track
 }  // namespace fw

@@ -216,12 +216,8 @@ struct TrackOptions {
   // the robot turned 5°) do that, a carried robot does not: carrying moves the position, and a place
   // that looks the same turned would fail the test against the prediction. The fault still widens the
   // covariance and needs `recovery_steps` consistent scans; MML still cross-checks in the background.
-  // When Gauss-Newton from a prediction 15–20° off stops short (outside the prediction's position
-  // PL), the turn hypothesis is searched directly: a heading search at the predicted position
-  // (PoseTracker::try_turn_hypothesis, the correlative search's widest heading window), kept only if
-  // it passes this same test. false = every heading fault beyond the alert limit waits for MML's
-  // confirmation. Corpus (the turn-spin wheels, the 23 such draws of dev seed 5): 7,683 `localized`
-  // without the rule, 8,200 with the test alone, 8,879 with the search; 0 wrong in all three.
+  // false = every heading fault beyond the alert limit waits for MML's confirmation. Corpus (the
+  // turn-spin wheels, the 23 such draws of dev seed 5): 7,683 → 8,200 `localized`, 0 wrong either way.
   bool heading_fault_local_recovery = true;
   // Confidence extent (fit_comparison.h): the protection level of a scan-supported pose covers at least
   // the farthest shift from the scan fix that the scan cannot reject (paired test at alias_z), plus
