@@ -218,6 +218,9 @@ struct TrackOptions {
   // covariance and needs `recovery_steps` consistent scans; MML still cross-checks in the background.
   // false = every heading fault beyond the alert limit waits for MML's confirmation. Corpus (the
   // turn-spin wheels, the 23 such draws of dev seed 5): 7,683 → 8,200 `localized`, 0 wrong either way.
+  // Only Gauss-Newton's reach from the prediction keeps a carry into a look-alike turned out: a
+  // heading search at the predicted position (tried) passed this test after such a carry (seed 707
+  // #136, 13 wrong steps) and was dropped (README, assumption 3).
   bool heading_fault_local_recovery = true;
   // Confidence extent (fit_comparison.h): the protection level of a scan-supported pose covers at least
   // the farthest shift from the scan fix that the scan cannot reject (paired test at alias_z), plus
