@@ -51,6 +51,7 @@ void PoseTracker::stop() {
   bias_theta_rad_ = 0.0f;
   unsupported_ = faulty_ = outside_ = 0;
   unpinned_m_ = 0.0f;
+  turn_since_fuse_rad_ = 0.0f;
   excess_xy_m_ = 0.0f;
   consistent_since_fault_ = 0;
   had_fault_ = false;
@@ -219,6 +220,7 @@ TrackStep PoseTracker::step(const Point2f* points, std::size_t n, const Se2f& od
     const Se2f d = prev_odom_.between(odom);
     odom_jump = !(std::hypot(d.x, d.y) <= o.max_odom_step_m && std::fabs(d.theta) <= o.max_odom_step_rad);
     unpinned_m_ += std::hypot(d.x, d.y);
+    turn_since_fuse_rad_ += std::fabs(d.theta);
     predict_to(odom);
   }
   StepWork w;
@@ -230,6 +232,9 @@ TrackStep PoseTracker::step(const Point2f* points, std::size_t n, const Se2f& od
   const TrackStep out0 = out;
   out.alignment = align_from_prediction(points, n, w.pred, &out);
   judge_scan(points, n, odom_jump, &w, &out);
+  if (w.v == ScanVerdict::kContradicting && !out.heading_fault && !odom_jump && predict) {
+    try_turn_hypothesis(points, n, w0, out0, &w, &out);
+  }
   if (w.v == ScanVerdict::kSupported && o.alias_check) check_aliases(points, n, &w, &out);
   // A rival the scan fits significantly better, within what the prediction promises (its PL), is
   // the fix Gauss-Newton missed from a prediction some degrees off (the white wheels' 4° per step),
@@ -262,6 +267,36 @@ TrackStep PoseTracker::step(const Point2f* points, std::size_t n, const Se2f& od
   publish(points, n, w, &out);
   last_ = out;
   return out;
+}
+
+// (3b) The wheels misreported the turn (the corpus's turn-spin wheels, mit-killian's over-reported
+// turns): the scan contradicts the prediction, and Gauss-Newton from a prediction 8–20° off stops
+// short or slides (dev seed 5 #49: a fix 0.22 m off, then a wait of 30 m for MML while right). The
+// hypothesis is tested directly: a correlative search at the predicted position (within its PL) over
+// the headings the wheels' reported turn allows, aligned from its best pose and judged again. It is
+// kept only as a heading-only fault — judge_scan's own test: the fix within the prediction's position
+// PL and the reported turn, the scan fitting it significantly better than the prediction — else the
+// first verdict stands.
+void PoseTracker::try_turn_hypothesis(const Point2f* points, std::size_t n, const StepWork& w0,
+                                      const TrackStep& out0, StepWork* w, TrackStep* out) {
+  const TrackOptions& o = options_;
+  if (!o.heading_fault_local_recovery || !o.search.enabled || n == 0) return;
+  const float turn_rad = turn_since_fuse_rad_ + w0.pred_pl.theta_rad;
+  if (turn_rad <= o.alert_limit_rad) return;  // no heading-only fault can pass judge_scan's test
+  CorrelativeWindow win;
+  win.xy_m = std::fmin(w0.pred_pl.xy_m, o.search.max_window_xy_m);
+  win.theta_rad = std::fmin(turn_rad, o.search.max_window_theta_rad);
+  const CorrelativeResult cr = correlative_search(map_, points, n, w0.pred, win, o.search, search_scratch_, kSearchScratch);
+  if (cr.candidates == 0 || !(cr.score > cr.seed_score)) return;
+  StepWork w1 = w0;
+  TrackStep out1 = out0;
+  out1.search_candidates = out->search_candidates + cr.candidates;
+  out1.turn_searched = true;
+  out1.alignment = align_scan(map_, points, n, cr.pose, o.align);
+  judge_scan(points, n, false, &w1, &out1);
+  if (!out1.heading_fault) return;
+  *w = w1;
+  *out = out1;
 }
 
 // (3) Verdict of this scan on the pose: outside the map, uninformative, a poor fit, or a fix that
@@ -340,8 +375,14 @@ void PoseTracker::judge_scan(const Point2f* points, std::size_t n, bool odom_jum
     // showed as 0.27 m and 6° at the first scan: the target fits the map next to the prediction).
     const float exy = std::hypot(w->e(0), w->e(1));
     out->large_fault = exy > o.alert_limit_m || std::fabs(w->e(2)) > o.alert_limit_rad;
-    if (out->large_fault && o.heading_fault_local_recovery && exy <= w->pred_pl.xy_m && exy <= o.alert_limit_m) {
-      // Heading only (track_options.h): the scan must prefer its fix to the prediction significantly.
+    // Heading only (track_options.h): the fix within the prediction's position PL, turned from it no
+    // more than the wheels reported turning since a scan last set the heading (plus the prediction's
+    // heading PL), since a wheel turn error is part of a reported turn: a robot carried to a place that
+    // looks alike turned has turned without its wheels (seed 707 #136, a twin aisle). And the scan must
+    // prefer its fix to the prediction significantly.
+    const bool wheels_turned = std::fabs(w->e(2)) <= turn_since_fuse_rad_ + w->pred_pl.theta_rad;
+    if (out->large_fault && o.heading_fault_local_recovery && exy <= w->pred_pl.xy_m && exy <= o.alert_limit_m &&
+        wheels_turned) {
       const std::size_t m = subsample_alias_points(points, n);
       out->heading_fault = rival_significantly_better(map_, alias_points_, m, pred, a.pose, o.alias_clip_m,
                                                       a.independent, o.alias_z);
@@ -498,6 +539,7 @@ void PoseTracker::apply_verdict(const Se2f& odom, const StepWork& w, const Updat
       odom_at_fuse_ = odom;
       pose_at_fuse_ = pose_;
       predicted_since_fuse_ = 0;
+      turn_since_fuse_rad_ = 0.0f;
       fuse_next_ = false;
       out->fused = true;
       odometry_check_.push(pose_, cov_, u.bias_xy, u.bias_theta);

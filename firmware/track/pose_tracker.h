@@ -90,6 +90,7 @@ struct TrackStep {
   std::uint32_t search_candidates = 0;  // correlative pre-search (0 = not run: prediction tight)
   bool search_moved = false;            // the alignment started from the search's best pose
   bool refit_at_rival = false;          // re-aligned from a better rival within the prediction's PL
+  bool turn_searched = false;           // the turn hypothesis was searched at the predicted position
   ScanAlignment alignment;
 };
 
@@ -142,6 +143,8 @@ class PoseTracker {
   };
   void predict_to(const Se2f& odom);
   void judge_scan(const Point2f* points, std::size_t n, bool odom_jump, StepWork* w, TrackStep* out);
+  void try_turn_hypothesis(const Point2f* points, std::size_t n, const StepWork& w0, const TrackStep& out0,
+                           StepWork* w, TrackStep* out);
   void check_aliases(const Point2f* points, std::size_t n, StepWork* w, TrackStep* out);
   Update propose_update(const Se2f& odom, bool predict, StepWork* w, TrackStep* out);
   void apply_verdict(const Se2f& odom, const StepWork& w, const Update& u, TrackStep* out);
@@ -180,6 +183,9 @@ class PoseTracker {
   // Metres the wheels carried the pose since a supported scan last pinned every direction of it
   // (no one-valley drop): how far a declared wheel slip could go unseen (odom_slip_per_100m).
   float unpinned_m_ = 0.0f;
+  // Turn the wheels reported (sum of |Δθ|) since the last fused scan: the most a wheel turn error
+  // can have turned the prediction since a scan last set the heading (heading-only fault, judge_scan).
+  float turn_since_fuse_rad_ = 0.0f;
   std::uint32_t consistent_since_fault_ = 0;  // consistent scans since the last contradicting one
   bool had_fault_ = false;
   // A contradicting scan since the last recovery_steps unique consistent scans (ambiguous scans do

@@ -482,6 +482,36 @@ TEST(PoseTrackerTest, HeadingFaultWithAPositionJumpStaysALargeFault) {
   EXPECT_TRUE(s.large_fault);
 }
 
+// The robot turned 14° while its wheels reported no turn (turned by hand, carried): the scan fix lies
+// at the predicted position, turned, and fits significantly better — but a wheel turn error is part
+// of a reported turn, so this is not the wheels' fault: a large fault (MML must confirm), with the
+// turn search or without. The same 14° of error where the wheels reported 28° and the robot turned
+// 14° is the heading-only fault the wheels allow.
+TEST(PoseTrackerTest, HeadingFaultBeyondTheWheelsReportedTurnIsALargeFault) {
+  for (const bool reported : {false, true}) {
+    for (const bool search : {true, false}) {
+      PoseTracker t;
+      TrackOptions o;
+      o.search.enabled = search;
+      o.odom_rot_per_rad = o.odom_rot_per_m = 0.05f;
+      ASSERT_TRUE(t.init(o, room_map().map).is_ok());
+      RandomStream rng(31, 0);
+      Se2f truth(5.0f, 3.0f, 0.3f);
+      t.start(truth, small_cov(), Se2f());
+      auto pts = testing::scan_at(room(), truth, &rng);
+      t.step(pts.data(), pts.size(), Se2f(), false);
+      const Se2f odom(0.0f, 0.0f, reported ? 0.4887f : 0.0f);
+      truth = Se2f(truth.x, truth.y, truth.theta + 0.2443f);
+      pts = testing::scan_at(room(), truth, &rng);
+      const TrackStep s = t.step(pts.data(), pts.size(), odom);
+      EXPECT_EQ(s.verdict, ScanVerdict::kContradicting) << reported << search;
+      EXPECT_NE(s.status, hal::LocalizationStatus::kLocalized) << reported << search;
+      EXPECT_EQ(s.heading_fault, reported) << reported << search;
+      EXPECT_EQ(s.large_fault, !reported) << reported << search;
+    }
+  }
+}
+
 // A corridor whose walls carry identical pillars every 2 m, 30 m long; with a 4 m laser its ends are
 // never seen, so a scan fits as well one period along the corridor (an alias). `unique_pillar`
 // adds one more pillar that only the true pose explains.
@@ -968,6 +998,38 @@ TEST(PoseTrackerTest, BadOptionsNameTheField) {
   o = TrackOptions();
   o.odom_scale_error = 2.0f;
   EXPECT_NE(std::string(o.validate().message()).find("odom_scale_error"), std::string::npos);
+}
+
+// Wheels that report 20° of turn the robot never made while it turns in place (the corpus's
+// turn-spin wheels): Gauss-Newton from the prediction stops 15° short, 0.26 m off, outside the
+// prediction's position PL — a large fault that waited for MML. The turn hypothesis (a heading
+// search at the predicted position, PoseTracker::try_turn_hypothesis) finds the right heading and the
+// scan is a heading-only fault the track recovers from itself. Without the search, the large fault.
+TEST(PoseTrackerTest, TurnOverReportedBeyondGaussNewtonsReachIsFoundByTheTurnSearch) {
+  for (const bool search : {true, false}) {
+    PoseTracker t;
+    TrackOptions o;
+    o.search.enabled = search;
+    o.odom_rot_per_rad = o.odom_rot_per_m = 0.05f;
+    ASSERT_TRUE(t.init(o, room_map().map).is_ok());
+    RandomStream rng(23, 0);
+    const Se2f truth(5.0f, 3.0f, 0.3f);
+    t.start(truth, small_cov(), Se2f());
+    auto pts = testing::scan_at(room(), truth, &rng);
+    t.step(pts.data(), pts.size(), Se2f(), false);
+    const Se2f odom(0.0f, 0.0f, 0.349066f);  // 20° reported, none made
+    pts = testing::scan_at(room(), truth, &rng);
+    const TrackStep s = t.step(pts.data(), pts.size(), odom);
+    EXPECT_EQ(s.verdict, ScanVerdict::kContradicting) << search;
+    EXPECT_NE(s.status, hal::LocalizationStatus::kLocalized) << search;
+    EXPECT_EQ(s.turn_searched, search);
+    EXPECT_EQ(s.heading_fault, search);
+    EXPECT_EQ(s.large_fault, !search);
+    if (search) {
+      EXPECT_LT(err_xy(s.alignment.pose, truth), 0.02f);
+      EXPECT_LT(std::fabs(wrap_angle(s.alignment.pose.theta - truth.theta)), 0.02f);
+    }
+  }
 }
 
 }  // namespace
