@@ -210,17 +210,17 @@ struct TrackOptions {
   // right poses this could turn all tested below z 1.0; the carry 3908 → 3827 above 1.64.
   float alias_credible_z = 1.645f;
   // A heading-only fault is recovered by the track itself: the scan fix lies inside the prediction's
-  // horizontal protection level (the position is where the track promised it) and turned beyond the
-  // heading alert limit, and the paired test (alias_z) says the scan fits significantly better at the
-  // fix than at the predicted pose. Wheels that over-report a turn (mit-killian: 23° of odometry where
-  // the robot turned 5°) do that, a carried robot does not: carrying moves the position, and a place
-  // that looks the same turned would fail the test against the prediction. The fault still widens the
-  // covariance and needs `recovery_steps` consistent scans; MML still cross-checks in the background.
-  // false = every heading fault beyond the alert limit waits for MML's confirmation. Corpus (the
-  // turn-spin wheels, the 23 such draws of dev seed 5): 7,683 → 8,200 `localized`, 0 wrong either way.
-  // Only Gauss-Newton's reach from the prediction keeps a carry into a look-alike turned out: a
-  // heading search at the predicted position (tried) passed this test after such a carry (seed 707
-  // #136, 13 wrong steps) and was dropped (README, assumption 3).
+  // horizontal protection level, turned beyond the heading alert limit but by no more than the wheels
+  // reported turning since a scan last set the heading (plus the prediction's heading PL), and the
+  // paired test (alias_z) says the scan fits significantly better at the fix than at the prediction.
+  // Wheels that over-report a turn (mit-killian: 23° where the robot turned 5°) do that; a carried
+  // robot does not: carrying moves the position, and a look-alike place turned has turned without
+  // the wheels (seed 707 #136). Where Gauss-Newton from a prediction 15–20° off stops short, a heading
+  // search at the predicted position over that turn looks for the fix (try_turn_hypothesis), kept only
+  // if it passes this test. The fault widens the covariance and needs `recovery_steps` consistent
+  // scans; MML still cross-checks. false = every heading fault beyond the alert limit waits for MML.
+  // Corpus (the 23 turn-spin draws of dev seed 5): 7,683 `localized` without the rule, 8,200 with the
+  // test alone, 8,879 with the search; 0 wrong in all three.
   bool heading_fault_local_recovery = true;
   // Confidence extent (fit_comparison.h): the protection level of a scan-supported pose covers at least
   // the farthest shift from the scan fix that the scan cannot reject (paired test at alias_z), plus
