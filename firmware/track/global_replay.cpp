@@ -65,7 +65,8 @@ Status GlobalContext::collect_replayed(const hal::LaserScan& scan, const hal::Od
   const hal::GlobalRecord& r = replay_records_[job_record_];
   if (us(scan.timestamp_ns) < us(r.scan_ns)) return Status::ok();  // held until its scan
   if (us(scan.timestamp_ns) > us(r.scan_ns)) {
-    fail_replay(job_record_, "the replay did not look for a global result at that scan", scan.timestamp_ns);
+    fail_replay(job_record_, "its scan passed without the replay taking (or dropping) the result there",
+                scan.timestamp_ns);
     return Status::ok();
   }
   const bool stale = job_generation_ != generation_;
