@@ -11,6 +11,7 @@
 #include "firmware/track/global_context.h"
 #include "firmware/track/track_test_util.h"
 #include "firmware/track/tracked_localizer.h"
+#include "tests/alloc_counter.h"
 
 namespace fw {
 namespace track {
@@ -115,6 +116,71 @@ TEST(GlobalReplayTest, RecordNotMetIsNamed) {
   EXPECT_EQ(replay.gc().replay_failed_record(), 2u);
   EXPECT_NE(std::strstr(replay.gc().replay_status().message(), "global record 2"), nullptr)
       << replay.gc().replay_status().message();
+}
+
+// The room tour's scans and (exact) odometry, made at start-up.
+struct Inputs {
+  std::vector<hal::LaserScan> scans;
+  std::vector<hal::Odometry> odom;
+};
+Inputs room_inputs() {
+  Inputs in;
+  const std::vector<Se2f> path = testing::room_tour();
+  in.scans.resize(path.size());
+  in.odom.resize(path.size());
+  for (std::size_t i = 0; i < path.size(); ++i) {
+    mcl::testing::simulate_scan(testing::room().view(), path[i].x, path[i].y, path[i].theta, &in.scans[i]);
+    in.scans[i].scan_id = static_cast<std::uint32_t>(i);
+    in.scans[i].timestamp_ns = in.odom[i].timestamp_ns = i * 100000000ull;
+    in.odom[i].x = path[i].x;
+    in.odom[i].y = path[i].y;
+    in.odom[i].theta = path[i].theta;
+  }
+  return in;
+}
+
+class FixedRecords final : public hal::GlobalRecordSink {
+ public:
+  void record_global(const hal::GlobalRecord& r) override {
+    if (n < kCapacity) records[n++] = r;
+  }
+  static constexpr std::size_t kCapacity = 1024;
+  hal::GlobalRecord records[kCapacity];
+  std::size_t n = 0;
+};
+
+// No heap after start-up: neither the threaded run recording its global results nor the replay.
+TEST(GlobalReplayTest, RecordingAndReplayAllocateNothing) {
+  if (!mmlfw_test::AllocCounter::available()) GTEST_SKIP() << "allocation counter unavailable under sanitizers";
+  static MonotonicClock clock;
+  static FixedRecords sink;
+  const Inputs in = room_inputs();
+  Rig robot, replay;
+  ASSERT_TRUE(robot.init().is_ok());
+  ASSERT_TRUE(replay.init().is_ok());
+  ExecutionContext context = kGlobalContext;
+  context.deadline_ns = 300000;
+  ASSERT_TRUE(robot.gc().start_thread(context, false, &clock).is_ok());
+  robot.gc().set_record_sink(&sink);
+  hal::PoseEstimate e;
+  mmlfw_test::AllocCounter::begin();
+  for (std::size_t i = 0; i < in.scans.size(); ++i) {
+    robot.loc->step(in.scans[i], in.odom[i], &e);
+    timespec ts{0, static_cast<long>((i % 3) * 1500000)};
+    nanosleep(&ts, nullptr);
+  }
+  const long recording = mmlfw_test::AllocCounter::end();
+  robot.gc().stop_thread();
+  ASSERT_GT(sink.n, 0u);
+  ASSERT_LT(sink.n, FixedRecords::kCapacity);
+  ASSERT_TRUE(replay.gc().replay(sink.records, sink.n).is_ok());
+  mmlfw_test::AllocCounter::begin();
+  for (std::size_t i = 0; i < in.scans.size(); ++i) replay.loc->step(in.scans[i], in.odom[i], &e);
+  const long replaying = mmlfw_test::AllocCounter::end();
+  EXPECT_EQ(recording, 0);
+  EXPECT_EQ(replaying, 0);
+  EXPECT_TRUE(replay.gc().replay_status().is_ok()) << replay.gc().replay_status().message();
+  EXPECT_EQ(replay.gc().replay_records_used(), sink.n);
 }
 
 TEST(GlobalReplayTest, ReplayNeedsTheThreadedSchedule) {
