@@ -32,6 +32,7 @@ Status GlobalContext::init(mml::MmlLocalizer* mml, const GlobalScheduleOptions& 
   generation_ = 0;
   jobs_ = overruns_ = skipped_offers_ = 0;
   reset_pending_ = false;
+  replaying_ = false;
   slot_.store(Slot::kIdle);
   return Status::ok();
 }
@@ -39,6 +40,7 @@ Status GlobalContext::init(mml::MmlLocalizer* mml, const GlobalScheduleOptions& 
 Status GlobalContext::attach_thread(GlobalThread* thread, const ExecutionContext& context, const hal::Clock* clock) {
   if (mml_ == nullptr) return Status::error(Errc::kNotInitialized, "global context: thread attached before init()");
   if (threaded_) return Status::error(Errc::kInvalidArgument, "global context: thread already started");
+  if (replaying_) return Status::error(Errc::kInvalidArgument, "global context: a replay runs inline");
   if (thread == nullptr || !thread->running()) {
     return Status::error(Errc::kInvalidArgument, "global context: the attached thread is not running");
   }

@@ -837,6 +837,7 @@ bool replay_black_box(const SimConfig& cfg_in, SimResult* out, BlackBoxReplay* r
   *replay = BlackBoxReplay();
   std::vector<BlackBoxLine> lines;
   if (!read_black_box(cfg_in.blackbox.replay_path, &lines, err)) return false;
+  const GlobalRecords global = global_records(lines);  // outlives the localizer's replay of them
   SimConfig cfg;
   // A robot's black box: its map (--map) and the localizer's options alone, no source to run.
   const bool robot = cfg_in.world.empty() && cfg_in.log_path.empty() && cfg_in.dataset.empty() &&
@@ -864,7 +865,6 @@ bool replay_black_box(const SimConfig& cfg_in, SimResult* out, BlackBoxReplay* r
   if (!localizer) return false;
   FirmwareRig rig;
   if (!wire_firmware(cfg, *localizer, &rig, &sum, err)) return false;
-  const GlobalRecords global = global_records(lines);
   fw::track::GlobalContext* gc = hooks.global_context ? hooks.global_context() : nullptr;
   if (!replay_global_records(cfg_in.blackbox.replay_path, global, gc, err)) return false;
   replay->global_records = global.records.size();
