@@ -162,7 +162,13 @@ void MapSet::activate(std::uint8_t id) {
   if (threaded_ && now.tracked() != nullptr) global_thread_.serve(&now.tracked()->global_context());
 }
 
+void MapSet::set_global_record_sink(hal::GlobalRecordSink* sink) {
+  record_sink_ = sink;
+  for (int id = 0; id < count_; ++id) system(id).set_global_record_sink(sink);
+}
+
 Status MapSet::attach_global(LocalizationSystem& sys) {
+  sys.set_global_record_sink(record_sink_);
   if (!threaded_) {
     if (sys.tracked() != nullptr) sys.tracked()->global_context().set_clock(clock_);
     return Status::ok();

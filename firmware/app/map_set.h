@@ -66,6 +66,9 @@ class MapSet : public MapSelector {
   // active map (a reloaded map too). Inline: `clock` times the global steps.
   Status start_global_contexts(bool threaded, bool realtime, const hal::Clock* clock, const ExecutionContext& context);
   void stop_global_contexts();
+  // Every map's global context records its results here (the black box, issue 60), a map
+  // reloaded later too. Sensor context (start-up).
+  void set_global_record_sink(hal::GlobalRecordSink* sink);
 
   Result<Localizer*> select(std::uint8_t id, bool reload) override;
   std::uint8_t active_id() const override { return active_; }
@@ -127,6 +130,7 @@ class MapSet : public MapSelector {
   track::GlobalThread global_thread_;
   const hal::Clock* clock_ = nullptr;
   ExecutionContext global_ctx_ = kGlobalContext;
+  hal::GlobalRecordSink* record_sink_ = nullptr;
 };
 
 }  // namespace fw

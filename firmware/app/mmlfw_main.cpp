@@ -363,6 +363,12 @@ int build_localizer(const Args& a, Startup* su) {
     if (g_maps.count() > 0) maps = {&g_maps, &on_map_switch, &g_loop};
     st = g_operator.init(c, g_arena, g_board, g_loop, active_system().localizer(), maps);
     if (!st) return fail("operator commands / black box", st);
+    // Issue 60: with global_context = thread the black box records when each global result was taken.
+    if (g_maps.count() > 0) {
+      g_maps.set_global_record_sink(g_operator.global_record_sink());
+    } else {
+      g_system.set_global_record_sink(g_operator.global_record_sink());
+    }
   }
   return 0;
 }

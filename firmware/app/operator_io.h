@@ -37,6 +37,8 @@ class OperatorIo {
   // Every loop cycle: a fault bit that was clear is set → one dump.
   void watch_faults(std::uint32_t fault_bits);
   const hal_can::BlackBox& black_box() const { return box_; }
+  // The global search's records (issue 60) go into the CAN ring; null without one.
+  hal::GlobalRecordSink* global_record_sink() { return box_.enabled() ? &box_ : nullptr; }
   const hal_serial::SerialBlackBox& serial_black_box() const { return serial_box_; }
   const CommandHandler& commands() const { return handler_; }
 

@@ -93,6 +93,11 @@ class LocalizationSystem {
   // map is active); creates no thread. Other localizers: nothing to attach (ok).
   Status attach_global_thread(track::GlobalThread* thread, const hal::Clock* clock, const ExecutionContext& context);
   void stop_global_context();
+  // mml-track: where the threaded global context records each result it takes or drops (the black
+  // box, issue 60; hal/global_record_sink.h); null = none. Other localizers: nothing to record.
+  void set_global_record_sink(hal::GlobalRecordSink* sink) {
+    if (tracked_ != nullptr) tracked_->global_context().set_record_sink(sink);
+  }
   // True when MML reads the map image's relation table in place (keep the image mapped).
   bool table_in_use() const;
   // Bytes of the localizer objects (they live in the arena; counted in arena.used()).

@@ -369,6 +369,7 @@ Status MmlLocalizer::step(const hal::LaserScan& scan, const hal::Odometry& odom,
     return Status::error(Errc::kInvalidArgument, "MmlLocalizer: non-finite odometry at scan %u", scan.scan_id);
   }
   const std::uint64_t step_begin_ns = deadline_clock_ != nullptr ? deadline_clock_->now_ns() : 0;
+  last_deadline_rounds_ = 0;
   Se2f rbsm_pose, local_pose;
   bool used = false;
   FW_RETURN_IF_ERROR(front_end_stage(scan, odom, &rbsm_pose, &local_pose, &used));
@@ -497,9 +498,14 @@ std::size_t MmlLocalizer::global_match_stage(const Se2f& local_pose, std::uint64
     mp.clock = deadline_clock_;
     mp.deadline_ns = step_begin_ns + static_cast<std::uint64_t>(static_cast<double>(deadline_budget_ns_) * deadline_share_);
   }
+  mp.stop_after_rounds = forced_deadline_rounds_;
+  forced_deadline_rounds_ = 0;
   const Status ms = matcher_.match(scene_, num_scene_, mp, &mr);
   if (!ms.is_ok()) return 0;
-  if (mr.stats.stop == pransam::StopReason::kDeadline) ++deadline_stops_;
+  if (mr.stats.stop == pransam::StopReason::kDeadline) {
+    ++deadline_stops_;
+    last_deadline_rounds_ = mr.stats.rounds;
+  }
   std::size_t nh = 0;
   Se2f best_h;
   float best_q = -1.0f;

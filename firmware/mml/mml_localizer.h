@@ -130,6 +130,12 @@ class MmlLocalizer final : public Localizer {
     deadline_share_ = pransam_share;
   }
   std::uint64_t deadline_stops() const { return deadline_stops_; }  // pRANSAM runs cut by the deadline
+  // pRANSAM's rounds in the last step when its deadline stopped it, else 0 (issue 60: recorded in
+  // the black box with the global result).
+  std::uint32_t last_deadline_rounds() const { return last_deadline_rounds_; }
+  // Replay of a recorded step (issue 60): the next step's pRANSAM stops after `rounds` rounds as
+  // its deadline did on the robot (0 = runs as configured). Overwritten by the next call.
+  void force_deadline_rounds(std::uint32_t rounds) { forced_deadline_rounds_ = rounds; }
 
  private:
   // The stages of step() (mml_localizer.cpp), in order.
@@ -218,6 +224,7 @@ class MmlLocalizer final : public Localizer {
   std::uint64_t deadline_budget_ns_ = 0;
   float deadline_share_ = 0.6f;
   std::uint64_t deadline_stops_ = 0;
+  std::uint32_t last_deadline_rounds_ = 0, forced_deadline_rounds_ = 0;
 
   // Local map correction (Eq. 5.23–5.27).
   Point2f corr_pts_[kMaxCorrectionPoints];

@@ -423,6 +423,10 @@ auto Matcher<D>::run_rounds(const MatchParams& params, MatchResult<D>* out) -> R
                                           ? remaining
                                           : static_cast<std::uint64_t>(batch) * static_cast<std::uint64_t>(T);
     std::uint64_t round_start = 0;
+    if (params.stop_after_rounds != 0 && tally.rounds >= params.stop_after_rounds) {
+      tally.deadline_hit = true;
+      break;
+    }
     if (deadline_mode) {
       round_start = params.clock->now_ns();
       if (tally.rounds > 0 &&

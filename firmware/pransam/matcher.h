@@ -72,6 +72,9 @@ struct MatchParams {
   // I_max stays the upper bound. Time-dependent, so not reproducible: off in the lockstep tools.
   const hal::Clock* clock = nullptr;
   std::uint64_t deadline_ns = 0;
+  // A replay of a deadline stop (issue 60: the black box's global records): stop as the deadline
+  // did, before round stop_after_rounds + 1 (stats.stop = kDeadline), without a clock. 0 = off.
+  std::uint32_t stop_after_rounds = 0;
   std::uint32_t first_batch = 256;        // round batch starts here and doubles up to max_batch
                                           // (fewer barriers: 2-thread runs on a busy machine suffer less)
   std::uint32_t min_extrapolation_points = 12;

@@ -32,6 +32,7 @@ Status GlobalContext::init(mml::MmlLocalizer* mml, const GlobalScheduleOptions& 
   generation_ = 0;
   jobs_ = overruns_ = skipped_offers_ = 0;
   reset_pending_ = false;
+  replaying_ = false;
   slot_.store(Slot::kIdle);
   return Status::ok();
 }
@@ -39,6 +40,7 @@ Status GlobalContext::init(mml::MmlLocalizer* mml, const GlobalScheduleOptions& 
 Status GlobalContext::attach_thread(GlobalThread* thread, const ExecutionContext& context, const hal::Clock* clock) {
   if (mml_ == nullptr) return Status::error(Errc::kNotInitialized, "global context: thread attached before init()");
   if (threaded_) return Status::error(Errc::kInvalidArgument, "global context: thread already started");
+  if (replaying_) return Status::error(Errc::kInvalidArgument, "global context: a replay runs inline");
   if (thread == nullptr || !thread->running()) {
     return Status::error(Errc::kInvalidArgument, "global context: the attached thread is not running");
   }
@@ -84,6 +86,7 @@ void GlobalContext::run_job() {
   if (job_reset_) mml_->reset();
   mml_->set_unmapped_hypothesis(job_unmapped_);
   job_status_ = mml_->step(job_scan_, job_odom_, &job_out_);
+  job_deadline_rounds_ = mml_->last_deadline_rounds();
   if (clock_ != nullptr) {
     const std::uint64_t dt = clock_->now_ns() - t0;
     pthread_mutex_lock(&stats_mutex_);
@@ -112,7 +115,7 @@ void GlobalContext::tick() {
 
 void GlobalContext::reset() {
   ++generation_;
-  if (!threaded_) {
+  if (!threaded_ && !replaying_) {
     mml_->reset();  // at once: the tracker as it always was
     reset_pending_ = false;
   } else {
@@ -155,18 +158,33 @@ Status GlobalContext::collect(const hal::LaserScan& scan, const hal::Odometry& o
   out->timestamp_ns = scan.timestamp_ns;
   out->scan_id = scan.scan_id;
   out->status = hal::LocalizationStatus::kSearching;
-  const std::uint64_t cur = index_ > 0 ? index_ - 1 : 0;
-  Status result_status;
   // A finished result whose window has come.
-  if (slot_.load(std::memory_order_acquire) == Slot::kDone) {
-    if (job_generation_ != generation_) {
-      slot_.store(Slot::kIdle, std::memory_order_release);  // asked before a reset: stale
-    } else if (cur >= job_index_ + schedule_.result_delay_scans) {
-      result_status = job_status_;
-      take_result(scan, odom, out);
-    }
+  if (slot_.load(std::memory_order_acquire) != Slot::kDone) return Status::ok();
+  return replaying_ ? collect_replayed(scan, odom, out) : collect_done(scan, odom, out);
+}
+
+Status GlobalContext::collect_done(const hal::LaserScan& scan, const hal::Odometry& odom, hal::PoseEstimate* out) {
+  const std::uint64_t cur = index_ > 0 ? index_ - 1 : 0;
+  if (job_generation_ != generation_) {
+    record(scan, true);
+    slot_.store(Slot::kIdle, std::memory_order_release);  // asked before a reset: stale
+    return Status::ok();
   }
+  if (cur < job_index_ + schedule_.result_delay_scans) return Status::ok();
+  record(scan, false);
+  const Status result_status = job_status_;
+  take_result(scan, odom, out);
   return result_status;
+}
+
+void GlobalContext::record(const hal::LaserScan& scan, bool dropped) {
+  if (!threaded_ || record_sink_ == nullptr) return;
+  hal::GlobalRecord r;
+  r.scan_ns = scan.timestamp_ns;
+  r.job_scan_ns = job_scan_.timestamp_ns;
+  r.deadline_rounds = job_deadline_rounds_;
+  r.dropped = dropped;
+  record_sink_->record_global(r);
 }
 
 Status GlobalContext::offer(const hal::LaserScan& scan, const hal::Odometry& odom, hal::PoseEstimate* out) {
@@ -191,6 +209,7 @@ Status GlobalContext::offer(const hal::LaserScan& scan, const hal::Odometry& odo
     thread_->notify();
     return result_status;
   }
+  if (replaying_) match_replay_job(scan);
   run_job();
   if (schedule_.result_delay_scans == 0) {
     result_status = job_status_;

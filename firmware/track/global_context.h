@@ -18,6 +18,11 @@
 //            skipped (skipped_offers()) — from then on the run differs from the inline one.
 // reset() forgets MML's state (fresh local map) before the next job; results of jobs handed over
 // before a reset are dropped. Nothing is allocated after init()/start_thread().
+// Black box (issue 60): threaded, each result taken (or dropped after a reset) is reported to the
+// record sink (set_record_sink) with the scan it was taken at, the scan of its job and pRANSAM's
+// deadline rounds (hal/msg/global_record.h). replay() executes such records: MML runs inline on
+// the same offers, stops pRANSAM after the recorded rounds, and its result is held until the
+// recorded scan — so a replay reproduces the threaded robot's poses (global_replay.cpp).
 #pragma once
 
 #include <pthread.h>
@@ -31,6 +36,7 @@
 #include "firmware/runtime/execution_contexts.h"
 #include "firmware/track/global_thread.h"
 #include "hal/clock.h"
+#include "hal/global_record_sink.h"
 
 namespace fw {
 namespace track {
@@ -80,6 +86,19 @@ class GlobalContext {
   bool threaded() const { return threaded_; }
   // Inline: the clock that times global steps (perf_step()); null = not timed.
   void set_clock(const hal::Clock* clock) { clock_ = clock; }
+  // Threaded: every result taken or dropped is recorded here (the black box); null = none.
+  // Sensor context, like step().
+  void set_record_sink(hal::GlobalRecordSink* sink) { record_sink_ = sink; }
+  // Replay of a threaded robot's records (in the order recorded; `records` must outlive the replay):
+  // not threaded, a schedule with result_delay_scans ≥ 1 (the robot's), pRANSAM's deadline mode off.
+  // A record the replay does not meet (another job scan, a take where the replay drops, a scan
+  // passed) stops the replay of records: replay_status() names the record's index and what differs.
+  Status replay(const hal::GlobalRecord* records, std::size_t n);
+  bool replaying() const { return replaying_; }
+  const Status& replay_status() const { return replay_status_; }
+  std::size_t replay_records_used() const { return replay_next_; }
+  // The index of the record replay_status() is about (valid when it is an error).
+  std::size_t replay_failed_record() const { return replay_failed_; }
 
   // Once per tracker step, before any step()/reset() of that scan.
   void tick();
@@ -118,6 +137,14 @@ class GlobalContext {
   void run_queued_job();  // GlobalThread: the queued job, on that thread
   void run_job();  // on whichever thread executes MML
   void take_result(const hal::LaserScan& scan, const hal::Odometry& odom, hal::PoseEstimate* out);
+  // The finished job's result at this scan: taken (its window has come) or dropped (stale); recorded
+  // when threaded. Replay: as its record says (global_replay.cpp).
+  Status collect_done(const hal::LaserScan& scan, const hal::Odometry& odom, hal::PoseEstimate* out);
+  void record(const hal::LaserScan& scan, bool dropped);
+  void match_replay_job(const hal::LaserScan& scan);
+  Status collect_replayed(const hal::LaserScan& scan, const hal::Odometry& odom, hal::PoseEstimate* out);
+  void fail_replay(std::size_t record, const char* what, std::uint64_t replay_ns);
+  static constexpr std::size_t kNoRecord = static_cast<std::size_t>(-1);
 
   mml::MmlLocalizer* mml_ = nullptr;
   GlobalScheduleOptions schedule_;
@@ -137,11 +164,18 @@ class GlobalContext {
   bool reset_pending_ = false;
   Status job_status_;
   hal::PoseEstimate job_out_;
+  std::uint32_t job_deadline_rounds_ = 0;  // pRANSAM's rounds when its deadline stopped the job
   std::atomic<Slot> slot_{Slot::kIdle};
 
   bool threaded_ = false;
   GlobalThread own_thread_;            // start_thread()
   GlobalThread* thread_ = nullptr;     // the thread running the jobs (own or attached)
+  hal::GlobalRecordSink* record_sink_ = nullptr;
+  // replay(): the records, the next one to meet, the one of the job held (kNoRecord: none).
+  const hal::GlobalRecord* replay_records_ = nullptr;
+  std::size_t replay_count_ = 0, replay_next_ = 0, job_record_ = kNoRecord, replay_failed_ = 0;
+  bool replaying_ = false;
+  Status replay_status_;
   mutable pthread_mutex_t stats_mutex_ = PTHREAD_MUTEX_INITIALIZER;
   PerfCounter perf_step_{"global.step"};
 };

@@ -16,17 +16,23 @@
 //                     corrupted image refused by a reload, the map in use still localizing.
 //   blackbox_*        a 300-scan run with --transport can recorded, written, replayed through the
 //                     CanNode in lockstep; replay_identical = the POSE frames match bit for bit.
-// Argument: the JSON path.
+//   blackbox_thread_* the same with the global search on its own thread (--opt global=thread, as
+//                     mmlfw's global_context = thread), paced x10 so MML returns results between
+//                     scans; the file's global records forced by the replay (hal/can/README.md).
+// Arguments: the JSON path [--only-map-switch | --only-black-box].
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
 #include <filesystem>
+#include <fstream>
 #include <string>
 #include <vector>
 
 #include "sim/cli/map_switch_scenario.h"
 #include "sim/cli/sim_runner.h"
 #include "sim/common/bench_json.h"
+#include "sim/devices/global_log_line.h"
+#include "sim/eval/mml_eval/mml_systems.h"
 
 namespace {
 
@@ -216,6 +222,47 @@ void black_box_figures(sim::BenchJson* j) {
   std::filesystem::remove_all(dir);
 }
 
+// Bytes of a black box file's global lines (newlines included).
+std::size_t global_line_bytes(const std::string& path) {
+  std::ifstream in(path);
+  std::string line;
+  std::size_t n = 0;
+  while (std::getline(in, line)) n += sim::is_global_log_line(line) ? line.size() + 1 : 0;
+  return n;
+}
+
+// The threaded global search recorded and replayed bit for bit (issue 60). The global mode is a
+// setting of the process: set back to the reference schedule afterwards.
+void black_box_thread_figures(sim::BenchJson* j) {
+  const std::string dir = std::filesystem::temp_directory_path() / "mmlfw_bench_ops_thread";
+  std::filesystem::create_directories(dir);
+  sim::SimConfig c = base_config("small-office", 300);
+  c.localizer_options["global"] = "thread";
+  c.paced = true;
+  c.pace_speed = 10;
+  c.blackbox.record_path = dir + "/blackbox.log";
+  c.hint.at_scan = 120;  // as black_box_figures: a command in the recording too
+  sim::SimResult r, rr;
+  sim::BlackBoxReplay replay;
+  std::string err;
+  bool ok = sim::run_simulation(c, &r, &err);
+  const double minutes = r.steps.empty() ? 0 : (r.steps.back().t - r.steps.front().t + c.synthetic.scan_period_s) / 60.0;
+  sim::SimConfig rc = base_config("small-office", 300);
+  rc.localizer_options["global"] = "thread";
+  rc.blackbox.replay_path = c.blackbox.record_path;
+  ok = ok && sim::replay_black_box(rc, &rr, &replay, &err);
+  sim::mmleval::set_eval_global_mode(sim::mmleval::EvalGlobalMode::kReference);
+  if (!ok) std::fprintf(stderr, "bench ops: threaded black box failed: %s\n", err.c_str());
+  if (!replay.global_mismatch.empty()) std::fprintf(stderr, "bench ops: %s\n", replay.global_mismatch.c_str());
+  const double global_bytes = static_cast<double>(global_line_bytes(c.blackbox.record_path));
+  j->add_bool("blackbox_thread_replay_identical", ok && replay.identical);
+  j->add_int("blackbox_thread_pose_frames", static_cast<long long>(replay.recorded_pose_frames));
+  j->add_int("blackbox_thread_global_records", static_cast<long long>(replay.global_records));
+  j->add("blackbox_thread_bytes_per_minute", minutes > 0 ? r.summary.blackbox_bytes / minutes : NAN);
+  j->add("blackbox_thread_global_bytes_per_minute", minutes > 0 ? global_bytes / minutes : NAN);
+  std::filesystem::remove_all(dir);
+}
+
 double median(std::vector<double> v) {
   if (v.empty()) return NAN;
   std::sort(v.begin(), v.end());
@@ -293,14 +340,21 @@ void map_switch_figures(sim::BenchJson* j) {
 
 int main(int argc, char** argv) {
   if (argc < 2) {
-    std::fprintf(stderr, "usage: bench_ops OUT.json [--only-map-switch]\n");
+    std::fprintf(stderr, "usage: bench_ops OUT.json [--only-map-switch | --only-black-box]\n");
     return 2;
   }
   sim::BenchJson j;
+  const std::string only = argc > 2 ? argv[2] : "";
+  if (only == "--only-black-box") {
+    black_box_figures(&j);
+    black_box_thread_figures(&j);
+    return j.write(argv[1]) ? 0 : 1;
+  }
   map_switch_figures(&j);
-  if (argc > 2 && std::string(argv[2]) == "--only-map-switch") return j.write(argv[1]) ? 0 : 1;
+  if (only == "--only-map-switch") return j.write(argv[1]) ? 0 : 1;
   black_box_figures(&j);
   baseline_figure(&j);
   hint_figures(&j);
+  black_box_thread_figures(&j);  // last: it sets the process's global mode (set back after it)
   return j.write(argv[1]) ? 0 : 1;
 }

@@ -46,7 +46,7 @@ std::vector<Entry>& registry() {
   static std::vector<Entry> entries = {
       {"mml-track",
        "MML global fix, confirmed and tracked on the global map at every scan with a protection level (firmware "
-       "default); --opt config=1..4, alert=M, odom_noise=TT,TR,RR,RT, odom_noise_per_step=M,DEG, valley=0|1 (default 1), outside_clean=0|1 (default 1), global=ref|live|live-deadline (default ref)",
+       "default); --opt config=1..4, alert=M, odom_noise=TT,TR,RR,RT, odom_noise_per_step=M,DEG, valley=0|1 (default 1), outside_clean=0|1 (default 1), global=ref|live|live-deadline|thread (default ref)",
        &mmleval::make_track_localizer},
       {"odom", "odometry pass-through (dead reckoning; status always searching); --opt anchor=origin|truth",
        &make_odom},

@@ -42,8 +42,10 @@ static int run_main(int argc, char** argv) {
       std::fprintf(stderr, "mml-sim: %s\n", err.c_str());
       return 1;
     }
-    const std::string serial =
+    if (!replay.global_mismatch.empty()) std::fprintf(stderr, "mml-sim: %s\n", replay.global_mismatch.c_str());
+    std::string serial =
         replay.rx_serial_lines > 0 ? std::to_string(replay.rx_serial_lines) + " rx serial chunks, " : std::string();
+    if (replay.global_records > 0) serial += std::to_string(replay.global_records) + " global records, ";
     std::printf("mml-sim replay-blackbox: %zu rx frames, %s%zu POSE frames recorded, %zu replayed: %s\n", replay.rx_frames,
                 serial.c_str(),
                 replay.recorded_pose_frames, replay.replayed_pose_frames,

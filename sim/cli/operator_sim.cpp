@@ -8,6 +8,7 @@
 
 #include "hal_can/codec.h"
 #include "sim/devices/candump_log.h"
+#include "sim/devices/global_log_line.h"
 #include "sim/devices/serial_log_line.h"
 
 namespace sim {
@@ -75,6 +76,19 @@ bool read_black_box(const std::string& path, std::vector<BlackBoxLine>* out, std
   while (std::getline(in, line)) {
     ++no;
     if (line.empty()) continue;
+    if (is_global_log_line(line)) {
+      BlackBoxLine b;
+      std::string why;
+      if (!parse_global_log_line(line, &b.record, &why)) {
+        *err = path + ":" + std::to_string(no) + ": not a black box line (" + why + ")";
+        return false;
+      }
+      b.global = true;
+      b.line_no = no;
+      b.frame.timestamp_ns = b.record.scan_ns;
+      out->push_back(std::move(b));
+      continue;
+    }
     if (is_serial_log_line(line)) {
       SerialLogLine sl;
       std::string why;
@@ -87,6 +101,7 @@ bool read_black_box(const std::string& path, std::vector<BlackBoxLine>* out, std
       b.tx = sl.tx;
       b.frame.timestamp_ns = sl.t_ns;
       b.bytes.swap(sl.bytes);
+      b.line_no = no;
       out->push_back(std::move(b));
       continue;
     }
@@ -102,6 +117,7 @@ bool read_black_box(const std::string& path, std::vector<BlackBoxLine>* out, std
     b.frame = l.frame;
     b.frame.timestamp_ns = ns;
     b.tx = l.iface == "tx";
+    b.line_no = no;
     out->push_back(b);
   }
   return true;
@@ -110,7 +126,7 @@ bool read_black_box(const std::string& path, std::vector<BlackBoxLine>* out, std
 std::vector<hal::CanFrame> pose_frames(const std::vector<BlackBoxLine>& lines) {
   std::vector<hal::CanFrame> out;
   for (const BlackBoxLine& l : lines)
-    if (l.tx && !l.serial && is_pose_frame(l.frame)) out.push_back(l.frame);
+    if (l.tx && !l.serial && !l.global && is_pose_frame(l.frame)) out.push_back(l.frame);
   return out;
 }
 
@@ -118,6 +134,7 @@ std::vector<hal::CanFrame> pose_frames(const hal_can::BlackBox& box) {
   std::vector<hal::CanFrame> out;
   for (std::size_t i = 0; i < box.size(); ++i) {
     const hal_can::BlackBoxEntry& e = box.entry(i);
+    if (e.is_global()) continue;
     const hal::CanFrame f = hal_can::BlackBox::frame_of(e);
     if ((e.flags & hal_can::BlackBoxEntry::kTx) && is_pose_frame(f)) out.push_back(f);
   }

@@ -13,6 +13,7 @@
 
 #include "firmware/base/se2.h"
 #include "hal/msg/command.h"
+#include "hal/msg/global_record.h"
 #include "hal/sensor_io.h"
 #include "hal_can/black_box.h"
 #include "hal_serial/serial_black_box.h"
@@ -75,9 +76,14 @@ struct BlackBoxLine {
   bool tx = false;
   bool serial = false;
   std::vector<std::uint8_t> bytes;
+  // A global search's record (sim/devices/global_log_line.h), not a frame: not fed, not compared.
+  bool global = false;
+  hal::GlobalRecord record;
+  std::size_t line_no = 0;  // 1-based line of the file
 };
-// Reads a black box (candump -L lines with interface rx / tx, and the serial lines "(T) rx laser
-// HEX" of sim/devices/serial_log_line.h); errors name the file and line.
+// Reads a black box (candump -L lines with interface rx / tx, the serial lines "(T) rx laser HEX" of
+// sim/devices/serial_log_line.h, the global records "(T) global take|drop T R" of
+// sim/devices/global_log_line.h); errors name the file and line.
 bool read_black_box(const std::string& path, std::vector<BlackBoxLine>* out, std::string* err);
 // POSE frames (0x120..0x125, 0x520) in order: of the file's tx lines / of a ring's tx entries.
 std::vector<hal::CanFrame> pose_frames(const std::vector<BlackBoxLine>& lines);
@@ -89,6 +95,8 @@ bool same_frames(const std::vector<hal::CanFrame>& a, const std::vector<hal::Can
 
 struct BlackBoxReplay {
   std::size_t rx_frames = 0, recorded_pose_frames = 0, replayed_pose_frames = 0;
+  std::size_t global_records = 0;  // global results forced to their recorded scans (issue 60)
+  std::string global_mismatch;     // "FILE:LINE: ..." of the first record the replay did not meet
   std::size_t rx_serial_lines = 0;  // serial chunks fed to the laser driver
   std::size_t first_difference = 0;
   bool identical = false;

@@ -16,6 +16,7 @@
 #include "firmware/base/arena.h"
 #include "firmware/map/map_image.h"
 #include "firmware/runtime/localization_loop.h"
+#include "firmware/track/global_context.h"
 #include "firmware/track/track_options.h"
 #include "hal/hal.h"
 #include "hal_linux/linux_clock.h"
@@ -751,6 +752,9 @@ bool run_simulation(const SimConfig& cfg_in, SimResult* out, std::string* err) {
   if (!localizer) return false;
   FirmwareRig rig;
   if (!wire_firmware(cfg, *localizer, &rig, &sum, err)) return false;
+  // Issue 60: a threaded global search records in the black box when it took each result.
+  fw::track::GlobalContext* gc = hooks.global_context ? hooks.global_context() : nullptr;
+  if (gc != nullptr && !cfg.blackbox.record_path.empty()) gc->set_record_sink(&rig.black_box.box);
 
   FrameLoop frames(cfg, src, rig, hooks, out);
   // The run through hal/sim and the localizer is timed on its own (wall_s); loading before it is load_s.
@@ -778,11 +782,62 @@ bool run_simulation(const SimConfig& cfg_in, SimResult* out, std::string* err) {
 
 namespace sim {
 
+namespace {
+
+// Issue 60: the file's global records (a robot with global_context = thread) and their lines.
+struct GlobalRecords {
+  std::vector<hal::GlobalRecord> records;
+  std::vector<std::size_t> lines;
+};
+
+GlobalRecords global_records(const std::vector<BlackBoxLine>& lines) {
+  GlobalRecords g;
+  for (const BlackBoxLine& l : lines) {
+    if (!l.global) continue;
+    g.records.push_back(l.record);
+    g.lines.push_back(l.line_no);
+  }
+  return g;
+}
+
+// The global context replays the records instead of running on its thread: each job inline, its
+// result held until the scan the robot took it at. Records need a threaded mml-track (its schedule).
+bool replay_global_records(const std::string& path, const GlobalRecords& g, fw::track::GlobalContext* gc,
+                           std::string* err) {
+  if (g.records.empty() && (gc == nullptr || !gc->threaded())) return true;
+  const std::string where = g.records.empty() ? path : path + ":" + std::to_string(g.lines.front());
+  if (gc == nullptr || !gc->threaded()) {
+    *err = where + ": a global record (a robot with global_context = thread): replay with --localizer mml-track "
+           "--opt global=thread (and the robot's global_period)";
+    return false;
+  }
+  gc->stop_thread();
+  const fw::Status s = gc->replay(g.records.data(), g.records.size());
+  if (!s.is_ok()) *err = where + ": " + s.message();
+  return s.is_ok();
+}
+
+// The first record the replay did not meet, as "FILE:LINE: ...", or empty.
+std::string global_mismatch(const std::string& path, const GlobalRecords& g, const fw::track::GlobalContext* gc) {
+  if (gc == nullptr || !gc->replaying()) return "";
+  if (!gc->replay_status().is_ok()) {
+    return path + ":" + std::to_string(g.lines[gc->replay_failed_record()]) + ": " + gc->replay_status().message();
+  }
+  if (gc->replay_records_used() < g.records.size()) {
+    return path + ":" + std::to_string(g.lines[gc->replay_records_used()]) +
+           ": global record never met (the replay offered no job at the scan it names)";
+  }
+  return "";
+}
+
+}  // namespace
+
 bool replay_black_box(const SimConfig& cfg_in, SimResult* out, BlackBoxReplay* replay, std::string* err) {
   *out = SimResult();
   *replay = BlackBoxReplay();
   std::vector<BlackBoxLine> lines;
   if (!read_black_box(cfg_in.blackbox.replay_path, &lines, err)) return false;
+  const GlobalRecords global = global_records(lines);  // outlives the localizer's replay of them
   SimConfig cfg;
   // A robot's black box: its map (--map) and the localizer's options alone, no source to run.
   const bool robot = cfg_in.world.empty() && cfg_in.log_path.empty() && cfg_in.dataset.empty() &&
@@ -810,10 +865,13 @@ bool replay_black_box(const SimConfig& cfg_in, SimResult* out, BlackBoxReplay* r
   if (!localizer) return false;
   FirmwareRig rig;
   if (!wire_firmware(cfg, *localizer, &rig, &sum, err)) return false;
+  fw::track::GlobalContext* gc = hooks.global_context ? hooks.global_context() : nullptr;
+  if (!replay_global_records(cfg_in.blackbox.replay_path, global, gc, err)) return false;
+  replay->global_records = global.records.size();
   // Lockstep: each received frame at its receive time, one loop cycle after it (the firmware's
   // loop runs as soon as input is pending). Sent frames are what is compared, not fed.
   for (const BlackBoxLine& l : lines) {
-    if (l.tx) continue;
+    if (l.tx || l.global) continue;
     ++(l.serial ? replay->rx_serial_lines : replay->rx_frames);
     if (l.frame.timestamp_ns > rig.sim_hal->clock.now_ns()) rig.sim_hal->clock.set_ns(l.frame.timestamp_ns);
     const bool fed = l.serial ? rig.transport->inject_serial(l.bytes.data(), l.bytes.size())
@@ -839,6 +897,8 @@ bool replay_black_box(const SimConfig& cfg_in, SimResult* out, BlackBoxReplay* r
   replay->recorded_pose_frames = recorded.size();
   replay->replayed_pose_frames = replayed.size();
   replay->identical = !recorded.empty() && same_frames(recorded, replayed, &replay->first_difference);
+  replay->global_mismatch = global_mismatch(cfg_in.blackbox.replay_path, global, gc);
+  if (!replay->global_mismatch.empty()) replay->identical = false;
   if (!cfg.out_dir.empty() && !write_steps_csv(cfg.out_dir + "/steps.csv", out->steps, err)) return false;
   return true;
 }

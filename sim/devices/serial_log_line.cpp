@@ -49,7 +49,7 @@ bool parse_serial_log_line(const std::string& line, SerialLogLine* out, std::str
     return false;
   }
   if (port != "laser") {
-    *error = "port '" + port + "' (expected laser)";
+    *error = "port '" + port + "' (expected laser; or a CAN line cut before its '#'?)";
     return false;
   }
   if (in >> extra) {

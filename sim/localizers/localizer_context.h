@@ -17,6 +17,10 @@
 #include "firmware/runtime/localizer.h"
 #include "sim/io/ros_map.h"
 
+namespace fw::track {
+class GlobalContext;  // firmware/track/global_context.h
+}  // namespace fw::track
+
 namespace sim {
 
 // One hypothesis as drawn in pictures (map frame); weight ∈ [0, 1] (e.g. normalised rating).
@@ -28,6 +32,8 @@ struct HypothesisPoint {
 // called after each step; it must not change the localizer's state.
 struct LocalizerHooks {
   std::function<void(std::vector<HypothesisPoint>*)> hypotheses;
+  // mml-track: its global context (the black box's global records, issue 60); null otherwise.
+  std::function<fw::track::GlobalContext*()> global_context;
 };
 
 struct LocalizerContext {

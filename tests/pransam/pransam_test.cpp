@@ -356,6 +356,51 @@ TEST_F(Matcher2DTest, DeadlineModeStopsWhenTheNextRoundWouldNotFit) {
   EXPECT_EQ(late.stats.iterations, full.stats.iterations);
 }
 
+// Issue 60: a deadline stop replayed without a clock (MatchParams::stop_after_rounds, the black
+// box's recorded rounds) gives the same hypotheses, stats and stop reason as the clock did.
+TEST_F(Matcher2DTest, DeadlineStopReplaysByItsRoundCount) {
+  struct StepClock final : hal::Clock {
+    mutable std::uint64_t t = 0;
+    std::uint64_t now_ns() const override { return t += 1000000; }
+  };
+  RandomStream rng(51, 0);
+  const std::vector<P2> x = sim::pransam_scenes::cast_scan(world_->segs, Se2f(6.0f, 5.0f, 0.4f), 10.0f, 0.01f, rng);
+  MatchParams p;
+  p.seed = 3;
+  p.max_iterations = 30000;
+  p.omega_thres = 0.3f;  // low: the cut run collects hypotheses to compare
+  p.collect_all = true;
+  StepClock clock;
+  p.clock = &clock;
+  p.deadline_ns = 20000000;  // a few rounds, then the deadline
+  MatchResult<2> cut;
+  ASSERT_TRUE(matcher_->match(x.data(), x.size(), p, &cut).is_ok());
+  ASSERT_EQ(cut.stats.stop, StopReason::kDeadline);
+  std::vector<Hypothesis<2>> want(cut.hypotheses, cut.hypotheses + cut.num_hypotheses);
+  MatchParams r = p;
+  r.clock = nullptr;
+  r.deadline_ns = 0;
+  r.stop_after_rounds = cut.stats.rounds;
+  MatchResult<2> again;
+  ASSERT_TRUE(matcher_->match(x.data(), x.size(), r, &again).is_ok());
+  EXPECT_EQ(again.stats.stop, StopReason::kDeadline);
+  EXPECT_EQ(again.stats.rounds, cut.stats.rounds);
+  EXPECT_EQ(again.stats.iterations, cut.stats.iterations);
+  EXPECT_LT(cut.stats.iterations, 30000u);
+  ASSERT_TRUE(cut.best_valid);
+  EXPECT_EQ(again.best.quality, cut.best.quality);
+  EXPECT_TRUE(again.best.translation == cut.best.translation);
+  ASSERT_EQ(again.num_hypotheses, want.size());
+  EXPECT_GT(want.size(), 0u);
+  for (std::size_t i = 0; i < want.size(); ++i) {
+    EXPECT_EQ(again.hypotheses[i].quality, want[i].quality) << i;
+    EXPECT_EQ(again.hypotheses[i].iteration, want[i].iteration) << i;
+    EXPECT_TRUE(again.hypotheses[i].translation == want[i].translation) << i;
+  }
+  std::printf("deadline stop after %u rounds (%llu iterations, %zu hypotheses) replayed identical\n",
+              cut.stats.rounds, static_cast<unsigned long long>(cut.stats.iterations), want.size());
+}
+
 TEST_F(Matcher2DTest, RefinementAndFreeSpaceGateKeepTheRightAnswer) {
   RandomStream rng(47, 0);
   const Se2f pose(20.0f, 13.0f, -0.8f);

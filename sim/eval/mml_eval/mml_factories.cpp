@@ -68,6 +68,9 @@ std::unique_ptr<fw::Localizer> wrap_hooks(std::unique_ptr<OwnedLocalizer> o, con
   if (o && ctx.hooks) {
     OwnedLocalizer* raw = o.get();
     ctx.hooks->hypotheses = [raw](std::vector<HypothesisPoint>* out) { raw->hypotheses(out); };
+    ctx.hooks->global_context = [raw]() -> fw::track::GlobalContext* {
+      return raw->tracked() != nullptr ? &raw->tracked()->global_context() : nullptr;
+    };
   }
   return o;
 }
@@ -262,8 +265,9 @@ static bool parse_rules_off(const std::map<std::string, std::string>& options, f
 // outside_clean=0|1 (TrackOptions::outside_map_needs_clean_exit; default 1, as TrackOptions);
 // wheels_bind=0|1 (TrackOptions::wheels_bind_mml_without_carry; default 1, as TrackOptions);
 // odom_slip=RATE,MAX (declared wheel slips, as mmlfw's config key); off=RULE[+RULE...] (ablation);
-// global=ref|live|live-deadline (the global search's schedule, mml_systems.h EvalGlobalMode; default ref);
-// global_period=1..8 (with live / live-deadline: mmlfw's global_period_scans; default 1).
+// global=ref|live|live-deadline|thread (the global search's schedule, mml_systems.h EvalGlobalMode;
+// default ref; thread = mmlfw's global_context = thread, on its own thread);
+// global_period=1..8 (with live / live-deadline / thread: mmlfw's global_period_scans; default 1).
 std::unique_ptr<fw::Localizer> make_track_localizer(const LocalizerContext& ctx, std::string* err) {
   const std::string bad = check_keys("mml-track", ctx.options, {"config", "correct", "reduce", "pool", "keep", "contested", "rivals", "alert", "odom_noise", "odom_noise_per_step", "valley", "outside_clean", "wheels_bind", "odom_slip", "off", "global", "global_period"});
   if (!bad.empty()) { *err = bad; return nullptr; }
@@ -273,8 +277,9 @@ std::unique_ptr<fw::Localizer> make_track_localizer(const LocalizerContext& ctx,
     if (g->second == "ref") set_eval_global_mode(EvalGlobalMode::kReference);
     else if (g->second == "live") set_eval_global_mode(EvalGlobalMode::kLive);
     else if (g->second == "live-deadline") set_eval_global_mode(EvalGlobalMode::kLiveDeadline);
+    else if (g->second == "thread") set_eval_global_mode(EvalGlobalMode::kThread);
     else {
-      *err = "localizer mml-track: option global='" + g->second + "' (expected ref, live or live-deadline)";
+      *err = "localizer mml-track: option global='" + g->second + "' (expected ref, live, live-deadline or thread)";
       return nullptr;
     }
   }

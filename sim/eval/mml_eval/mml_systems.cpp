@@ -77,6 +77,10 @@ std::unique_ptr<OwnedLocalizer> OwnedLocalizer::make(const fw::SystemSpec& spec,
     if (s.is_ok() && track && g_global_mode == EvalGlobalMode::kLiveDeadline && o->system_.mml() != nullptr) {
       o->system_.mml()->set_deadline_mode(&g_mono_clock, fw::track::global_context_for(g_global_period).deadline_ns);
     }
+    // As mmlfw starts it (not realtime): the thread's clock puts MML in deadline mode.
+    if (s.is_ok() && track && g_global_mode == EvalGlobalMode::kThread) {
+      s = o->system_.start_global_context(false, &g_mono_clock, fw::track::global_context_for(g_global_period));
+    }
   }
   if (!s.is_ok()) {
     *err = s.message();
@@ -136,6 +140,8 @@ void OwnedLocalizer::hypotheses(std::vector<HypothesisPoint>* out) const {
   if (mml == nullptr) return;
   if (system_.handoff() != nullptr && system_.handoff()->tracking()) return;
   if (system_.tracked() != nullptr && system_.tracked()->tracking()) return;
+  // MML belongs to the global thread: its clusters are not read from here.
+  if (system_.tracked() != nullptr && system_.tracked()->global_context().threaded()) return;
   const fw::mml::Interpreter& it = mml->interpreter();
   for (std::size_t i = 0; i < it.cluster_count(); ++i) {
     const fw::mml::Cluster& c = it.clusters()[i];

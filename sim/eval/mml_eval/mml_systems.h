@@ -48,7 +48,10 @@ using fw::mcl::mcl_tracking_options;
 //                   later, moved by odometry) + the RBSM window re-centre spread over steps; inline,
 //                   deterministic — what the threaded firmware computes when every global step is on time
 //   kLiveDeadline   kLive + pRANSAM deadline mode at the global context's deadline (time-dependent)
-enum class EvalGlobalMode { kReference, kLive, kLiveDeadline };
+//   kThread         mmlfw's global_context = thread: kLive's schedule with MML on its own thread in
+//                   deadline mode (time-dependent; the black box records when each result was taken
+//                   and --replay-blackbox replays it bit for bit, issue 60)
+enum class EvalGlobalMode { kReference, kLive, kLiveDeadline, kThread };
 void set_eval_global_mode(EvalGlobalMode mode);
 // kLive / kLiveDeadline: MML on every n-th scan, its result n scans later, its deadline n scan periods
 // — mmlfw's config key global_period_scans (1..8; default 1, the execution-context table's).
