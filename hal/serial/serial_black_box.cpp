@@ -2,6 +2,7 @@
 
 #include <cstdio>
 #include <cstring>
+#include "hal/hex_bytes.h"
 
 namespace hal_serial {
 
@@ -38,11 +39,7 @@ std::size_t SerialBlackBox::format_line(std::size_t i, char* buf, std::size_t ca
   const unsigned long long us = e.t_ns / 1000;
   int n = std::snprintf(buf, cap, "(%llu.%06llu) %s laser ", us / 1000000, us % 1000000,
                         (e.flags & SerialBlackBoxEntry::kTx) ? "tx" : "rx");
-  static const char kHex[] = "0123456789ABCDEF";
-  for (std::uint8_t k = 0; k < e.len; ++k) {
-    buf[n++] = kHex[e.data[k] >> 4];
-    buf[n++] = kHex[e.data[k] & 0xF];
-  }
+  n += static_cast<int>(hal::write_hex_bytes(e.data, e.len, buf + n));
   buf[n++] = '\n';
   buf[n] = '\0';
   return static_cast<std::size_t>(n);
