@@ -240,11 +240,14 @@ TrackStep PoseTracker::step(const Point2f* points, std::size_t n, const Se2f& od
   // the fix Gauss-Newton missed from a prediction some degrees off (the white wheels' 4° per step),
   // not a sign that the robot is elsewhere: the innovation test's own criterion (judge_scan). The
   // scan is aligned again from the rival and judged again, once; beyond the prediction's PL the
-  // rival stays a contradiction (a large fault beyond the alert limits).
+  // rival stays a contradiction (a large fault beyond the alert limits) — unless it lies at the
+  // predicted position turned within the turn the wheels reported, the turn hypothesis
+  // (try_turn_hypothesis; seed 808 #200: wheels that over-reported 31° of a 43° turn, the alias
+  // check's turned rival was the truth).
   if (w.rival_better && o.refit_at_better_rival) {
     const Se2f r = out.alias_rival;
     const Eigen::Vector3f er(r.x - w.pred.x, r.y - w.pred.y, wrap_angle(r.theta - w.pred.theta));
-    if (!outside_bound(er, w.pred_pl)) {
+    if (!outside_bound(er, w.pred_pl) || rival_within_reported_turn(er, w.pred_pl)) {
       const std::uint32_t searched = out.search_candidates;
       w = w0;
       out = out0;
@@ -269,14 +272,23 @@ TrackStep PoseTracker::step(const Point2f* points, std::size_t n, const Se2f& od
   return out;
 }
 
+// The turn hypothesis's reach: at the predicted position (within its PL), turned by no more than
+// the wheels reported turning since a scan last set the heading, plus the prediction's heading PL.
+// An over-reported turn is part of a reported turn; a carry into a place that looks like the old
+// one turned has no such turn (seed 707 #136: a twin aisle; a search unbounded by it, 13 wrong steps).
+bool PoseTracker::rival_within_reported_turn(const Eigen::Vector3f& e, const ProtectionLevel& pred_pl) const {
+  if (!options_.heading_fault_local_recovery) return false;
+  return std::hypot(e(0), e(1)) <= pred_pl.xy_m && std::fabs(e(2)) <= turn_since_fuse_rad_ + pred_pl.theta_rad;
+}
+
 // (3b) The wheels misreported the turn (the corpus's turn-spin wheels, mit-killian's over-reported
 // turns): the scan contradicts the prediction, and Gauss-Newton from a prediction 8–20° off stops
 // short or slides (dev seed 5 #49: a fix 0.22 m off, then a wait of 30 m for MML while right). The
 // hypothesis is tested directly: a correlative search at the predicted position (within its PL) over
 // the headings the wheels' reported turn allows, aligned from its best pose and judged again. It is
 // kept only as a heading-only fault — judge_scan's own test: the fix within the prediction's position
-// PL and the reported turn, the scan fitting it significantly better than the prediction — else the
-// first verdict stands.
+// PL, the scan fitting it significantly better than the prediction — and within the reported turn,
+// else the first verdict stands.
 void PoseTracker::try_turn_hypothesis(const Point2f* points, std::size_t n, const StepWork& w0,
                                       const TrackStep& out0, StepWork* w, TrackStep* out) {
   const TrackOptions& o = options_;
@@ -285,8 +297,15 @@ void PoseTracker::try_turn_hypothesis(const Point2f* points, std::size_t n, cons
   if (turn_rad <= o.alert_limit_rad) return;  // no heading-only fault can pass judge_scan's test
   CorrelativeWindow win;
   win.xy_m = std::fmin(w0.pred_pl.xy_m, o.search.max_window_xy_m);
-  win.theta_rad = std::fmin(turn_rad, o.search.max_window_theta_rad);
-  const CorrelativeResult cr = correlative_search(map_, points, n, w0.pred, win, o.search, search_scratch_, kSearchScratch);
+  // The whole turn the wheels allow, not the pre-search's 20° cap: two events within one scan step
+  // over-reported 31° (seed 808 #200). The candidate budget coarsens the grid; Gauss-Newton refines.
+  win.theta_rad = std::fmin(turn_rad, static_cast<float>(M_PI));
+  // One candidate budget per scan (limit_next_search), shared with this step's pre-search.
+  CorrelativeSearchOptions so = o.search;
+  if (search_cap_ > 0 && search_cap_ < so.max_candidates) so.max_candidates = search_cap_;
+  if (out->search_candidates >= so.max_candidates) return;
+  so.max_candidates -= out->search_candidates;
+  const CorrelativeResult cr = correlative_search(map_, points, n, w0.pred, win, so, search_scratch_, kSearchScratch);
   if (cr.candidates == 0 || !(cr.score > cr.seed_score)) return;
   StepWork w1 = w0;
   TrackStep out1 = out0;
@@ -294,7 +313,7 @@ void PoseTracker::try_turn_hypothesis(const Point2f* points, std::size_t n, cons
   out1.turn_searched = true;
   out1.alignment = align_scan(map_, points, n, cr.pose, o.align);
   judge_scan(points, n, false, &w1, &out1);
-  if (!out1.heading_fault) return;
+  if (!out1.heading_fault || !rival_within_reported_turn(w1.e, w0.pred_pl)) return;
   *w = w1;
   *out = out1;
 }
@@ -375,14 +394,8 @@ void PoseTracker::judge_scan(const Point2f* points, std::size_t n, bool odom_jum
     // showed as 0.27 m and 6° at the first scan: the target fits the map next to the prediction).
     const float exy = std::hypot(w->e(0), w->e(1));
     out->large_fault = exy > o.alert_limit_m || std::fabs(w->e(2)) > o.alert_limit_rad;
-    // Heading only (track_options.h): the fix within the prediction's position PL, turned from it no
-    // more than the wheels reported turning since a scan last set the heading (plus the prediction's
-    // heading PL), since a wheel turn error is part of a reported turn: a robot carried to a place that
-    // looks alike turned has turned without its wheels (seed 707 #136, a twin aisle). And the scan must
-    // prefer its fix to the prediction significantly.
-    const bool wheels_turned = std::fabs(w->e(2)) <= turn_since_fuse_rad_ + w->pred_pl.theta_rad;
-    if (out->large_fault && o.heading_fault_local_recovery && exy <= w->pred_pl.xy_m && exy <= o.alert_limit_m &&
-        wheels_turned) {
+    if (out->large_fault && o.heading_fault_local_recovery && exy <= w->pred_pl.xy_m && exy <= o.alert_limit_m) {
+      // Heading only (track_options.h): the scan must prefer its fix to the prediction significantly.
       const std::size_t m = subsample_alias_points(points, n);
       out->heading_fault = rival_significantly_better(map_, alias_points_, m, pred, a.pose, o.alias_clip_m,
                                                       a.independent, o.alias_z);

@@ -146,6 +146,7 @@ class PoseTracker {
   void try_turn_hypothesis(const Point2f* points, std::size_t n, const StepWork& w0, const TrackStep& out0,
                            StepWork* w, TrackStep* out);
   void check_aliases(const Point2f* points, std::size_t n, StepWork* w, TrackStep* out);
+  bool rival_within_reported_turn(const Eigen::Vector3f& e, const ProtectionLevel& pred_pl) const;
   Update propose_update(const Se2f& odom, bool predict, StepWork* w, TrackStep* out);
   void apply_verdict(const Se2f& odom, const StepWork& w, const Update& u, TrackStep* out);
   void publish(const Point2f* points, std::size_t n, const StepWork& w, TrackStep* out);
@@ -184,7 +185,7 @@ class PoseTracker {
   // (no one-valley drop): how far a declared wheel slip could go unseen (odom_slip_per_100m).
   float unpinned_m_ = 0.0f;
   // Turn the wheels reported (sum of |Δθ|) since the last fused scan: the most a wheel turn error
-  // can have turned the prediction since a scan last set the heading (heading-only fault, judge_scan).
+  // can have turned the prediction since a scan last set the heading (rival_within_reported_turn).
   float turn_since_fuse_rad_ = 0.0f;
   std::uint32_t consistent_since_fault_ = 0;  // consistent scans since the last contradicting one
   bool had_fault_ = false;
