@@ -221,7 +221,7 @@ bool SensorTransport::init(const TransportOptions& options, const hal::Clock* cl
     return false;
   }
   if (options.byte_fault_rate > 0.0 && options.transport == Transport::kNone) {
-    *err = "--byte-fault-rate needs a transport with bytes (--transport can or sick)";
+    *err = "--byte-fault-rate needs a transport with bytes (--transport can, sick, hokuyo or rplidar)";
     return false;
   }
   options_ = options;
