@@ -7,7 +7,8 @@
 # by the simulated device at the first serial line's time; every later byte is the file's): the
 # POSE frames must be identical. A flipped byte must not replay identical (Hokuyo: a character of a
 # SCIP line, caught by its sum; RPLIDAR: the start flag of a turn, so two turns run together); a
-# cut line is an error naming the file and line.
+# cut line is an error naming the file and line. Another unit (--laser-model) replays identical when
+# the replay names it.
 # Usage: blackbox_lidar_replay_test.sh MML_SIM hokuyo|rplidar
 set -eu
 sim=$1
@@ -51,4 +52,12 @@ head -n "$n" "$t/bb.log" | sed '$ s/...$//' > "$t/cut.log"
 # shellcheck disable=SC2086
 if "$sim" $args --replay-blackbox "$t/cut.log" 2> "$t/cut.txt"; then echo "FAIL: a cut file replayed"; exit 1; fi
 grep -q "cut.log:$n: not a black box line" "$t/cut.txt" || { cat "$t/cut.txt"; exit 1; }
+# Another unit (--laser-model): its replay's handshake must be answered by that unit too.
+if [ "$laser" = hokuyo ]; then model=urg-04lx; else model=a2; fi
+short="--world small-office --steps 40 --timing none --quiet --no-pictures"
+# shellcheck disable=SC2086
+"$sim" $short --transport "$laser" --laser-model "$model" --blackbox "$t/model.log" --out "$t/model" > /dev/null
+# shellcheck disable=SC2086
+"$sim" $short --transport "$laser" --laser-model "$model" --replay-blackbox "$t/model.log" | tee "$t/model.txt"
+grep -q ': identical$' "$t/model.txt" || { echo "FAIL: a $model black box did not replay identical"; exit 1; }
 echo "blackbox_lidar_replay_test $laser: ok ($(wc -l < "$t/bb.log") lines, $(wc -c < "$t/bb.log") bytes)"

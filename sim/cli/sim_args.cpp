@@ -204,6 +204,7 @@ Parsed parse_transport_option(ArgCursor* cur, SimConfig* cfg) {
     return Parsed::kOk;
   }
   if (a == "--byte-fault-rate") return ok_if(cur->double_value(0, 1, &cfg->transport.byte_fault_rate));
+  if (a == "--laser-model") return ok_if(cur->value(&cfg->transport.laser_model));
   return Parsed::kNotMine;
 }
 
@@ -447,6 +448,9 @@ run:
   --sensor-resolution exact|can|sick  what the simulated sensors report: what a wire carries (can:
                           the default with --transport none, so none and can give the same steps.csv
                           with --timing none; sick: always with --transport sick) or exact floats
+  --laser-model NAME      the unit --transport hokuyo|rplidar plays: utm-30lx (default), urg-04lx,
+                          ust-10lx; a1 (default), a2, a3, s1. A replay's start-up handshake is
+                          answered by it: give the recorded unit's (with --transport)
   --byte-fault-rate P     with a transport but none: drop or bit-flip each frame / telegram / answer with
                           probability P (seeded by --seed); the firmware's decoder drops and counts
                           what it cannot use (summary.json, summary line)

@@ -224,6 +224,7 @@ bool SensorTransport::init(const TransportOptions& options, const hal::Clock* cl
     *err = "--byte-fault-rate needs a transport with bytes (--transport can, sick, hokuyo or rplidar)";
     return false;
   }
+  if (!laser_model_ok(options, err)) return false;
   options_ = options;
   // A Hokuyo or an RPLIDAR samples the scan at its own angles (its driver gives the geometry).
   const SensorResolution own = options.transport == Transport::kSick ? SensorResolution::kSick
@@ -244,12 +245,27 @@ bool SensorTransport::init(const TransportOptions& options, const hal::Clock* cl
   return true;
 }
 
+bool SensorTransport::laser_model_ok(const TransportOptions& options, std::string* err) {
+  if (options.laser_model.empty()) return true;
+  const bool hokuyo = options.transport == Transport::kHokuyo;
+  if (!hokuyo && options.transport != Transport::kRplidar) {
+    *err = "--laser-model needs --transport hokuyo or rplidar";
+    return false;
+  }
+  if (SerialLidarLink::valid_model(hokuyo ? SerialLidarKind::kHokuyo : SerialLidarKind::kRplidar, options.laser_model)) {
+    return true;
+  }
+  *err = "--laser-model: '" + options.laser_model + "' (expected " +
+         (hokuyo ? hokuyo_model_names() : rplidar_model_names()) + " with --transport " + transport_name(options.transport) + ")";
+  return false;
+}
+
 void SensorTransport::init_serial_laser(const hal::Clock* clock) {
   Parts& p = *parts_;
   if (options_.transport == Transport::kHokuyo || options_.transport == Transport::kRplidar) {
     const SerialLidarKind kind =
         options_.transport == Transport::kHokuyo ? SerialLidarKind::kHokuyo : SerialLidarKind::kRplidar;
-    p.link = std::make_unique<SerialLidarLink>(kind, &p.port, clock);
+    p.link = std::make_unique<SerialLidarLink>(kind, options_.laser_model, &p.port, clock);
     p.recording_port.init(&p.link->device_port(), clock, nullptr);
     p.link->init_driver(&p.recording_port);
     // A Hokuyo's scan time comes from its ms counter mapped by the smallest offset: within 1 ms.

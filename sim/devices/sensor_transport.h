@@ -79,6 +79,9 @@ struct TransportOptions {
   // laser and `odometry = socketcan:IFACE` has them; off, odometry goes straight into its ring.
   // The black box turns it on (issue 60): a replay needs every input on a wire it recorded.
   bool sick_odometry_on_can = false;
+  // kHokuyo / kRplidar: the unit the device model plays (--laser-model; empty: utm-30lx / a1). A
+  // replay's start-up handshake is answered by it, so it must be the recorded unit.
+  std::string laser_model;
 };
 
 struct TransportStats {
@@ -161,6 +164,7 @@ class SensorTransport {
 
  private:
   void transmit(hal::CanFrame* frames, std::size_t n, std::uint64_t t_ns);
+  static bool laser_model_ok(const TransportOptions& options, std::string* err);
   void init_serial_laser(const hal::Clock* clock);
   void send_serial_scan(const hal::LaserScan& scan);
   void send_sick_scan(const hal::LaserScan& scan);

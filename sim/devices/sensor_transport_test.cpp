@@ -268,6 +268,15 @@ TEST(SensorTransport, BadOptionsAreRefused) {
   opt.resolution = SensorResolution::kCan;  // sick carries its own wire's values
   opt.transport = Transport::kSick;
   EXPECT_FALSE(t->init(opt, &clock, &err));
+  opt.resolution = SensorResolution::kAuto;
+  opt.laser_model = "urg-04lx";  // a Hokuyo, not an RPLIDAR
+  opt.transport = Transport::kRplidar;
+  EXPECT_FALSE(t->init(opt, &clock, &err));
+  EXPECT_NE(err.find("a1, a2, a3, s1"), std::string::npos) << err;
+  opt.transport = Transport::kSick;  // a SICK plays no model
+  EXPECT_FALSE(t->init(opt, &clock, &err));
+  opt.transport = Transport::kHokuyo;
+  EXPECT_TRUE(t->init(opt, &clock, &err)) << err;
   Transport tr;
   EXPECT_TRUE(parse_transport("can", &tr));
   EXPECT_EQ(tr, Transport::kCan);

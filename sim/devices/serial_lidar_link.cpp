@@ -4,7 +4,7 @@ namespace sim {
 
 namespace {
 
-// The units the simulator plays: the laser of the Hokuyo and RPLIDAR HIL tests.
+// The units the simulator plays by default: the laser of the Hokuyo and RPLIDAR HIL tests.
 constexpr const char* kHokuyoModel = "utm-30lx";
 constexpr const char* kRplidarModel = "a1";
 // Polls of the driver the start-up handshake may take (each answer moves it one request on).
@@ -36,15 +36,21 @@ long DeviceLoopPort::write(const std::uint8_t* buf, std::size_t len) {
   return static_cast<long>(len);
 }
 
-SerialLidarLink::SerialLidarLink(SerialLidarKind kind, hal_sim::SimSerialPort* wire, const hal::Clock* clock)
+bool SerialLidarLink::valid_model(SerialLidarKind kind, const std::string& model) {
+  if (model.empty()) return true;
+  return kind == SerialLidarKind::kHokuyo ? find_hokuyo_model(model) != nullptr : find_rplidar_model(model) != nullptr;
+}
+
+SerialLidarLink::SerialLidarLink(SerialLidarKind kind, const std::string& model, hal_sim::SimSerialPort* wire,
+                                 const hal::Clock* clock)
     : kind_(kind),
-      hokuyo_dev_(*find_hokuyo_model(kHokuyoModel)),
-      rplidar_dev_(*find_rplidar_model(kRplidarModel)),
+      hokuyo_dev_(*find_hokuyo_model(kind == SerialLidarKind::kHokuyo && !model.empty() ? model : kHokuyoModel)),
+      rplidar_dev_(*find_rplidar_model(kind == SerialLidarKind::kRplidar && !model.empty() ? model : kRplidarModel)),
       clock_(clock),
       loop_(kind, wire, &hokuyo_dev_, &rplidar_dev_) {}
 
 const char* SerialLidarLink::model_name() const {
-  return kind_ == SerialLidarKind::kHokuyo ? kHokuyoModel : kRplidarModel;
+  return kind_ == SerialLidarKind::kHokuyo ? hokuyo_dev_.model().name : rplidar_dev_.model().name;
 }
 
 void SerialLidarLink::init_driver(hal::SerialPort* port) {

@@ -65,7 +65,10 @@ class DeviceLoopPort final : public hal::SerialPort {
 
 class SerialLidarLink {
  public:
-  SerialLidarLink(SerialLidarKind kind, hal_sim::SimSerialPort* wire, const hal::Clock* clock);
+  // `model`: a HokuyoModel / RplidarModel name (find_hokuyo_model / find_rplidar_model); empty: the
+  // default unit (utm-30lx, a1). False from valid_model for a name the kind does not know.
+  SerialLidarLink(SerialLidarKind kind, const std::string& model, hal_sim::SimSerialPort* wire, const hal::Clock* clock);
+  static bool valid_model(SerialLidarKind kind, const std::string& model);
   SerialLidarKind kind() const { return kind_; }
   // The port the driver is to write to and read from (wrap it in a recording port first).
   hal::SerialPort& device_port() { return loop_; }
@@ -81,7 +84,7 @@ class SerialLidarLink {
   // RPLIDAR: the samples of one turn of the head, the next turn's start flag ending it); the bytes
   // are appended to *out, empty while the device is not streaming.
   void encode_scan(const hal::LaserScan& scan, std::string* out);
-  // The resolution the driver is given (for messages): the model's name.
+  // The unit played (for messages): the model's name.
   const char* model_name() const;
 
  private:
