@@ -144,7 +144,7 @@ class SensorTransport {
   // kCan: the CanNode's command queue, and its black box (null = none).
   hal::CommandSource& commands();
   void attach_black_box(hal_can::BlackBox* box);
-  // kSick: the bytes the SickLaser reads from (and writes to) its port recorded in `box` (null =
+  // A serial laser (kSick, kHokuyo, kRplidar): the bytes its driver reads from (and writes to) its port recorded in `box` (null =
   // none), and bytes as they were received (a black box replay) queued for it; false if the port
   // is full.
   void attach_serial_black_box(hal_serial::SerialBlackBox* box);
@@ -155,7 +155,7 @@ class SensorTransport {
   // the file's). No-op for the other transports and once started; false with *err if it failed.
   bool start_serial_laser(std::uint64_t t_ns, bool replay, std::string* err);
 
-  // The sources the localization loop reads for kCan (the CanNode's) and kSick (the SickLaser's scans).
+  // The sources the localization loop reads for kCan (the CanNode's) and a serial laser (its driver's scans).
   hal::LaserScanSource& laser();
   hal::OdometrySource& odometry();
 
