@@ -144,9 +144,9 @@ class SensorTransport {
   // kCan: the CanNode's command queue, and its black box (null = none).
   hal::CommandSource& commands();
   void attach_black_box(hal_can::BlackBox* box);
-  // A serial laser (kSick, kHokuyo, kRplidar): the bytes its driver reads from (and writes to) its port recorded in `box` (null =
-  // none), and bytes as they were received (a black box replay) queued for it; false if the port
-  // is full.
+  // A serial laser (kSick, kHokuyo, kRplidar): the bytes its driver reads from (and writes to) its
+  // port recorded in `box` (null = none), and bytes as they were received (a black box replay)
+  // queued for it; false if the port is full.
   void attach_serial_black_box(hal_serial::SerialBlackBox* box);
   bool inject_serial(const std::uint8_t* bytes, std::size_t n);
   // kHokuyo / kRplidar: the driver's start-up handshake at t_ns against the simulated device, not
