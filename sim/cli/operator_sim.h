@@ -31,7 +31,7 @@ struct BlackBoxOptions {
   std::string record_path;   // --blackbox FILE: written after the run (needs --transport can or sick)
   std::string replay_path;   // --replay-blackbox FILE
   std::size_t frames = std::size_t{1} << 21;  // the ring (host: the whole run of a bench world)
-  std::size_t serial_chunks = std::size_t{1} << 21;  // --transport sick: the serial ring's entries
+  std::size_t serial_chunks = std::size_t{1} << 21;  // a serial laser (--transport sick|hokuyo|rplidar): the serial ring's entries
 };
 
 // The hint a run sends at its scan: `truth` moved by the options' offset, or their absolute pose.

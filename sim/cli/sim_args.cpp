@@ -189,7 +189,7 @@ Parsed parse_transport_option(ArgCursor* cur, SimConfig* cfg) {
   if (a == "--transport") {
     if (!cur->value(&v)) return Parsed::kError;
     if (!parse_transport(v, &cfg->transport.transport)) {
-      return fail_with(cur->err, "--transport: '" + v + "' (expected none, can or sick)");
+      return fail_with(cur->err, "--transport: '" + v + "' (expected none, can, sick, hokuyo or rplidar)");
     }
     return Parsed::kOk;
   }
@@ -204,6 +204,7 @@ Parsed parse_transport_option(ArgCursor* cur, SimConfig* cfg) {
     return Parsed::kOk;
   }
   if (a == "--byte-fault-rate") return ok_if(cur->double_value(0, 1, &cfg->transport.byte_fault_rate));
+  if (a == "--laser-model") return ok_if(cur->value(&cfg->transport.laser_model));
   return Parsed::kNotMine;
 }
 
@@ -436,25 +437,37 @@ run:
   --deadline-ms MS        count localizer steps longer than MS as deadline misses (default off)
   --out DIR               output directory (default build/run)
   --timing wall|none      measure step times with the wall clock (default) or not (byte-identical CSV)
-  --transport none|can|sick  how scans and odometry reach the firmware: straight into the hal/sim
-                          rings (none, default); through our CAN encoder, the hal/sim loopback bus and
-                          the firmware's CanNode decoder (can); scans as SICK LMS2xx telegrams on the
-                          hal/sim serial port through the firmware's SickLaser driver (sick)
+  --transport none|can|sick|hokuyo|rplidar  how scans and odometry reach the firmware: straight
+                          into the hal/sim rings (none, default); through our CAN encoder, the hal/sim
+                          loopback bus and the firmware's CanNode decoder (can); scans as SICK LMS2xx
+                          telegrams on the hal/sim serial port through the firmware's SickLaser driver
+                          (sick); as a Hokuyo UTM-30LX's SCIP 2.0 answers through HokuyoLaser (hokuyo)
+                          or an RPLIDAR A1's SCAN samples through RplidarLaser (rplidar), after the
+                          driver's start-up handshake answered by the simulated device (the firmware
+                          sees that unit's geometry: 1081 beams over 270° / 360 beams over 360°)
   --sensor-resolution exact|can|sick  what the simulated sensors report: what a wire carries (can:
                           the default with --transport none, so none and can give the same steps.csv
                           with --timing none; sick: always with --transport sick) or exact floats
-  --byte-fault-rate P     with --transport can|sick: drop or bit-flip each frame / telegram with
+  --laser-model NAME      the unit --transport hokuyo|rplidar plays: utm-30lx (default), urg-04lx,
+                          ust-10lx; a1 (default), a2, a3, s1. A replay's start-up handshake is
+                          answered by it: give the recorded unit's (with --transport)
+  --byte-fault-rate P     with a transport but none: drop or bit-flip each frame / telegram / answer with
                           probability P (seeded by --seed); the firmware's decoder drops and counts
                           what it cannot use (summary.json, summary line)
   --hint-at N             at scan N the operator sends a pose hint (SET_POSE_HINT; on the CAN wire with
                           --transport can): the truth moved by --hint-offset DX,DY,DEG (default 0,0,0)
                           or the pose --hint-pose X,Y,DEG, with --hint-sigma M,DEG (default 0.1,3)
-  --blackbox FILE         with --transport can: the firmware's black box (frames in and out, candump
-                          format, hal/can/README.md) written to FILE after the run
-  --replay-blackbox FILE  feed FILE's received frames back through the firmware's CanNode in lockstep
-                          and compare the POSE frames with FILE's; exit 0 when identical bit for bit,
-                          1 otherwise. Give the recording's --world/--dataset and options, or for a
-                          robot's black box its --map and localizer options (--opt) alone
+  --blackbox FILE         with --transport can|sick|hokuyo|rplidar: the firmware's black box (frames
+                          in and out, candump format, hal/can/README.md; a serial laser's bytes as
+                          "rx laser HEX" lines, hal/serial/README.md) written to FILE after the run
+  --replay-blackbox FILE  feed FILE's received frames (and serial bytes, through the laser's driver:
+                          SICK, Hokuyo or RPLIDAR as the bytes tell, or as --transport says) back
+                          through the firmware in lockstep and compare the POSE frames with FILE's;
+                          exit 0 when identical bit for bit, 1 otherwise. A Hokuyo's / RPLIDAR's
+                          start-up handshake, never in a black box, is answered by the simulated
+                          UTM-30LX / A1 at the first serial line's time. Give the recording's
+                          --world/--dataset and options, or for a robot's black box its --map and
+                          localizer options (--opt) alone
   --quiet                 no progress line
   --no-pictures           skip run.svg / run.png
 synthetic world:

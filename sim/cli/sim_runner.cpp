@@ -355,10 +355,10 @@ struct FirmwareRig {
 bool wire_operator(const SimConfig& cfg, fw::Localizer& localizer, FirmwareRig* rig, std::string* err) {
   hal::Hal& hal = rig->sim_hal->hal;
   const bool can = rig->transport->carries_odometry();  // commands travel with the odometry
-  const bool sick = rig->topt.transport == Transport::kSick;
+  const bool serial = is_serial(rig->topt.transport);
   const bool black_box = !cfg.blackbox.record_path.empty() || !cfg.blackbox.replay_path.empty();
   if (black_box && !can) {
-    *err = "--blackbox / --replay-blackbox record the firmware's wires: they need --transport can or sick";
+    *err = "--blackbox / --replay-blackbox record the firmware's wires: they need --transport can, sick, hokuyo or rplidar";
     return false;
   }
   hal.commands = can ? &rig->transport->commands() : static_cast<hal::CommandSource*>(&rig->direct_commands);
@@ -369,7 +369,7 @@ bool wire_operator(const SimConfig& cfg, fw::Localizer& localizer, FirmwareRig* 
     r.storage.resize(cfg.blackbox.frames);
     r.box.init(r.storage.data(), r.storage.size());
     rig->transport->attach_black_box(&r.box);
-    if (sick) {
+    if (serial) {
       r.serial_storage.resize(cfg.blackbox.serial_chunks);
       r.serial.init(r.serial_storage.data(), r.serial_storage.size());
       rig->transport->attach_serial_black_box(&r.serial);
@@ -380,8 +380,8 @@ bool wire_operator(const SimConfig& cfg, fw::Localizer& localizer, FirmwareRig* 
   return true;
 }
 
-// --transport can|sick: the loop reads the firmware's CanNode on the hal/sim loopback bus or its
-// SickLaser on a hal/sim serial port instead of the rings (sim/devices/sensor_transport.h), on the
+// --transport can|sick|hokuyo|rplidar: the loop reads the firmware's CanNode on the hal/sim loopback
+// bus or its SickLaser / HokuyoLaser / RplidarLaser on a hal/sim serial port instead of the rings (sim/devices/sensor_transport.h), on the
 // same stepped clock.
 bool wire_firmware(const SimConfig& cfg, fw::Localizer& localizer, FirmwareRig* rig, SimSummary* sum,
                    std::string* err) {
@@ -790,6 +790,25 @@ struct GlobalRecords {
   std::vector<std::size_t> lines;
 };
 
+// Which laser a file's serial lines come from, when --transport does not say: SCIP 2.0 is text
+// (LF-terminated ASCII lines), a SICK LMS2xx measured-value telegram starts 02 80 LEN LEN B0, an
+// RPLIDAR sends binary samples with neither.
+Transport serial_laser_of(const std::vector<BlackBoxLine>& lines) {
+  std::string bytes;
+  for (const BlackBoxLine& l : lines) {
+    if (l.serial && !l.tx) bytes.append(l.bytes.begin(), l.bytes.end());
+    if (bytes.size() > 16384) break;
+  }
+  const bool text = std::all_of(bytes.begin(), bytes.end(), [](char c) { return c == '\n' || (c >= 0x20 && c < 0x7F); });
+  if (text) return Transport::kHokuyo;
+  for (std::size_t i = 0; i + 4 < bytes.size(); ++i) {
+    if (bytes[i] == 0x02 && static_cast<std::uint8_t>(bytes[i + 1]) == 0x80 && static_cast<std::uint8_t>(bytes[i + 4]) == 0xB0) {
+      return Transport::kSick;
+    }
+  }
+  return Transport::kRplidar;
+}
+
 GlobalRecords global_records(const std::vector<BlackBoxLine>& lines) {
   GlobalRecords g;
   for (const BlackBoxLine& l : lines) {
@@ -849,10 +868,13 @@ bool replay_black_box(const SimConfig& cfg_in, SimResult* out, BlackBoxReplay* r
   } else if (!complete_config(cfg_in, &cfg, err)) {
     return false;
   }
-  // CAN frames alone: the CAN laser; serial lines too: the SICK driver on the serial port, the
-  // odometry and commands on the CAN wire (issue 60).
+  // CAN frames alone: the CAN laser; serial lines too: the serial laser's driver on the serial port
+  // (--transport names it, else the bytes tell: serial_laser_of), the odometry and commands on the
+  // CAN wire (issue 60).
   const bool serial = std::any_of(lines.begin(), lines.end(), [](const BlackBoxLine& l) { return l.serial; });
-  cfg.transport.transport = serial ? Transport::kSick : Transport::kCan;
+  cfg.transport.transport = !serial                                 ? Transport::kCan
+                            : is_serial(cfg_in.transport.transport) ? cfg_in.transport.transport
+                                                                    : serial_laser_of(lines);
   cfg.transport.byte_fault_rate = 0;
   SimSummary& sum = out->summary;
   sum.localizer = cfg.localizer;
@@ -874,6 +896,12 @@ bool replay_black_box(const SimConfig& cfg_in, SimResult* out, BlackBoxReplay* r
     if (l.tx || l.global) continue;
     ++(l.serial ? replay->rx_serial_lines : replay->rx_frames);
     if (l.frame.timestamp_ns > rig.sim_hal->clock.now_ns()) rig.sim_hal->clock.set_ns(l.frame.timestamp_ns);
+    // Hokuyo / RPLIDAR: the start-up handshake (not in the file) against the simulated device, at
+    // the time of the first serial line, as the recording ran it at its first scan.
+    if (l.serial && !rig.transport->start_serial_laser(l.frame.timestamp_ns, true, err)) {
+      *err = cfg_in.blackbox.replay_path + ":" + std::to_string(l.line_no) + ": " + *err;
+      return false;
+    }
     const bool fed = l.serial ? rig.transport->inject_serial(l.bytes.data(), l.bytes.size())
                               : rig.transport->inject_frame(l.frame);
     if (!fed) {

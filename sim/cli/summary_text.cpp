@@ -68,8 +68,26 @@ std::string kidnap_text(const SimSummary& s) {
   return t + fmt(", re-fixed after %.1f m / %.1f s", s.refix_travelled_m, s.refix_s);
 }
 
+namespace {
+
+// --transport hokuyo|rplidar: the driver's common counters (hal_serial::SerialLaserCounters).
+std::string serial_lidar_text(const SimSummary& s) {
+  const TransportStats& t = s.transport_stats;
+  std::string x = fmt("transport %s: %llu scans sent, %llu dropped + %llu corrupted by fault injection; driver: %u scans, "
+                      "%u checksum errors, %u dropped, %u bad measurements, %u handshakes again",
+                      s.transport.c_str(), static_cast<unsigned long long>(t.scans_sent),
+                      static_cast<unsigned long long>(t.frames_dropped), static_cast<unsigned long long>(t.frames_corrupted),
+                      t.serial.scans, t.serial.checksum_errors, t.serial.dropped, t.serial.bad_measurements,
+                      t.serial.device_restarts);
+  if (!t.serial_handshake_error.empty()) x += "; start-up handshake failed: " + t.serial_handshake_error;
+  return x;
+}
+
+}  // namespace
+
 std::string transport_text(const SimSummary& s) {
   if (s.transport == "none") return {};
+  if (s.transport == "hokuyo" || s.transport == "rplidar") return serial_lidar_text(s);
   const TransportStats& t = s.transport_stats;
   if (s.transport == "sick") {
     const std::uint64_t lost = t.scans_sent > t.sick_scans ? t.scans_sent - t.sick_scans : 0;

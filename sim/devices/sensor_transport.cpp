@@ -21,6 +21,10 @@ const char* transport_name(Transport t) {
       return "can";
     case Transport::kSick:
       return "sick";
+    case Transport::kHokuyo:
+      return "hokuyo";
+    case Transport::kRplidar:
+      return "rplidar";
   }
   return "?";
 }
@@ -32,6 +36,10 @@ bool parse_transport(const std::string& name, Transport* out) {
     *out = Transport::kCan;
   } else if (name == "sick") {
     *out = Transport::kSick;
+  } else if (name == "hokuyo") {
+    *out = Transport::kHokuyo;
+  } else if (name == "rplidar") {
+    *out = Transport::kRplidar;
   } else {
     return false;
   }
@@ -98,19 +106,23 @@ class FixedClock final : public hal::Clock {
 // Named (not anonymous): fields of SensorTransport::Parts, a class with linkage.
 namespace transport_detail {
 
-// Scans the SickLaser delivers carry its own counter; the simulator needs its step index back. The
-// device side notes (sample time, index) per telegram, and a delivered scan (stamped at receipt,
-// which in lockstep is its sample time) takes the index of its time; telegrams lost on the way are
-// skipped. A robot's loop sees the driver's counter.
+// Scans a serial laser driver delivers carry its own counter; the simulator needs its step index
+// back. The device side notes (sample time, index) per scan sent, and a delivered scan (stamped at
+// receipt, which in lockstep is its sample time; a Hokuyo's from its ms counter, within tolerance_ns)
+// takes the index of its time; scans lost on the way are skipped. A robot's loop sees the driver's
+// counter.
 class IndexedSickLaser final : public hal::LaserScanSource {
  public:
-  explicit IndexedSickLaser(hal_serial::SickLaser* inner) : inner_(inner) {}
+  void set_inner(hal::LaserScanSource* inner, std::uint64_t tolerance_ns) {
+    inner_ = inner;
+    tolerance_ns_ = tolerance_ns;
+  }
   void sent(std::uint64_t t_ns, std::uint32_t id) { (void)sent_.push_overwrite({t_ns, id}); }
   bool poll(hal::LaserScan* out) override {
     if (!inner_->poll(out)) return false;
     Sent s;
-    while (!sent_.empty() && sent_[0].t_ns < out->timestamp_ns) (void)sent_.pop(&s);
-    if (!sent_.empty() && sent_[0].t_ns == out->timestamp_ns) {
+    while (!sent_.empty() && sent_[0].t_ns + tolerance_ns_ < out->timestamp_ns) (void)sent_.pop(&s);
+    if (!sent_.empty() && sent_[0].t_ns <= out->timestamp_ns + tolerance_ns_) {
       (void)sent_.pop(&s);
       out->scan_id = s.id;
     }
@@ -125,7 +137,8 @@ class IndexedSickLaser final : public hal::LaserScanSource {
     std::uint64_t t_ns;
     std::uint32_t id;
   };
-  hal_serial::SickLaser* inner_;
+  hal::LaserScanSource* inner_ = nullptr;
+  std::uint64_t tolerance_ns_ = 0;
   fw::RingBuffer<Sent, 64> sent_;
 };
 
@@ -191,8 +204,12 @@ struct SensorTransport::Parts {
   hal_sim::SimSerialPort port;
   hal_serial::RecordingSerialPort recording_port;  // between the driver and its port: the black box
   hal_serial::SickLaser sick;
-  IndexedSickLaser sick_laser{&sick};
+  IndexedSickLaser sick_laser;
   std::uint8_t bytes[hal_serial::kMaxTelegramData + 16];
+  // --transport hokuyo|rplidar (issue 60): device model, its loop port and the driver.
+  std::unique_ptr<SerialLidarLink> link;
+  hal_serial::SerialBlackBox* serial_box = nullptr;
+  std::string device_bytes;
 };
 
 SensorTransport::SensorTransport() : parts_(std::make_unique<Parts>()) {}
@@ -204,11 +221,15 @@ bool SensorTransport::init(const TransportOptions& options, const hal::Clock* cl
     return false;
   }
   if (options.byte_fault_rate > 0.0 && options.transport == Transport::kNone) {
-    *err = "--byte-fault-rate needs a transport with bytes (--transport can or sick)";
+    *err = "--byte-fault-rate needs a transport with bytes (--transport can, sick, hokuyo or rplidar)";
     return false;
   }
+  if (!laser_model_ok(options, err)) return false;
   options_ = options;
-  const SensorResolution own = options.transport == Transport::kSick ? SensorResolution::kSick : SensorResolution::kCan;
+  // A Hokuyo or an RPLIDAR samples the scan at its own angles (its driver gives the geometry).
+  const SensorResolution own = options.transport == Transport::kSick ? SensorResolution::kSick
+                               : is_serial(options.transport)      ? SensorResolution::kExact
+                                                                   : SensorResolution::kCan;
   // The direct path's sensors report what the product's own wire carries (CAN: ranges in mm, angles
   // in µrad, times in µs), as the firmware on a robot only ever sees: `--transport none` and
   // `--transport can` give the same run. Exact floats only when asked for (kExact).
@@ -218,13 +239,53 @@ bool SensorTransport::init(const TransportOptions& options, const hal::Clock* cl
            " carries its own wire's values (leave --sensor-resolution out, or say " + transport_name(options.transport) + ")";
     return false;
   }
-  hal_serial::SickLaserOptions so;
-  so.request_continuous = false;  // the simulated scanner streams from the start
-  parts_->recording_port.init(&parts_->port, clock, nullptr);
-  parts_->sick.init(&parts_->recording_port, clock, so);
+  init_serial_laser(clock);
   faults_.reseed(options.seed, kFaultStream);
   parts_->node.init(&parts_->bus, clock, options.fd);
   return true;
+}
+
+bool SensorTransport::laser_model_ok(const TransportOptions& options, std::string* err) {
+  if (options.laser_model.empty()) return true;
+  const bool hokuyo = options.transport == Transport::kHokuyo;
+  if (!hokuyo && options.transport != Transport::kRplidar) {
+    *err = "--laser-model needs --transport hokuyo or rplidar";
+    return false;
+  }
+  if (SerialLidarLink::valid_model(hokuyo ? SerialLidarKind::kHokuyo : SerialLidarKind::kRplidar, options.laser_model)) {
+    return true;
+  }
+  *err = "--laser-model: '" + options.laser_model + "' (expected " +
+         (hokuyo ? hokuyo_model_names() : rplidar_model_names()) + " with --transport " + transport_name(options.transport) + ")";
+  return false;
+}
+
+void SensorTransport::init_serial_laser(const hal::Clock* clock) {
+  Parts& p = *parts_;
+  if (options_.transport == Transport::kHokuyo || options_.transport == Transport::kRplidar) {
+    const SerialLidarKind kind =
+        options_.transport == Transport::kHokuyo ? SerialLidarKind::kHokuyo : SerialLidarKind::kRplidar;
+    p.link = std::make_unique<SerialLidarLink>(kind, options_.laser_model, &p.port, clock);
+    p.recording_port.init(&p.link->device_port(), clock, nullptr);
+    p.link->init_driver(&p.recording_port);
+    // A Hokuyo's scan time comes from its ms counter mapped by the smallest offset: within 1 ms.
+    p.sick_laser.set_inner(&p.link->laser(), kind == SerialLidarKind::kHokuyo ? 2000000u : 0u);
+    return;
+  }
+  hal_serial::SickLaserOptions so;
+  so.request_continuous = false;  // the simulated scanner streams from the start
+  p.recording_port.init(&p.port, clock, nullptr);
+  p.sick.init(&p.recording_port, clock, so);
+  p.sick_laser.set_inner(&p.sick, 0);
+}
+
+bool SensorTransport::start_serial_laser(std::uint64_t t_ns, bool replay, std::string* err) {
+  Parts& p = *parts_;
+  if (!p.link || p.link->started()) return true;
+  p.recording_port.set_black_box(nullptr);  // on a robot the handshake is over before the ring exists
+  const bool ok = p.link->handshake(t_ns, !replay, err);
+  p.recording_port.set_black_box(p.serial_box);
+  return ok;
 }
 
 void SensorTransport::transmit(hal::CanFrame* frames, std::size_t n, std::uint64_t t_ns) {
@@ -285,31 +346,8 @@ void SensorTransport::send_odometry(const hal::Odometry& odom) {
 }
 
 void SensorTransport::send_scan(const hal::LaserScan& scan) {
-  if (options_.transport == Transport::kSick) {
-    const std::size_t len =
-        hal_serial::encode_measured_values(sick_values(scan), parts_->bytes, sizeof(parts_->bytes));
-    if (len == 0) {
-      ++stats_.encode_failed;
-      last_encode_error_ = "sick telegram: scan " + std::to_string(scan.scan_id) + " has no beams";
-      return;
-    }
-    ++stats_.scans_sent;
-    ++stats_.telegrams_sent;
-    parts_->sick_laser.sent(scan.timestamp_ns, scan.scan_id);
-    if (frame_index_++ == options_.fault_frame && len > 8) {
-      parts_->bytes[8] ^= 0x01u;  // a range byte: only the CRC-16 can notice
-      ++stats_.frames_corrupted;
-    }
-    std::uint32_t byte = 0;
-    std::uint8_t mask = 0;
-    bool drop = false;
-    if (fault_draw(len, &byte, &mask, &drop)) {
-      if (drop) return;
-      parts_->bytes[byte] ^= mask;
-    }
-    if (!parts_->port.device_send(parts_->bytes, len)) ++stats_.bus_full;
-    return;
-  }
+  if (options_.transport == Transport::kSick) return send_sick_scan(scan);
+  if (is_serial(options_.transport)) return send_serial_scan(scan);
   std::size_t n = 0;
   hal_can::EncodeOptions eo;
   eo.fd = options_.fd;
@@ -321,6 +359,58 @@ void SensorTransport::send_scan(const hal::LaserScan& scan) {
   }
   ++stats_.scans_sent;
   transmit(parts_->frames, n, scan.timestamp_ns);
+}
+
+// Byte-level faults on one scan's bytes (a telegram, an answer, a turn), then onto the wire.
+void SensorTransport::put_serial(std::uint8_t* bytes, std::size_t len) {
+  std::uint32_t byte = 0;
+  std::uint8_t mask = 0;
+  bool drop = false;
+  if (fault_draw(len, &byte, &mask, &drop)) {
+    if (drop) return;
+    bytes[byte] ^= mask;
+  }
+  if (!parts_->port.device_send(bytes, len)) ++stats_.bus_full;
+}
+
+// --transport hokuyo|rplidar: the device model's bytes for the scan (the handshake first, once).
+void SensorTransport::send_serial_scan(const hal::LaserScan& scan) {
+  Parts& p = *parts_;
+  if (!p.link->started() && !start_serial_laser(scan.timestamp_ns, false, &stats_.serial_handshake_error)) {
+    last_encode_error_ = stats_.serial_handshake_error;
+  }
+  p.device_bytes.clear();
+  p.link->encode_scan(scan, &p.device_bytes);
+  if (p.device_bytes.empty()) {
+    ++stats_.encode_failed;
+    last_encode_error_ = std::string(transport_name(options_.transport)) + ": the simulated device is not streaming";
+    return;
+  }
+  ++stats_.scans_sent;
+  p.sick_laser.sent(scan.timestamp_ns, scan.scan_id);
+  std::uint8_t* bytes = reinterpret_cast<std::uint8_t*>(p.device_bytes.data());
+  if (frame_index_++ == options_.fault_frame && p.device_bytes.size() > 64) {
+    bytes[p.device_bytes.size() / 2] ^= 0x01u;  // a byte in the middle: only a sum / check bit can notice
+    ++stats_.frames_corrupted;
+  }
+  put_serial(bytes, p.device_bytes.size());
+}
+
+void SensorTransport::send_sick_scan(const hal::LaserScan& scan) {
+  const std::size_t len = hal_serial::encode_measured_values(sick_values(scan), parts_->bytes, sizeof(parts_->bytes));
+  if (len == 0) {
+    ++stats_.encode_failed;
+    last_encode_error_ = "sick telegram: scan " + std::to_string(scan.scan_id) + " has no beams";
+    return;
+  }
+  ++stats_.scans_sent;
+  ++stats_.telegrams_sent;
+  parts_->sick_laser.sent(scan.timestamp_ns, scan.scan_id);
+  if (frame_index_++ == options_.fault_frame && len > 8) {
+    parts_->bytes[8] ^= 0x01u;  // a range byte: only the CRC-16 can notice
+    ++stats_.frames_corrupted;
+  }
+  put_serial(parts_->bytes, len);
 }
 
 bool SensorTransport::send_command(const hal::Command& command, std::uint64_t t_ns, std::string* err) {
@@ -338,6 +428,7 @@ bool SensorTransport::inject_frame(const hal::CanFrame& frame) { return parts_->
 hal::CommandSource& SensorTransport::commands() { return parts_->node.commands(); }
 void SensorTransport::attach_black_box(hal_can::BlackBox* box) { parts_->node.attach_black_box(box); }
 void SensorTransport::attach_serial_black_box(hal_serial::SerialBlackBox* box) {
+  parts_->serial_box = box;
   parts_->recording_port.set_black_box(box);
 }
 bool SensorTransport::inject_serial(const std::uint8_t* bytes, std::size_t n) {
@@ -345,7 +436,7 @@ bool SensorTransport::inject_serial(const std::uint8_t* bytes, std::size_t n) {
 }
 
 hal::LaserScanSource& SensorTransport::laser() {
-  if (options_.transport == Transport::kSick) return parts_->sick_laser;
+  if (is_serial(options_.transport)) return parts_->sick_laser;
   return parts_->laser;
 }
 hal::OdometrySource& SensorTransport::odometry() { return parts_->node.odometry(); }
@@ -363,6 +454,7 @@ TransportStats SensorTransport::stats() const {
   s.sick_scans = parts_->sick.stats().scans;
   s.sick_bad_measurements = parts_->sick.stats().bad_measurements;
   s.sick_overwritten = parts_->sick.stats().overwritten;
+  if (parts_->link) s.serial = parts_->link->laser().counters();
   return s;
 }
 

@@ -10,6 +10,14 @@
 //         simulation backend's serial port (hal_sim::SimSerialPort) and the loop reads them from
 //         the firmware's SickLaser driver (telegram parser, CRC-16, geometry, time stamp at
 //         receipt); odometry, which a scanner does not carry, goes straight into its ring.
+//   hokuyo, rplidar  (issue 60) the scans become the bytes of a Hokuyo UTM-30LX (SCIP 2.0 "99"
+//         answers) or of an RPLIDAR A1 (SCAN samples, one turn of the head per scan), made by the
+//         device models of mml-hokuyodev / mml-rplidardev (sim/devices/serial_lidar_link.h), and the
+//         loop reads them from the firmware's HokuyoLaser / RplidarLaser, after their start-up
+//         handshake answered by the simulated device at the first scan's time. The device samples
+//         the simulated scan at its own angles (1081 steps over 270°; ~364 samples a turn resampled
+//         by the driver onto 360 beams): the firmware sees that unit's geometry. An RPLIDAR turn
+//         reaches the firmware when the next one begins: one scan later.
 //
 // The wire is lossy (CAN: ranges in the range unit, 1 mm up to 65 m; angles in µrad / 0.1 µrad;
 // odometry in mm and µrad; times in µs. SICK: ranges in mm up to 8.191 m, else cm; the geometry
@@ -42,16 +50,19 @@
 #include "hal_serial/sick_laser.h"
 #include "hal_sim/sim_can_bus.h"
 #include "hal_sim/sim_serial_port.h"
+#include "sim/devices/serial_lidar_link.h"
 
 namespace sim {
 
-enum class Transport : std::uint8_t { kNone, kCan, kSick };
+enum class Transport : std::uint8_t { kNone, kCan, kSick, kHokuyo, kRplidar };
+// A laser on a serial port (sick, hokuyo, rplidar): bytes a black box records as serial lines.
+inline bool is_serial(Transport t) { return t == Transport::kSick || t == Transport::kHokuyo || t == Transport::kRplidar; }
 // What the simulated sensors report: exact floats, or the values a wire carries. kAuto: the
 // transport's own (the only possible one with can / sick); with none, the CAN wire's (the product's
 // wire: a robot's firmware never sees more than it carries), so none and can give the same run.
 enum class SensorResolution : std::uint8_t { kAuto, kExact, kCan, kSick };
 const char* transport_name(Transport t);
-// false for an unknown name (expected none, can or sick).
+// false for an unknown name (expected none, can, sick, hokuyo or rplidar).
 bool parse_transport(const std::string& name, Transport* out);
 
 struct TransportOptions {
@@ -64,10 +75,13 @@ struct TransportOptions {
   // or of byte 8 (a range byte) of this SICK telegram (0-based count of frames / telegrams sent);
   // -1 = off.
   std::int64_t fault_frame = -1;
-  // kSick: odometry and operator commands on the CAN wire (the CanNode), as a robot with a serial
+  // A serial laser: odometry and operator commands on the CAN wire (the CanNode), as a robot with a serial
   // laser and `odometry = socketcan:IFACE` has them; off, odometry goes straight into its ring.
   // The black box turns it on (issue 60): a replay needs every input on a wire it recorded.
   bool sick_odometry_on_can = false;
+  // kHokuyo / kRplidar: the unit the device model plays (--laser-model; empty: utm-30lx / a1). A
+  // replay's start-up handshake is answered by it, so it must be the recorded unit.
+  std::string laser_model;
 };
 
 struct TransportStats {
@@ -83,6 +97,9 @@ struct TransportStats {
   std::uint64_t telegrams_sent = 0;
   std::uint32_t sick_telegrams = 0, sick_crc_errors = 0, sick_bad_length = 0, sick_garbage_bytes = 0;
   std::uint32_t sick_scans = 0, sick_bad_measurements = 0, sick_overwritten = 0;
+  // --transport hokuyo|rplidar: the driver's common counters, and a handshake that failed.
+  hal_serial::SerialLaserCounters serial;
+  std::string serial_handshake_error;
 };
 
 // The value a simulated sensor reports: the message as the wire carries it (encode + decode with
@@ -110,8 +127,7 @@ class SensorTransport {
   // Whether odometry and commands travel on the CAN wire (can; sick with sick_odometry_on_can) or
   // straight into their ring / queue.
   bool carries_odometry() const {
-    return options_.transport == Transport::kCan ||
-           (options_.transport == Transport::kSick && options_.sick_odometry_on_can);
+    return options_.transport == Transport::kCan || (is_serial(options_.transport) && options_.sick_odometry_on_can);
   }
 
   // kCan: encode and send (frames stamped with the message's time on the simulation clock: the
@@ -128,13 +144,18 @@ class SensorTransport {
   // kCan: the CanNode's command queue, and its black box (null = none).
   hal::CommandSource& commands();
   void attach_black_box(hal_can::BlackBox* box);
-  // kSick: the bytes the SickLaser reads from (and writes to) its port recorded in `box` (null =
-  // none), and bytes as they were received (a black box replay) queued for it; false if the port
-  // is full.
+  // A serial laser (kSick, kHokuyo, kRplidar): the bytes its driver reads from (and writes to) its
+  // port recorded in `box` (null = none), and bytes as they were received (a black box replay)
+  // queued for it; false if the port is full.
   void attach_serial_black_box(hal_serial::SerialBlackBox* box);
   bool inject_serial(const std::uint8_t* bytes, std::size_t n);
+  // kHokuyo / kRplidar: the driver's start-up handshake at t_ns against the simulated device, not
+  // recorded (send_scan runs it before the first scan). A replay runs it before the file's first
+  // serial line, at that line's time, and the device answers nothing after it (every later byte is
+  // the file's). No-op for the other transports and once started; false with *err if it failed.
+  bool start_serial_laser(std::uint64_t t_ns, bool replay, std::string* err);
 
-  // The sources the localization loop reads for kCan (the CanNode's) and kSick (the SickLaser's scans).
+  // The sources the localization loop reads for kCan (the CanNode's) and a serial laser (its driver's scans).
   hal::LaserScanSource& laser();
   hal::OdometrySource& odometry();
 
@@ -143,6 +164,11 @@ class SensorTransport {
 
  private:
   void transmit(hal::CanFrame* frames, std::size_t n, std::uint64_t t_ns);
+  static bool laser_model_ok(const TransportOptions& options, std::string* err);
+  void init_serial_laser(const hal::Clock* clock);
+  void send_serial_scan(const hal::LaserScan& scan);
+  void send_sick_scan(const hal::LaserScan& scan);
+  void put_serial(std::uint8_t* bytes, std::size_t len);
   bool fault_draw(std::size_t len, std::uint32_t* byte, std::uint8_t* mask, bool* drop);
 
   TransportOptions options_;

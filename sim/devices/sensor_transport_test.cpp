@@ -203,6 +203,56 @@ TEST(SensorTransport, SickPathDeliversTheSickResolutionScanAndCountsACorruptTele
   EXPECT_EQ(st.sick_scans, 3u);
 }
 
+// Issue 60: the Hokuyo path (a UTM-30LX's SCIP 2.0 answers → HokuyoLaser) runs the driver's
+// start-up handshake against the simulated device at the first scan and delivers every scan with the
+// simulator's index, in that unit's geometry (1081 steps of 0.25°), the ranges to the mm.
+TEST(SensorTransport, HokuyoPathHandshakesAndDeliversEachScan) {
+  hal_sim::SteppedClock clock;
+  auto t = std::make_unique<SensorTransport>();
+  std::string err;
+  TransportOptions opt;
+  opt.transport = Transport::kHokuyo;
+  ASSERT_TRUE(t->init(opt, &clock, &err)) << err;
+  auto got = std::make_unique<hal::LaserScan>();
+  for (std::uint32_t k = 0; k < 4; ++k) {
+    const std::uint64_t ts = 1'000'000'000ull + 25'000'000ull * k;
+    auto s = std::make_unique<hal::LaserScan>(make_scan(100 + k, 361, ts));
+    t->send_scan(*s);
+    clock.set_ns(ts);
+    ASSERT_TRUE(t->laser().poll(got.get())) << k << " " << t->stats().serial_handshake_error;
+    EXPECT_EQ(got->scan_id, 100 + k);
+    EXPECT_EQ(got->timestamp_ns, ts);  // whole ms: the sensor's counter maps back exactly
+    ASSERT_EQ(got->beam_count, 1081u);
+    EXPECT_NEAR(got->ranges[540], s->ranges[180], 0.0006f);  // straight ahead, in mm
+  }
+  EXPECT_EQ(t->stats().serial.scans, 4u);
+  EXPECT_TRUE(t->stats().serial_handshake_error.empty());
+}
+
+// The RPLIDAR path (an A1's SCAN samples, one turn per scan → RplidarLaser): a turn reaches the
+// firmware when the next begins, stamped with its own time and index, resampled onto 360 beams.
+TEST(SensorTransport, RplidarPathDeliversEachTurnOneScanLater) {
+  hal_sim::SteppedClock clock;
+  auto t = std::make_unique<SensorTransport>();
+  std::string err;
+  TransportOptions opt;
+  opt.transport = Transport::kRplidar;
+  ASSERT_TRUE(t->init(opt, &clock, &err)) << err;
+  auto got = std::make_unique<hal::LaserScan>();
+  for (std::uint32_t k = 0; k < 4; ++k) {
+    const std::uint64_t ts = 1'000'000'000ull + 181'818'000ull * k;
+    t->send_scan(make_scan(100 + k, 361, ts));
+    clock.set_ns(ts);
+    const bool delivered = t->laser().poll(got.get());
+    EXPECT_EQ(delivered, k > 0) << k;
+    if (!delivered) continue;
+    EXPECT_EQ(got->scan_id, 100 + k - 1);
+    EXPECT_EQ(got->timestamp_ns, ts - 181'818'000ull);
+    EXPECT_EQ(got->beam_count, 360u);
+  }
+  EXPECT_EQ(t->stats().serial.scans, 3u);
+}
+
 TEST(SensorTransport, BadOptionsAreRefused) {
   hal_sim::SteppedClock clock;
   auto t = std::make_unique<SensorTransport>();
@@ -218,10 +268,23 @@ TEST(SensorTransport, BadOptionsAreRefused) {
   opt.resolution = SensorResolution::kCan;  // sick carries its own wire's values
   opt.transport = Transport::kSick;
   EXPECT_FALSE(t->init(opt, &clock, &err));
+  opt.resolution = SensorResolution::kAuto;
+  opt.laser_model = "urg-04lx";  // a Hokuyo, not an RPLIDAR
+  opt.transport = Transport::kRplidar;
+  EXPECT_FALSE(t->init(opt, &clock, &err));
+  EXPECT_NE(err.find("a1, a2, a3, s1"), std::string::npos) << err;
+  opt.transport = Transport::kSick;  // a SICK plays no model
+  EXPECT_FALSE(t->init(opt, &clock, &err));
+  opt.transport = Transport::kHokuyo;
+  EXPECT_TRUE(t->init(opt, &clock, &err)) << err;
   Transport tr;
   EXPECT_TRUE(parse_transport("can", &tr));
   EXPECT_EQ(tr, Transport::kCan);
   EXPECT_TRUE(parse_transport("sick", &tr));
+  EXPECT_TRUE(parse_transport("hokuyo", &tr));
+  EXPECT_EQ(tr, Transport::kHokuyo);
+  EXPECT_TRUE(parse_transport("rplidar", &tr));
+  EXPECT_EQ(tr, Transport::kRplidar);
   EXPECT_FALSE(parse_transport("serial", &tr));
 }
 
