@@ -210,17 +210,19 @@ struct TrackOptions {
   // right poses this could turn all tested below z 1.0; the carry 3908 → 3827 above 1.64.
   float alias_credible_z = 1.645f;
   // A heading-only fault is recovered by the track itself: the scan fix lies inside the prediction's
-  // horizontal protection level, turned beyond the heading alert limit but by no more than the wheels
-  // reported turning since a scan last set the heading (plus the prediction's heading PL), and the
-  // paired test (alias_z) says the scan fits significantly better at the fix than at the prediction.
-  // Wheels that over-report a turn (mit-killian: 23° where the robot turned 5°) do that; a carried
-  // robot does not: carrying moves the position, and a look-alike place turned has turned without
-  // the wheels (seed 707 #136). Where Gauss-Newton from a prediction 15–20° off stops short, a heading
-  // search at the predicted position over that turn looks for the fix (try_turn_hypothesis), kept only
-  // if it passes this test. The fault widens the covariance and needs `recovery_steps` consistent
-  // scans; MML still cross-checks. false = every heading fault beyond the alert limit waits for MML.
-  // Corpus (the 23 turn-spin draws of dev seed 5): 7,683 `localized` without the rule, 8,200 with the
-  // test alone, 8,879 with the search; 0 wrong in all three.
+  // horizontal protection level (the position is where the track promised it), turned beyond the
+  // heading alert limit, and the paired test (alias_z) says the scan fits significantly better at the
+  // fix than at the prediction. Wheels that over-report a turn (mit-killian: 23° where the robot
+  // turned 5°) do that; a carried robot does not: carrying moves the position. Where Gauss-Newton
+  // from a prediction 15–30° off stops short, the turn hypothesis is tested directly (a heading search
+  // at the predicted position, or the alias check's turned rival there) and kept only if it passes
+  // this test — reaching no farther than the turn the wheels reported since a scan last set the
+  // heading (rival_within_reported_turn): a place that looks like the old one turned, reached by a
+  // carry with no reported turn, stays a large fault (seed 707 #136). The fault widens the covariance
+  // and needs `recovery_steps` consistent scans; MML still cross-checks. false = every heading fault
+  // beyond the alert limit waits for MML. Turn-spin draws, 0 wrong in every variant: dev seed 5 7,683
+  // `localized` without the rule, 8,200 with the test alone, 8,905 with the turn hypothesis; seed 808
+  // 18,270 with the test alone, 20,082 with the hypothesis.
   bool heading_fault_local_recovery = true;
   // Confidence extent (fit_comparison.h): the protection level of a scan-supported pose covers at least
   // the farthest shift from the scan fix that the scan cannot reject (paired test at alias_z), plus
