@@ -595,6 +595,10 @@ void print_timing_report(const Startup& su) {
                  static_cast<unsigned long long>(gc.jobs()), static_cast<unsigned long long>(gc.overruns()),
                  static_cast<unsigned long long>(gc.skipped_offers()), gc.schedule().every_n_scans,
                  gc.schedule().result_delay_scans);
+    if (su.global_thread) {
+      std::fprintf(stderr, "  global: last window %.3f ms (median scan interval %.3f ms, at least %.3f ms)\n",
+                   gc.last_window_ns() * 1e-6, gc.median_scan_interval_ns() * 1e-6, su.global_ctx.deadline_ns * 1e-6);
+    }
   }
 }
 

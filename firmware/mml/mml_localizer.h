@@ -129,6 +129,8 @@ class MmlLocalizer final : public Localizer {
     deadline_budget_ns_ = step_budget_ns;
     deadline_share_ = pransam_share;
   }
+  // The budget of the next steps, the mode unchanged (the global context's measured window).
+  void set_deadline_budget(std::uint64_t step_budget_ns) { deadline_budget_ns_ = step_budget_ns; }
   std::uint64_t deadline_stops() const { return deadline_stops_; }  // pRANSAM runs cut by the deadline
   // pRANSAM's rounds in the last step when its deadline stopped it, else 0 (issue 60: recorded in
   // the black box with the global result).

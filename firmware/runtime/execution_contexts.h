@@ -10,7 +10,8 @@
 //  global  the MML step (RBSM + pRANSAM + interpretation, Ch. 5), lower priority. The sensor
 //          context hands it the scan + odometry of every `period_scans`-th scan through a one-slot
 //          mailbox and takes its result (a fix hypothesis, moved to the current scan by odometry)
-//          `period_scans` scans later; the global step's deadline is that window. It never blocks
+//          `period_scans` scans later; the global step's deadline is that window, measured from the
+//          sensor context's scan intervals with deadline_ns as its floor (track/scan_window.h). It never blocks
 //          the sensor context (the mailbox copy is the only shared section); a step still running
 //          when the next scan is due makes the sensor context skip that offer (counted).
 //  workers pRANSAM / RBSM worker pool threads (firmware/base/worker_pool.h), run by the global

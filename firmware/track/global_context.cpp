@@ -47,7 +47,11 @@ Status GlobalContext::attach_thread(GlobalThread* thread, const ExecutionContext
   FW_RETURN_IF_ERROR(schedule_.validate(true));
   clock_ = clock;
   // Anytime global search: pRANSAM's iterations are cut so the step fits the context's window.
+  // Each job's window is measured by the sensor context (scan_window.h); the context's deadline is
+  // its floor.
   if (clock != nullptr) mml_->set_deadline_mode(clock, context.deadline_ns);
+  configured_window_ns_ = context.deadline_ns;
+  scan_window_.reset();
   thread_ = thread;
   threaded_ = true;
   return Status::ok();
@@ -84,6 +88,7 @@ void GlobalContext::run_job() {
   // out once, and hid 14-17 ms resets of RBSM's grid behind a 10 ms step p99).
   const std::uint64_t t0 = clock_ != nullptr ? clock_->now_ns() : 0;
   if (job_reset_) mml_->reset();
+  if (job_window_ns_ != 0) mml_->set_deadline_budget(job_window_ns_);
   mml_->set_unmapped_hypothesis(job_unmapped_);
   job_status_ = mml_->step(job_scan_, job_odom_, &job_out_);
   job_deadline_rounds_ = mml_->last_deadline_rounds();
@@ -106,6 +111,7 @@ PerfStats GlobalContext::step_stats() const {
 void GlobalContext::tick() {
   ++index_;
   if (!threaded_) return;
+  if (clock_ != nullptr) scan_window_.step(clock_->now_ns());
   const Slot s = slot_.load(std::memory_order_acquire);
   // The job's window closes at index job_index_ + delay: still not done then is an overrun.
   if ((s == Slot::kQueued || s == Slot::kRunning) && index_ - 1 == job_index_ + schedule_.result_delay_scans) {
@@ -204,6 +210,9 @@ Status GlobalContext::offer(const hal::LaserScan& scan, const hal::Odometry& odo
   job_unmapped_ = unmapped_hypothesis_;
   reset_pending_ = false;
   ++jobs_;
+  job_window_ns_ = threaded_ && clock_ != nullptr && configured_window_ns_ != 0
+                      ? scan_window_.window_ns(schedule_.result_delay_scans, configured_window_ns_)
+                      : 0;
   if (threaded_) {
     slot_.store(Slot::kQueued, std::memory_order_release);
     thread_->notify();

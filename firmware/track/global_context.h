@@ -35,6 +35,7 @@
 #include "firmware/mml/mml_localizer.h"
 #include "firmware/runtime/execution_contexts.h"
 #include "firmware/track/global_thread.h"
+#include "firmware/track/scan_window.h"
 #include "hal/clock.h"
 #include "hal/global_record_sink.h"
 
@@ -130,6 +131,10 @@ class GlobalContext {
   const PerfCounter& perf_step() const { return perf_step_; }
   // Thread-safe copy of the global step's stats (threaded: written by the global thread).
   PerfStats step_stats() const;
+  // Threaded with a clock: the window the last job was given (its pRANSAM deadline budget,
+  // scan_window.h) and the median scan interval it came from; 0 = none yet.
+  std::uint64_t last_window_ns() const { return job_window_ns_; }
+  std::uint64_t median_scan_interval_ns() const { return scan_window_.median_interval_ns(); }
 
  private:
   friend class GlobalThread;
@@ -165,6 +170,9 @@ class GlobalContext {
   Status job_status_;
   hal::PoseEstimate job_out_;
   std::uint32_t job_deadline_rounds_ = 0;  // pRANSAM's rounds when its deadline stopped the job
+  std::uint64_t job_window_ns_ = 0;  // the job's deadline budget (threaded with a clock), else 0
+  ScanWindow scan_window_;           // the sensor context's step intervals (tick())
+  std::uint64_t configured_window_ns_ = 0;  // the context's deadline: the window's floor
   std::atomic<Slot> slot_{Slot::kIdle};
 
   bool threaded_ = false;

@@ -22,7 +22,7 @@ while read -r name iface config replay; do
   # Record only the firmware's output (pose 0x120.., health 0x130.., and their FD variants).
   candump -L "$iface,120:7F0,130:7F0,520:7F0,530:7F0" > "$d/capture.log" 2> "$d/candump.err" &
   cpid=$!
-  "$B/firmware/app/mmlfw" --config "$config" > "$d/mmlfw.out" 2> "$d/mmlfw.log" &
+  "$B/firmware/app/mmlfw" --config "$config" --timing-report > "$d/mmlfw.out" 2> "$d/mmlfw.log" &
   fpid=$!
   # Start-up includes loading the map image (and filling the relation table when the image has none).
   for i in $(seq 1 600); do grep -q "mmlfw: running" "$d/mmlfw.log" 2>/dev/null && break; kill -0 $fpid 2>/dev/null || break; sleep 0.1; done
