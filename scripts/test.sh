@@ -110,7 +110,7 @@ asan() {
 }
 # TSan: the tests where threads meet (tests/CMakeLists.txt, label tsan); only their targets are built.
 tsan() {
-  BUILD_TARGETS="fw_base_test fw_pransam_test fw_mml_reset_test replay_budget_test fw_track_test" \
+  BUILD_TARGETS="fw_base_test fw_pransam_test fw_mml_reset_test replay_budget_test fw_track_test fw_track_global_replay_test" \
     build_and_test tsan "TSan (threaded tests only, label tsan)" -j 1 --timeout 1200 -L '^tsan$'
 }
 # libFuzzer: seeds from the real logs, every target over its seeds + committed reproducers + a

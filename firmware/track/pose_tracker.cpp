@@ -571,6 +571,13 @@ void PoseTracker::apply_verdict(const Se2f& odom, const StepWork& w, const Updat
       ++consistent_since_fault_;
       if (consistent_since_fault_ >= options_.recovery_steps) contradicted_ = false;
     }
+    // TrackOptions::repin_needs_confirmation: this scan alone vouches for the pose along the axis
+    // it pins; it does not count as one of its own confirmations.
+    if (u.fuse && w.predicted && options_.repin_needs_confirmation &&
+        (last_.pl.xy_m > options_.alert_limit_m || last_.pl.theta_rad > options_.alert_limit_rad)) {
+      had_fault_ = true;
+      consistent_since_fault_ = 0;
+    }
     return;
   }
   ++unsupported_;

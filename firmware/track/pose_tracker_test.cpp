@@ -127,6 +127,45 @@ TEST(PoseTrackerTest, UninformativeScansGrowProtectionLevelUntilStatusDrops) {
   EXPECT_TRUE(dropped);
 }
 
+// TrackOptions::repin_needs_confirmation: a pose whose published PL was beyond the alert limits is
+// brought back within them by a scan the prediction could not check: `localized` only after
+// recovery_steps consistent scans, as a fix; with the rule off, at once.
+TEST(PoseTrackerTest, ScanThatPinsAnOpenPoseIsConfirmedLikeAFix) {
+  for (const bool rule : {true, false}) {
+    TrackOptions o;
+    o.repin_needs_confirmation = rule;
+    PoseTracker t;
+    ASSERT_TRUE(t.init(o, room_map().map).is_ok());
+    RandomStream rng(21, 0);
+    Se2f truth(6.0f, 2.5f, 0.0f), odom;
+    Eigen::Matrix3f wide = small_cov();
+    wide(0, 0) = wide(1, 1) = 0.2f * 0.2f;  // PL ≈ 0.8 m: beyond the 0.5 m alert limit
+    t.start(truth, wide, odom);
+    TrackStep s = t.step(nullptr, 0, odom, false);  // nothing seen yet
+    ASSERT_EQ(s.reason, hal::StatusReason::kTrackBeyondAlert) << "rule " << rule;
+    ASSERT_GT(s.pl.xy_m, o.alert_limit_m);
+    std::uint32_t recovering = 0;
+    bool localized = false;
+    for (int i = 0; i < 12 && !localized; ++i) {
+      const Se2f d(0.05f, 0.0f, 0.0f);
+      odom = odom.compose(d);
+      truth = truth.compose(d);
+      const auto pts = testing::scan_at(room(), truth, &rng);
+      s = t.step(pts.data(), pts.size(), odom);
+      ASSERT_LE(s.pl.xy_m, o.alert_limit_m) << "rule " << rule << " step " << i;  // the first scan pins it
+      ASSERT_LT(err_xy(s.pose, truth), 0.05f);
+      if (s.status == hal::LocalizationStatus::kLocalized) {
+        localized = true;
+      } else {
+        EXPECT_EQ(s.reason, hal::StatusReason::kTrackRecovering) << "rule " << rule << " step " << i;
+        ++recovering;
+      }
+    }
+    EXPECT_TRUE(localized) << "rule " << rule;
+    EXPECT_EQ(recovering, rule ? o.recovery_steps : 0u) << "rule " << rule;
+  }
+}
+
 // Standing still: the same scan 300 times neither moves the pose nor shrinks the covariance below
 // what one scan supports (the same map error is not counted again).
 TEST(PoseTrackerTest, StandingStillNeitherDriftsNorBecomesOverconfident) {
@@ -404,7 +443,9 @@ TEST(PoseTrackerTest, OdometryFaultRecoversOnlyAfterConsistentScans) {
     pts = testing::scan_at(room(), tr, &rng);
     const TrackStep s = t.step(pts.data(), pts.size(), odom);
     EXPECT_EQ(s.verdict, ScanVerdict::kSupported) << i;
-    if (i + 1 < o.recovery_steps) {
+    // The first consistent scan brings the widened pose back within the alert limit by itself
+    // (TrackOptions::repin_needs_confirmation): it is not one of its own confirmations.
+    if (i < o.recovery_steps) {
       EXPECT_NE(s.status, hal::LocalizationStatus::kLocalized) << "too early at " << i;
       // Still widened by the fault (beyond the alert limit) or counting consistent scans.
       EXPECT_TRUE(s.reason == hal::StatusReason::kTrackRecovering || s.reason == hal::StatusReason::kTrackBeyondAlert)

@@ -221,6 +221,7 @@ static bool parse_rules_off(const std::map<std::string, std::string>& options, f
       {"alias_valley_is_one_mode", &T::alias_valley_is_one_mode},
       {"alias_valley_drops_information", &T::alias_valley_drops_information},
       {"heading_fault_local_recovery", &T::heading_fault_local_recovery},
+      {"repin_needs_confirmation", &T::repin_needs_confirmation},
       {"confidence_extent_xy", &T::confidence_extent_xy},
       {"confidence_cap_with_update", &T::confidence_cap_with_update},
       {"confidence_cap_needs_a_pinned_axis", &T::confidence_cap_needs_a_pinned_axis},
