@@ -194,6 +194,12 @@ check "fd: the black box holds the scans received, the poses sent and the comman
   bash -c "grep -q ' rx 518##' '$W/fd/blackbox.log' && grep -q ' tx 520##' '$W/fd/blackbox.log' && grep -q ' rx 149#04' '$W/fd/blackbox.log'"
 if [ "$USES_MML" = 1 ]; then
   check "fd: mmlfw used the image's precomputed relation table" grep -q "precomputed relation table" "$W/fd/mmlfw.log"
+  # The global job's window is the scan interval mmlfw sees (firmware/track/scan_window.h), not the
+  # 75 Hz period: at least half the replay's mean scan interval (canplayer's wall time / scans).
+  win=$(sed -n 's/.*global: last window \([0-9.]*\) ms.*/\1/p' "$W/fd/mmlfw.log" | tail -1)
+  per=$(awk -v n="$SCANS" '{printf "%.3f", ($2 - $1) * 1000 / n}' "$W/fd/replay_times" 2>/dev/null)
+  check "fd: the global window follows the scan interval (${win:-none} ms, replay ${per:-?} ms a scan)" \
+    awk -v w="${win:-0}" -v p="${per:-0}" 'BEGIN { exit !(w > 0 && p > 0 && w >= 0.5 * p) }'
   check "classic: mmlfw filled the relation table at start-up" grep -q "filling it at start-up" "$W/classic/mmlfw.log"
 fi
 
