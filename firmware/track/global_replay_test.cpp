@@ -4,6 +4,7 @@
 #include <gtest/gtest.h>
 #include <time.h>
 
+#include <cstdio>
 #include <cstring>
 #include <memory>
 #include <vector>
@@ -107,16 +108,21 @@ TEST(GlobalReplayTest, RecordNotMetIsNamed) {
   ASSERT_TRUE(robot.init().is_ok());
   RecordVector sink;
   threaded_run(&robot, &sink);
-  ASSERT_GE(sink.records.size(), 3u);
+  // Under qemu-arm the sensor steps are slow, so the measured global window (scan_window.h) is
+  // wide and few jobs finish: tamper the third record, or the last when there are fewer.
+  ASSERT_GE(sink.records.size(), 1u);
+  const std::size_t k = sink.records.size() >= 3 ? 2 : sink.records.size() - 1;
   std::vector<hal::GlobalRecord> tampered = sink.records;
-  tampered[2].scan_ns = tampered[2].job_scan_ns;  // taken on its own scan: before its window
+  tampered[k].scan_ns = tampered[k].job_scan_ns;  // taken on its own scan: before its window
   Rig replay;
   ASSERT_TRUE(replay.init().is_ok());
   ASSERT_TRUE(replay.gc().replay(tampered.data(), tampered.size()).is_ok());
   mml::testing::drive(replay.loc.get(), testing::room(), testing::room_tour(), 1);
   ASSERT_FALSE(replay.gc().replay_status().is_ok());
-  EXPECT_EQ(replay.gc().replay_failed_record(), 2u);
-  EXPECT_NE(std::strstr(replay.gc().replay_status().message(), "global record 2"), nullptr)
+  EXPECT_EQ(replay.gc().replay_failed_record(), k);
+  char name[32];
+  std::snprintf(name, sizeof name, "global record %zu", k);
+  EXPECT_NE(std::strstr(replay.gc().replay_status().message(), name), nullptr)
       << replay.gc().replay_status().message();
 }
 
