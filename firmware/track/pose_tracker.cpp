@@ -272,6 +272,31 @@ TrackStep PoseTracker::step(const Point2f* points, std::size_t n, const Se2f& od
   return out;
 }
 
+// TrackOptions::repin_needs_confirmation. The innovation test passes a scan fix within the
+// prediction's PL of the prediction (outside_bound), and the update moves the pose by the gain
+// G = I − P_post·P_pred⁻¹ times the fix's error. So an undetected fault of the scan's fix (a moved
+// rack, a repeated feature) shifts the fused pose by up to |G|·PL_pred: RAIM's protection level, the
+// largest slope times the detection threshold (Brown 1992), with the innovation gate as the
+// threshold. Where that reaches the alert limit, nothing but this scan vouches for the pose along
+// the axis it pins. The position only: that is where one feature may pin an axis (a rack's end along
+// an aisle, a door frame along a corridor) and where moved furniture and repeated features put a
+// fix's fault. Every wall seen sets the heading; a heading fault with the position right needs a map
+// rotated locally, which the map bias b_θ bounds (README, assumption 2). Heading gains are near 1
+// at every scan (the wheels' heading PL is ~5° after a few steps), so a heading clause would hold
+// every scan for confirmation (PoseTrackerTest.TracksWithinProtectionLevel: 14 of 191 `localized`).
+bool PoseTracker::undetected_fault_reaches_alert(const Eigen::Matrix3f& p_pred, const Eigen::Matrix3f& p_post,
+                                                 const ProtectionLevel& pred_pl) const {
+  const Eigen::Matrix3d inv = p_pred.cast<double>().inverse();
+  if (!inv.allFinite() || !std::isfinite(pred_pl.xy_m) || !std::isfinite(pred_pl.theta_rad)) return true;
+  const Eigen::Matrix3d g = Eigen::Matrix3d::Identity() - p_post.cast<double>() * inv;
+  // σ_max of the position block: √λ_max(GᵀG).
+  const Eigen::Matrix2d gxy = g.topLeftCorner<2, 2>();
+  const Eigen::Matrix2d gtg = gxy.transpose() * gxy;
+  const double s_xy = std::sqrt(std::fmax(sym2_eigen(gtg(0, 0), gtg(0, 1), gtg(1, 1)).lambda_max, 0.0f));
+  const double shift_xy = s_xy * pred_pl.xy_m + std::hypot(g(0, 2), g(1, 2)) * pred_pl.theta_rad;
+  return shift_xy > options_.alert_limit_m;
+}
+
 // The turn hypothesis's reach: at the predicted position (within its PL), turned by no more than
 // the wheels reported turning since a scan last set the heading, plus the prediction's heading PL.
 // An over-reported turn is part of a reported turn; a carry into a place that looks like the old
@@ -546,6 +571,9 @@ PoseTracker::Update PoseTracker::propose_update(const Se2f& odom, bool predict, 
 void PoseTracker::apply_verdict(const Se2f& odom, const StepWork& w, const Update& u, TrackStep* out) {
   const ScanVerdict v = w.v;
   if (v == ScanVerdict::kSupported || v == ScanVerdict::kAmbiguous) {
+    // TrackOptions::repin_needs_confirmation, measured before the prediction is replaced.
+    const bool repins = u.fuse && w.predicted && options_.repin_needs_confirmation &&
+                        undetected_fault_reaches_alert(cov_, u.cov, w.pred_pl);
     if (u.fuse) {
       pose_ = u.pose;
       cov_ = u.cov;
@@ -573,8 +601,7 @@ void PoseTracker::apply_verdict(const Se2f& odom, const StepWork& w, const Updat
     }
     // TrackOptions::repin_needs_confirmation: this scan alone vouches for the pose along the axis
     // it pins; it does not count as one of its own confirmations.
-    if (u.fuse && w.predicted && options_.repin_needs_confirmation &&
-        (last_.pl.xy_m > options_.alert_limit_m || last_.pl.theta_rad > options_.alert_limit_rad)) {
+    if (repins) {
       had_fault_ = true;
       consistent_since_fault_ = 0;
     }

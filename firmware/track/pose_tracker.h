@@ -147,6 +147,8 @@ class PoseTracker {
                            StepWork* w, TrackStep* out);
   void check_aliases(const Point2f* points, std::size_t n, StepWork* w, TrackStep* out);
   bool rival_within_reported_turn(const Eigen::Vector3f& e, const ProtectionLevel& pred_pl) const;
+  bool undetected_fault_reaches_alert(const Eigen::Matrix3f& p_pred, const Eigen::Matrix3f& p_post,
+                                      const ProtectionLevel& pred_pl) const;
   Update propose_update(const Se2f& odom, bool predict, StepWork* w, TrackStep* out);
   void apply_verdict(const Se2f& odom, const StepWork& w, const Update& u, TrackStep* out);
   void publish(const Point2f* points, std::size_t n, const StepWork& w, TrackStep* out);
