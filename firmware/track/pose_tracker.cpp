@@ -276,7 +276,8 @@ TrackStep PoseTracker::step(const Point2f* points, std::size_t n, const Se2f& od
 // prediction's PL of the prediction (outside_bound), and the update moves the pose by the gain
 // G = I − P_post·P_pred⁻¹ times the fix's error. So an undetected fault of the scan's fix (a moved
 // rack, a repeated feature) shifts the fused pose by up to |G|·PL_pred: RAIM's protection level, the
-// largest slope times the detection threshold (Brown 1992), with the innovation gate as the
+// largest slope times the detection threshold (the classic RAIM PL, reviewed by Zhao, Song, Wang,
+// Sensors 24(11) 3283, 2024), with the innovation gate as the
 // threshold. Where that reaches the alert limit, nothing but this scan vouches for the pose along
 // the axis it pins. The position only: that is where one feature may pin an axis (a rack's end along
 // an aisle, a door frame along a corridor) and where moved furniture and repeated features put a

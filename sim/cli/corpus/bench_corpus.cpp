@@ -9,26 +9,39 @@
 #include "sim/cli/corpus/corpus_runner.h"
 
 namespace {
-std::uint64_t env_or(const char* name, std::uint64_t fallback) {
+// A variable set to something that is not a number is an error, not a silent default: a corpus run
+// under the wrong seed would publish figures for a seed nobody asked for.
+bool env_or(const char* name, std::uint64_t fallback, std::uint64_t* out) {
+  *out = fallback;
   const char* v = std::getenv(name);
-  if (v == nullptr || *v == '\0') return fallback;
+  if (v == nullptr || *v == '\0') return true;
   char* end = nullptr;
   const unsigned long long x = std::strtoull(v, &end, 10);
-  if (*end != '\0') {
-    std::fprintf(stderr, "bench_corpus: %s='%s' is not a number; using %llu\n", name, v,
-                 static_cast<unsigned long long>(fallback));
-    return fallback;
+  if (*end != '\0' || *v == '-') {
+    std::fprintf(stderr, "bench_corpus: %s='%s' is not a non-negative integer\n", name, v);
+    return false;
   }
-  return x;
+  *out = x;
+  return true;
 }
 }  // namespace
 
 int main(int argc, char** argv) {
   const std::string out = argc > 1 ? argv[1] : "build/bench/corpus.json";
   sim::corpus::CorpusOptions opt;
-  opt.seed = env_or("MMLFW_CORPUS_SEED", 1010);
-  opt.runs = env_or("MMLFW_CORPUS_RUNS", 260);
-  opt.jobs = static_cast<int>(env_or("MMLFW_CORPUS_JOBS", 2));
+  std::uint64_t seed = 0, runs = 0, jobs = 0;
+  if (!env_or("MMLFW_CORPUS_SEED", 1010, &seed) || !env_or("MMLFW_CORPUS_RUNS", 260, &runs) ||
+      !env_or("MMLFW_CORPUS_JOBS", 2, &jobs)) {
+    return 2;
+  }
+  if (runs == 0 || jobs == 0 || jobs > 64) {
+    std::fprintf(stderr, "bench_corpus: MMLFW_CORPUS_RUNS must be >= 1 and MMLFW_CORPUS_JOBS 1..64 (got %llu, %llu)\n",
+                 static_cast<unsigned long long>(runs), static_cast<unsigned long long>(jobs));
+    return 2;
+  }
+  opt.seed = seed;
+  opt.runs = static_cast<std::size_t>(runs);
+  opt.jobs = static_cast<int>(jobs);
   opt.out_dir = "build/bench/corpus_" + std::to_string(opt.seed);
   std::printf("bench_corpus: seed %llu, %zu runs, %d at once -> %s\n", static_cast<unsigned long long>(opt.seed), opt.runs,
               opt.jobs, opt.out_dir.c_str());
