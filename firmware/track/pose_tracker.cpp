@@ -461,8 +461,14 @@ void PoseTracker::check_aliases(const Point2f* points, std::size_t n, StepWork* 
       rival_significantly_better(map_, alias_points_, m, a.pose, u.rival, o.alias_clip_m, a.independent, o.alias_z)) {
     w->v = ScanVerdict::kContradicting;  // the scan says the robot is elsewhere
     w->rival_better = true;
-    out->large_fault = std::hypot(u.rival.x - a.pose.x, u.rival.y - a.pose.y) > o.alert_limit_m ||
-                       std::fabs(wrap_angle(u.rival.theta - a.pose.theta)) > o.alert_limit_rad;
+    // The fault's size is where the scan puts the robot against where the track says it is: the
+    // prediction (this scan is not fused, so the published pose is the prediction), not the fix
+    // Gauss-Newton reached from it, which the scan may already have pulled most of the way (seed
+    // 1111 #135: carried during a spin into a place like the old one turned 90°; the rival 8.5°
+    // from the prediction, < 5° from the fix; a small fault, recovered locally, then 4 steps
+    // `localized` 10 m off).
+    out->large_fault = std::hypot(u.rival.x - w->pred.x, u.rival.y - w->pred.y) > o.alert_limit_m ||
+                       std::fabs(wrap_angle(u.rival.theta - w->pred.theta)) > o.alert_limit_rad;
   } else if (!u.unique) {
     w->v = ScanVerdict::kAmbiguous;  // fused (odometry keeps the mode), never `localized`
     const bool beyond = std::hypot(u.rival.x - a.pose.x, u.rival.y - a.pose.y) > o.alert_limit_m ||

@@ -564,6 +564,7 @@ TEST(PoseTrackerTest, HeadingFaultBeyondTheWheelsReportedTurnIsALargeFault) {
       TrackOptions o;
       o.search.enabled = search;
       o.odom_rot_per_rad = o.odom_rot_per_m = 0.05f;
+      o.heading_fault_local_recovery = true;  // the rule under test (off by default)
       ASSERT_TRUE(t.init(o, room_map().map).is_ok());
       RandomStream rng(31, 0);
       Se2f truth(5.0f, 3.0f, 0.3f);
@@ -1081,6 +1082,7 @@ TEST(PoseTrackerTest, TurnOverReportedBeyondGaussNewtonsReachIsFoundByTheTurnSea
     TrackOptions o;
     o.search.enabled = search;
     o.odom_rot_per_rad = o.odom_rot_per_m = 0.05f;
+    o.heading_fault_local_recovery = true;  // the rule under test (off by default)
     ASSERT_TRUE(t.init(o, room_map().map).is_ok());
     RandomStream rng(23, 0);
     const Se2f truth(5.0f, 3.0f, 0.3f);

@@ -208,9 +208,10 @@ static bool parse_odom_slip(const std::map<std::string, std::string>& options, f
   return true;
 }
 
-// off=NAME[+NAME...] → those rules of TrackOptions off (the ablations of issue 56: what each rule
-// buys on the generated corpus, `mml-eval --corpus N --opt off=NAME`).
-static bool parse_rules_off(const std::map<std::string, std::string>& options, fw::track::TrackOptions* to,
+// off=NAME[+NAME...] → those rules of TrackOptions off, on=NAME[+NAME...] → on (the ablations of
+// issue 56: what each rule buys on the generated corpus, `mml-eval --corpus N --opt off=NAME`; on=
+// for a rule off by default, heading_fault_local_recovery).
+static bool parse_rule_switches(const std::map<std::string, std::string>& options, fw::track::TrackOptions* to,
                             fw::mml::MmlOptions* mo, std::string* err) {
   using T = fw::track::TrackOptions;
   static const std::pair<const char*, bool T::*> kRules[] = {
@@ -232,27 +233,30 @@ static bool parse_rules_off(const std::map<std::string, std::string>& options, f
       {"confirm_fix", &T::confirm_fix},
       {"hint_awaits_mml", &T::hint_awaits_mml},
       {"confirm_fix_on_past_scans", &T::confirm_fix_on_past_scans}};
-  const auto it = options.find("off");
-  if (it == options.end()) return true;
-  std::string rest = it->second;
-  while (!rest.empty()) {
-    const std::size_t plus = rest.find('+');
-    const std::string name = rest.substr(0, plus);
-    rest = plus == std::string::npos ? "" : rest.substr(plus + 1);
-    // MML's: the unmapped-space hypothesis before the first fix (map/unmapped_space.h).
-    bool found = name == "unmapped_space_contact";
-    if (found) mo->unmapped_space_min_area_m2 = 0.0f;
-    for (const auto& [rule, member] : kRules) {
-      if (name == rule) {
-        to->*member = false;
-        found = true;
+  for (const char* key : {"off", "on"}) {
+    const bool value = key[1] == 'n';
+    const auto it = options.find(key);
+    if (it == options.end()) continue;
+    std::string rest = it->second;
+    while (!rest.empty()) {
+      const std::size_t plus = rest.find('+');
+      const std::string name = rest.substr(0, plus);
+      rest = plus == std::string::npos ? "" : rest.substr(plus + 1);
+      // MML's: the unmapped-space hypothesis before the first fix (map/unmapped_space.h).
+      bool found = !value && name == "unmapped_space_contact";
+      if (found) mo->unmapped_space_min_area_m2 = 0.0f;
+      for (const auto& [rule, member] : kRules) {
+        if (name == rule) {
+          to->*member = value;
+          found = true;
+        }
       }
-    }
-    if (!found) {
-      std::string list = "unmapped_space_contact";
-      for (const auto& r : kRules) list += ", " + std::string(r.first);
-      *err = "localizer mml-track: option off='" + it->second + "': unknown rule '" + name + "' (rules: " + list + ")";
-      return false;
+      if (!found) {
+        std::string list = "unmapped_space_contact";
+        for (const auto& r : kRules) list += ", " + std::string(r.first);
+        *err = "localizer mml-track: option " + std::string(key) + "='" + it->second + "': unknown rule '" + name + "' (rules: " + list + ")";
+        return false;
+      }
     }
   }
   return true;
@@ -265,12 +269,12 @@ static bool parse_rules_off(const std::map<std::string, std::string>& options, f
 // valley=0|1 (TrackOptions::alias_valley_is_one_mode; default 1, as TrackOptions);
 // outside_clean=0|1 (TrackOptions::outside_map_needs_clean_exit; default 1, as TrackOptions);
 // wheels_bind=0|1 (TrackOptions::wheels_bind_mml_without_carry; default 1, as TrackOptions);
-// odom_slip=RATE,MAX (declared wheel slips, as mmlfw's config key); off=RULE[+RULE...] (ablation);
+// odom_slip=RATE,MAX (declared wheel slips, as mmlfw's config key); off=RULE[+RULE...], on=RULE[+RULE...] (ablation);
 // global=ref|live|live-deadline|thread (the global search's schedule, mml_systems.h EvalGlobalMode;
 // default ref; thread = mmlfw's global_context = thread, on its own thread);
 // global_period=1..8 (with live / live-deadline / thread: mmlfw's global_period_scans; default 1).
 std::unique_ptr<fw::Localizer> make_track_localizer(const LocalizerContext& ctx, std::string* err) {
-  const std::string bad = check_keys("mml-track", ctx.options, {"config", "correct", "reduce", "pool", "keep", "contested", "rivals", "alert", "odom_noise", "odom_noise_per_step", "valley", "outside_clean", "wheels_bind", "odom_slip", "off", "global", "global_period"});
+  const std::string bad = check_keys("mml-track", ctx.options, {"config", "correct", "reduce", "pool", "keep", "contested", "rivals", "alert", "odom_noise", "odom_noise_per_step", "valley", "outside_clean", "wheels_bind", "odom_slip", "off", "on", "global", "global_period"});
   if (!bad.empty()) { *err = bad; return nullptr; }
   if (ctx.global_map == nullptr) { *err = "localizer mml-track: needs a global map"; return nullptr; }
   const auto g = ctx.options.find("global");
@@ -313,7 +317,7 @@ std::unique_ptr<fw::Localizer> make_track_localizer(const LocalizerContext& ctx,
   long wheels_bind = to.wheels_bind_mml_without_carry ? 1 : 0;
   if (!parse_int(ctx.options, "wheels_bind", 0, 1, &wheels_bind, "mml-track", err)) return nullptr;
   to.wheels_bind_mml_without_carry = wheels_bind == 1;
-  if (!parse_rules_off(ctx.options, &to, &cfg.mml, err)) return nullptr;
+  if (!parse_rule_switches(ctx.options, &to, &cfg.mml, err)) return nullptr;
   static const std::vector<std::uint8_t> kEmpty;
   return wrap_hooks(OwnedLocalizer::make_track(*ctx.global_map, ctx.map_image ? *ctx.map_image : kEmpty, cfg, to,
                                                ctx.threads, err),
