@@ -579,7 +579,10 @@ void PoseTracker::apply_verdict(const Se2f& odom, const StepWork& w, const Updat
   const ScanVerdict v = w.v;
   if (v == ScanVerdict::kSupported || v == ScanVerdict::kAmbiguous) {
     // TrackOptions::repin_needs_confirmation, measured before the prediction is replaced.
+    // A re-pin: the published pose was beyond the alert limits, and this scan alone brings it back
+    // (an undetected fault of it could carry the fused pose beyond them).
     const bool repins = u.fuse && w.predicted && options_.repin_needs_confirmation &&
+                        (last_.pl.xy_m > options_.alert_limit_m || last_.pl.theta_rad > options_.alert_limit_rad) &&
                         undetected_fault_reaches_alert(cov_, u.cov, w.pred_pl);
     if (u.fuse) {
       pose_ = u.pose;
