@@ -335,6 +335,44 @@ TEST(PoseTrackerTest, ScanTheMapCannotExplainIsALargeFault) {
   }
 }
 
+// Few end-points on mapped cells make a scan uninformative about the fit — not about whether the
+// map explains it. 40 end-points, 8 on walls, 12 on free cells, 20 off the map: too few known ones
+// for the inlier test (20 < min_points), but the map explains a fifth of the scan, what a robot
+// carried elsewhere sees (corpus seed 1313 #135: 8 of 39, 37.9 m after a carry, published
+// `localized` on the odometry). A large fault. The same few known end-points all on walls (25 of
+// 40, the rest unknown) stay uninformative: the pose coasts on the wheels.
+TEST(PoseTrackerTest, ScanWithFewKnownEndPointsMostlyUnexplainedIsALargeFault) {
+  RandomStream rng(23, 0);
+  const Se2f a(4.5f, 6.0f, -0.4f);
+  const auto full = testing::scan_at(room(), a, &rng);
+  ASSERT_GT(full.size(), 100u);
+  for (const int on_walls : {8, 25}) {
+    std::vector<Point2f> pts;
+    for (int i = 0; i < 40; ++i) {
+      const Point2f p = full[static_cast<std::size_t>(i) * full.size() / 40];
+      if (i < on_walls) pts.push_back(p);
+      else if (on_walls == 8 && i < 20) pts.push_back(Point2f(0.3f, 0.0f));  // free space ahead
+      else pts.push_back(Point2f(p.x() + 100.0f, p.y()));                    // off the map: unknown
+    }
+    PoseTracker t;
+    TrackOptions o;
+    ASSERT_TRUE(t.init(o, room_map().map).is_ok());
+    t.start(a, small_cov(), Se2f());
+    const TrackStep s = t.step(pts.data(), pts.size(), Se2f(), false);
+    EXPECT_LT(s.alignment.inliers + s.alignment.contradicting, o.min_points);
+    EXPECT_LE(s.alignment.unknown_fraction(), o.outside_map_fraction);
+    if (on_walls == 8) {
+      EXPECT_EQ(s.verdict, ScanVerdict::kContradicting);
+      EXPECT_TRUE(s.unexplained);
+      EXPECT_TRUE(s.large_fault);
+      EXPECT_NE(s.status, hal::LocalizationStatus::kLocalized);
+    } else {
+      EXPECT_EQ(s.verdict, ScanVerdict::kUninformative);
+      EXPECT_FALSE(s.large_fault);
+    }
+  }
+}
+
 // A scan that fits the map significantly worse than the previous one (here 40 % of its end-points
 // suddenly on free space, though 60 % still fit: both the inlier and the explained tests pass) is a
 // fault — what a robot carried elsewhere sees first when that scan still fits near the old pose
