@@ -25,6 +25,25 @@ const char* verdict_name(ScanVerdict v) {
   return "unknown";
 }
 
+const char* large_fault_name(LargeFault f) {
+  switch (f) {
+    case LargeFault::kNone: return "none";
+    case LargeFault::kOdometryJump: return "odometry-jump";
+    case LargeFault::kUnexplained: return "unexplained";
+    case LargeFault::kInnovation: return "innovation";
+    case LargeFault::kBetterRival: return "better-rival";
+    case LargeFault::kOdometryWindow: return "odometry-window";
+  }
+  return "unknown";
+}
+
+namespace {
+void set_large_fault(TrackStep* out, bool large, LargeFault why) {
+  out->large_fault = large;
+  out->large_fault_cause = large ? why : LargeFault::kNone;
+}
+}  // namespace
+
 Status PoseTracker::init(const TrackOptions& options, const GlobalMap& map) {
   FW_RETURN_IF_ERROR(options.validate());
   if (!map.valid()) return Status::error(Errc::kInvalidArgument, "PoseTracker: global map is empty");
@@ -351,7 +370,7 @@ void PoseTracker::judge_scan(const Point2f* points, std::size_t n, bool odom_jum
   const ScanAlignment& a = out->alignment;
   if (odom_jump) {
     w->v = ScanVerdict::kContradicting;  // the pose cannot be carried across a non-physical increment
-    out->large_fault = true;
+    set_large_fault(out, true, LargeFault::kOdometryJump);
     return;
   }
   if (a.points > 0 && a.unknown_fraction() > o.outside_map_fraction) {
@@ -383,7 +402,7 @@ void PoseTracker::judge_scan(const Point2f* points, std::size_t n, bool odom_jum
   if (unexplained) {
     w->v = ScanVerdict::kContradicting;
     out->unexplained = true;
-    out->large_fault = true;
+    set_large_fault(out, true, LargeFault::kUnexplained);
     return;
   }
   // A sudden drop of the fit: two-proportion test of this scan's inlier fraction against the
@@ -423,13 +442,13 @@ void PoseTracker::judge_scan(const Point2f* points, std::size_t n, bool odom_jum
     // Beyond an alert limit: the robot may be somewhere else (the aces kidnap into a twin corridor
     // showed as 0.27 m and 6° at the first scan: the target fits the map next to the prediction).
     const float exy = std::hypot(w->e(0), w->e(1));
-    out->large_fault = exy > o.alert_limit_m || std::fabs(w->e(2)) > o.alert_limit_rad;
+    set_large_fault(out, exy > o.alert_limit_m || std::fabs(w->e(2)) > o.alert_limit_rad, LargeFault::kInnovation);
     if (out->large_fault && o.heading_fault_local_recovery && exy <= w->pred_pl.xy_m && exy <= o.alert_limit_m) {
       // Heading only (track_options.h): the scan must prefer its fix to the prediction significantly.
       const std::size_t m = subsample_alias_points(points, n);
       out->heading_fault = rival_significantly_better(map_, alias_points_, m, pred, a.pose, o.alias_clip_m,
                                                       a.independent, o.alias_z);
-      out->large_fault = !out->heading_fault;
+      set_large_fault(out, !out->heading_fault, LargeFault::kInnovation);
     }
   } else {
     w->p_post = post.cast<float>();
@@ -471,8 +490,10 @@ void PoseTracker::check_aliases(const Point2f* points, std::size_t n, StepWork* 
     // 1111 #135: carried during a spin into a place like the old one turned 90°; the rival 8.5°
     // from the prediction, < 5° from the fix; a small fault, recovered locally, then 4 steps
     // `localized` 10 m off).
-    out->large_fault = std::hypot(u.rival.x - w->pred.x, u.rival.y - w->pred.y) > o.alert_limit_m ||
-                       std::fabs(wrap_angle(u.rival.theta - w->pred.theta)) > o.alert_limit_rad;
+    set_large_fault(out,
+                    std::hypot(u.rival.x - w->pred.x, u.rival.y - w->pred.y) > o.alert_limit_m ||
+                        std::fabs(wrap_angle(u.rival.theta - w->pred.theta)) > o.alert_limit_rad,
+                    LargeFault::kBetterRival);
   } else if (!u.unique) {
     w->v = ScanVerdict::kAmbiguous;  // fused (odometry keeps the mode), never `localized`
     const bool beyond = std::hypot(u.rival.x - a.pose.x, u.rival.y - a.pose.y) > o.alert_limit_m ||
@@ -571,7 +592,7 @@ PoseTracker::Update PoseTracker::propose_update(const Se2f& odom, bool predict, 
   out->odometry_chi2 = odometry_check_.max_chi2(u.pose, u.cov, u.bias_xy, u.bias_theta);
   if (out->odometry_chi2 > o.innovation_chi2) {
     w->v = ScanVerdict::kContradicting;  // the scans hold the pose where the wheels say it is not
-    out->large_fault = true;             // a slow slide: its size is unknown, assume the worst
+    set_large_fault(out, true, LargeFault::kOdometryWindow);  // a slow slide: its size is unknown, assume the worst
     u.fuse = false;
   }
   return u;

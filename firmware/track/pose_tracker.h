@@ -45,6 +45,18 @@ enum class ScanVerdict : std::uint8_t {
 };
 const char* verdict_name(ScanVerdict v);
 
+// Which monitor found a fault beyond the alert limits (TrackStep::large_fault): what the silence
+// that follows is charged to (the corpus's withheld-while-right figures by cause).
+enum class LargeFault : std::uint8_t {
+  kNone = 0,
+  kOdometryJump = 1,    // a non-physical odometry increment
+  kUnexplained = 2,     // the map explains under min_explained_fraction of the scan
+  kInnovation = 3,      // the scan fix beyond the prediction's PL and beyond the alert limits
+  kBetterRival = 4,     // the alias check's rival fits significantly better, beyond the alert limits
+  kOdometryWindow = 5,  // the fused poses disagree with the wheels over the window
+};
+const char* large_fault_name(LargeFault f);
+
 struct TrackStep {
   Se2f pose;
   Eigen::Matrix3f cov = Eigen::Matrix3f::Zero();
@@ -58,6 +70,7 @@ struct TrackStep {
   // beyond them, the odometry disagreeing over the window): the robot may have been carried
   // anywhere, so local evidence alone can no longer make the pose `localized` (tracked_localizer.h).
   bool large_fault = false;
+  LargeFault large_fault_cause = LargeFault::kNone;  // which monitor (kNone when !large_fault)
   // The map explains fewer than TrackOptions::min_explained_fraction of the scan's end-points.
   bool unexplained = false;
   // The scan fits the map significantly worse than the previous one (TrackOptions::fit_drop_z).

@@ -85,13 +85,14 @@ void TrackedLocalizer::start_from_hint(const Se2f& wheel, std::size_t n, hal::Po
   if (had_track) {
     // The operator contradicts a track: the robot may have been carried. MML's local map starts
     // now (it holds no scan from before the doubt), as after a large fault.
-    await_mml_confirmation();
+    await_mml_confirmation("hint");
   } else {
     // MML was searching: its scans are as good as before the hint; it goes on, and its fix must
     // land on the hinted pose (cross_check) for the hint to count.
     cross_check_left_ = tracker_.options().cross_check_steps;
   }
   unconfirmed_ = hint_needs_mml();
+  wait_cause_ = "hint";
   hal::PoseEstimate g;
   g.x = hint_.x;
   g.y = hint_.y;
@@ -154,8 +155,9 @@ void TrackedLocalizer::publish_track(const TrackStep& ts, hal::PoseEstimate* out
 
 // The track stays, but it is `localized` again only on MML's word, from a local map that starts
 // now (so it holds no scan from before the doubt), checked over cross_check_steps scans.
-void TrackedLocalizer::await_mml_confirmation() {
+void TrackedLocalizer::await_mml_confirmation(const char* cause) {
   unconfirmed_ = true;
+  wait_cause_ = cause;
   global_.reset();
   cross_check_left_ = tracker_.options().cross_check_steps;
 }
@@ -268,7 +270,7 @@ Status TrackedLocalizer::step_scan(const hal::LaserScan& scan, const hal::Odomet
     if (ts.large_fault && !ts.lost && tracker_.options().cross_check_steps > 0) {
       // The robot may have been carried anywhere (a kidnap into a twin corridor fits every local
       // test): the pose needs MML's word again, from a local map that starts after the fault.
-      await_mml_confirmation();
+      await_mml_confirmation(large_fault_name(ts.large_fault_cause));
     }
     if (tracker_.options().confirm_alias_beyond_alert && ts.alias_beyond_alert && !ts.large_fault && !ts.lost &&
         !unconfirmed_ && tracker_.options().cross_check_steps > 0) {
@@ -280,7 +282,7 @@ Status TrackedLocalizer::step_scan(const hal::LaserScan& scan, const hal::Odomet
       // Like a large fault, only MML's word makes it `localized` again; its local map
       // starts here, so it holds no scan from before the doubt. Once per episode: resetting it on
       // every such scan of a long corridor would keep MML from ever isolating anything.
-      await_mml_confirmation();
+      await_mml_confirmation("alias-beyond-alert");
     }
     if (!ts.lost) return cross_check(scan, odom, wheel, n, ts, out);
     {
@@ -408,6 +410,7 @@ bool TrackedLocalizer::start_forward(const Se2f& fix, const Eigen::Matrix3f& cov
   if (accepted && !ts.lost) {
     ++fixes_;
     unconfirmed_ = hint_needs_mml();  // MML has just isolated this pose (unless it is a hint's)
+    wait_cause_ = "hint";
     publish_track(ts, out);
     if (unconfirmed_) {
       out->status = hal::LocalizationStatus::kAmbiguous;
@@ -477,6 +480,7 @@ bool TrackedLocalizer::replay_past_scans(const Se2f& wheel, std::size_t n, hal::
     ++fixes_;
     ++fixes_on_past_scans_;
     unconfirmed_ = hint_needs_mml();
+    wait_cause_ = "hint";
     publish_track(ts, out);
     if (unconfirmed_) {
       out->status = hal::LocalizationStatus::kAmbiguous;
@@ -537,6 +541,7 @@ Status TrackedLocalizer::cross_check(const hal::LaserScan& scan, const hal::Odom
     if (!scan_prefers_mml) {
       ++cross_check_conflicts_;
       unconfirmed_ = true;
+      wait_cause_ = "mml-conflict";
       out->status = hal::LocalizationStatus::kAmbiguous;
       out->reason = hal::StatusReason::kTrackAwaitingMml;
       global_.reset();

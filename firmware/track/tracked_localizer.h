@@ -92,6 +92,10 @@ class TrackedLocalizer final : public Localizer {
   bool cross_checking() const { return cross_check_left_ > 0; }
   // A large fault (TrackStep::large_fault) was seen and MML has not yet isolated the tracked pose.
   bool awaiting_confirmation() const { return unconfirmed_; }
+  // Why the track awaits MML's word (while awaiting_confirmation(); "none" otherwise): the large
+  // fault's monitor (large_fault_name), "alias-beyond-alert", "hint" or "mml-conflict". A
+  // diagnostic for the evaluation's withheld-while-right figures by cause.
+  const char* wait_cause() const { return unconfirmed_ ? wait_cause_ : "none"; }
   std::uint32_t confirmations() const { return confirmations_; }  // tracked poses MML confirmed
   // The most correlative pre-search candidates of one scan's tracker steps, since reset (the replay
   // of confirm_fix_on_past_scans holds them to search.max_candidates; a failed replay's forward
@@ -102,7 +106,7 @@ class TrackedLocalizer final : public Localizer {
   std::size_t scan_points(const hal::LaserScan& scan);
   void publish_track(const TrackStep& ts, hal::PoseEstimate* out) const;
   void note_how_the_map_was_left(const TrackStep& ts, const Se2f& wheel, std::size_t n, hal::PoseEstimate* out);
-  void await_mml_confirmation();
+  void await_mml_confirmation(const char* cause);
   // MML's fix in `g` → tracker started on it: true when accepted on this scan or while its replay
   // on the scans before it catches up (replay_past_scans); false (tracker reset) if rejected.
   bool start_from_fix(const hal::PoseEstimate& g, const Se2f& wheel, std::size_t n, hal::PoseEstimate* out);
@@ -155,6 +159,7 @@ class TrackedLocalizer final : public Localizer {
   std::uint32_t cross_check_left_ = 0;  // scans the background search still runs (0 = idle)
   std::uint32_t confirmations_ = 0, cross_check_conflicts_ = 0, fixes_on_past_scans_ = 0, fix_replays_failed_ = 0;
   bool unconfirmed_ = false;
+  const char* wait_cause_ = "none";  // a string literal (wait_cause())
   // Since the last track was given up (reset() clears it): its last pose carried by the wheels, for
   // the outside-map status while MML searches and, after a track given up outside the map, as the
   // rival MML's fixes must agree with (dead_reckoning.h).

@@ -6,6 +6,7 @@
 #include <cstdio>
 #include <cstdlib>
 #include <memory>
+#include <string>
 
 #include "firmware/track/track_test_util.h"
 #include "tests/alloc_counter.h"
@@ -275,6 +276,7 @@ struct JumpRun {
   int awaiting_reason = 0;  // awaiting steps published with the reason track-awaiting-mml
   bool jumped = false;
   std::size_t jump_at = 0;
+  std::string first_wait_cause;  // TrackedLocalizer::wait_cause at the first awaiting step
 };
 
 void drive_through_heading_jump(Rig& rig, JumpRun* r) {
@@ -318,6 +320,8 @@ void drive_through_heading_jump(Rig& rig, JumpRun* r) {
       EXPECT_LT(std::fabs(wrap_angle(est.theta - path[i].theta)), 0.0873f) << i;
     }
     if (r->jumped) {
+      if (rig.loc->awaiting_confirmation() && r->first_wait_cause.empty()) r->first_wait_cause = rig.loc->wait_cause();
+      if (!rig.loc->awaiting_confirmation()) EXPECT_STREQ(rig.loc->wait_cause(), "none") << i;
       r->awaiting_steps += rig.loc->awaiting_confirmation();
       r->awaiting_reason += rig.loc->awaiting_confirmation() && est.reason == hal::StatusReason::kTrackAwaitingMml;
       r->awaiting_localized += rig.loc->awaiting_confirmation() && loc;
@@ -337,6 +341,7 @@ TEST(TrackedLocalizerTest, LargeFaultWaitsForGlobalConfirmation) {
   drive_through_heading_jump(rig, &r);
   ASSERT_TRUE(r.jumped) << "never localized before the jump";
   EXPECT_GT(r.awaiting_steps, 0) << "the 20° jump at step " << r.jump_at << " was not a large fault";
+  EXPECT_EQ(r.first_wait_cause, "innovation") << "the wait is charged to the monitor that saw the jump";
   EXPECT_EQ(r.awaiting_localized, 0);
   EXPECT_EQ(r.awaiting_reason, r.awaiting_steps) << "the silence while MML confirms is published as such";
   EXPECT_GT(r.withheld, 0) << "the tracker alone would have published `localized` before MML confirmed";

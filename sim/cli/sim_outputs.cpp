@@ -50,7 +50,7 @@ bool write_steps_csv(const std::string& path, const std::vector<StepRecord>& ste
   std::fprintf(f,
                "step,t_s,scan_id,status,mode,x,y,theta,truth_x,truth_y,truth_theta,err_m,err_deg,travelled_m,"
                "hypotheses,clusters,rating,odom_x,odom_y,odom_theta,cov_xx,cov_yy,cov_tt,step_ms,kidnapped,"
-               "pl_xy_m,pl_theta_deg,unsupported_steps,in_unknown,truth_bound_m,truth_bound_deg,map_err_m,map_err_deg,reason\n");
+               "pl_xy_m,pl_theta_deg,unsupported_steps,in_unknown,truth_bound_m,truth_bound_deg,map_err_m,map_err_deg,reason,wait_cause\n");
   for (const StepRecord& s : steps) {
     const hal::PoseEstimate& e = s.estimate;
     std::fprintf(f, "%u,%.3f,%u,%s,%s,%.4f,%.4f,%.5f,", s.step, s.t, e.scan_id, hal::status_name(e.status),
@@ -89,7 +89,8 @@ bool write_steps_csv(const std::string& path, const std::vector<StepRecord>& ste
     } else {
       std::fprintf(f, ",,");
     }
-    std::fprintf(f, "%s\n", hal::reason_name(e.reason));  // why not `localized` (none when it is)
+    // Why not `localized` (none when it is), and what the wait for MML's word is charged to.
+    std::fprintf(f, "%s,%s\n", hal::reason_name(e.reason), s.wait_cause);
   }
   const bool ok = std::fclose(f) == 0;
   if (!ok) *err = "error writing '" + path + "'";

@@ -565,6 +565,7 @@ class FrameLoop {
     const hal::Odometry& o = rig_.loop->last_odometry();
     r.odom = fw::Se2d(o.x, o.y, o.theta);
     r.step_ms = static_cast<double>(rig_.loop->last_step_ns()) * 1e-6;
+    if (hooks_.wait_cause) r.wait_cause = hooks_.wait_cause();
     return r;
   }
 

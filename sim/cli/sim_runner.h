@@ -111,6 +111,8 @@ struct StepRecord {
   bool kidnapped = false;  // the robot was carried away just before this scan
   fw::Se2d odom;
   double step_ms = 0;
+  // mml-track: why the track awaits MML's word (LocalizerHooks::wait_cause; a string literal).
+  const char* wait_cause = "none";
 };
 
 struct SimSummary {

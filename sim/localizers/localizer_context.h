@@ -34,6 +34,9 @@ struct LocalizerHooks {
   std::function<void(std::vector<HypothesisPoint>*)> hypotheses;
   // mml-track: its global context (the black box's global records, issue 60); null otherwise.
   std::function<fw::track::GlobalContext*()> global_context;
+  // mml-track: why the track awaits MML's word (TrackedLocalizer::wait_cause; "none" when it does
+  // not); null otherwise.
+  std::function<const char*()> wait_cause;
 };
 
 struct LocalizerContext {

@@ -125,6 +125,9 @@ CorpusFigures corpus_figures(const std::vector<const CorpusRun*>& runs) {
         if (!localized(s) && right(s) && !s.in_unknown) {
           ++f.withheld_while_right;
           ++f.withheld_by_reason[std::min<std::size_t>(s.reason, 15)];
+          if (s.reason == static_cast<std::uint8_t>(hal::StatusReason::kTrackAwaitingMml)) {
+            ++f.awaiting_by_cause[wait_cause_names()[std::min<std::size_t>(s.wait_cause, wait_cause_names().size() - 1)]];
+          }
         }
       }
       if (!localized(s) || !s.has_pose) continue;
@@ -193,6 +196,9 @@ void add_figures(const std::string& p, const CorpusFigures& f, bool with_timing,
     if (f.withheld_by_reason[r] == 0) continue;
     j->add_int(p + "withheld_while_right_" + hal::reason_name(static_cast<hal::StatusReason>(r)),
                static_cast<long long>(f.withheld_by_reason[r]));
+  }
+  for (const auto& [cause, count] : f.awaiting_by_cause) {
+    j->add_int(p + "withheld_while_right_awaiting_mml_" + cause, static_cast<long long>(count));
   }
   j->add(p + "longest_gap_m_p99", f.longest_gap_m_p99);
   j->add(p + "longest_gap_m_max", f.longest_gap_m_max);

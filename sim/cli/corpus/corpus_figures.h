@@ -6,6 +6,7 @@
 #pragma once
 
 #include <cstddef>
+#include <map>
 #include <string>
 #include <vector>
 
@@ -28,6 +29,9 @@ struct CorpusFigures {
   double availability_median = 0, availability_p10 = 0;
   std::size_t tracking_steps = 0, withheld_while_right = 0;
   std::size_t withheld_by_reason[16] = {};  // hal::StatusReason
+  // Withheld while right with reason track-awaiting-mml, by what the wait is charged to
+  // (TrackedLocalizer::wait_cause: the large fault's monitor, alias-beyond-alert, hint, mml-conflict).
+  std::map<std::string, std::size_t> awaiting_by_cause;
   double withheld_while_right_rate = 0;
   double longest_gap_m_p99 = 0, longest_gap_m_max = 0;
   double first_fix_success = 0, metres_to_fix_median = 0, metres_to_fix_p90 = 0;

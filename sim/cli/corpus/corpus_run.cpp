@@ -85,10 +85,27 @@ CorpusStep corpus_step(const StepRecord& r) {
   s.has_pose = r.has_pose && r.has_truth ? 1 : 0;
   s.in_unknown = r.in_unknown ? 1 : 0;
   s.kidnapped = r.kidnapped ? 1 : 0;
+  s.wait_cause = wait_cause_index(r.wait_cause);
   return s;
 }
 
 }  // namespace
+
+const std::vector<std::string>& wait_cause_names() {
+  static const std::vector<std::string> names = {"none",  "odometry-jump",      "unexplained", "innovation",
+                                                 "better-rival", "odometry-window", "alias-beyond-alert",
+                                                 "hint", "mml-conflict",   "other"};
+  return names;
+}
+
+std::uint8_t wait_cause_index(const char* name) {
+  const std::vector<std::string>& n = wait_cause_names();
+  if (name == nullptr) return 0;
+  for (std::size_t k = 0; k + 1 < n.size(); ++k) {
+    if (n[k] == name) return static_cast<std::uint8_t>(k);
+  }
+  return static_cast<std::uint8_t>(n.size() - 1);
+}
 
 CorpusRun run_draw(const CorpusDraw& d, const CorpusRunOptions& opt) {
   const auto t0 = std::chrono::steady_clock::now();

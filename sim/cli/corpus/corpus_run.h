@@ -21,7 +21,13 @@ struct CorpusStep {
   float step_ms = 0;
   std::uint8_t status = 0, mode = 0, reason = 0;  // hal::LocalizationStatus / LocalizationMode / StatusReason
   std::uint8_t has_pose = 0, in_unknown = 0, kidnapped = 0;
+  std::uint8_t wait_cause = 0;  // StepRecord::wait_cause as an index of wait_cause_names()
 };
+
+// The names TrackedLocalizer::wait_cause gives, "none" first and "other" last (a step's index is
+// memcpy'd between processes, a pointer would not be).
+const std::vector<std::string>& wait_cause_names();
+std::uint8_t wait_cause_index(const char* name);
 
 struct CorpusRun {
   CorpusDraw draw;

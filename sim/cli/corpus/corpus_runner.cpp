@@ -193,6 +193,13 @@ void write_table(const std::string& path, const CorpusOptions& opt,
                   x.withheld_while_right_rate, x.longest_gap_m_p99, x.track_err_m_p50, x.track_err_m_p95);
     f << buf;
   }
+  // The wait for MML's word is most of the silence: what each wait was charged to.
+  for (const auto& [name, x] : rows) {
+    if (x.awaiting_by_cause.empty()) continue;
+    f << "\nWithheld while right awaiting MML, " << name << ", by cause:";
+    for (const auto& [cause, count] : x.awaiting_by_cause) f << " " << cause << " " << count << ";";
+    f << "\n";
+  }
 }
 
 }  // namespace

@@ -86,6 +86,33 @@ TEST(CorpusFiguresTest, AvailabilityGapsAndKidnapsFromTheSteps) {
   EXPECT_EQ(c.pl_exceed_xy, 1u);  // 0.6 m against 0.2 m
 }
 
+// The wait for MML's word is charged to its cause: withheld-while-right steps awaiting MML are
+// counted by CorpusStep::wait_cause; other reasons and wrong steps are not.
+TEST(CorpusFiguresTest, AwaitingMmlWhileRightIsCountedByCause) {
+  using S = hal::LocalizationStatus;
+  CorpusRun r;
+  r.ok = true;
+  r.steps.push_back(step(0, S::kLocalized, 0.02f));
+  const auto awaiting = [](float travelled, float err_m, const char* cause) {
+    CorpusStep s = step(travelled, S::kAmbiguous, err_m);
+    s.reason = static_cast<std::uint8_t>(hal::StatusReason::kTrackAwaitingMml);
+    s.wait_cause = wait_cause_index(cause);
+    return s;
+  };
+  r.steps.push_back(awaiting(1, 0.02f, "innovation"));
+  r.steps.push_back(awaiting(2, 0.03f, "innovation"));
+  r.steps.push_back(awaiting(3, 0.02f, "unexplained"));
+  r.steps.push_back(awaiting(4, 0.90f, "unexplained"));  // wrong: rightly withheld, not counted
+  r.steps.push_back(step(5, S::kAmbiguous, 0.02f));      // beyond alert: not a wait for MML
+  r.steps.push_back(awaiting(6, 0.02f, "a cause nobody names"));
+  const CorpusFigures c = corpus_figures({&r});
+  EXPECT_EQ(c.withheld_while_right, 5u);
+  ASSERT_EQ(c.awaiting_by_cause.size(), 3u);
+  EXPECT_EQ(c.awaiting_by_cause.at("innovation"), 2u);
+  EXPECT_EQ(c.awaiting_by_cause.at("unexplained"), 1u);
+  EXPECT_EQ(c.awaiting_by_cause.at("other"), 1u);
+}
+
 // Issue 58: the global step's figures come from the steps in global mode only.
 TEST(CorpusFiguresTest, GlobalStepTimesFromTheGlobalSteps) {
   using S = hal::LocalizationStatus;

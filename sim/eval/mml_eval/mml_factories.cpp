@@ -71,6 +71,9 @@ std::unique_ptr<fw::Localizer> wrap_hooks(std::unique_ptr<OwnedLocalizer> o, con
     ctx.hooks->global_context = [raw]() -> fw::track::GlobalContext* {
       return raw->tracked() != nullptr ? &raw->tracked()->global_context() : nullptr;
     };
+    ctx.hooks->wait_cause = [raw]() -> const char* {
+      return raw->tracked() != nullptr ? raw->tracked()->wait_cause() : "none";
+    };
   }
   return o;
 }
