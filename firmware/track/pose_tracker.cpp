@@ -665,6 +665,14 @@ void PoseTracker::apply_verdict(const Se2f& odom, const StepWork& w, const Updat
   } else {
     faulty_ = 0;
   }
+  // An outside-map scan whose end-points on the map contradict the pose fails the inlier test on
+  // what it sees of the map: the same fault as a contradicting scan, for the recovery that follows
+  // (without it, the next uninformative scan was `localized` on the wheels at once).
+  if (v == ScanVerdict::kOutsideMap && out->known_part_contradicts) {
+    had_fault_ = true;
+    contradicted_ = true;
+    consistent_since_fault_ = 0;
+  }
   if (v == ScanVerdict::kOutsideMap) ++outside_; else outside_ = 0;
 }
 

@@ -373,6 +373,47 @@ TEST(PoseTrackerTest, ScanWithFewKnownEndPointsMostlyUnexplainedIsALargeFault) {
   }
 }
 
+// An outside-map scan whose end-points on the map contradict the pose (18 on walls, 22 on free
+// cells, 60 unknown: inlier fraction 0.45) is a fault of the track like a contradicting scan: the
+// scans that follow must be consistent for recovery_steps before `localized` again. Scans with no
+// end-points (uninformative) say nothing and never end that wait.
+TEST(PoseTrackerTest, OutsideMapScanWhoseKnownPartContradictsIsAFault) {
+  RandomStream rng(23, 0);
+  const Se2f a(4.5f, 6.0f, -0.4f);
+  const auto full = testing::scan_at(room(), a, &rng);
+  ASSERT_GT(full.size(), 100u);
+  std::vector<Point2f> pts;
+  for (int i = 0; i < 100; ++i) {
+    const Point2f p = full[static_cast<std::size_t>(i) * full.size() / 100];
+    if (i < 18) pts.push_back(p);
+    else if (i < 40) pts.push_back(Point2f(0.3f, 0.0f));      // free space ahead
+    else pts.push_back(Point2f(p.x() + 100.0f, p.y()));       // off the map: unknown
+  }
+  PoseTracker t;
+  TrackOptions o;
+  ASSERT_TRUE(t.init(o, room_map().map).is_ok());
+  t.start(a, small_cov(), Se2f());
+  for (std::uint32_t k = 0; k < o.recovery_steps + 1; ++k) {
+    const auto good = testing::scan_at(room(), a, &rng);
+    t.step(good.data(), good.size(), Se2f(), false);
+  }
+  ASSERT_EQ(t.last().status, hal::LocalizationStatus::kLocalized);
+  const TrackStep s = t.step(pts.data(), pts.size(), Se2f(), false);
+  EXPECT_EQ(s.verdict, ScanVerdict::kOutsideMap);
+  EXPECT_TRUE(s.known_part_contradicts);
+  for (int k = 0; k < 3; ++k) {
+    const TrackStep e = t.step(nullptr, 0, Se2f(), false);
+    EXPECT_EQ(e.verdict, ScanVerdict::kUninformative);
+    EXPECT_NE(e.status, hal::LocalizationStatus::kLocalized) << k;
+    EXPECT_EQ(e.reason, hal::StatusReason::kTrackRecovering) << k;
+  }
+  for (std::uint32_t k = 0; k < o.recovery_steps; ++k) {
+    const auto good = testing::scan_at(room(), a, &rng);
+    t.step(good.data(), good.size(), Se2f(), false);
+  }
+  EXPECT_EQ(t.last().status, hal::LocalizationStatus::kLocalized);
+}
+
 // A scan that fits the map significantly worse than the previous one (here 40 % of its end-points
 // suddenly on free space, though 60 % still fit: both the inlier and the explained tests pass) is a
 // fault — what a robot carried elsewhere sees first when that scan still fits near the old pose
