@@ -42,27 +42,6 @@ void RandomStream::reseed(std::uint64_t seed, std::uint64_t stream_index) {
   has_spare_ = false;
 }
 
-std::uint32_t RandomStream::next_u32() {
-  const std::uint64_t old = state_;
-  state_ = old * 6364136223846793005ull + inc_;
-  const std::uint32_t xorshifted = static_cast<std::uint32_t>(((old >> 18u) ^ old) >> 27u);
-  const std::uint32_t rot = static_cast<std::uint32_t>(old >> 59u);
-  return (xorshifted >> rot) | (xorshifted << ((32u - rot) & 31u));
-}
-
-std::uint32_t RandomStream::uniform_index(std::uint32_t n) {
-  std::uint64_t m = static_cast<std::uint64_t>(next_u32()) * n;
-  std::uint32_t l = static_cast<std::uint32_t>(m);
-  if (l < n) {
-    const std::uint32_t t = (0u - n) % n;
-    while (l < t) {
-      m = static_cast<std::uint64_t>(next_u32()) * n;
-      l = static_cast<std::uint32_t>(m);
-    }
-  }
-  return static_cast<std::uint32_t>(m >> 32);
-}
-
 double RandomStream::gaussian() {
   if (has_spare_) {
     has_spare_ = false;

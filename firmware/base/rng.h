@@ -23,9 +23,28 @@ class RandomStream {
   RandomStream(std::uint64_t seed, std::uint64_t stream_index) { reseed(seed, stream_index); }
   void reseed(std::uint64_t seed, std::uint64_t stream_index);
 
-  std::uint32_t next_u32();
+  // Inline, as the draws below: pRANSAM takes three uniform_index draws per triple, ~50 million at
+  // the start-up fill of a corpus map's relation table, where the calls cost ~13 % of the draws.
+  std::uint32_t next_u32() {
+    const std::uint64_t old = state_;
+    state_ = old * 6364136223846793005ull + inc_;
+    const std::uint32_t xorshifted = static_cast<std::uint32_t>(((old >> 18u) ^ old) >> 27u);
+    const std::uint32_t rot = static_cast<std::uint32_t>(old >> 59u);
+    return (xorshifted >> rot) | (xorshifted << ((32u - rot) & 31u));
+  }
   // Uniform integer in [0, n) without modulo bias (Lemire); n > 0.
-  std::uint32_t uniform_index(std::uint32_t n);
+  std::uint32_t uniform_index(std::uint32_t n) {
+    std::uint64_t m = static_cast<std::uint64_t>(next_u32()) * n;
+    std::uint32_t l = static_cast<std::uint32_t>(m);
+    if (l < n) {
+      const std::uint32_t t = (0u - n) % n;
+      while (l < t) {
+        m = static_cast<std::uint64_t>(next_u32()) * n;
+        l = static_cast<std::uint32_t>(m);
+      }
+    }
+    return static_cast<std::uint32_t>(m >> 32);
+  }
   // Uniform in [0, 1).
   float uniform01f() { return static_cast<float>(next_u32() >> 8) * (1.0f / 16777216.0f); }
   double uniform01() {

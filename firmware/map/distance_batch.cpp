@@ -28,8 +28,9 @@ void sample_scalar(const GlobalMap& map, const Point2f* points, std::size_t n, f
   }
 }
 
-// Three loops over the batch: the transform and cell coordinates (branch-free, vectorised), the
-// 2×2 corner look-up (DistanceField::corners, one point at a time: the tiled field needs scattered
+// Three loops over the batch: the transform, cell coordinates and tile addresses (branch-free,
+// vectorised), the 2×2 corner look-up (DistanceField::corners_in_tile, or corners at a tile's edge;
+// one point at a time: the tiled field needs scattered
 // loads, and AVX2 gathers of all of them were slower than these loads on the AMD EPYC this was
 // measured on), the interpolation and the Jacobian column (vectorised). Every value is computed by
 // DistanceSampler's expression in its order, so each lane gives the scalar bits.
@@ -51,6 +52,12 @@ __attribute__((always_inline)) inline void sample_kernel(const GlobalMap& map, c
   float* const c01 = cs[2];
   float* const c11 = cs[3];
   alignas(32) std::int32_t inside[kDistanceBatch];
+  // Where the look-up loop reads a block: its tile and first cell in it (DistanceField::corners_in_tile)
+  // and whether it straddles a tile edge (then DistanceField::corners), computed in the vectorised
+  // loop so that the scalar one only loads.
+  alignas(32) std::uint32_t tile[kDistanceBatch], offset[kDistanceBatch];
+  alignas(32) std::int32_t edge[kDistanceBatch];
+  constexpr std::uint32_t kLog2 = DistanceField::kTileLog2, kMask = DistanceField::kTileSide - 1;
   for (std::size_t i = 0; i < n; ++i) {
     px[i] = points[i].x();
     py[i] = points[i].y();
@@ -69,10 +76,18 @@ __attribute__((always_inline)) inline void sample_kernel(const GlobalMap& map, c
     ax[i] = fx - static_cast<float>(ix[i]);
     ay[i] = fy - static_cast<float>(iy[i]);
     inside[i] = in;
+    const std::uint32_t ux = static_cast<std::uint32_t>(ix[i]), uy = static_cast<std::uint32_t>(iy[i]);
+    tile[i] = (uy >> kLog2) * f.tiles_x + (ux >> kLog2);
+    offset[i] = ((uy & kMask) << kLog2) | (ux & kMask);
+    edge[i] = static_cast<std::int32_t>((ux & kMask) == kMask) | static_cast<std::int32_t>((uy & kMask) == kMask);
   }
   for (std::size_t i = 0; i < n; ++i) {
     float cc[4];
-    f.corners(ix[i], iy[i], cc);
+    if (edge[i] == 0) {
+      f.corners_in_tile(tile[i], offset[i], cc);
+    } else {
+      f.corners(ix[i], iy[i], cc);
+    }
     c00[i] = cc[0];
     c10[i] = cc[1];
     c01[i] = cc[2];

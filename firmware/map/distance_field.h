@@ -56,22 +56,28 @@ struct DistanceField {
     const std::uint32_t x = static_cast<std::uint32_t>(cx), y = static_cast<std::uint32_t>(cy);
     const std::uint32_t lx = x & (kTileSide - 1), ly = y & (kTileSide - 1);
     if (lx != kTileSide - 1 && ly != kTileSide - 1) {
-      const std::uint32_t slot = tile_slot[(y >> kTileLog2) * tiles_x + (x >> kTileLog2)];
-      if (slot == kNoTile) {
-        out[0] = out[1] = out[2] = out[3] = truncation_m;
-        return;
-      }
-      const std::uint16_t* t = d2 + (static_cast<std::size_t>(slot) << (2 * kTileLog2)) + (ly << kTileLog2) + lx;
-      out[0] = metres_of_d2[t[0]];
-      out[1] = metres_of_d2[t[1]];
-      out[2] = metres_of_d2[t[kTileSide]];
-      out[3] = metres_of_d2[t[kTileSide + 1]];
+      corners_in_tile((y >> kTileLog2) * tiles_x + (x >> kTileLog2), (ly << kTileLog2) | lx, out);
       return;
     }
     out[0] = at(cx, cy);
     out[1] = at(cx + 1, cy);
     out[2] = at(cx, cy + 1);
     out[3] = at(cx + 1, cy + 1);
+  }
+  // corners() of a block inside one tile, from the tile's index (row-major over the tiles) and the
+  // block's first cell within it ((ly << kTileLog2) | lx, lx and ly < kTileSide − 1): a batch
+  // computes both for many cells at once (distance_batch.cpp).
+  void corners_in_tile(std::uint32_t tile, std::uint32_t offset, float out[4]) const {
+    const std::uint32_t slot = tile_slot[tile];
+    if (slot == kNoTile) {
+      out[0] = out[1] = out[2] = out[3] = truncation_m;
+      return;
+    }
+    const std::uint16_t* t = d2 + (static_cast<std::size_t>(slot) << (2 * kTileLog2)) + offset;
+    out[0] = metres_of_d2[t[0]];
+    out[1] = metres_of_d2[t[1]];
+    out[2] = metres_of_d2[t[kTileSide]];
+    out[3] = metres_of_d2[t[kTileSide + 1]];
   }
   // Bytes of the three arrays (what the arena holds).
   std::size_t bytes() const {

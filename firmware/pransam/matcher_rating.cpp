@@ -32,13 +32,27 @@ float Matcher<D>::rate(const Hypothesis<D>& h, float bound, std::uint32_t start,
   float sum = 0.0f;
   std::uint32_t k = 0;
   std::uint32_t idx = start;
-  for (; k < n;) {
-    const Point<D> p = h.rotation * scene_[scene_order_[idx]] + h.translation;
-    std::uint8_t c = field_.contact(p);
-    if (unmapped_active_ && c != 255 && unmapped_fn_(unmapped_ctx_, p)) c = 255;
-    sum += lut[c];
-    ++k;
-    if (++idx == n) idx = 0;
+  // Eq. 4.8's test runs after every kBlock-th point, so the points between two tests are looked up
+  // first and summed after, in the same order (the same sum, bit for bit): the look-ups of a block
+  // wait neither on each other nor on a branch on a byte read, so their cache misses overlap. On a
+  // map larger than the cache (aces: 1.4 MB of contact bytes) the byte's load was half of rate's time.
+  constexpr std::uint32_t kBlock = 8;
+  static_assert(kBlock == 8, "a block ends where Eq. 4.8 is tested (k & 7 == 0)");
+  while (k < n) {
+    const std::uint32_t len = n - k < kBlock ? n - k : kBlock;
+    Point<D> p[kBlock];
+    std::uint8_t c[kBlock];
+    for (std::uint32_t j = 0; j < len; ++j) {
+      p[j] = h.rotation * scene_[scene_order_[idx]] + h.translation;
+      c[j] = field_.contact(p[j]);
+      if (++idx == n) idx = 0;
+    }
+    for (std::uint32_t j = 0; j < len; ++j) {
+      std::uint8_t cj = c[j];
+      if (unmapped_active_ && cj != 255 && unmapped_fn_(unmapped_ctx_, p[j])) cj = 255;
+      sum += lut[cj];
+    }
+    k += len;
     // Eq. 4.8: Ω⁺(k) = mean + 1.96 / (2√k); give up once it cannot beat the bound.
     if (extrapolate && (k & 7u) == 0 && k >= kmin && k < n) {
       const float kf = static_cast<float>(k);

@@ -32,6 +32,11 @@ class PointIndex {
   float cell_size() const { return cell_size_; }
 
  private:
+  static constexpr int kNeighbours = D == 2 ? 9 : 27;
+  // The 3^D cells around cell c (axis 0 the fastest digit, offsets −1, 0, +1) and their point counts
+  // (0 off the grid); returns the sum of the counts.
+  std::uint32_t neighbourhood(std::uint32_t c, std::uint32_t* cells, std::uint32_t* counts) const;
+
   std::uint32_t max_points_ = 0, max_cells_ = 0;
   const Point<D>* points_ = nullptr;
   std::uint32_t n_ = 0;
